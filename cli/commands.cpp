@@ -1,0 +1,153 @@
+#include "cli/commands.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+
+#include "core/equations.hpp"
+#include "io/model_loader.hpp"
+#include "io/output.hpp"
+
+namespace femdyn::cli {
+namespace {
+
+constexpr const char* kInfoHelp = R"(usage: femdyn info MODEL [--json] [--gravity gx,gy,gz]
+
+Prints the generalized coordinates, joints (with the coupling level θ = C q + θ0), bodies and
+their elements, the transition coordinates u kept and those left out, and the correlation
+table N_m (one row per element; per node x y z rx ry rz; 0 = left out).
+)";
+
+constexpr const char* kEquationsHelp = R"(usage: femdyn equations MODEL [--q a,b,…] [--qd …] [--tau …] [--tensor] [--json]
+                        [--gravity gx,gy,gz]
+
+Prints the system equations M^s(q) q̈ + h(q, q̇) = Q(q, q̇, τ) at the state, and
+q̈ = (M^s)⁻¹(Q − h). Omitted q, q̇, τ are zero; τ is the actuation force on each generalized
+coordinate. --tensor adds D (n x n x n) with h_a = Σ_bc D_abc q̇_b q̇_c.
+--json prints one object: {"coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd"[, "D"]}.
+)";
+
+std::vector<double> parse_numbers(const std::string& opt, const std::string& text) {
+  std::vector<double> out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    std::size_t end = text.find(',', start);
+    if (end == std::string::npos) end = text.size();
+    const std::string item = text.substr(start, end - start);
+    std::size_t used = 0;
+    double x = 0;
+    try {
+      x = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (item.empty() || used != item.size())
+      throw CliError("--" + opt + ": '" + item + "' is not a number");
+    if (!std::isfinite(x)) throw CliError("--" + opt + ": '" + item + "' is NaN or Inf");
+    out.push_back(x);
+    start = end + 1;
+  }
+  return out;
+}
+
+VecX state_vector(const Args& a, const std::string& opt, const Model& m) {
+  if (!a.has(opt)) return VecX::Zero(m.n());
+  const std::vector<double> v = parse_numbers(opt, a.options.at(opt));
+  if (static_cast<int>(v.size()) != m.n()) {
+    std::string names;
+    for (const auto& c : m.coordinate_names) names += (names.empty() ? "" : ", ") + c;
+    throw CliError("--" + opt + " has " + std::to_string(v.size()) + " values, expected " +
+                   std::to_string(m.n()) + " (" + names + ")");
+  }
+  return Eigen::Map<const VecX>(v.data(), m.n());
+}
+
+Model load(const Args& a) {
+  if (a.positional.size() != 1) throw CliError("expected one MODEL file (try --help)");
+  LoadOptions opt;
+  if (a.has("gravity")) {
+    const std::vector<double> g = parse_numbers("gravity", a.options.at("gravity"));
+    if (g.size() != 3) throw CliError("--gravity expects 3 values gx,gy,gz");
+    opt.gravity = Vec3(g[0], g[1], g[2]);
+  }
+  return load_model(a.positional[0], opt);
+}
+
+}  // namespace
+
+Args parse_args(int argc, char** argv, int first, const std::vector<std::string>& flags,
+                const std::vector<std::string>& valued) {
+  Args a;
+  for (int i = first; i < argc; ++i) {
+    std::string s = argv[i];
+    if (s.rfind("--", 0) != 0) {
+      a.positional.push_back(s);
+      continue;
+    }
+    std::string key = s.substr(2), value;
+    const auto eq = key.find('=');
+    const bool inline_value = eq != std::string::npos;
+    if (inline_value) {
+      value = key.substr(eq + 1);
+      key = key.substr(0, eq);
+    }
+    if (std::find(flags.begin(), flags.end(), key) != flags.end()) {
+      if (inline_value) throw CliError("--" + key + " takes no value");
+      a.options[key] = "";
+    } else if (std::find(valued.begin(), valued.end(), key) != valued.end()) {
+      if (!inline_value) {
+        if (i + 1 >= argc) throw CliError("--" + key + " needs a value");
+        value = argv[++i];
+      }
+      a.options[key] = value;
+    } else {
+      throw CliError("unknown option --" + key + " (try --help)");
+    }
+  }
+  return a;
+}
+
+int cmd_info(int argc, char** argv) {
+  const Args a = parse_args(argc, argv, 2, {"help", "json"}, {"gravity"});
+  if (a.has("help")) {
+    std::cout << kInfoHelp;
+    return 0;
+  }
+  const Model m = load(a);
+  if (a.has("json"))
+    std::cout << info_json(m).dump(2) << "\n";
+  else
+    std::cout << info_text(m);
+  return 0;
+}
+
+int cmd_equations(int argc, char** argv) {
+  const Args a =
+      parse_args(argc, argv, 2, {"help", "json", "tensor"}, {"gravity", "q", "qd", "tau"});
+  if (a.has("help")) {
+    std::cout << kEquationsHelp;
+    return 0;
+  }
+  const Model m = load(a);
+  const VecX q = state_vector(a, "q", m), qd = state_vector(a, "qd", m),
+             tau = state_vector(a, "tau", m);
+  Workspace ws(m);
+  const Status st = forward_dynamics(m, ws, q, qd, tau);
+  std::vector<MatX> D;
+  if (a.has("tensor")) {
+    D = third_order_tensor(m, ws, q);
+    evaluate(m, ws, q, qd, tau);  // the tensor sweep reuses the workspace
+  }
+  if (a.has("json"))
+    std::cout << equations_json(m, ws, q, qd, tau, st.ok, D).dump(2) << "\n";
+  else
+    std::cout << equations_text(m, ws, q, qd, tau, st.ok, D);
+  if (!st.ok) {
+    std::cerr << "femdyn equations: " << a.positional[0] << ": at this state " << st.message
+              << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace femdyn::cli

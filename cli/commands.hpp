@@ -1,0 +1,28 @@
+// The femdyn command line: `femdyn COMMAND MODEL [options]`. Each command returns the exit
+// code; user errors are thrown as CliError / ModelError and printed as one line by main().
+#pragma once
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace femdyn::cli {
+
+struct CliError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Parsed arguments: positionals and --options (flags map to "").
+struct Args {
+  std::vector<std::string> positional;
+  std::map<std::string, std::string> options;
+  bool has(const std::string& k) const { return options.count(k) > 0; }
+};
+
+Args parse_args(int argc, char** argv, int first, const std::vector<std::string>& flags,
+                const std::vector<std::string>& valued);
+
+int cmd_info(int argc, char** argv);
+int cmd_equations(int argc, char** argv);
+
+}  // namespace femdyn::cli

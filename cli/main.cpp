@@ -1,0 +1,45 @@
+#include <cstring>
+#include <iostream>
+
+#include "cli/commands.hpp"
+#include "core/errors.hpp"
+
+namespace {
+
+constexpr const char* kUsage = R"(femdyn — equations of motion of mechanisms by the equivalent-element method
+
+usage: femdyn COMMAND MODEL [options]
+
+commands:
+  info        coordinates, bodies, elements, DOFs kept and left out, the correlation table
+  equations   M^s, h, Q and q̈ at a state (D with --tensor)
+
+every command takes --help, and --gravity gx,gy,gz to override the model's gravity (m/s^2).
+models: JSON files, see docs/model-format.md.
+)";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace femdyn::cli;
+  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") ||
+      !std::strcmp(argv[1], "help")) {
+    std::cout << kUsage;
+    return argc < 2 ? 2 : 0;
+  }
+  const std::string cmd = argv[1];
+  try {
+    if (cmd == "info") return cmd_info(argc, argv);
+    if (cmd == "equations") return cmd_equations(argc, argv);
+    throw CliError("unknown command '" + cmd + "' (try femdyn --help)");
+  } catch (const CliError& e) {
+    std::cerr << "femdyn " << cmd << ": " << e.what() << "\n";
+    return 2;
+  } catch (const femdyn::ModelError& e) {
+    std::cerr << "femdyn " << cmd << ": " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "femdyn " << cmd << ": " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,179 @@
+// compile(): MechanismSpec -> Model. Tree order and joints, the coupling level θ = C q + θ0,
+// then the node level and the correlation table (core/correlation.cpp).
+#include <cmath>
+#include <functional>
+#include <map>
+#include <set>
+
+#include "core/correlation.hpp"
+#include "core/errors.hpp"
+#include "core/model.hpp"
+
+namespace femdyn {
+namespace {
+
+bool finite(const Vec3& v) { return v.allFinite(); }
+
+void check_finite(double x, const std::string& where, const std::string& what) {
+  if (!std::isfinite(x)) throw ModelError(where, what + " is NaN or Inf");
+}
+
+// Bodies in depth-first order from the world, children in file order. Returns spec indices.
+std::vector<int> tree_order(const MechanismSpec& spec) {
+  std::map<std::string, int> index;
+  for (std::size_t i = 0; i < spec.bodies.size(); ++i) {
+    const BodySpec& b = spec.bodies[i];
+    if (b.name.empty()) throw ModelError(b.where, "body has an empty name");
+    if (b.name == "world") throw ModelError(b.where, "'world' is reserved for the ground");
+    if (!index.emplace(b.name, static_cast<int>(i)).second)
+      throw ModelError(b.where, "duplicate body name '" + b.name + "'");
+  }
+  std::map<std::string, std::vector<int>> children;
+  for (std::size_t i = 0; i < spec.bodies.size(); ++i) {
+    const BodySpec& b = spec.bodies[i];
+    if (b.parent != "world" && !index.count(b.parent))
+      throw ModelError(b.where + "/parent", "unknown parent body '" + b.parent + "'");
+    if (b.parent == b.name) throw ModelError(b.where + "/parent", "body is its own parent");
+    children[b.parent].push_back(static_cast<int>(i));
+  }
+  std::vector<int> order;
+  std::function<void(const std::string&)> visit = [&](const std::string& name) {
+    for (int c : children[name]) {
+      order.push_back(c);
+      visit(spec.bodies[c].name);
+    }
+  };
+  visit("world");
+  if (order.size() != spec.bodies.size()) {
+    std::set<int> reached(order.begin(), order.end());
+    for (std::size_t i = 0; i < spec.bodies.size(); ++i)
+      if (!reached.count(static_cast<int>(i)))
+        throw ModelError(spec.bodies[i].where + "/parent",
+                         "body '" + spec.bodies[i].name +
+                             "' is not connected to the world (its parents form a cycle)");
+  }
+  return order;
+}
+
+Joint compile_joint(const JointSpec& js, const std::string& body_name) {
+  Joint j;
+  j.name = js.name.empty() ? body_name : js.name;
+  j.type = js.type;
+  j.where = js.where;
+  if (!finite(js.xyz)) throw ModelError(js.where + "/origin/xyz", "origin xyz is NaN or Inf");
+  if (!finite(js.rpy)) throw ModelError(js.where + "/origin/rpy", "origin rpy is NaN or Inf");
+  j.p_pj = js.xyz;
+  j.R_pj = rpy_to_rotation(js.rpy);
+  if (js.type != JointType::Fixed) {
+    if (!finite(js.axis)) throw ModelError(js.where + "/axis", "axis is NaN or Inf");
+    const double norm = js.axis.norm();
+    if (!(norm > 1e-12)) throw ModelError(js.where + "/axis", "axis is zero");
+    j.axis = js.axis / norm;
+  }
+  for (auto [x, what] : {std::pair{js.stiffness, "stiffness"}, {js.rest, "rest"},
+                         {js.damping, "damping"}})
+    check_finite(x, js.where, what);
+  if (js.stiffness < 0) throw ModelError(js.where + "/spring", "negative stiffness");
+  if (js.damping < 0) throw ModelError(js.where + "/damping", "negative damping");
+  if (std::isnan(js.lower) || std::isnan(js.upper) || js.lower > js.upper)
+    throw ModelError(js.where + "/limits", "joint limits are NaN or lower > upper");
+  j.stiffness = js.stiffness;
+  j.rest = js.rest;
+  j.damping = js.damping;
+  j.lower = js.lower;
+  j.upper = js.upper;
+  return j;
+}
+
+// The coupling level: C (nθ x n) and θ0 from the couplings; the remaining movable joints,
+// in tree order, are the generalized coordinates q.
+void compile_coupling(const MechanismSpec& spec, Model& m) {
+  std::map<std::string, int> theta_of;  // joint name -> θ index
+  for (std::size_t t = 0; t < m.theta_joint.size(); ++t)
+    theta_of[m.bodies[m.theta_joint[t]].joint.name] = static_cast<int>(t);
+  std::map<int, const CouplingSpec*> coupled;
+  for (const CouplingSpec& c : spec.couplings) {
+    auto it = theta_of.find(c.joint);
+    if (it == theta_of.end())
+      throw ModelError(c.where + "/joint", "unknown or fixed joint '" + c.joint + "'");
+    if (!coupled.emplace(it->second, &c).second)
+      throw ModelError(c.where + "/joint", "joint '" + c.joint + "' is coupled twice");
+    check_finite(c.offset, c.where + "/offset", "offset");
+    for (const auto& [name, ratio] : c.terms) {
+      if (!theta_of.count(name))
+        throw ModelError(c.where + "/follows", "unknown or fixed joint '" + name + "'");
+      check_finite(ratio, c.where + "/ratio", "ratio");
+    }
+  }
+  const int nt = m.n_theta();
+  std::vector<int> q_of(nt, -1);
+  for (int t = 0; t < nt; ++t)
+    if (!coupled.count(t)) {
+      q_of[t] = static_cast<int>(m.coordinate_names.size());
+      m.coordinate_names.push_back(m.bodies[m.theta_joint[t]].joint.name);
+    }
+  const int n = static_cast<int>(m.coordinate_names.size());
+  m.C = MatX::Zero(nt, n);
+  m.theta0 = VecX::Zero(nt);
+  std::vector<int> state(nt, 0);  // 0 new, 1 in progress, 2 done
+  std::function<void(int)> resolve = [&](int t) {
+    if (state[t] == 2) return;
+    if (state[t] == 1)
+      throw ModelError(coupled.at(t)->where, "couplings form a cycle through joint '" +
+                                                 m.bodies[m.theta_joint[t]].joint.name + "'");
+    state[t] = 1;
+    if (q_of[t] >= 0) {
+      m.C(t, q_of[t]) = 1.0;
+    } else {
+      const CouplingSpec& c = *coupled.at(t);
+      m.theta0[t] = c.offset;
+      for (const auto& [name, ratio] : c.terms) {
+        const int f = theta_of.at(name);
+        resolve(f);
+        m.C.row(t) += ratio * m.C.row(f);
+        m.theta0[t] += ratio * m.theta0[f];
+      }
+    }
+    state[t] = 2;
+  };
+  for (int t = 0; t < nt; ++t) resolve(t);
+}
+
+}  // namespace
+
+Model compile(MechanismSpec spec) {
+  Model m;
+  m.name = spec.name;
+  if (!finite(spec.gravity)) throw ModelError(spec.where + "/gravity", "gravity is NaN or Inf");
+  m.gravity = spec.gravity;
+  if (spec.bodies.empty()) throw ModelError(spec.where + "/bodies", "the model has no bodies");
+
+  const std::vector<int> order = tree_order(spec);
+  std::vector<int> body_of_spec(spec.bodies.size());
+  std::set<std::string> joint_names;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const BodySpec& bs = spec.bodies[order[k]];
+    body_of_spec[order[k]] = static_cast<int>(k);
+    Body b;
+    b.name = bs.name;
+    b.where = bs.where;
+    b.joint = compile_joint(bs.joint, bs.name);
+    if (!joint_names.insert(b.joint.name).second)
+      throw ModelError(bs.joint.where + "/name", "duplicate joint name '" + b.joint.name + "'");
+    b.parent = -1;
+    if (bs.parent != "world")
+      for (std::size_t p = 0; p < k; ++p)
+        if (m.bodies[p].name == bs.parent) b.parent = static_cast<int>(p);
+    if (b.joint.type != JointType::Fixed) {
+      b.joint.theta = static_cast<int>(m.theta_joint.size());
+      m.theta_joint.push_back(static_cast<int>(k));
+    }
+    m.bodies.push_back(std::move(b));
+  }
+  compile_coupling(spec, m);
+  build_node_level(spec, body_of_spec, m);
+  check_mass_matrix(m);
+  return m;
+}
+
+}  // namespace femdyn

@@ -1,0 +1,287 @@
+#include "core/correlation.hpp"
+
+#include <map>
+#include <random>
+#include <tuple>
+
+#include "core/equations.hpp"
+#include "core/errors.hpp"
+#include "core/kinematics.hpp"
+
+namespace femdyn {
+namespace {
+
+constexpr const char* kAxis[] = {"x", "y", "z"};
+
+// The shallowest body on which a point of body b stays fixed: a point on a revolute axis, or
+// behind a fixed joint, moves with the parent too. Coincident element nodes thus share one
+// system node, as at the paper's hinges.
+std::pair<int, Vec3> canonical_point(const Model& m, int b, Vec3 r) {
+  while (m.bodies[b].parent >= 0) {
+    const Joint& j = m.bodies[b].joint;
+    const bool on_axis = j.type == JointType::Revolute &&
+                         r.cross(j.axis).norm() <= 1e-12 * (1.0 + r.norm());
+    if (!(j.type == JointType::Fixed || on_axis)) break;
+    r = j.R_pj * r + j.p_pj;
+    b = m.bodies[b].parent;
+  }
+  return {b, r};
+}
+
+int find_or_add_node(Model& m, int body, const Vec3& r_body, const std::string& label) {
+  const auto [b, r] = canonical_point(m, body, r_body);
+  for (std::size_t i = 0; i < m.nodes.size(); ++i)
+    if (m.nodes[i].body == b && (m.nodes[i].r - r).norm() <= 1e-12 * (1.0 + r.norm()))
+      return static_cast<int>(i);
+  m.nodes.push_back({b, r, label});
+  return static_cast<int>(m.nodes.size()) - 1;
+}
+
+// Candidate transition coordinates, numbered in order of first use.
+struct Candidates {
+  std::vector<SystemDof> list;
+  std::vector<bool> needed;  // used by an element or a load
+  std::map<std::tuple<int, int, int>, int> index;
+  int add(DofKind kind, int carrier, int axis, bool use) {
+    auto key = std::make_tuple(static_cast<int>(kind), carrier, axis);
+    auto [it, fresh] = index.emplace(key, static_cast<int>(list.size()));
+    if (fresh) {
+      list.push_back({kind, carrier, axis});
+      needed.push_back(false);
+    }
+    if (use) needed[it->second] = true;
+    return it->second;
+  }
+};
+
+void set_dofs(Model& m, const std::vector<SystemDof>& dofs) {
+  m.dofs = dofs;
+  m.node_dof.assign(m.nodes.size(), {-1, -1, -1});
+  m.body_rot_dof.assign(m.bodies.size(), {-1, -1, -1});
+  for (std::size_t i = 0; i < dofs.size(); ++i) {
+    auto& slot = dofs[i].kind == DofKind::Translation ? m.node_dof[dofs[i].carrier]
+                                                      : m.body_rot_dof[dofs[i].carrier];
+    slot[dofs[i].axis] = static_cast<int>(i);
+  }
+}
+
+// Rows of T at seeded random states: a row that is zero at all of them is a DOF that never
+// moves (T is analytic in q, so a non-zero row vanishes only on a set of measure zero).
+std::vector<MatX> sample_T(const Model& m) {
+  std::vector<MatX> out;
+  Workspace ws(m);
+  for (const VecX& q : sample_states(m, 3)) {
+    propagate(m, ws, q, VecX::Zero(m.n()), {.jacobian = true, .bias = false});
+    out.push_back(ws.T);
+  }
+  return out;
+}
+
+double length_scale(const Model& m) {
+  double L = 1.0;
+  for (const Body& b : m.bodies) L = std::max(L, b.joint.p_pj.norm());
+  for (const SystemNode& n : m.nodes) L = std::max(L, n.r.norm());
+  return L;
+}
+
+bool moves(const std::vector<MatX>& Ts, int i, double tol) {
+  for (const MatX& T : Ts)
+    if (T.row(i).cwiseAbs().maxCoeff() > tol) return true;
+  return false;
+}
+
+bool same_motion(const std::vector<MatX>& Ts, int i, int j, double tol) {
+  for (const MatX& T : Ts)
+    if ((T.row(i) - T.row(j)).cwiseAbs().maxCoeff() > tol) return false;
+  return true;
+}
+
+}  // namespace
+
+std::vector<VecX> sample_states(const Model& m, int count) {
+  std::mt19937 rng(20261122u);
+  std::uniform_real_distribution<double> uni(-2.0, 2.0);
+  std::vector<VecX> qs;
+  for (int s = 0; s < count; ++s) {
+    VecX q(m.n());
+    for (int a = 0; a < m.n(); ++a) q[a] = uni(rng);
+    qs.push_back(q);
+  }
+  return qs;
+}
+
+void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec, Model& m) {
+  // Elements in file order; each local DOF gets its candidate transition coordinate.
+  Candidates cand;
+  std::vector<std::vector<int>> local_cand;  // per element: 6k, -1 where unused
+  std::vector<std::vector<int>> all_cand;    // per element: 6k, also for unused local DOFs
+  for (std::size_t s = 0; s < spec.bodies.size(); ++s) {
+    const int b = body_of_spec[s];
+    for (ElementSpec& es : spec.bodies[s].elements) {
+      ElementEntry e;
+      e.element = std::move(es.element);
+      e.body = b;
+      e.where = es.where;
+      e.node_labels = es.node_labels;
+      const auto nodes = e.element->nodes();
+      std::vector<int> used, all;
+      for (std::size_t l = 0; l < nodes.size(); ++l) {
+        const std::string label =
+            l < es.node_labels.size() ? es.node_labels[l] : m.bodies[b].name + "/node";
+        if (!nodes[l].position.allFinite())
+          throw ModelError(es.where, "element node position is NaN or Inf");
+        const int node = find_or_add_node(m, b, nodes[l].position, label);
+        for (int k = 0; k < kNodeDofs; ++k) {
+          const bool use = nodes[l].uses[k];
+          const int c = k < 3 ? cand.add(DofKind::Translation, node, k, use)
+                              : cand.add(DofKind::Rotation, b, k - 3, use);
+          all.push_back(c);
+          used.push_back(nodes[l].uses[k] ? c : -1);
+        }
+      }
+      const MatX me = e.element->local_mass();
+      if (me.rows() != e.element->local_dof_count() || me.cols() != me.rows() ||
+          !me.allFinite() || (me - me.transpose()).norm() > 1e-12 * (1.0 + me.norm()))
+        throw ModelError(es.where, "element local mass is not a finite symmetric matrix");
+      local_cand.push_back(std::move(used));
+      all_cand.push_back(std::move(all));
+      m.elements.push_back(std::move(e));
+    }
+  }
+  // Loads need the DOFs they push on.
+  struct LoadAt {
+    int node, body;
+    Vec3 force, torque;
+  };
+  std::vector<LoadAt> loads;
+  for (const LoadSpec& ls : spec.loads) {
+    int b = -1;
+    for (std::size_t k = 0; k < m.bodies.size(); ++k)
+      if (m.bodies[k].name == ls.body) b = static_cast<int>(k);
+    if (b < 0) throw ModelError(ls.where + "/body", "unknown body '" + ls.body + "'");
+    if (!ls.point.allFinite() || !ls.force.allFinite() || !ls.torque.allFinite())
+      throw ModelError(ls.where, "load has NaN or Inf");
+    const int node = find_or_add_node(m, b, ls.point, ls.body + "/load");
+    if (!ls.force.isZero(0))
+      for (int k = 0; k < 3; ++k) cand.add(DofKind::Translation, node, k, true);
+    if (!ls.torque.isZero(0))
+      for (int k = 0; k < 3; ++k) cand.add(DofKind::Rotation, b, k, true);
+    loads.push_back({node, b, ls.force, ls.torque});
+  }
+
+  // Which candidates move at all.
+  set_dofs(m, cand.list);
+  const std::vector<MatX> Ts = sample_T(m);
+  const double tol = 1e-10 * length_scale(m);
+  const int nc = static_cast<int>(cand.list.size());
+
+  std::vector<int> number(nc, 0);  // candidate -> 1-based system DOF, 0 left out
+  std::vector<SystemDof> dofs;
+  if (!spec.correlation) {
+    for (int c = 0; c < nc; ++c) {
+      if (!cand.needed[c]) continue;
+      if (moves(Ts, c, tol)) {
+        dofs.push_back(cand.list[c]);
+        number[c] = static_cast<int>(dofs.size());
+      } else {
+        m.left_out.push_back(m.dof_name_of(cand.list[c]) + " (never moves)");
+      }
+    }
+    for (std::size_t e = 0; e < m.elements.size(); ++e)
+      for (int c : local_cand[e]) m.elements[e].table_row.push_back(c >= 0 ? number[c] : 0);
+  } else {
+    // Explicit N_m, checked: each number must name one physical motion.
+    m.explicit_table = true;
+    const CorrelationSpec& cs = *spec.correlation;
+    if (cs.rows.size() != m.elements.size())
+      throw ModelError(cs.where, "has " + std::to_string(cs.rows.size()) + " rows, expected " +
+                                     std::to_string(m.elements.size()) + " (one per element)");
+    int N = 0;
+    for (std::size_t e = 0; e < cs.rows.size(); ++e) {
+      const std::string where = cs.where + "/" + std::to_string(e);
+      if (cs.rows[e].size() != all_cand[e].size())
+        throw ModelError(where, "has " + std::to_string(cs.rows[e].size()) +
+                                    " entries, expected " + std::to_string(all_cand[e].size()) +
+                                    " (6 per element node)");
+      for (int d : cs.rows[e]) {
+        if (d < 0) throw ModelError(where, "negative system DOF number");
+        N = std::max(N, d);
+      }
+    }
+    std::vector<int> def(N + 1, -1);  // system DOF -> defining candidate
+    for (std::size_t e = 0; e < cs.rows.size(); ++e)
+      for (std::size_t l = 0; l < cs.rows[e].size(); ++l) {
+        const int d = cs.rows[e][l], c = all_cand[e][l];
+        if (d == 0) {
+          if (local_cand[e][l] >= 0 && moves(Ts, c, tol))
+            m.left_out.push_back(m.dof_name_of(cand.list[c]) +
+                                 " (left out by the table although it moves)");
+          continue;
+        }
+        if (def[d] < 0) {
+          def[d] = c;
+        } else if (def[d] != c && !same_motion(Ts, def[d], c, tol)) {
+          throw ModelError(cs.where + "/" + std::to_string(e) + "/" + std::to_string(l),
+                           "system DOF " + std::to_string(d) + " joins " +
+                               m.dof_name_of(cand.list[def[d]]) + " and " +
+                               m.dof_name_of(cand.list[c]) + ", which move differently");
+        }
+      }
+    for (int d = 1; d <= N; ++d) {
+      if (def[d] < 0) throw ModelError(cs.where, "system DOF " + std::to_string(d) + " is unused");
+      dofs.push_back(cand.list[def[d]]);
+    }
+    for (std::size_t e = 0; e < m.elements.size(); ++e) m.elements[e].table_row = cs.rows[e];
+  }
+  set_dofs(m, dofs);
+
+  // Assembly: M = Σ_e scatter(m_e) through N_m.
+  const int N = m.n_u();
+  std::vector<Eigen::Triplet<double>> trip;
+  for (const ElementEntry& e : m.elements) {
+    const MatX me = e.element->local_mass();
+    const auto& row = e.table_row;
+    for (std::size_t l = 0; l < row.size(); ++l)
+      for (std::size_t k = 0; k < row.size(); ++k)
+        if (row[l] && row[k] && me(l, k) != 0) trip.emplace_back(row[l] - 1, row[k] - 1, me(l, k));
+    if (e.element->has_velocity_force()) m.has_velocity_forces = true;
+  }
+  m.M.resize(N, N);
+  m.M.setFromTriplets(trip.begin(), trip.end());
+  m.M.makeCompressed();
+
+  // F = M·G (gravity: every translation accelerates by g) + point loads.
+  VecX G = VecX::Zero(N);
+  for (int i = 0; i < N; ++i)
+    if (m.dofs[i].kind == DofKind::Translation) G[i] = m.gravity[m.dofs[i].axis];
+  m.F_constant = m.M * G;
+  for (const LoadAt& l : loads) {
+    for (int k = 0; k < 3; ++k)
+      if (m.node_dof[l.node][k] >= 0) m.F_constant[m.node_dof[l.node][k]] += l.force[k];
+    if (!l.torque.isZero(0)) m.torques.push_back({l.body, l.torque});
+  }
+}
+
+void check_mass_matrix(const Model& m) {
+  if (m.n() == 0) return;
+  Workspace ws(m);
+  std::vector<VecX> states = sample_states(m, 2);
+  states.insert(states.begin(), VecX::Zero(m.n()));
+  for (const VecX& q : states) {
+    evaluate(m, ws, q, VecX::Zero(m.n()), VecX());
+    const Status st = ws.solver.factorize(ws.Ms);
+    if (st.ok) continue;
+    std::string where;
+    if (st.coordinate >= 0)
+      for (const Body& b : m.bodies)
+        if (b.joint.name == m.coordinate_names[st.coordinate]) where = b.joint.where;
+    throw ModelError(where, st.message);
+  }
+}
+
+std::string Model::dof_name_of(const SystemDof& d) const {
+  if (d.kind == DofKind::Translation) return nodes[d.carrier].label + "." + kAxis[d.axis];
+  return bodies[d.carrier].name + ".r" + kAxis[d.axis];
+}
+
+}  // namespace femdyn

@@ -1,0 +1,22 @@
+// The node level and the correlation table N_m (paper §IV): which transition coordinates u
+// the mechanism has, how each element's local DOFs map onto them, and the assembled system
+// lumped mass M and constant nodal forces F.
+#pragma once
+#include <vector>
+
+#include "core/model.hpp"
+
+namespace femdyn {
+
+// Fills m.nodes, m.dofs, m.node_dof, m.body_rot_dof, m.elements (moved out of spec),
+// m.left_out, m.M, m.F_constant, m.torques. body_of_spec maps spec body index -> model body.
+void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec, Model& m);
+
+// Throws ModelError at the joint of the first coordinate whose M^s pivot vanishes, at the
+// reference state and at seeded random states.
+void check_mass_matrix(const Model& m);
+
+// Seeded random generalized coordinates used for structural checks.
+std::vector<VecX> sample_states(const Model& m, int count);
+
+}  // namespace femdyn

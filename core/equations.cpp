@@ -1,0 +1,161 @@
+#include "core/equations.hpp"
+
+#include "core/kinematics.hpp"
+#include "core/mass_solver.hpp"
+
+namespace femdyn {
+namespace {
+
+// nodal += g(x, y): element velocity forces, gathered and scattered through N_m.
+template <class X, class Y>
+void add_velocity_forces(const Model& model, Workspace& ws, const X& x, const Y& y,
+                         VecX& nodal) {
+  for (std::size_t e = 0; e < model.elements.size(); ++e) {
+    const ElementEntry& E = model.elements[e];
+    if (!E.element->has_velocity_force()) continue;
+    VecX& xe = ws.local_x[e];
+    VecX& ye = ws.local_y[e];
+    VecX& ge = ws.local_g[e];
+    // Gather x_e = N_mᵀ x, y_e = N_mᵀ y (a left-out DOF never moves: its rate is 0).
+    for (std::size_t l = 0; l < E.table_row.size(); ++l) {
+      const int i = E.table_row[l] - 1;
+      xe[l] = i >= 0 ? x[i] : 0.0;
+      ye[l] = i >= 0 ? y[i] : 0.0;
+    }
+    ge.setZero();
+    E.element->add_velocity_force(xe, ye, ge);
+    // Scatter g_e through N_m.
+    for (std::size_t l = 0; l < E.table_row.size(); ++l)
+      if (E.table_row[l]) nodal[E.table_row[l] - 1] += ge[l];
+  }
+}
+
+// Q = Tᵀ F + Cᵀ(spring + damper) + τ, with F = F_constant + body torques (R_bᵀ τ_w).
+void assemble_forces(const Model& model, Workspace& ws, const VecX& tau, bool with_rates) {
+  ws.nodal = model.F_constant;
+  for (const BodyTorque& t : model.torques) {
+    const Vec3 tb = ws.body[t.body].R.transpose() * t.torque;
+    for (int k = 0; k < 3; ++k)
+      if (model.body_rot_dof[t.body][k] >= 0) ws.nodal[model.body_rot_dof[t.body][k]] += tb[k];
+  }
+  ws.Q.noalias() = ws.T.transpose() * ws.nodal;
+  // Joint springs and dampers act on θ; the coupling level maps them to q by Cᵀ.
+  for (int j = 0; j < model.n_theta(); ++j) {
+    const Joint& J = model.bodies[model.theta_joint[j]].joint;
+    double f = 0;
+    if (J.stiffness != 0) f -= J.stiffness * (ws.theta[j] - J.rest);
+    if (with_rates && J.damping != 0) f -= J.damping * ws.theta_dot[j];
+    if (f != 0) ws.Q.noalias() += f * model.C.row(j).transpose();
+  }
+  if (tau.size() == ws.Q.size()) ws.Q += tau;
+}
+
+bool is_zero(const VecX& v) { return v.size() == 0 || v.cwiseAbs().maxCoeff() == 0.0; }
+
+}  // namespace
+
+void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau) {
+  const bool moving = !is_zero(qd);
+  propagate(model, ws, q, qd, {.jacobian = true, .bias = moving});
+  if (!moving) ws.theta_dot.setZero();
+
+  // M^s = Tᵀ (M T)
+  ws.MT.noalias() = model.M * ws.T;
+  ws.Ms.noalias() = ws.T.transpose() * ws.MT;
+
+  // h = Tᵀ (M T'[q̇,q̇] + g(u̇,u̇)); zero at rest.
+  if (moving) {
+    ws.nodal.noalias() = model.M * ws.bias;
+    if (model.has_velocity_forces) add_velocity_forces(model, ws, ws.u_dot, ws.u_dot, ws.nodal);
+    ws.h.noalias() = ws.T.transpose() * ws.nodal;
+  } else {
+    ws.h.setZero();
+  }
+  assemble_forces(model, ws, tau, moving);
+}
+
+void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
+  if (is_zero(qd)) {
+    ws.h.setZero();
+    return;
+  }
+  propagate(model, ws, q, qd, {.jacobian = true, .bias = true});
+  ws.nodal.noalias() = model.M * ws.bias;
+  if (model.has_velocity_forces) add_velocity_forces(model, ws, ws.u_dot, ws.u_dot, ws.nodal);
+  ws.h.noalias() = ws.T.transpose() * ws.nodal;
+}
+
+Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+                        const VecX& tau) {
+  evaluate(model, ws, q, qd, tau);
+  Status st = ws.solver.factorize(ws.Ms);
+  if (!st.ok) return st;
+  ws.solver.solve(ws.Q - ws.h, ws.qdd);
+  return st;
+}
+
+void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+                      const VecX& qdd) {
+  // τ = M^s q̈ + h − Q(τ = 0)
+  evaluate(model, ws, q, qd, VecX());
+  ws.tau.noalias() = ws.Ms * qdd;
+  ws.tau += ws.h - ws.Q;
+}
+
+std::vector<MatX> transform_hessian(const Model& model, Workspace& ws, const VecX& q) {
+  // T'[x, y] = ¼ (T'[x+y, x+y] − T'[x−y, x−y]): the bias sweep is a quadratic form in q̇.
+  const int n = model.n(), N = model.n_u();
+  std::vector<MatX> H(N, MatX::Zero(n, n));
+  VecX d = VecX::Zero(n);
+  for (int b = 0; b < n; ++b)
+    for (int c = b; c < n; ++c) {
+      d.setZero();
+      d[b] += 1;
+      d[c] += 1;
+      propagate(model, ws, q, d, {.jacobian = false, .bias = true});
+      const VecX plus = ws.bias;
+      d[c] -= 2;
+      propagate(model, ws, q, d, {.jacobian = false, .bias = true});
+      for (int i = 0; i < N; ++i) H[i](b, c) = H[i](c, b) = 0.25 * (plus[i] - ws.bias[i]);
+    }
+  return H;
+}
+
+std::vector<MatX> third_order_tensor(const Model& model, Workspace& ws, const VecX& q) {
+  const int n = model.n(), N = model.n_u();
+  const std::vector<MatX> Tp = transform_hessian(model, ws, q);
+  propagate(model, ws, q, VecX::Zero(n), {.jacobian = true, .bias = false});
+  const MatX T = ws.T;
+  std::vector<MatX> D(n, MatX::Zero(n, n));
+  VecX col(N), nodal(N);
+  for (int b = 0; b < n; ++b)
+    for (int c = 0; c < n; ++c) {
+      // (M T'_{·bc} + G_{·bc}),  G_{·bc} = g(T e_b, T e_c)
+      for (int i = 0; i < N; ++i) col[i] = Tp[i](b, c);
+      nodal = model.M * col;
+      if (model.has_velocity_forces) add_velocity_forces(model, ws, T.col(b), T.col(c), nodal);
+      const VecX Dbc = T.transpose() * nodal;
+      for (int a = 0; a < n; ++a) D[a](b, c) = Dbc[a];
+    }
+  return D;
+}
+
+Energy energy(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
+  evaluate(model, ws, q, qd, VecX());
+  Energy E;
+  E.kinetic = 0.5 * qd.dot(ws.Ms * qd);
+  // Potential of constant nodal forces: −F·x over translation DOFs (positions in world).
+  for (std::size_t n = 0; n < model.nodes.size(); ++n) {
+    const BodyState& B = ws.body[model.nodes[n].body];
+    const Vec3 x = B.p + B.R * model.nodes[n].r;
+    for (int k = 0; k < 3; ++k)
+      if (model.node_dof[n][k] >= 0) E.potential -= model.F_constant[model.node_dof[n][k]] * x[k];
+  }
+  for (int j = 0; j < model.n_theta(); ++j) {
+    const Joint& J = model.bodies[model.theta_joint[j]].joint;
+    E.potential += 0.5 * J.stiffness * (ws.theta[j] - J.rest) * (ws.theta[j] - J.rest);
+  }
+  return E;
+}
+
+}  // namespace femdyn

@@ -1,0 +1,46 @@
+// System equations of motion at a state (paper §III, corrected — docs/formulation.md):
+//
+//   M^s q̈ + h = Q,     M^s = Tᵀ M T,
+//   h = D[q̇,q̇] = Tᵀ (M T'[q̇,q̇] + g(u̇,u̇)),        g: element velocity (gyroscopic) forces
+//   Q = Tᵀ F + Cᵀ (−k (θ − θ_rest) − c θ̇) + τ,      F: gravity, loads; τ: actuation on q
+//
+// Only what the state needs is computed: no h at rest (q̇ = 0), no T at all for h alone.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "core/status.hpp"
+#include "core/workspace.hpp"
+
+namespace femdyn {
+
+// Fills ws.Ms, ws.h, ws.Q for the state (q, q̇, τ). Sizes are checked by the caller (io/cli).
+void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau);
+
+// Velocity terms alone, h(q, q̇) (one kinematic sweep, T not formed).
+void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX& qd);
+
+// q̈ = (M^s)⁻¹ (Q − h) into ws.qdd; evaluates first. Fails on a singular M^s.
+Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+                        const VecX& tau);
+
+// τ such that M^s q̈ + h = Q(τ), into ws.tau.
+void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+                      const VecX& qdd);
+
+// D_abc with h_a = Σ_bc D_abc q̇_b q̇_c:  D_abc = Σ_i T_ia (M T'_{·bc} + G_{·bc})_i,
+// T'_{·bc} by polarisation of the bias sweep, G_{·bc} = g(T e_b, T e_c). D[a](b, c). On request.
+std::vector<MatX> third_order_tensor(const Model& model, Workspace& ws, const VecX& q);
+
+// T'_{ibc} as N_u matrices of n x n, for tests and for the paper's case study.
+std::vector<MatX> transform_hessian(const Model& model, Workspace& ws, const VecX& q);
+
+// Mechanical energy: kinetic ½ q̇ᵀ M^s q̇; potential of the conservative forces,
+// V = −Σ_i F_i x_i (gravity and constant loads, x_i the node positions) + Σ ½ k (θ − θ_rest)².
+struct Energy {
+  double kinetic = 0, potential = 0;
+  double total() const { return kinetic + potential; }
+};
+Energy energy(const Model& model, Workspace& ws, const VecX& q, const VecX& qd);
+
+}  // namespace femdyn

@@ -1,0 +1,104 @@
+#include "core/kinematics.hpp"
+
+namespace femdyn {
+namespace {
+
+// Tree level: body poses, rates and biases, parents first.
+void propagate_tree(const Model& model, Workspace& ws, KinematicsRequest req) {
+  const BodyState root;
+  for (std::size_t b = 0; b < model.bodies.size(); ++b) {
+    const Joint& j = model.bodies[b].joint;
+    const int parent = model.bodies[b].parent;
+    const BodyState& P = parent < 0 ? root : ws.body[parent];
+    BodyState& B = ws.body[b];
+
+    const Mat3 R_j = P.R * j.R_pj;
+    const Vec3 origin = P.p + P.R * j.p_pj;
+    const Vec3 s = R_j * j.axis;
+    const double th = j.theta >= 0 ? ws.theta[j.theta] : 0.0;
+    const double thd = j.theta >= 0 ? ws.theta_dot[j.theta] : 0.0;
+    const bool rev = j.type == JointType::Revolute;
+    const bool pri = j.type == JointType::Prismatic;
+
+    B.R = rev ? Mat3(R_j * axis_rotation(j.axis, th)) : R_j;
+    B.p = pri ? Vec3(origin + s * th) : origin;
+    const Vec3 r = B.p - P.p;
+
+    if (req.bias) {
+      B.w = P.w + (rev ? Vec3(s * thd) : Vec3::Zero());
+      B.v = P.v + P.w.cross(r) + (pri ? Vec3(s * thd) : Vec3::Zero());
+      B.alpha = P.alpha + (rev ? Vec3(P.w.cross(s) * thd) : Vec3::Zero());
+      B.a = P.a + P.alpha.cross(r) + P.w.cross(P.w.cross(r)) +
+            (pri ? Vec3(2.0 * P.w.cross(s) * thd) : Vec3::Zero());
+    }
+    if (req.jacobian) {
+      auto Jw = ws.Jw.middleRows<3>(3 * b);
+      auto Jv = ws.Jv.middleRows<3>(3 * b);
+      if (parent < 0) {
+        Jw.setZero();
+        Jv.setZero();
+      } else {
+        Jw = ws.Jw.middleRows<3>(3 * parent);
+        Jv.noalias() = ws.Jv.middleRows<3>(3 * parent) - skew(r) * ws.Jw.middleRows<3>(3 * parent);
+      }
+      if (rev) Jw.noalias() += s * model.C.row(j.theta);
+      if (pri) Jv.noalias() += s * model.C.row(j.theta);
+    }
+  }
+}
+
+// Node level: rows of T, T'[q̇,q̇] and u̇ for every kept transition coordinate.
+void propagate_nodes(const Model& model, Workspace& ws, KinematicsRequest req) {
+  for (std::size_t n = 0; n < model.nodes.size(); ++n) {
+    const auto& idx = model.node_dof[n];
+    if (idx[0] < 0 && idx[1] < 0 && idx[2] < 0) continue;
+    const int b = model.nodes[n].body;
+    const BodyState& B = ws.body[b];
+    const Vec3 rw = B.R * model.nodes[n].r;
+    Vec3 vel, acc;
+    if (req.bias) {
+      vel = B.v + B.w.cross(rw);
+      acc = B.a + B.alpha.cross(rw) + B.w.cross(B.w.cross(rw));
+    }
+    for (int k = 0; k < 3; ++k) {
+      const int i = idx[k];
+      if (i < 0) continue;
+      if (req.jacobian) {
+        // e_kᵀ(Jv − [r_w]× Jω) = Jv.row(k) − ([r_w]×).row(k) Jω
+        ws.T.row(i) = ws.Jv.row(3 * b + k) - skew(rw).row(k) * ws.Jw.middleRows<3>(3 * b);
+      }
+      if (req.bias) {
+        ws.u_dot[i] = vel[k];
+        ws.bias[i] = acc[k];
+      }
+    }
+  }
+  for (std::size_t b = 0; b < model.bodies.size(); ++b) {
+    const auto& idx = model.body_rot_dof[b];
+    const BodyState& B = ws.body[b];
+    for (int k = 0; k < 3; ++k) {
+      const int i = idx[k];
+      if (i < 0) continue;
+      const Vec3 e = B.R.col(k);  // body axis k in world
+      if (req.jacobian) ws.T.row(i) = e.transpose() * ws.Jw.middleRows<3>(3 * b);
+      if (req.bias) {
+        ws.u_dot[i] = e.dot(B.w);
+        ws.bias[i] = e.dot(B.alpha);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void propagate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+               KinematicsRequest request) {
+  // Coupling level.
+  ws.theta.noalias() = model.C * q;
+  ws.theta += model.theta0;
+  if (request.bias) ws.theta_dot.noalias() = model.C * qd;
+  propagate_tree(model, ws, request);
+  propagate_nodes(model, ws, request);
+}
+
+}  // namespace femdyn

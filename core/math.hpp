@@ -1,0 +1,32 @@
+// Small 3D helpers shared by the kinematic levels and the elements.
+#pragma once
+#include <Eigen/Dense>
+
+namespace femdyn {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+using VecX = Eigen::VectorXd;
+using MatX = Eigen::MatrixXd;
+
+// [a]x, the cross-product matrix: skew(a) * b = a x b.
+inline Mat3 skew(const Vec3& a) {
+  Mat3 s;
+  s << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
+  return s;
+}
+
+// URDF convention: R = Rz(yaw) * Ry(pitch) * Rx(roll).
+inline Mat3 rpy_to_rotation(const Vec3& rpy) {
+  using Eigen::AngleAxisd;
+  return (AngleAxisd(rpy.z(), Vec3::UnitZ()) * AngleAxisd(rpy.y(), Vec3::UnitY()) *
+          AngleAxisd(rpy.x(), Vec3::UnitX()))
+      .toRotationMatrix();
+}
+
+// Rotation by angle about a unit axis (Rodrigues).
+inline Mat3 axis_rotation(const Vec3& unit_axis, double angle) {
+  return Eigen::AngleAxisd(angle, unit_axis).toRotationMatrix();
+}
+
+}  // namespace femdyn

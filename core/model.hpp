@@ -1,0 +1,105 @@
+// Model: a compiled mechanism, immutable after compile(). Flat arrays in tree order.
+//
+// The transform levels (docs/notation.md):
+//   q (n)  --coupling-->  θ (nθ) = C q + θ0
+//   θ      --tree------>  body frames (R_b, p_b) along the tree, parents first
+//   bodies --nodes----->  u (N_u): node translations (world axes) and body rotations (body axes)
+// The correlation table N_m maps each element's local DOFs onto u.
+#pragma once
+#include <Eigen/Sparse>
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/element.hpp"
+#include "core/spec.hpp"
+
+namespace femdyn {
+
+using SpMat = Eigen::SparseMatrix<double>;
+
+struct Joint {
+  std::string name;
+  JointType type = JointType::Fixed;
+  Mat3 R_pj = Mat3::Identity();  // joint frame orientation in the parent body frame
+  Vec3 p_pj = Vec3::Zero();      // joint frame origin in the parent body frame
+  Vec3 axis = Vec3::UnitZ();     // unit, joint frame
+  int theta = -1;                // index in θ; -1 for a fixed joint
+  double lower = 0, upper = 0;
+  double stiffness = 0, rest = 0, damping = 0;
+  std::string where;
+};
+
+struct Body {
+  std::string name;
+  int parent = -1;  // body index, -1 for the world
+  Joint joint;      // joint to the parent; the body frame is the joint frame after motion
+  std::string where;
+};
+
+// A point that carries translation DOFs (x y z, world axes). Coincident element nodes share one.
+struct SystemNode {
+  int body = -1;  // carrier body (the shallowest body on which the point is fixed)
+  Vec3 r = Vec3::Zero();  // body frame
+  std::string label;
+};
+
+enum class DofKind : unsigned char { Translation, Rotation };
+
+// One transition coordinate u_i: a translation of a node or a rotation rate of a body.
+struct SystemDof {
+  DofKind kind = DofKind::Translation;
+  int carrier = 0;  // node index (translation) or body index (rotation)
+  int axis = 0;     // 0, 1, 2
+};
+
+struct ElementEntry {
+  std::unique_ptr<Element> element;
+  int body = -1;
+  std::vector<std::string> node_labels;
+  std::vector<int> table_row;  // N_m row: 6 per node, 1-based system DOF number, 0 = left out
+  std::string where;
+};
+
+struct BodyTorque {
+  int body;
+  Vec3 torque;  // world frame
+};
+
+struct Model {
+  std::string name;
+  Vec3 gravity = Vec3::Zero();
+  std::vector<Body> bodies;  // parents before children
+  std::vector<int> theta_joint;  // θ index -> body index of its joint
+
+  // Coupling level θ = C q + θ0.
+  MatX C;
+  VecX theta0;
+  std::vector<std::string> coordinate_names;  // n: the independent joints
+
+  // Node level.
+  std::vector<SystemNode> nodes;
+  std::vector<SystemDof> dofs;                  // u
+  std::vector<std::array<int, 3>> node_dof;     // node -> u index per axis, -1 if left out
+  std::vector<std::array<int, 3>> body_rot_dof;  // body -> u index per axis, -1 if left out
+  std::vector<std::string> left_out;            // descriptions of DOFs left out, and why
+  bool explicit_table = false;
+
+  std::vector<ElementEntry> elements;
+  SpMat M;           // system lumped mass, N_u x N_u
+  VecX F_constant;   // nodal forces that do not depend on the state (gravity, point loads)
+  std::vector<BodyTorque> torques;
+  bool has_velocity_forces = false;  // some element has a gyroscopic term
+
+  int n() const { return static_cast<int>(C.cols()); }
+  int n_theta() const { return static_cast<int>(theta_joint.size()); }
+  int n_u() const { return static_cast<int>(dofs.size()); }
+  std::string dof_name(int i) const { return dof_name_of(dofs.at(i)); }
+  std::string dof_name_of(const SystemDof& d) const;  // e.g. "link2/tip.x" or "link2.rz"
+};
+
+// Compiles a spec; throws ModelError naming spec `where` labels on bad input.
+Model compile(MechanismSpec spec);
+
+}  // namespace femdyn

@@ -1,0 +1,78 @@
+// MechanismSpec: a mechanism as described by the user, before compilation. Front ends (io/)
+// fill it; core/model.cpp compiles it into an immutable Model. Every part carries `where`,
+// an opaque label naming its place in the source file, used in error messages.
+#pragma once
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/element.hpp"
+
+namespace femdyn {
+
+enum class JointType { Revolute, Prismatic, Fixed };
+
+struct JointSpec {
+  std::string name;
+  JointType type = JointType::Fixed;
+  Vec3 xyz = Vec3::Zero();  // joint frame origin in the parent body frame
+  Vec3 rpy = Vec3::Zero();  // joint frame orientation, R = Rz(y) Ry(p) Rx(r)
+  Vec3 axis = Vec3::UnitZ();  // in the joint frame (normalised on compile)
+  double lower = -std::numeric_limits<double>::infinity();
+  double upper = std::numeric_limits<double>::infinity();
+  double stiffness = 0, rest = 0, damping = 0;  // linear spring / damper on θ
+  std::string where;
+};
+
+struct ElementSpec {
+  std::unique_ptr<Element> element;
+  std::vector<std::string> node_labels;  // one per element node (for tables)
+  std::string where;
+};
+
+struct BodySpec {
+  std::string name;
+  std::string parent;  // "world" for the ground
+  JointSpec joint;
+  std::vector<ElementSpec> elements;
+  std::string where;
+};
+
+// θ_joint = Σ ratio_i θ_{follows_i} + offset   (the coupling level θ = C q + θ0)
+struct CouplingSpec {
+  std::string joint;
+  std::vector<std::pair<std::string, double>> terms;
+  double offset = 0;
+  std::string where;
+};
+
+// Constant external force (world frame, N) at a point of a body (body frame),
+// and/or a constant torque (world frame, N·m) on the body.
+struct LoadSpec {
+  std::string body;
+  Vec3 point = Vec3::Zero();
+  Vec3 force = Vec3::Zero();
+  Vec3 torque = Vec3::Zero();
+  std::string where;
+};
+
+// Explicit correlation table: one row per element (in file order), 6 entries per element
+// node, each a 1-based system DOF number or 0 (left out).
+struct CorrelationSpec {
+  std::vector<std::vector<int>> rows;
+  std::string where;
+};
+
+struct MechanismSpec {
+  std::string name;
+  Vec3 gravity = Vec3::Zero();
+  std::vector<BodySpec> bodies;
+  std::vector<CouplingSpec> couplings;
+  std::vector<LoadSpec> loads;
+  std::optional<CorrelationSpec> correlation;
+  std::string where;  // the file
+};
+
+}  // namespace femdyn

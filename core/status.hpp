@@ -1,0 +1,13 @@
+// Numerical outcome of an algorithm: failures are reported, never aborted on.
+#pragma once
+#include <string>
+
+namespace femdyn {
+
+struct Status {
+  bool ok = true;
+  std::string message;
+  int coordinate = -1;  // the coordinate a failure is attributed to, if any
+};
+
+}  // namespace femdyn

@@ -1,0 +1,28 @@
+#include "core/workspace.hpp"
+
+namespace femdyn {
+
+Workspace::Workspace(const Model& model) : solver(model) {
+  const int n = model.n(), nt = model.n_theta(), N = model.n_u();
+  const int nb = static_cast<int>(model.bodies.size());
+  theta = VecX::Zero(nt);
+  theta_dot = VecX::Zero(nt);
+  body.assign(nb, BodyState{});
+  Jw = MatX::Zero(3 * nb, n);
+  Jv = MatX::Zero(3 * nb, n);
+  T = MatX::Zero(N, n);
+  bias = VecX::Zero(N);
+  u_dot = VecX::Zero(N);
+  nodal = VecX::Zero(N);
+  MT = MatX::Zero(N, n);
+  for (const ElementEntry& e : model.elements) {
+    const auto k = static_cast<Eigen::Index>(e.table_row.size());
+    local_x.emplace_back(VecX::Zero(k));
+    local_y.emplace_back(VecX::Zero(k));
+    local_g.emplace_back(VecX::Zero(k));
+  }
+  Ms = MatX::Zero(n, n);
+  h = Q = qdd = tau = VecX::Zero(n);
+}
+
+}  // namespace femdyn

@@ -1,0 +1,39 @@
+// Workspace: everything an evaluation writes. Sized once for a Model, so the algorithms
+// (core/kinematics.hpp, core/equations.hpp) do not allocate per call.
+#pragma once
+#include <vector>
+
+#include "core/mass_solver.hpp"
+#include "core/model.hpp"
+
+namespace femdyn {
+
+struct BodyState {
+  Mat3 R = Mat3::Identity();  // R_WB, body orientation in world
+  Vec3 p = Vec3::Zero();      // p_WB, body origin in world
+  Vec3 w = Vec3::Zero();      // ω, angular velocity (world)
+  Vec3 v = Vec3::Zero();      // velocity of the body origin (world)
+  Vec3 alpha = Vec3::Zero();  // bias angular acceleration (q̈ = 0)
+  Vec3 a = Vec3::Zero();      // bias acceleration of the body origin (q̈ = 0)
+};
+
+struct Workspace {
+  explicit Workspace(const Model& model);
+
+  VecX theta, theta_dot;           // θ, θ̇
+  std::vector<BodyState> body;     // per body
+  MatX Jw, Jv;                     // body Jacobians in q: rows 3b..3b+2 of body b (3nb x n)
+  MatX T;                          // T = ∂u/∂q (N_u x n)
+  VecX bias;                       // T'[q̇,q̇] (N_u)
+  VecX u_dot;                      // u̇ = T q̇
+  VecX nodal;                      // M T'[q̇,q̇] + g, then nodal forces F (N_u)
+  MatX MT;                         // M T (N_u x n)
+  std::vector<VecX> local_x, local_y, local_g;  // per element local DOF buffers (6k)
+
+  // System equations M^s q̈ + h = Q at the last evaluated state.
+  MatX Ms;
+  VecX h, Q, qdd, tau;
+  MassSolver solver;  // factorisation of M^s (dense or CHOLMOD, chosen for the model)
+};
+
+}  // namespace femdyn

@@ -1,0 +1,30 @@
+#include "elements/rigid_body.hpp"
+
+#include "core/inertia.hpp"
+#include "elements/lumped_point.hpp"
+#include "elements/rotary_node.hpp"
+
+namespace femdyn {
+
+void RigidBodyShorthand::from_params(const Params& p, ElementSink& sink) {
+  p.allow_only({"type", "mass", "com", "inertia", "equivalent"});
+  const double m = p.positive("mass");
+  const Vec3 c = p.vec3_or("com", Vec3::Zero());
+  const Mat3 I = p.inertia("inertia");
+  if (auto problem = inertia_problem(I)) p.fail("inertia", *problem);
+  const std::string how = p.has("equivalent") ? p.string("equivalent") : "point_rotary";
+  if (how == "point_rotary") {
+    sink.add(std::make_unique<LumpedPoint>(c, m), {"com"});
+    sink.add(std::make_unique<RotaryNode>(c, I), {"com"});
+  } else if (how == "four_points") {
+    const auto pts = equimomental_points(m, c, I);
+    if (!pts) p.fail("inertia", "four equimomental points need a strictly physical inertia "
+                                "(positive definite pseudo-inertia); use point_rotary");
+    for (int i = 0; i < 4; ++i)
+      sink.add(std::make_unique<LumpedPoint>((*pts)[i], m / 4), {"p" + std::to_string(i + 1)});
+  } else {
+    p.fail("equivalent", "expected \"point_rotary\" or \"four_points\", got \"" + how + "\"");
+  }
+}
+
+}  // namespace femdyn

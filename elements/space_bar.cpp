@@ -1,0 +1,86 @@
+#include "elements/space_bar.hpp"
+
+#include "core/inertia.hpp"
+
+namespace femdyn {
+
+namespace {
+constexpr std::array<bool, 6> kAll = {true, true, true, true, true, true};
+}
+
+SpaceBar::SpaceBar(const Vec3& a, const Vec3& b, double mass, const Mat3& J_rot_body)
+    : nodes_{ElementNode{a, kAll}, ElementNode{b, kAll}}, mass_(mass), J_(J_rot_body) {}
+
+MatX SpaceBar::local_mass() const {
+  // ½ [m, m, m, J, m, m, m, J]: half the mass and half of J_rot at each end.
+  MatX m = MatX::Zero(12, 12);
+  for (int end = 0; end < 2; ++end) {
+    m.block<3, 3>(6 * end, 6 * end) = 0.5 * mass_ * Mat3::Identity();
+    m.block<3, 3>(6 * end + 3, 6 * end + 3) = 0.5 * J_;
+  }
+  return m;
+}
+
+void SpaceBar::add_velocity_force(const Eigen::Ref<const VecX>& x, const Eigen::Ref<const VecX>& y,
+                                  Eigen::Ref<VecX> g) const {
+  // Each end carries J/2 turning with the bar's ω: g_end = x_ω × (J/2 y_ω).
+  const Mat3 half = 0.5 * J_;
+  for (int end = 0; end < 2; ++end)
+    add_gyroscopic(half, x.segment<3>(6 * end + 3), y.segment<3>(6 * end + 3),
+                   g.segment<3>(6 * end + 3));
+}
+
+Mat3 SpaceBar::bar_frame(const Vec3& a, const Vec3& b, const Vec3* y_hint) {
+  const Vec3 x = (b - a).normalized();
+  Vec3 y;
+  if (y_hint) {
+    y = *y_hint - y_hint->dot(x) * x;
+  } else {
+    int k = 0;
+    x.cwiseAbs().minCoeff(&k);
+    y = Vec3::Unit(k) - x[k] * x;
+  }
+  y.normalize();
+  Mat3 R;
+  R << x, y, x.cross(y);
+  return R;
+}
+
+// {"type": "space_bar", "nodes": [a, b], "density": ρ, "area": A, "Iy": …, "Iz": …,
+//  "section_y": [..]}  or  {"type": "space_bar", "nodes": [a, b], "mass": m, "inertia": I_c}
+void SpaceBar::from_params(const Params& p, ElementSink& sink) {
+  p.allow_only({"type", "nodes", "density", "area", "Iy", "Iz", "section_y", "mass", "inertia"});
+  if (p.json().at("nodes").size() != 2) p.fail("nodes", "a space bar has exactly 2 nodes");
+  const NodeRef a = p.node_at("nodes", 0), b = p.node_at("nodes", 1);
+  const double l = (b.position - a.position).norm();
+  if (!(l > 1e-12)) p.fail("nodes", "the two nodes of a space bar coincide");
+  const Vec3 x = (b.position - a.position) / l;
+  double m;
+  Mat3 J;
+  if (p.has("mass")) {
+    if (p.has("density") || p.has("area"))
+      p.fail("mass", "give either mass and inertia or density, area, Iy, Iz");
+    m = p.positive("mass");
+    const Mat3 Ic = p.inertia("inertia");
+    if (auto problem = inertia_problem(Ic)) p.fail("inertia", *problem);
+    J = Ic - 0.25 * m * l * l * (Mat3::Identity() - x * x.transpose());
+  } else {
+    const double rho = p.positive("density"), A = p.positive("area");
+    const double Iy = p.positive("Iy"), Iz = p.positive("Iz");
+    Vec3 hint;
+    const bool has_hint = p.has("section_y");
+    if (has_hint) {
+      hint = p.vec3("section_y");
+      if ((hint - hint.dot(x) * x).norm() < 1e-9 * (1 + hint.norm()))
+        p.fail("section_y", "is parallel to the bar");
+    }
+    const Mat3 R = bar_frame(a.position, b.position, has_hint ? &hint : nullptr);
+    m = rho * A * l;
+    const Vec3 Jbar(rho * l * (Iy + Iz), rho * l * (Iy - A * l * l / 6.0),
+                    rho * l * (Iz - A * l * l / 6.0));
+    J = R * Jbar.asDiagonal() * R.transpose();
+  }
+  sink.add(std::make_unique<SpaceBar>(a.position, b.position, m, J), {a.label, b.label});
+}
+
+}  // namespace femdyn

@@ -1,0 +1,218 @@
+#include "io/model_loader.hpp"
+
+#include <fstream>
+#include <sstream>
+
+#include "elements/registry.hpp"
+#include "io/params.hpp"
+
+namespace femdyn {
+namespace {
+
+std::string line_col(const std::string& text, std::size_t byte) {
+  std::size_t line = 1, col = 1;
+  for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return "line " + std::to_string(line) + ", column " + std::to_string(col);
+}
+
+JointType joint_type(const Params& p) {
+  const std::string t = p.string("type");
+  if (t == "revolute" || t == "continuous") return JointType::Revolute;
+  if (t == "prismatic") return JointType::Prismatic;
+  if (t == "fixed") return JointType::Fixed;
+  p.fail("type", "unknown joint type '" + t + "' (expected revolute, prismatic or fixed)");
+}
+
+JointSpec read_joint(const Params& p) {
+  p.allow_only({"name", "type", "origin", "axis", "limits", "spring", "damping"});
+  JointSpec j;
+  j.where = p.where();
+  j.name = p.has("name") ? p.string("name") : "";
+  j.type = joint_type(p);
+  if (p.has("origin")) {
+    const Params o(p.json().at("origin"), p.path("origin"));
+    o.allow_only({"xyz", "rpy"});
+    j.xyz = o.vec3_or("xyz", Vec3::Zero());
+    j.rpy = o.vec3_or("rpy", Vec3::Zero());
+  }
+  if (j.type != JointType::Fixed) j.axis = p.vec3("axis");
+  if (p.has("limits")) {
+    const Json& l = p.json().at("limits");
+    if (!l.is_array() || l.size() != 2) p.fail("limits", "expected [lower, upper]");
+    j.lower = json_number(l[0], p.path("limits") + "/0");
+    j.upper = json_number(l[1], p.path("limits") + "/1");
+  }
+  if (p.has("spring")) {
+    const Params s(p.json().at("spring"), p.path("spring"));
+    s.allow_only({"stiffness", "rest"});
+    j.stiffness = s.non_negative("stiffness");
+    j.rest = s.number_or("rest", 0.0);
+  }
+  if (p.has("damping")) j.damping = p.non_negative("damping");
+  return j;
+}
+
+BodySpec read_body(const Json& jb, const std::string& where) {
+  const Params p(jb, where);
+  p.allow_only({"name", "parent", "joint", "nodes", "elements"});
+  BodySpec b;
+  b.where = where;
+  b.name = p.string("name");
+  b.parent = p.string("parent");
+  b.joint = read_joint(Params(p.json().at("joint"), p.path("joint")));
+  std::map<std::string, Vec3> nodes;
+  if (p.has("nodes")) {
+    const Json& jn = jb.at("nodes");
+    if (!jn.is_object()) p.fail("nodes", "expected an object {name: [x, y, z]}");
+    for (auto it = jn.begin(); it != jn.end(); ++it)
+      nodes[it.key()] = json_vec3(it.value(), p.path("nodes") + "/" + it.key());
+  }
+  if (p.has("elements")) {
+    const Json& je = jb.at("elements");
+    if (!je.is_array()) p.fail("elements", "expected an array");
+    for (std::size_t e = 0; e < je.size(); ++e) {
+      const Params ep(je[e], p.path("elements") + "/" + std::to_string(e), b.name, &nodes);
+      const std::string type = ep.string("type");
+      const ElementType* t = find_element_type(type);
+      if (!t) {
+        std::string known;
+        for (const ElementType& k : element_types()) known += (known.empty() ? "" : ", ") + std::string(k.name);
+        ep.fail("type", "unknown element type '" + type + "' (known: " + known + ")");
+      }
+      ElementSink sink(b.elements, ep.where());
+      t->make(ep, sink);
+    }
+  }
+  return b;
+}
+
+CouplingSpec read_coupling(const Params& p) {
+  // {"joint": j, "follows": f, "ratio": k, "offset": o}
+  // or {"joint": j, "follows": [{"joint": f1, "ratio": k1}, …], "offset": o}
+  p.allow_only({"joint", "follows", "ratio", "offset"});
+  CouplingSpec c;
+  c.where = p.where();
+  c.joint = p.string("joint");
+  c.offset = p.number_or("offset", 0.0);
+  const Json& f = p.json().contains("follows") ? p.json().at("follows") : Json();
+  if (f.is_string()) {
+    c.terms.emplace_back(f.get<std::string>(), p.number_or("ratio", 1.0));
+  } else if (f.is_array()) {
+    if (p.has("ratio")) p.fail("ratio", "give ratios inside \"follows\" when it is a list");
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      const Params t(f[i], p.path("follows") + "/" + std::to_string(i));
+      t.allow_only({"joint", "ratio"});
+      c.terms.emplace_back(t.string("joint"), t.number("ratio"));
+    }
+  } else {
+    p.fail("follows", "expected a joint name or a list of {joint, ratio}");
+  }
+  return c;
+}
+
+LoadSpec read_load(const Params& p, const Json& bodies) {
+  p.allow_only({"body", "point", "node", "force", "torque"});
+  LoadSpec l;
+  l.where = p.where();
+  l.body = p.string("body");
+  if (p.has("node")) {
+    std::map<std::string, Vec3> nodes;
+    for (const Json& b : bodies)
+      if (b.is_object() && b.value("name", "") == l.body && b.contains("nodes") && b["nodes"].is_object())
+        for (auto it = b["nodes"].begin(); it != b["nodes"].end(); ++it)
+          nodes[it.key()] = json_vec3(it.value(), p.path("node"));
+    const Params np(p.json(), p.where(), l.body, &nodes);
+    l.point = np.node("node").position;
+  } else {
+    l.point = p.vec3_or("point", Vec3::Zero());
+  }
+  l.force = p.vec3_or("force", Vec3::Zero());
+  l.torque = p.vec3_or("torque", Vec3::Zero());
+  return l;
+}
+
+}  // namespace
+
+MechanismSpec parse_spec(const std::string& text, const std::string& source) {
+  Json root;
+  try {
+    root = Json::parse(text);
+  } catch (const Json::parse_error& e) {
+    std::string what = e.what();
+    const auto colon = what.rfind(": ");
+    throw ModelError(source, "malformed JSON at " + line_col(text, e.byte == 0 ? 0 : e.byte - 1) +
+                                 (colon == std::string::npos ? "" : ": " + what.substr(colon + 2)));
+  }
+  if (!root.is_object()) throw ModelError(source, "expected a JSON object at the top level");
+  MechanismSpec spec;
+  spec.where = source + ": ";
+  const auto path = [&](const std::string& s) { return source + ": /" + s; };
+  for (auto it = root.begin(); it != root.end(); ++it) {
+    static const char* known[] = {"name", "description", "gravity", "bodies", "couplings",
+                                  "loads", "correlation_table", "$schema"};
+    bool ok = false;
+    for (const char* k : known) ok = ok || it.key() == k;
+    if (!ok) throw ModelError(path(it.key()), "unknown key '" + it.key() + "'");
+  }
+  spec.name = root.value("name", "");
+  if (root.contains("gravity")) spec.gravity = json_vec3(root["gravity"], path("gravity"));
+  if (!root.contains("bodies") || !root["bodies"].is_array())
+    throw ModelError(path("bodies"), "expected an array of bodies");
+  const Json& bodies = root["bodies"];
+  for (std::size_t i = 0; i < bodies.size(); ++i)
+    spec.bodies.push_back(read_body(bodies[i], path("bodies/" + std::to_string(i))));
+  if (root.contains("couplings")) {
+    if (!root["couplings"].is_array()) throw ModelError(path("couplings"), "expected an array");
+    for (std::size_t i = 0; i < root["couplings"].size(); ++i)
+      spec.couplings.push_back(
+          read_coupling(Params(root["couplings"][i], path("couplings/" + std::to_string(i)))));
+  }
+  if (root.contains("loads")) {
+    if (!root["loads"].is_array()) throw ModelError(path("loads"), "expected an array");
+    for (std::size_t i = 0; i < root["loads"].size(); ++i)
+      spec.loads.push_back(
+          read_load(Params(root["loads"][i], path("loads/" + std::to_string(i))), bodies));
+  }
+  if (root.contains("correlation_table")) {
+    const Json& t = root["correlation_table"];
+    CorrelationSpec cs;
+    cs.where = path("correlation_table");
+    if (!t.is_array()) throw ModelError(cs.where, "expected an array of rows");
+    for (std::size_t r = 0; r < t.size(); ++r) {
+      const std::string w = cs.where + "/" + std::to_string(r);
+      if (!t[r].is_array()) throw ModelError(w, "expected an array of integers");
+      std::vector<int> row;
+      for (std::size_t k = 0; k < t[r].size(); ++k) {
+        if (!t[r][k].is_number_integer())
+          throw ModelError(w + "/" + std::to_string(k), "expected an integer DOF number");
+        row.push_back(t[r][k].get<int>());
+      }
+      cs.rows.push_back(std::move(row));
+    }
+    spec.correlation = std::move(cs);
+  }
+  return spec;
+}
+
+MechanismSpec read_spec(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ModelError(path, "cannot open file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_spec(ss.str(), path);
+}
+
+Model load_model(const std::string& path, const LoadOptions& options) {
+  MechanismSpec spec = read_spec(path);
+  if (options.gravity) spec.gravity = *options.gravity;
+  return compile(std::move(spec));
+}
+
+}  // namespace femdyn

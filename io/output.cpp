@@ -1,0 +1,197 @@
+#include "io/output.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <system_error>
+#include <filesystem>
+
+namespace femdyn {
+namespace {
+
+Json vec_json(const VecX& v) {
+  Json a = Json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v[i]);
+  return a;
+}
+
+Json mat_json(const MatX& m) {
+  Json a = Json::array();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) {
+    Json row = Json::array();
+    for (Eigen::Index c = 0; c < m.cols(); ++c) row.push_back(m(r, c));
+    a.push_back(row);
+  }
+  return a;
+}
+
+std::string num(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "% .10e", x);
+  return buf;
+}
+
+void print_vec(std::ostringstream& out, const char* name, const VecX& v) {
+  out << name << " =";
+  for (Eigen::Index i = 0; i < v.size(); ++i) out << " " << num(v[i]);
+  out << "\n";
+}
+
+void print_mat(std::ostringstream& out, const MatX& m) {
+  for (Eigen::Index r = 0; r < m.rows(); ++r) {
+    out << "  ";
+    for (Eigen::Index c = 0; c < m.cols(); ++c) out << " " << num(m(r, c));
+    out << "\n";
+  }
+}
+
+}  // namespace
+
+Json equations_json(const Model& model, const Workspace& ws, const VecX& q, const VecX& qd,
+                    const VecX& tau, bool have_qdd, const std::vector<MatX>& D) {
+  Json j;
+  j["coordinates"] = model.coordinate_names;
+  j["q"] = vec_json(q);
+  j["qd"] = vec_json(qd);
+  j["tau"] = vec_json(tau);
+  j["M"] = mat_json(ws.Ms);
+  j["h"] = vec_json(ws.h);
+  j["Q"] = vec_json(ws.Q);
+  j["qdd"] = have_qdd ? vec_json(ws.qdd) : Json();
+  if (!D.empty()) {
+    Json d = Json::array();
+    for (const MatX& Da : D) d.push_back(mat_json(Da));
+    j["D"] = d;
+  }
+  return j;
+}
+
+std::string equations_text(const Model& model, const Workspace& ws, const VecX& q,
+                           const VecX& qd, const VecX& tau, bool have_qdd,
+                           const std::vector<MatX>& D) {
+  std::ostringstream out;
+  out << "model: " << model.name << "\n";
+  out << "coordinates:";
+  for (const auto& c : model.coordinate_names) out << " " << c;
+  out << "\n";
+  print_vec(out, "q  ", q);
+  print_vec(out, "qd ", qd);
+  print_vec(out, "tau", tau);
+  out << "M^s (mass matrix):\n";
+  print_mat(out, ws.Ms);
+  print_vec(out, "h  ", ws.h);
+  print_vec(out, "Q  ", ws.Q);
+  if (have_qdd)
+    print_vec(out, "qdd", ws.qdd);
+  else
+    out << "qdd = (M^s is singular at this state)\n";
+  for (std::size_t a = 0; a < D.size(); ++a) {
+    out << "D[" << a << "] (" << model.coordinate_names[a] << "):\n";
+    print_mat(out, D[a]);
+  }
+  return out.str();
+}
+
+std::string correlation_table_text(const Model& model) {
+  std::ostringstream out;
+  out << "correlation table N_m (" << model.elements.size() << " elements x 6 per node; "
+      << "per node: x y z rx ry rz; 0 = left out):\n";
+  for (std::size_t e = 0; e < model.elements.size(); ++e) {
+    const ElementEntry& E = model.elements[e];
+    out << "  " << std::setw(3) << e + 1 << " " << std::left << std::setw(13)
+        << E.element->type_name() << std::right << " [";
+    for (std::size_t l = 0; l < E.table_row.size(); ++l)
+      out << (l ? (l % 6 == 0 ? " | " : ", ") : "") << E.table_row[l];
+    out << "]\n";
+  }
+  return out.str();
+}
+
+std::string info_text(const Model& model) {
+  std::ostringstream out;
+  out << "model: " << model.name << "\n";
+  out << "gravity: [" << model.gravity.transpose() << "] m/s^2\n";
+  out << "coordinates (n = " << model.n() << "):";
+  for (const auto& c : model.coordinate_names) out << " " << c;
+  out << "\n";
+  out << "joints (" << model.n_theta() << " movable):\n";
+  for (const Body& b : model.bodies) {
+    const Joint& j = b.joint;
+    const char* type = j.type == JointType::Revolute    ? "revolute"
+                       : j.type == JointType::Prismatic ? "prismatic"
+                                                        : "fixed";
+    out << "  " << j.name << " (" << type << ") "
+        << (b.parent < 0 ? std::string("world") : model.bodies[b.parent].name) << " -> "
+        << b.name;
+    if (j.theta >= 0) {
+      out << "   theta =";
+      bool first = true;
+      for (int a = 0; a < model.n(); ++a) {
+        const double c = model.C(j.theta, a);
+        if (c == 0) continue;
+        out << (first ? " " : " + ") << (c == 1 ? "" : num(c) + "*") << model.coordinate_names[a];
+        first = false;
+      }
+      if (model.theta0[j.theta] != 0) out << " + " << model.theta0[j.theta];
+    }
+    out << "\n";
+  }
+  out << "bodies and elements (" << model.elements.size() << " elements):\n";
+  for (std::size_t b = 0; b < model.bodies.size(); ++b) {
+    out << "  " << model.bodies[b].name << ":";
+    for (const ElementEntry& e : model.elements)
+      if (e.body == static_cast<int>(b)) out << " " << e.element->type_name();
+    out << "\n";
+  }
+  out << "transition coordinates u (N_u = " << model.n_u() << " kept):\n";
+  for (int i = 0; i < model.n_u(); ++i)
+    out << "  " << std::setw(3) << i + 1 << " " << model.dof_name(i) << "\n";
+  out << "left out (" << model.left_out.size() << "):\n";
+  for (const auto& s : model.left_out) out << "  " << s << "\n";
+  out << (model.explicit_table ? "(table given in the model file)\n" : "");
+  out << correlation_table_text(model);
+  return out.str();
+}
+
+Json info_json(const Model& model) {
+  Json j;
+  j["model"] = model.name;
+  j["coordinates"] = model.coordinate_names;
+  Json u = Json::array();
+  for (int i = 0; i < model.n_u(); ++i) u.push_back(model.dof_name(i));
+  j["transition_coordinates"] = u;
+  j["left_out"] = model.left_out;
+  Json table = Json::array();
+  for (const ElementEntry& e : model.elements) table.push_back(e.table_row);
+  j["correlation_table"] = table;
+  Json elements = Json::array();
+  for (const ElementEntry& e : model.elements)
+    elements.push_back({{"type", std::string(e.element->type_name())},
+                        {"body", model.bodies[e.body].name},
+                        {"nodes", e.node_labels}});
+  j["elements"] = elements;
+  return j;
+}
+
+void write_file_atomic(const std::string& path, const std::string& content) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    if (!f) throw std::runtime_error(path + ": cannot write");
+    f << content;
+    f.flush();
+    if (!f) {
+      std::remove(tmp.c_str());
+      throw std::runtime_error(path + ": write failed");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error(path + ": cannot rename into place: " + ec.message());
+  }
+}
+
+}  // namespace femdyn

@@ -1,0 +1,30 @@
+// Output formatting: the equations as text or as one JSON object, the correlation table,
+// and writing files atomically (a temporary file renamed into place).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "core/workspace.hpp"
+#include "io/params.hpp"
+
+namespace femdyn {
+
+// {"coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd"} (+ "D" when D is non-empty).
+// qdd is null when M^s is singular at the state.
+Json equations_json(const Model& model, const Workspace& ws, const VecX& q, const VecX& qd,
+                    const VecX& tau, bool have_qdd, const std::vector<MatX>& D);
+
+std::string equations_text(const Model& model, const Workspace& ws, const VecX& q,
+                           const VecX& qd, const VecX& tau, bool have_qdd,
+                           const std::vector<MatX>& D);
+
+std::string info_text(const Model& model);
+Json info_json(const Model& model);
+
+// The paper-style correlation table N_m: one row per element, 6 entries per node.
+std::string correlation_table_text(const Model& model);
+
+// Writes content to path via path.tmp + rename, so readers never see a half-written file.
+void write_file_atomic(const std::string& path, const std::string& content);
+
+}  // namespace femdyn
