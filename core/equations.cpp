@@ -103,20 +103,18 @@ void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const Ve
 }
 
 std::vector<MatX> transform_hessian(const Model& model, Workspace& ws, const VecX& q) {
-  // T'[x, y] = ¼ (T'[x+y, x+y] − T'[x−y, x−y]): the bias sweep is a quadratic form in q̇.
+  // T'_{·bc} = ∂T_{·b}/∂q_c = T'[e_b, e_c]: one bilinear sweep per pair.
   const int n = model.n(), N = model.n_u();
   std::vector<MatX> H(N, MatX::Zero(n, n));
-  VecX d = VecX::Zero(n);
+  VecX eb = VecX::Zero(n), ec = VecX::Zero(n);
   for (int b = 0; b < n; ++b)
-    for (int c = b; c < n; ++c) {
-      d.setZero();
-      d[b] += 1;
-      d[c] += 1;
-      propagate(model, ws, q, d, {.jacobian = false, .bias = true});
-      const VecX plus = ws.bias;
-      d[c] -= 2;
-      propagate(model, ws, q, d, {.jacobian = false, .bias = true});
-      for (int i = 0; i < N; ++i) H[i](b, c) = H[i](c, b) = 0.25 * (plus[i] - ws.bias[i]);
+    for (int c = 0; c < n; ++c) {
+      eb.setZero();
+      ec.setZero();
+      eb[b] = 1;
+      ec[c] = 1;
+      propagate_bilinear(model, ws, q, eb, ec, {.jacobian = false, .bias = true});
+      for (int i = 0; i < N; ++i) H[i](b, c) = ws.bias[i];
     }
   return H;
 }

@@ -29,10 +29,12 @@ void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const Ve
                       const VecX& qdd);
 
 // D_abc with h_a = Σ_bc D_abc q̇_b q̇_c:  D_abc = Σ_i T_ia (M T'_{·bc} + G_{·bc})_i,
-// T'_{·bc} by polarisation of the bias sweep, G_{·bc} = g(T e_b, T e_c). D[a](b, c). On request.
+// T'_{·bc} = ∂T_{·b}/∂q_c, G_{·bc} = g(T e_b, T e_c). D[a](b, c). On request.
+// With this D, C_ab = Σ_c D_abc q̇_c = Tᵀ M Ṫ + Tᵀ G[·, q̇] makes Ṁ^s − 2C skew, and the part
+// of D symmetric in (b, c) is the Christoffel symbols of the first kind of M^s.
 std::vector<MatX> third_order_tensor(const Model& model, Workspace& ws, const VecX& q);
 
-// T'_{ibc} as N_u matrices of n x n, for tests and for the paper's case study.
+// T'_{ibc} = ∂T_ib/∂q_c as N_u matrices of n x n (not symmetric in b, c on rotation rows).
 std::vector<MatX> transform_hessian(const Model& model, Workspace& ws, const VecX& q);
 
 // Mechanical energy: kinetic ½ q̇ᵀ M^s q̇; potential of the conservative forces,

@@ -17,6 +17,7 @@ void propagate_tree(const Model& model, Workspace& ws, KinematicsRequest req) {
     const Vec3 s = R_j * j.axis;
     const double th = j.theta >= 0 ? ws.theta[j.theta] : 0.0;
     const double thd = j.theta >= 0 ? ws.theta_dot[j.theta] : 0.0;
+    const double thd_y = j.theta >= 0 ? ws.theta_dot_y[j.theta] : 0.0;
     const bool rev = j.type == JointType::Revolute;
     const bool pri = j.type == JointType::Prismatic;
 
@@ -26,10 +27,11 @@ void propagate_tree(const Model& model, Workspace& ws, KinematicsRequest req) {
 
     if (req.bias) {
       B.w = P.w + (rev ? Vec3(s * thd) : Vec3::Zero());
+      B.w_y = P.w_y + (rev ? Vec3(s * thd_y) : Vec3::Zero());
       B.v = P.v + P.w.cross(r) + (pri ? Vec3(s * thd) : Vec3::Zero());
-      B.alpha = P.alpha + (rev ? Vec3(P.w.cross(s) * thd) : Vec3::Zero());
-      B.a = P.a + P.alpha.cross(r) + P.w.cross(P.w.cross(r)) +
-            (pri ? Vec3(2.0 * P.w.cross(s) * thd) : Vec3::Zero());
+      B.alpha = P.alpha + (rev ? Vec3(P.w_y.cross(s) * thd) : Vec3::Zero());
+      B.a = P.a + P.alpha.cross(r) + P.w.cross(P.w_y.cross(r));
+      if (pri) B.a += P.w.cross(s) * thd_y + P.w_y.cross(s) * thd;
     }
     if (req.jacobian) {
       auto Jw = ws.Jw.middleRows<3>(3 * b);
@@ -58,7 +60,7 @@ void propagate_nodes(const Model& model, Workspace& ws, KinematicsRequest req) {
     Vec3 vel, acc;
     if (req.bias) {
       vel = B.v + B.w.cross(rw);
-      acc = B.a + B.alpha.cross(rw) + B.w.cross(B.w.cross(rw));
+      acc = B.a + B.alpha.cross(rw) + B.w.cross(B.w_y.cross(rw));
     }
     for (int k = 0; k < 3; ++k) {
       const int i = idx[k];
@@ -76,6 +78,8 @@ void propagate_nodes(const Model& model, Workspace& ws, KinematicsRequest req) {
   for (std::size_t b = 0; b < model.bodies.size(); ++b) {
     const auto& idx = model.body_rot_dof[b];
     const BodyState& B = ws.body[b];
+    if (idx[0] < 0 && idx[1] < 0 && idx[2] < 0) continue;
+    const Vec3 alpha_body = req.bias ? Vec3(B.alpha + B.w.cross(B.w_y)) : Vec3::Zero();
     for (int k = 0; k < 3; ++k) {
       const int i = idx[k];
       if (i < 0) continue;
@@ -83,7 +87,7 @@ void propagate_nodes(const Model& model, Workspace& ws, KinematicsRequest req) {
       if (req.jacobian) ws.T.row(i) = e.transpose() * ws.Jw.middleRows<3>(3 * b);
       if (req.bias) {
         ws.u_dot[i] = e.dot(B.w);
-        ws.bias[i] = e.dot(B.alpha);
+        ws.bias[i] = e.dot(alpha_body);
       }
     }
   }
@@ -91,14 +95,22 @@ void propagate_nodes(const Model& model, Workspace& ws, KinematicsRequest req) {
 
 }  // namespace
 
-void propagate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
-               KinematicsRequest request) {
+void propagate_bilinear(const Model& model, Workspace& ws, const VecX& q, const VecX& x,
+                        const VecX& y, KinematicsRequest request) {
   // Coupling level.
   ws.theta.noalias() = model.C * q;
   ws.theta += model.theta0;
-  if (request.bias) ws.theta_dot.noalias() = model.C * qd;
+  if (request.bias) {
+    ws.theta_dot.noalias() = model.C * x;
+    ws.theta_dot_y.noalias() = model.C * y;
+  }
   propagate_tree(model, ws, request);
   propagate_nodes(model, ws, request);
+}
+
+void propagate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+               KinematicsRequest request) {
+  propagate_bilinear(model, ws, q, qd, qd, request);
 }
 
 }  // namespace femdyn

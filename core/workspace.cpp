@@ -7,6 +7,7 @@ Workspace::Workspace(const Model& model) : solver(model) {
   const int nb = static_cast<int>(model.bodies.size());
   theta = VecX::Zero(nt);
   theta_dot = VecX::Zero(nt);
+  theta_dot_y = VecX::Zero(nt);
   body.assign(nb, BodyState{});
   Jw = MatX::Zero(3 * nb, n);
   Jv = MatX::Zero(3 * nb, n);

@@ -11,7 +11,8 @@ namespace femdyn {
 struct BodyState {
   Mat3 R = Mat3::Identity();  // R_WB, body orientation in world
   Vec3 p = Vec3::Zero();      // p_WB, body origin in world
-  Vec3 w = Vec3::Zero();      // ω, angular velocity (world)
+  Vec3 w = Vec3::Zero();      // ω, angular velocity (world), along the rate x
+  Vec3 w_y = Vec3::Zero();    // ω along the second rate y of the bilinear bias
   Vec3 v = Vec3::Zero();      // velocity of the body origin (world)
   Vec3 alpha = Vec3::Zero();  // bias angular acceleration (q̈ = 0)
   Vec3 a = Vec3::Zero();      // bias acceleration of the body origin (q̈ = 0)
@@ -20,7 +21,7 @@ struct BodyState {
 struct Workspace {
   explicit Workspace(const Model& model);
 
-  VecX theta, theta_dot;           // θ, θ̇
+  VecX theta, theta_dot, theta_dot_y;  // θ, θ̇ (= C x), C y
   std::vector<BodyState> body;     // per body
   MatX Jw, Jv;                     // body Jacobians in q: rows 3b..3b+2 of body b (3nb x n)
   MatX T;                          // T = ∂u/∂q (N_u x n)

@@ -64,6 +64,7 @@ void SpaceBar::from_params(const Params& p, ElementSink& sink) {
     const Mat3 Ic = p.inertia("inertia");
     if (auto problem = inertia_problem(Ic)) p.fail("inertia", *problem);
     J = Ic - 0.25 * m * l * l * (Mat3::Identity() - x * x.transpose());
+    J = 0.5 * (J + J.transpose()).eval();
   } else {
     const double rho = p.positive("density"), A = p.positive("area");
     const double Iy = p.positive("Iy"), Iz = p.positive("Iz");
@@ -79,6 +80,7 @@ void SpaceBar::from_params(const Params& p, ElementSink& sink) {
     const Vec3 Jbar(rho * l * (Iy + Iz), rho * l * (Iy - A * l * l / 6.0),
                     rho * l * (Iz - A * l * l / 6.0));
     J = R * Jbar.asDiagonal() * R.transpose();
+    J = 0.5 * (J + J.transpose()).eval();  // exactly symmetric
   }
   sink.add(std::make_unique<SpaceBar>(a.position, b.position, m, J), {a.label, b.label});
 }

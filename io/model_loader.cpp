@@ -149,6 +149,11 @@ MechanismSpec parse_spec(const std::string& text, const std::string& source) {
     const auto colon = what.rfind(": ");
     throw ModelError(source, "malformed JSON at " + line_col(text, e.byte == 0 ? 0 : e.byte - 1) +
                                  (colon == std::string::npos ? "" : ": " + what.substr(colon + 2)));
+  } catch (const Json::exception& e) {  // e.g. number overflow (1e999)
+    std::string what = e.what();
+    const auto bracket = what.find("] ");
+    throw ModelError(source, "malformed JSON: " +
+                                 (bracket == std::string::npos ? what : what.substr(bracket + 2)));
   }
   if (!root.is_object()) throw ModelError(source, "expected a JSON object at the top level");
   MechanismSpec spec;

@@ -1,0 +1,32 @@
+// Test helpers: loading models, seeded random mechanisms, finite differences, matrix checks.
+#pragma once
+#include <random>
+#include <string>
+
+#include "core/equations.hpp"
+#include "core/kinematics.hpp"
+#include "io/model_loader.hpp"
+
+namespace femdyn::test {
+
+std::string model_path(const std::string& name);  // FEMDYN_SOURCE_DIR/models/name
+Model load_text(const std::string& json_text);
+
+// A seeded random tree as JSON text: random axes, offsets and rpy, full physical inertia
+// tensors (rigid_body), revolute and prismatic joints; `branching` in [0, 1]: the chance a
+// body hangs from an earlier body instead of the last one.
+std::string random_tree_json(unsigned seed, int bodies, double branching, bool prismatic,
+                             double gravity = 9.81);
+
+VecX random_vector(std::mt19937& rng, int n, double scale);
+
+// max |a − b| / max(|b|, floor)
+double rel_error(const MatX& a, const MatX& b, double floor = 1e-12);
+
+// World position of translation DOF i's node component, for finite differences of u(q).
+double translation_value(const Model& m, const Workspace& ws, int i);
+
+// Body rotation R_WB after propagate().
+Mat3 body_rotation(const Workspace& ws, int body);
+
+}  // namespace femdyn::test

@@ -1,0 +1,115 @@
+// The femdyn command end to end: JSON output equals the library, bad input exits non-zero
+// with one line naming file and path.
+#include <catch2/catch.hpp>
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "tests/helpers.hpp"
+
+using namespace femdyn;
+using namespace femdyn::test;
+
+namespace {
+
+struct Run {
+  int code;
+  std::string out;
+};
+
+Run run(const std::string& args) {
+  const std::string cmd = std::string(FEMDYN_BINARY) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  REQUIRE(p);
+  std::string out;
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
+  const int status = pclose(p);
+  return {WEXITSTATUS(status), out};
+}
+
+VecX vec(const nlohmann::json& j) {
+  VecX v(j.size());
+  for (std::size_t i = 0; i < j.size(); ++i) v[i] = j[i].get<double>();
+  return v;
+}
+
+}  // namespace
+
+TEST_CASE("femdyn equations --json equals the library on the spatial double pendulum", "[cli]") {
+  const std::string path = model_path("spatial_double_pendulum.json");
+  const Run r = run("equations " + path + " --q 0.4,-1.1 --qd 1.5,-0.7 --tau 0.2,0.1 --json --tensor");
+  REQUIRE(r.code == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  const Model m = load_model(path);
+  Workspace ws(m);
+  VecX q(2), qd(2), tau(2);
+  q << 0.4, -1.1;
+  qd << 1.5, -0.7;
+  tau << 0.2, 0.1;
+  REQUIRE(forward_dynamics(m, ws, q, qd, tau).ok);
+  CHECK(j["coordinates"] == nlohmann::json({"hinge1", "hinge2"}));
+  CHECK(rel_error(vec(j["h"]), ws.h) < 1e-15);
+  CHECK(rel_error(vec(j["Q"]), ws.Q) < 1e-15);
+  CHECK(rel_error(vec(j["qdd"]), ws.qdd) < 1e-15);
+  for (int a = 0; a < 2; ++a) CHECK(rel_error(vec(j["M"][a]), ws.Ms.row(a).transpose()) < 1e-15);
+  // M q̈ + h = Q holds in the printed numbers, and h = D[q̇,q̇].
+  MatX M(2, 2);
+  for (int a = 0; a < 2; ++a) M.row(a) = vec(j["M"][a]).transpose();
+  CHECK(rel_error(M * vec(j["qdd"]) + vec(j["h"]), vec(j["Q"])) < 1e-13);
+  for (int a = 0; a < 2; ++a) {
+    MatX Da(2, 2);
+    for (int b = 0; b < 2; ++b) Da.row(b) = vec(j["D"][a][b]).transpose();
+    CHECK(std::abs(qd.dot(Da * qd) - ws.h[a]) < 1e-12 * ws.h.norm());
+  }
+}
+
+TEST_CASE("the gravity option overrides the model's gravity", "[cli]") {
+  const Run r = run("equations " + model_path("pendulum.json") + " --q 0.5 --gravity 0,0,-1 --json");
+  REQUIRE(r.code == 0);
+  CHECK(std::abs(nlohmann::json::parse(r.out)["Q"][0].get<double>() + std::sin(0.5)) < 1e-14);
+}
+
+TEST_CASE("bad command lines and bad models: one line, non-zero exit", "[cli]") {
+  const std::string pend = model_path("pendulum.json");
+  Run r = run("equations " + pend + " --q 1,2");
+  CHECK(r.code == 2);
+  CHECK(r.out == "femdyn equations: --q has 2 values, expected 1 (theta)\n");
+  r = run("equations " + pend + " --q nan");
+  CHECK(r.code == 2);
+  CHECK(r.out == "femdyn equations: --q: 'nan' is NaN or Inf\n");
+  r = run("equations " + pend + " --bogus");
+  CHECK(r.code == 2);
+  r = run("equations /nonexistent.json");
+  CHECK(r.code == 1);
+  CHECK(r.out == "femdyn equations: /nonexistent.json: cannot open file\n");
+  const std::string bad = "femdyn_test_bad.json";
+  std::ofstream(bad) << R"({"bodies": [{"name": "a", "parent": "world", "joint": {"type": "revolute", "axis": [0, 0, 1]}, "elements": [{"type": "rigid_body", "mass": 1, "inertia": {"ixx": NaN}}]}]})";
+  r = run("info " + bad);
+  CHECK(r.code == 1);
+  CHECK_THAT(r.out, Catch::StartsWith("femdyn info: femdyn_test_bad.json: malformed JSON at line 1"));
+  CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
+  std::remove(bad.c_str());
+}
+
+TEST_CASE("every command has --help; info lists the correlation table", "[cli]") {
+  for (const char* cmd : {"info", "equations"}) {
+    const Run r = run(std::string(cmd) + " --help");
+    CHECK(r.code == 0);
+    CHECK_THAT(r.out, Catch::StartsWith("usage: femdyn " + std::string(cmd)));
+  }
+  const Run r = run("info " + model_path("double_pendulum_planar.json"));
+  REQUIRE(r.code == 0);
+  CHECK_THAT(r.out, Catch::Contains("1 space_bar     [0, 0, 0, 0, 0, 1 | 2, 3, 0, 0, 0, 1]"));
+  CHECK_THAT(r.out, Catch::Contains("2 space_bar     [2, 3, 0, 0, 0, 4 | 5, 6, 0, 0, 0, 4]"));
+}
+
+TEST_CASE("every bundled model loads and has a positive definite M^s", "[cli]") {
+  for (const char* name : {"pendulum.json", "double_pendulum_planar.json",
+                           "spatial_double_pendulum.json", "branched_tree.json"}) {
+    INFO(name);
+    const Run r = run(std::string("equations ") + model_path(name) + " --json");
+    CHECK(r.code == 0);
+  }
+}

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Installs femdyn's build dependencies from Debian 12's packages and builds it in Release.
+# Idempotent: re-running only rebuilds what changed. Run from anywhere; builds into ./build.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(cmake g++ make libeigen3-dev libsuitesparse-dev nlohmann-json3-dev catch2
+          libsimbody-dev libtinyxml2-dev)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  echo "femdyn setup: installing ${missing[*]}" >&2
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$(nproc)" >/dev/null
+echo "femdyn setup: built ./build/femdyn" >&2
