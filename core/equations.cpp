@@ -90,7 +90,8 @@ Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const 
   evaluate(model, ws, q, qd, tau);
   Status st = ws.solver.factorize(ws.Ms);
   if (!st.ok) return st;
-  ws.solver.solve(ws.Q - ws.h, ws.qdd);
+  ws.qdd = ws.Q - ws.h;
+  ws.solver.solve_in_place(ws.qdd);
   return st;
 }
 

@@ -41,7 +41,8 @@ void propagate_tree(const Model& model, Workspace& ws, KinematicsRequest req) {
         Jv.setZero();
       } else {
         Jw = ws.Jw.middleRows<3>(3 * parent);
-        Jv.noalias() = ws.Jv.middleRows<3>(3 * parent) - skew(r) * ws.Jw.middleRows<3>(3 * parent);
+        Jv = ws.Jv.middleRows<3>(3 * parent);
+        Jv.noalias() -= skew(r) * ws.Jw.middleRows<3>(3 * parent);
       }
       if (rev) Jw.noalias() += s * model.C.row(j.theta);
       if (pri) Jv.noalias() += s * model.C.row(j.theta);
@@ -67,7 +68,8 @@ void propagate_nodes(const Model& model, Workspace& ws, KinematicsRequest req) {
       if (i < 0) continue;
       if (req.jacobian) {
         // e_kᵀ(Jv − [r_w]× Jω) = Jv.row(k) − ([r_w]×).row(k) Jω
-        ws.T.row(i) = ws.Jv.row(3 * b + k) - skew(rw).row(k) * ws.Jw.middleRows<3>(3 * b);
+        ws.T.row(i) = ws.Jv.row(3 * b + k);
+        ws.T.row(i).noalias() -= skew(rw).row(k) * ws.Jw.middleRows<3>(3 * b);
       }
       if (req.bias) {
         ws.u_dot[i] = vel[k];
@@ -84,7 +86,7 @@ void propagate_nodes(const Model& model, Workspace& ws, KinematicsRequest req) {
       const int i = idx[k];
       if (i < 0) continue;
       const Vec3 e = B.R.col(k);  // body axis k in world
-      if (req.jacobian) ws.T.row(i) = e.transpose() * ws.Jw.middleRows<3>(3 * b);
+      if (req.jacobian) ws.T.row(i).noalias() = e.transpose() * ws.Jw.middleRows<3>(3 * b);
       if (req.bias) {
         ws.u_dot[i] = e.dot(B.w);
         ws.bias[i] = e.dot(alpha_body);

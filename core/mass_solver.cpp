@@ -112,6 +112,13 @@ Status MassSolver::factorize(const MatX& Ms) {
   return {};
 }
 
+void MassSolver::solve_in_place(VecX& x) const {
+  if (kind_ == SolverKind::Dense)
+    impl_->dense.solveInPlace(x);
+  else
+    x = impl_->cholmod.solve(x);
+}
+
 void MassSolver::solve(const VecX& y, VecX& x) const {
   if (kind_ == SolverKind::Dense)
     x = impl_->dense.solve(y);
