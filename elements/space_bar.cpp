@@ -50,7 +50,8 @@ Mat3 SpaceBar::bar_frame(const Vec3& a, const Vec3& b, const Vec3* y_hint) {
 //  "section_y": [..]}  or  {"type": "space_bar", "nodes": [a, b], "mass": m, "inertia": I_c}
 void SpaceBar::from_params(const Params& p, ElementSink& sink) {
   p.allow_only({"type", "nodes", "density", "area", "Iy", "Iz", "section_y", "mass", "inertia"});
-  if (p.json().at("nodes").size() != 2) p.fail("nodes", "a space bar has exactly 2 nodes");
+  if (!p.has("nodes") || !p.json().at("nodes").is_array() || p.json().at("nodes").size() != 2)
+    p.fail("nodes", "expected the bar's 2 nodes [a, b]");
   const NodeRef a = p.node_at("nodes", 0), b = p.node_at("nodes", 1);
   const double l = (b.position - a.position).norm();
   if (!(l > 1e-12)) p.fail("nodes", "the two nodes of a space bar coincide");

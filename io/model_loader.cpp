@@ -37,7 +37,7 @@ JointSpec read_joint(const Params& p) {
   j.name = p.has("name") ? p.string("name") : "";
   j.type = joint_type(p);
   if (p.has("origin")) {
-    const Params o(p.json().at("origin"), p.path("origin"));
+    const Params o = p.child("origin");
     o.allow_only({"xyz", "rpy"});
     j.xyz = o.vec3_or("xyz", Vec3::Zero());
     j.rpy = o.vec3_or("rpy", Vec3::Zero());
@@ -50,7 +50,7 @@ JointSpec read_joint(const Params& p) {
     j.upper = json_number(l[1], p.path("limits") + "/1");
   }
   if (p.has("spring")) {
-    const Params s(p.json().at("spring"), p.path("spring"));
+    const Params s = p.child("spring");
     s.allow_only({"stiffness", "rest"});
     j.stiffness = s.non_negative("stiffness");
     j.rest = s.number_or("rest", 0.0);
@@ -66,7 +66,7 @@ BodySpec read_body(const Json& jb, const std::string& where) {
   b.where = where;
   b.name = p.string("name");
   b.parent = p.string("parent");
-  b.joint = read_joint(Params(p.json().at("joint"), p.path("joint")));
+  b.joint = read_joint(p.child("joint"));
   std::map<std::string, Vec3> nodes;
   if (p.has("nodes")) {
     const Json& jn = jb.at("nodes");
@@ -125,7 +125,8 @@ LoadSpec read_load(const Params& p, const Json& bodies) {
   if (p.has("node")) {
     std::map<std::string, Vec3> nodes;
     for (const Json& b : bodies)
-      if (b.is_object() && b.value("name", "") == l.body && b.contains("nodes") && b["nodes"].is_object())
+      if (b.is_object() && b.contains("name") && b["name"] == l.body && b.contains("nodes") &&
+          b["nodes"].is_object())
         for (auto it = b["nodes"].begin(); it != b["nodes"].end(); ++it)
           nodes[it.key()] = json_vec3(it.value(), p.path("node"));
     const Params np(p.json(), p.where(), l.body, &nodes);
@@ -166,7 +167,10 @@ MechanismSpec parse_spec(const std::string& text, const std::string& source) {
     for (const char* k : known) ok = ok || it.key() == k;
     if (!ok) throw ModelError(path(it.key()), "unknown key '" + it.key() + "'");
   }
-  spec.name = root.value("name", "");
+  if (root.contains("name")) {
+    if (!root["name"].is_string()) throw ModelError(path("name"), "expected a string");
+    spec.name = root["name"].get<std::string>();
+  }
   if (root.contains("gravity")) spec.gravity = json_vec3(root["gravity"], path("gravity"));
   if (!root.contains("bodies") || !root["bodies"].is_array())
     throw ModelError(path("bodies"), "expected an array of bodies");

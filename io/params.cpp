@@ -32,6 +32,8 @@ void Params::fail(const char* key, const std::string& what) const {
   throw ModelError(path(key), what);
 }
 
+Params Params::child(const char* key) const { return Params(at(key), path(key), body_, nodes_); }
+
 double Params::number(const char* key) const { return json_number(at(key), path(key)); }
 
 double Params::number_or(const char* key, double fallback) const {

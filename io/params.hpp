@@ -30,6 +30,7 @@ class Params {
   const std::string& where() const { return where_; }
   const Json& json() const { return j_; }
 
+  Params child(const char* key) const;  // a required nested object
   double number(const char* key) const;
   double number_or(const char* key, double fallback) const;
   double positive(const char* key) const;      // > 0
