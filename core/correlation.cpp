@@ -260,6 +260,7 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
       if (m.node_dof[l.node][k] >= 0) m.F_constant[m.node_dof[l.node][k]] += l.force[k];
     if (!l.torque.isZero(0)) m.torques.push_back({l.body, l.torque});
   }
+  m.has_nodal_forces = !m.torques.empty() || (N > 0 && m.F_constant.cwiseAbs().maxCoeff() > 0);
 }
 
 void check_mass_matrix(const Model& m) {

@@ -32,13 +32,18 @@ void add_velocity_forces(const Model& model, Workspace& ws, const X& x, const Y&
 
 // Q = Tᵀ F + Cᵀ(spring + damper) + τ, with F = F_constant + body torques (R_bᵀ τ_w).
 void assemble_forces(const Model& model, Workspace& ws, const VecX& tau, bool with_rates) {
-  ws.nodal = model.F_constant;
-  for (const BodyTorque& t : model.torques) {
-    const Vec3 tb = ws.body[t.body].R.transpose() * t.torque;
-    for (int k = 0; k < 3; ++k)
-      if (model.body_rot_dof[t.body][k] >= 0) ws.nodal[model.body_rot_dof[t.body][k]] += tb[k];
+  // No gravity, no loads: no nodal forces to map.
+  if (model.has_nodal_forces) {
+    ws.nodal = model.F_constant;
+    for (const BodyTorque& t : model.torques) {
+      const Vec3 tb = ws.body[t.body].R.transpose() * t.torque;
+      for (int k = 0; k < 3; ++k)
+        if (model.body_rot_dof[t.body][k] >= 0) ws.nodal[model.body_rot_dof[t.body][k]] += tb[k];
+    }
+    ws.Q.noalias() = ws.T.transpose() * ws.nodal;
+  } else {
+    ws.Q.setZero();
   }
-  ws.Q.noalias() = ws.T.transpose() * ws.nodal;
   // Joint springs and dampers act on θ; the coupling level maps them to q by Cᵀ.
   for (int j = 0; j < model.n_theta(); ++j) {
     const Joint& J = model.bodies[model.theta_joint[j]].joint;

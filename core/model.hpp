@@ -90,6 +90,7 @@ struct Model {
   SpMat M;           // system lumped mass, N_u x N_u
   VecX F_constant;   // nodal forces that do not depend on the state (gravity, point loads)
   std::vector<BodyTorque> torques;
+  bool has_nodal_forces = false;     // gravity or loads present
   bool has_velocity_forces = false;  // some element has a gyroscopic term
 
   int n() const { return static_cast<int>(C.cols()); }
