@@ -144,6 +144,7 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
 Model compile(MechanismSpec spec) {
   Model m;
   m.name = spec.name;
+  m.where = spec.where.size() >= 2 ? spec.where.substr(0, spec.where.size() - 2) : spec.where;
   if (!finite(spec.gravity)) throw ModelError(spec.where + "/gravity", "gravity is NaN or Inf");
   m.gravity = spec.gravity;
   if (spec.bodies.empty()) throw ModelError(spec.where + "/bodies", "the model has no bodies");

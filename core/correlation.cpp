@@ -1,5 +1,6 @@
 #include "core/correlation.hpp"
 
+#include <algorithm>
 #include <map>
 #include <random>
 #include <tuple>
@@ -94,6 +95,16 @@ bool same_motion(const std::vector<MatX>& Ts, int i, int j, double tol) {
   for (const MatX& T : Ts)
     if ((T.row(i) - T.row(j)).cwiseAbs().maxCoeff() > tol) return false;
   return true;
+}
+
+int carrier_body(const Model& m, const SystemDof& d) {
+  return d.kind == DofKind::Translation ? m.nodes[d.carrier].body : d.carrier;
+}
+
+int depth(const Model& m, int body) {
+  int k = 0;
+  for (int b = body; b >= 0; b = m.bodies[b].parent) ++k;
+  return k;
 }
 
 }  // namespace
@@ -209,24 +220,33 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
       }
     }
     std::vector<int> def(N + 1, -1);  // system DOF -> defining candidate
+    std::vector<std::pair<int, std::string>> joined;  // approximate joins (join_deepest)
     for (std::size_t e = 0; e < cs.rows.size(); ++e)
       for (std::size_t l = 0; l < cs.rows[e].size(); ++l) {
         const int d = cs.rows[e][l], c = all_cand[e][l];
         if (d == 0) {
-          if (local_cand[e][l] >= 0 && moves(Ts, c, tol))
-            m.left_out.push_back(m.dof_name_of(cand.list[c]) +
-                                 " (left out by the table although it moves)");
+          const std::string note =
+              m.dof_name_of(cand.list[c]) + " (left out by the table although it moves)";
+          if (local_cand[e][l] >= 0 && moves(Ts, c, tol) &&
+              std::find(m.left_out.begin(), m.left_out.end(), note) == m.left_out.end())
+            m.left_out.push_back(note);
           continue;
         }
         if (def[d] < 0) {
           def[d] = c;
         } else if (def[d] != c && !same_motion(Ts, def[d], c, tol)) {
-          throw ModelError(cs.where + "/" + std::to_string(e) + "/" + std::to_string(l),
-                           "system DOF " + std::to_string(d) + " joins " +
-                               m.dof_name_of(cand.list[def[d]]) + " and " +
-                               m.dof_name_of(cand.list[c]) + ", which move differently");
+          const std::string joins = "system DOF " + std::to_string(d) + " joins " +
+                                    m.dof_name_of(cand.list[def[d]]) + " and " +
+                                    m.dof_name_of(cand.list[c]) + ", which move differently";
+          if (!cs.join_deepest)
+            throw ModelError(cs.where + "/" + std::to_string(e) + "/" + std::to_string(l), joins);
+          if (depth(m, carrier_body(m, cand.list[c])) > depth(m, carrier_body(m, cand.list[def[d]])))
+            def[d] = c;
+          joined.emplace_back(d, joins);
         }
       }
+    for (const auto& [d, joins] : joined)
+      m.approximations.push_back(joins + ": takes " + m.dof_name_of(cand.list[def[d]]));
     for (int d = 1; d <= N; ++d) {
       if (def[d] < 0) throw ModelError(cs.where, "system DOF " + std::to_string(d) + " is unused");
       dofs.push_back(cand.list[def[d]]);
@@ -272,7 +292,7 @@ void check_mass_matrix(const Model& m) {
     evaluate(m, ws, q, VecX::Zero(m.n()), VecX());
     const Status st = ws.solver.factorize(ws.Ms);
     if (st.ok) continue;
-    std::string where;
+    std::string where = m.where;
     if (st.coordinate >= 0)
       for (const Body& b : m.bodies)
         if (b.joint.name == m.coordinate_names[st.coordinate]) where = b.joint.where;

@@ -69,6 +69,7 @@ struct BodyTorque {
 
 struct Model {
   std::string name;
+  std::string where;  // the source, for messages
   Vec3 gravity = Vec3::Zero();
   std::vector<Body> bodies;  // parents before children
   std::vector<int> theta_joint;  // θ index -> body index of its joint
@@ -85,6 +86,7 @@ struct Model {
   std::vector<std::array<int, 3>> body_rot_dof;  // body -> u index per axis, -1 if left out
   std::vector<std::string> left_out;            // descriptions of DOFs left out, and why
   bool explicit_table = false;
+  std::vector<std::string> approximations;      // joins made by an explicit table
 
   std::vector<ElementEntry> elements;
   SpMat M;           // system lumped mass, N_u x N_u

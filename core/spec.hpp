@@ -60,8 +60,12 @@ struct LoadSpec {
 
 // Explicit correlation table: one row per element (in file order), 6 entries per element
 // node, each a 1-based system DOF number or 0 (left out).
+// join_deepest: a number may join local DOFs that move differently (the paper's shared hinge
+// rotations); the system DOF then takes the motion of the one on the deepest body. This is an
+// approximation, listed by `femdyn info`; by default each number must name one motion.
 struct CorrelationSpec {
   std::vector<std::vector<int>> rows;
+  bool join_deepest = false;
   std::string where;
 };
 

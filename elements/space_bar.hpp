@@ -6,6 +6,7 @@
 // Given by mass and centroidal inertia instead: J_rot = I_c − (m l²/4)(1 − x̂ x̂ᵀ).
 // J_rot is usually indefinite (J_y, J_z < 0): the element total is what is physical, and both
 // ends turn with the bar's own ω, so the gyroscopic term is ω × (J_rot ω).
+// "lumping": "paper" reproduces the paper's printed (erroneous) lumping for its case study.
 #pragma once
 #include <array>
 

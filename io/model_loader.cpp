@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "elements/registry.hpp"
+#include "models/plugins.hpp"
 #include "io/params.hpp"
 
 namespace femdyn {
@@ -139,24 +140,33 @@ LoadSpec read_load(const Params& p, const Json& bodies) {
   return l;
 }
 
-}  // namespace
+// {"model": NAME, "params": {…}, "name", "description", "gravity", "loads"}: the plugin writes
+// the bodies (and couplings, loads, table); the file's own name, gravity and loads apply on top.
+MechanismSpec parse_document(const Json& root, const std::string& source);
 
-MechanismSpec parse_spec(const std::string& text, const std::string& source) {
-  Json root;
-  try {
-    root = Json::parse(text);
-  } catch (const Json::parse_error& e) {
-    std::string what = e.what();
-    const auto colon = what.rfind(": ");
-    throw ModelError(source, "malformed JSON at " + line_col(text, e.byte == 0 ? 0 : e.byte - 1) +
-                                 (colon == std::string::npos ? "" : ": " + what.substr(colon + 2)));
-  } catch (const Json::exception& e) {  // e.g. number overflow (1e999)
-    std::string what = e.what();
-    const auto bracket = what.find("] ");
-    throw ModelError(source, "malformed JSON: " +
-                                 (bracket == std::string::npos ? what : what.substr(bracket + 2)));
+Json expand_plugin(const Json& root, const std::string& source) {
+  const Params p(root, source + ": ");
+  p.allow_only({"model", "params", "name", "description", "gravity", "loads", "$schema"});
+  const std::string name = p.string("model");
+  const ModelPlugin* plugin = find_model_plugin(name);
+  if (!plugin) {
+    std::string known;
+    for (const ModelPlugin& k : model_plugins()) known += (known.empty() ? "" : ", ") + std::string(k.name);
+    p.fail("model", "unknown model plugin '" + name + "' (known: " + known + ")");
   }
-  if (!root.is_object()) throw ModelError(source, "expected a JSON object at the top level");
+  static const Json empty = Json::object();
+  Json doc = plugin->expand(p.has("params") ? p.child("params") : Params(empty, p.path("params")));
+  for (const char* key : {"name", "description", "gravity"})
+    if (root.contains(key)) doc[key] = root[key];
+  if (root.contains("loads")) {
+    if (!root["loads"].is_array()) p.fail("loads", "expected an array");
+    if (!doc.contains("loads")) doc["loads"] = Json::array();
+    for (const Json& l : root["loads"]) doc["loads"].push_back(l);
+  }
+  return doc;
+}
+
+MechanismSpec parse_document(const Json& root, const std::string& source) {
   MechanismSpec spec;
   spec.where = source + ": ";
   const auto path = [&](const std::string& s) { return source + ": /" + s; };
@@ -190,9 +200,22 @@ MechanismSpec parse_spec(const std::string& text, const std::string& source) {
           read_load(Params(root["loads"][i], path("loads/" + std::to_string(i))), bodies));
   }
   if (root.contains("correlation_table")) {
-    const Json& t = root["correlation_table"];
+    // [[…], …]  or  {"rows": [[…], …], "join": "same" | "deepest"}
+    const Json* tp = &root["correlation_table"];
     CorrelationSpec cs;
     cs.where = path("correlation_table");
+    if (tp->is_object()) {
+      const Params tparams(*tp, cs.where);
+      tparams.allow_only({"rows", "join"});
+      const std::string join = tparams.has("join") ? tparams.string("join") : "same";
+      if (join != "same" && join != "deepest")
+        tparams.fail("join", "expected \"same\" or \"deepest\", got \"" + join + "\"");
+      cs.join_deepest = join == "deepest";
+      if (!tp->contains("rows")) tparams.fail("rows", "is missing");
+      tp = &tp->at("rows");
+      cs.where += "/rows";
+    }
+    const Json& t = *tp;
     if (!t.is_array()) throw ModelError(cs.where, "expected an array of rows");
     for (std::size_t r = 0; r < t.size(); ++r) {
       const std::string w = cs.where + "/" + std::to_string(r);
@@ -208,6 +231,28 @@ MechanismSpec parse_spec(const std::string& text, const std::string& source) {
     spec.correlation = std::move(cs);
   }
   return spec;
+}
+
+}  // namespace
+
+MechanismSpec parse_spec(const std::string& text, const std::string& source) {
+  Json root;
+  try {
+    root = Json::parse(text);
+  } catch (const Json::parse_error& e) {
+    std::string what = e.what();
+    const auto colon = what.rfind(": ");
+    throw ModelError(source, "malformed JSON at " + line_col(text, e.byte == 0 ? 0 : e.byte - 1) +
+                                 (colon == std::string::npos ? "" : ": " + what.substr(colon + 2)));
+  } catch (const Json::exception& e) {  // e.g. number overflow (1e999)
+    std::string what = e.what();
+    const auto bracket = what.find("] ");
+    throw ModelError(source, "malformed JSON: " +
+                                 (bracket == std::string::npos ? what : what.substr(bracket + 2)));
+  }
+  if (!root.is_object()) throw ModelError(source, "expected a JSON object at the top level");
+  if (root.contains("model")) return parse_document(expand_plugin(root, source), source);
+  return parse_document(root, source);
 }
 
 MechanismSpec read_spec(const std::string& path) {

@@ -150,6 +150,10 @@ std::string info_text(const Model& model) {
   out << "left out (" << model.left_out.size() << "):\n";
   for (const auto& s : model.left_out) out << "  " << s << "\n";
   out << (model.explicit_table ? "(table given in the model file)\n" : "");
+  if (!model.approximations.empty()) {
+    out << "approximations made by the table (" << model.approximations.size() << "):\n";
+    for (const auto& s : model.approximations) out << "  " << s << "\n";
+  }
   out << correlation_table_text(model);
   return out.str();
 }
@@ -162,6 +166,7 @@ Json info_json(const Model& model) {
   for (int i = 0; i < model.n_u(); ++i) u.push_back(model.dof_name(i));
   j["transition_coordinates"] = u;
   j["left_out"] = model.left_out;
+  j["approximations"] = model.approximations;
   Json table = Json::array();
   for (const ElementEntry& e : model.elements) table.push_back(e.table_row);
   j["correlation_table"] = table;

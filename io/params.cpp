@@ -58,6 +58,13 @@ std::string Params::string(const char* key) const {
   return v.get<std::string>();
 }
 
+bool Params::boolean_or(const char* key, bool fallback) const {
+  if (!has(key)) return fallback;
+  const Json& v = at(key);
+  if (!v.is_boolean()) fail(key, "expected true or false");
+  return v.get<bool>();
+}
+
 Vec3 Params::vec3(const char* key) const { return json_vec3(at(key), path(key)); }
 
 Vec3 Params::vec3_or(const char* key, const Vec3& fallback) const {

@@ -36,6 +36,7 @@ class Params {
   double positive(const char* key) const;      // > 0
   double non_negative(const char* key) const;  // >= 0
   std::string string(const char* key) const;
+  bool boolean_or(const char* key, bool fallback) const;
   Vec3 vec3(const char* key) const;
   Vec3 vec3_or(const char* key, const Vec3& fallback) const;
   // [[ixx,ixy,ixz],[ixy,iyy,iyz],[ixz,iyz,izz]] or {"ixx":…, "iyy":…, "izz":…, "ixy":…, …}

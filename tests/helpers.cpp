@@ -1,12 +1,22 @@
 #include "tests/helpers.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <sstream>
 
 namespace femdyn::test {
 
 std::string model_path(const std::string& name) {
   return std::string(FEMDYN_SOURCE_DIR) + "/models/" + name;
+}
+
+std::vector<std::string> bundled_models() {
+  std::vector<std::string> out;
+  for (const auto& e : std::filesystem::directory_iterator(std::string(FEMDYN_SOURCE_DIR) + "/models"))
+    if (e.path().extension() == ".json") out.push_back(e.path().filename().string());
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 Model load_text(const std::string& json_text) { return compile(parse_spec(json_text, "test")); }

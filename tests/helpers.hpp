@@ -2,6 +2,7 @@
 #pragma once
 #include <random>
 #include <string>
+#include <vector>
 
 #include "core/equations.hpp"
 #include "core/kinematics.hpp"
@@ -10,6 +11,7 @@
 namespace femdyn::test {
 
 std::string model_path(const std::string& name);  // FEMDYN_SOURCE_DIR/models/name
+std::vector<std::string> bundled_models();          // file names of models/*.json, sorted
 Model load_text(const std::string& json_text);
 
 // A seeded random tree as JSON text: random axes, offsets and rpy, full physical inertia

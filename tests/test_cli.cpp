@@ -106,10 +106,9 @@ TEST_CASE("every command has --help; info lists the correlation table", "[cli]")
 }
 
 TEST_CASE("every bundled model loads and has a positive definite M^s", "[cli]") {
-  for (const char* name : {"pendulum.json", "double_pendulum_planar.json",
-                           "spatial_double_pendulum.json", "branched_tree.json"}) {
+  for (const std::string& name : bundled_models()) {
     INFO(name);
-    const Run r = run(std::string("equations ") + model_path(name) + " --json");
+    const Run r = run("equations " + model_path(name) + " --json");
     CHECK(r.code == 0);
   }
 }

@@ -1,0 +1,145 @@
+#include "models/dexterous_finger.hpp"
+
+#include <cmath>
+#include <numbers>
+
+namespace femdyn {
+namespace {
+
+template <std::size_t N>
+std::array<double, N> numbers_or(const Params& p, const char* key, std::array<double, N> fallback,
+                                 bool positive) {
+  if (!p.has(key)) return fallback;
+  const Json& v = p.json().at(key);
+  std::array<double, N> out;
+  if (v.is_number()) {
+    out.fill(json_number(v, p.path(key)));
+  } else {
+    if (!v.is_array() || v.size() != N)
+      p.fail(key, "expected a number or an array of " + std::to_string(N) + " numbers");
+    for (std::size_t i = 0; i < N; ++i) out[i] = json_number(v[i], p.path(key) + "/" + std::to_string(i));
+  }
+  for (double x : out)
+    if (positive ? !(x > 0) : x < 0)
+      p.fail(key, positive ? "must be positive" : "must not be negative");
+  return out;
+}
+
+Json vec(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+// The paper's correlation table N_m, as printed (4 units x 12).
+const int kPaperTable[4][12] = {{0, 0, 0, 0, 0, 1, 2, 3, 0, 4, 0, 0},
+                                {2, 3, 0, 4, 0, 0, 5, 6, 7, 8, 0, 0},
+                                {5, 6, 7, 8, 0, 0, 9, 10, 11, 12, 0, 0},
+                                {9, 10, 11, 12, 0, 0, 13, 14, 15, 16, 0, 0}};
+
+}  // namespace
+
+FingerParams FingerParams::from(const Params& p) {
+  p.allow_only({"lengths", "width", "height", "density", "limits", "stiffness", "rest",
+                "damping", "coupling", "tip_force", "lumping"});
+  FingerParams f;
+  f.length = numbers_or<4>(p, "lengths", f.length, true);
+  f.width = numbers_or<4>(p, "width", f.width, true);
+  f.height = numbers_or<4>(p, "height", f.height, true);
+  if (p.has("density")) f.density = p.positive("density");
+  f.stiffness = numbers_or<4>(p, "stiffness", f.stiffness, false);
+  f.rest = numbers_or<4>(p, "rest", f.rest, false);
+  f.damping = numbers_or<4>(p, "damping", f.damping, false);
+  if (p.has("limits")) {
+    const Json& l = p.json().at("limits");
+    if (!l.is_array() || l.size() != 4) p.fail("limits", "expected 4 pairs [lower, upper]");
+    for (int i = 0; i < 4; ++i) {
+      const std::string w = p.path("limits") + "/" + std::to_string(i);
+      if (!l[i].is_array() || l[i].size() != 2) throw ModelError(w, "expected [lower, upper]");
+      f.limits[i] = {json_number(l[i][0], w + "/0"), json_number(l[i][1], w + "/1")};
+    }
+  }
+  if (p.has("coupling") && !p.json().at("coupling").is_null()) {
+    const Params c = p.child("coupling");
+    c.allow_only({"ratio", "offset"});
+    f.coupled = true;
+    f.ratio = c.number_or("ratio", 1.0);
+    f.offset = c.number_or("offset", 0.0);
+  }
+  f.tip_force = p.vec3_or("tip_force", Vec3::Zero());
+  if (p.has("lumping")) {
+    const std::string l = p.string("lumping");
+    if (l != "exact" && l != "paper") p.fail("lumping", "expected \"exact\" or \"paper\"");
+    f.paper_lumping = l == "paper";
+  }
+  return f;
+}
+
+void append_finger(const FingerParams& f, const std::string& prefix, const std::string& parent,
+                   const Vec3& xyz, const Vec3& rpy, Json& bodies, Json& couplings, Json& loads) {
+  static const char* body[] = {"base", "proximal", "middle", "distal"};
+  static const char* joint[] = {"abduction", "mcp", "pip", "dip"};
+  // Unit k runs from its joint to the next: the base radially along −y, knuckles along +z.
+  const Vec3 along[] = {Vec3(0, -f.length[0], 0), Vec3(0, 0, f.length[1]),
+                        Vec3(0, 0, f.length[2]), Vec3(0, 0, f.length[3])};
+  for (int k = 0; k < 4; ++k) {
+    Json j = {{"name", prefix + joint[k]},
+              {"type", "revolute"},
+              {"axis", k == 0 ? vec(Vec3::UnitZ()) : vec(Vec3::UnitX())},
+              {"limits", Json::array({f.limits[k][0], f.limits[k][1]})}};
+    // Base joint: the mount, then a quarter turn so that the body x is the flexion axis.
+    j["origin"] = k == 0 ? Json{{"xyz", vec(xyz)}, {"rpy", vec(rpy)}}
+                         : Json{{"xyz", vec(along[k - 1])}};
+    if (f.stiffness[k] > 0) j["spring"] = {{"stiffness", f.stiffness[k]}, {"rest", f.rest[k]}};
+    if (f.damping[k] > 0) j["damping"] = f.damping[k];
+    // Section: width w along the flexion axis (body x), height h across it. In the bar frame
+    // (x̂ along the bar, ŷ = section_y) I_y = ∫z² dA, I_z = ∫y² dA.
+    const double w = f.width[k], h = f.height[k];
+    const bool radial = k == 0;  // base unit: bar along −y, section ŷ = body x, ẑ = body z
+    Json bar = {{"type", "space_bar"},
+                {"nodes", Json::array({"a", "b"})},
+                {"density", f.density},
+                {"area", w * h}};
+    if (f.paper_lumping) {
+      // The paper's lumping in body axes: I_y, I_z as the paper labels them (about body y, z).
+      bar["Iy"] = radial ? w * h * h * h / 12 : h * w * w * w / 12;
+      bar["Iz"] = radial ? h * w * w * w / 12 : w * h * h * h / 12;
+      bar["lumping"] = "paper";
+    } else {
+      bar["section_y"] = vec(Vec3::UnitX());
+      // x̂ × ŷ = ẑ: for the base (x̂ = −y) ẑ = −y × x = z; for knuckles (x̂ = z) ẑ = z × x = y.
+      bar["Iy"] = w * h * h * h / 12;  // ∫ z² dA, z across the width
+      bar["Iz"] = h * w * w * w / 12;
+    }
+    Json b = {{"name", prefix + body[k]},
+              {"parent", k == 0 ? parent : prefix + body[k - 1]},
+              {"joint", j},
+              {"nodes", {{"a", vec(Vec3::Zero())}, {"b", vec(along[k])}}},
+              {"elements", Json::array({bar})}};
+    bodies.push_back(b);
+  }
+  if (f.coupled)
+    couplings.push_back({{"joint", prefix + "dip"},
+                         {"follows", prefix + "pip"},
+                         {"ratio", f.ratio},
+                         {"offset", f.offset}});
+  if (!f.tip_force.isZero(0))
+    loads.push_back({{"body", prefix + "distal"}, {"point", vec(along[3])}, {"force", vec(f.tip_force)}});
+}
+
+Json dexterous_finger(const Params& params) {
+  const FingerParams f = FingerParams::from(params);
+  Json bodies = Json::array(), couplings = Json::array(), loads = Json::array();
+  append_finger(f, "", "world", Vec3::Zero(), Vec3(0, 0, std::numbers::pi / 2), bodies, couplings,
+                loads);
+  Json model = {{"name", f.paper_lumping ? "dexterous finger (paper's discretisation)"
+                                         : "dexterous finger"},
+                {"bodies", bodies}};
+  if (!couplings.empty()) model["couplings"] = couplings;
+  if (!loads.empty()) model["loads"] = loads;
+  if (f.paper_lumping) {
+    if (f.coupled) params.fail("coupling", "the paper's discretisation has 4 independent joints");
+    Json rows = Json::array();
+    for (const auto& row : kPaperTable) rows.push_back(Json(std::vector<int>(row, row + 12)));
+    model["correlation_table"] = {{"rows", rows}, {"join", "deepest"}};
+  }
+  return model;
+}
+
+}  // namespace femdyn

@@ -1,0 +1,11 @@
+// A hand composed from the dexterous finger plugin: a palm on an optional 2-DOF wrist
+// (flexion, deviation) carrying four fingers and, optionally, an opposed thumb. Every finger is
+// the same `dexterous_finger` (params under "finger"), mounted at its own place on the palm.
+#pragma once
+#include "io/params.hpp"
+
+namespace femdyn {
+
+Json dexterous_hand(const Params& params);
+
+}  // namespace femdyn
