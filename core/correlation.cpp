@@ -59,10 +59,14 @@ void set_dofs(Model& m, const std::vector<SystemDof>& dofs) {
   m.dofs = dofs;
   m.node_dof.assign(m.nodes.size(), {-1, -1, -1});
   m.body_rot_dof.assign(m.bodies.size(), {-1, -1, -1});
+  m.dof_alias.clear();
   for (std::size_t i = 0; i < dofs.size(); ++i) {
     auto& slot = dofs[i].kind == DofKind::Translation ? m.node_dof[dofs[i].carrier]
                                                       : m.body_rot_dof[dofs[i].carrier];
-    slot[dofs[i].axis] = static_cast<int>(i);
+    if (slot[dofs[i].axis] >= 0)
+      m.dof_alias.emplace_back(static_cast<int>(i), slot[dofs[i].axis]);
+    else
+      slot[dofs[i].axis] = static_cast<int>(i);
   }
 }
 

@@ -148,12 +148,13 @@ Energy energy(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) 
   evaluate(model, ws, q, qd, VecX());
   Energy E;
   E.kinetic = 0.5 * qd.dot(ws.Ms * qd);
-  // Potential of constant nodal forces: −F·x over translation DOFs (positions in world).
-  for (std::size_t n = 0; n < model.nodes.size(); ++n) {
-    const BodyState& B = ws.body[model.nodes[n].body];
-    const Vec3 x = B.p + B.R * model.nodes[n].r;
-    for (int k = 0; k < 3; ++k)
-      if (model.node_dof[n][k] >= 0) E.potential -= model.F_constant[model.node_dof[n][k]] * x[k];
+  // Potential of constant nodal forces: −F_i x_i over translation DOFs (positions in world).
+  for (int i = 0; i < model.n_u(); ++i) {
+    const SystemDof& d = model.dofs[i];
+    if (d.kind != DofKind::Translation || model.F_constant[i] == 0) continue;
+    const SystemNode& node = model.nodes[d.carrier];
+    const BodyState& B = ws.body[node.body];
+    E.potential -= model.F_constant[i] * (B.p + B.R * node.r)[d.axis];
   }
   for (int j = 0; j < model.n_theta(); ++j) {
     const Joint& J = model.bodies[model.theta_joint[j]].joint;

@@ -108,6 +108,13 @@ void propagate_bilinear(const Model& model, Workspace& ws, const VecX& q, const 
   }
   propagate_tree(model, ws, request);
   propagate_nodes(model, ws, request);
+  for (const auto& [copy, original] : model.dof_alias) {
+    if (request.jacobian) ws.T.row(copy) = ws.T.row(original);
+    if (request.bias) {
+      ws.bias[copy] = ws.bias[original];
+      ws.u_dot[copy] = ws.u_dot[original];
+    }
+  }
 }
 
 void propagate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,

@@ -84,6 +84,8 @@ struct Model {
   std::vector<SystemDof> dofs;                  // u
   std::vector<std::array<int, 3>> node_dof;     // node -> u index per axis, -1 if left out
   std::vector<std::array<int, 3>> body_rot_dof;  // body -> u index per axis, -1 if left out
+  std::vector<std::pair<int, int>> dof_alias;   // (copy, original): an explicit table may give
+                                                // one motion two numbers (the paper's u12, u16)
   std::vector<std::string> left_out;            // descriptions of DOFs left out, and why
   bool explicit_table = false;
   std::vector<std::string> approximations;      // joins made by an explicit table

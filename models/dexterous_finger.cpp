@@ -104,7 +104,7 @@ void append_finger(const FingerParams& f, const std::string& prefix, const std::
     } else {
       bar["section_y"] = vec(Vec3::UnitX());
       // x̂ × ŷ = ẑ: for the base (x̂ = −y) ẑ = −y × x = z; for knuckles (x̂ = z) ẑ = z × x = y.
-      bar["Iy"] = w * h * h * h / 12;  // ∫ z² dA, z across the width
+      bar["Iy"] = w * h * h * h / 12;  // ∫ z² dA, z (body y) across the height
       bar["Iz"] = h * w * w * w / 12;
     }
     Json b = {{"name", prefix + body[k]},
