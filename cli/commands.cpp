@@ -27,6 +27,8 @@ coordinate. --tensor adds D (n x n x n) with h_a = Σ_bc D_abc q̇_b q̇_c.
 --json prints one object: {"coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd"[, "D"]}.
 )";
 
+}  // namespace
+
 std::vector<double> parse_numbers(const std::string& opt, const std::string& text) {
   std::vector<double> out;
   std::size_t start = 0;
@@ -62,18 +64,22 @@ VecX state_vector(const Args& a, const std::string& opt, const Model& m) {
   return Eigen::Map<const VecX>(v.data(), m.n());
 }
 
-Model load(const Args& a) {
-  if (a.positional.size() != 1) throw CliError("expected one MODEL file (try --help)");
+Model load(const Args& a, std::size_t count) {
+  if (a.positional.size() != count)
+    throw CliError(count == 1 ? "expected one MODEL file (try --help)"
+                              : "expected " + std::to_string(count) + " MODEL files (try --help)");
+  return load_model(a.positional[0], load_options(a));
+}
+
+LoadOptions load_options(const Args& a) {
   LoadOptions opt;
   if (a.has("gravity")) {
     const std::vector<double> g = parse_numbers("gravity", a.options.at("gravity"));
     if (g.size() != 3) throw CliError("--gravity expects 3 values gx,gy,gz");
     opt.gravity = Vec3(g[0], g[1], g[2]);
   }
-  return load_model(a.positional[0], opt);
+  return opt;
 }
-
-}  // namespace
 
 Args parse_args(int argc, char** argv, int first, const std::vector<std::string>& flags,
                 const std::vector<std::string>& valued) {

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "io/model_loader.hpp"
+
 namespace femdyn::cli {
 
 struct CliError : std::runtime_error {
@@ -22,7 +24,15 @@ struct Args {
 Args parse_args(int argc, char** argv, int first, const std::vector<std::string>& flags,
                 const std::vector<std::string>& valued);
 
+// Shared by the commands.
+std::vector<double> parse_numbers(const std::string& opt, const std::string& text);
+VecX state_vector(const Args& a, const std::string& opt, const Model& m);  // zero if absent
+LoadOptions load_options(const Args& a);                                   // --gravity
+Model load(const Args& a, std::size_t count = 1);  // the first positional; expects `count`
+
 int cmd_info(int argc, char** argv);
 int cmd_equations(int argc, char** argv);
+int cmd_compare(int argc, char** argv);
+int cmd_track(int argc, char** argv);
 
 }  // namespace femdyn::cli

@@ -13,6 +13,8 @@ usage: femdyn COMMAND MODEL [options]
 commands:
   info        coordinates, bodies, elements, DOFs kept and left out, the correlation table
   equations   M^s, h, Q and q̈ at a state (D with --tensor)
+  compare     relative error of one model's equations against another's
+  track       computed-torque feed-forward along a smooth motion, replayed in simulation
 
 every command takes --help, and --gravity gx,gy,gz to override the model's gravity (m/s^2).
 models: JSON files, see docs/model-format.md.
@@ -31,6 +33,8 @@ int main(int argc, char** argv) {
   try {
     if (cmd == "info") return cmd_info(argc, argv);
     if (cmd == "equations") return cmd_equations(argc, argv);
+    if (cmd == "compare") return cmd_compare(argc, argv);
+    if (cmd == "track") return cmd_track(argc, argv);
     throw CliError("unknown command '" + cmd + "' (try femdyn --help)");
   } catch (const CliError& e) {
     std::cerr << "femdyn " << cmd << ": " << e.what() << "\n";

@@ -94,7 +94,7 @@ TEST_CASE("bad command lines and bad models: one line, non-zero exit", "[cli]") 
 }
 
 TEST_CASE("every command has --help; info lists the correlation table", "[cli]") {
-  for (const char* cmd : {"info", "equations"}) {
+  for (const char* cmd : {"info", "equations", "compare", "track"}) {
     const Run r = run(std::string(cmd) + " --help");
     CHECK(r.code == 0);
     CHECK_THAT(r.out, Catch::StartsWith("usage: femdyn " + std::string(cmd)));
@@ -111,4 +111,42 @@ TEST_CASE("every bundled model loads and has a positive definite M^s", "[cli]") 
     const Run r = run("equations " + model_path(name) + " --json");
     CHECK(r.code == 0);
   }
+}
+
+TEST_CASE("track: feed-forward torques from inverse dynamics reproduce the motion", "[cli]") {
+  for (const char* name : {"finger_coupled.json", "branched_tree.json"}) {
+    INFO(name);
+    const Model m = load_model(model_path(name));
+    std::string to;
+    for (int a = 0; a < m.n(); ++a) to += (a ? "," : "") + std::to_string(0.1 + 0.05 * a);
+    const std::string csv = "femdyn_test_track.csv";
+    const Run r = run("track " + model_path(name) + " --to " + to +
+                      " --duration 0.4 --steps 400 --json --csv " + csv);
+    REQUIRE(r.code == 0);
+    const auto j = nlohmann::json::parse(r.out);
+    CHECK(j["max_abs_tau"].get<double>() > 1e-4);            // it needed torque
+    CHECK(j["max_tracking_error"].get<double>() < 1e-8);      // RK4 error only
+    std::ifstream f(csv);
+    std::string header;
+    std::getline(f, header);
+    CHECK(std::count(header.begin(), header.end(), ',') == 3 * m.n());
+    int lines = 0;
+    for (std::string line; std::getline(f, line);) ++lines;
+    CHECK(lines == 401);
+    std::remove(csv.c_str());
+  }
+}
+
+TEST_CASE("compare: a model against itself is exact; the paper's finger is not", "[cli]") {
+  Run r = run("compare " + model_path("finger.json") + " " + model_path("finger.json") + " --states 5 --json");
+  REQUIRE(r.code == 0);
+  auto j = nlohmann::json::parse(r.out);
+  CHECK(j["max_rel_error"]["M"].get<double>() == 0.0);
+  r = run("compare " + model_path("finger_paper.json") + " " + model_path("finger.json") + " --states 20 --json");
+  REQUIRE(r.code == 0);
+  j = nlohmann::json::parse(r.out);
+  CHECK(j["max_rel_error"]["M"].get<double>() > 0.01);
+  r = run("compare " + model_path("finger.json") + " " + model_path("finger_coupled.json"));
+  CHECK(r.code == 2);
+  CHECK(r.out == "femdyn compare: the models have 4 and 3 coordinates; compare needs the same\n");
 }
