@@ -15,9 +15,10 @@ namespace femdyn::cli {
 namespace {
 
 constexpr const char* kHelp = R"(usage: femdyn compare MODEL_A MODEL_B [--states K] [--seed S] [--qd-scale V]
-                       [--q a,b,… [--qd …]] [--json] [--gravity gx,gy,gz]
+                       [--q a,b,… [--qd …]] [--tau …] [--json] [--gravity gx,gy,gz]
 
-Relative error of A against B, ‖A − B‖ / ‖B‖ (max-norm), for M^s, h and q̈ (τ = 0), at K seeded
+Relative error of A against B, ‖A − B‖ / ‖B‖ (max-norm), for M^s, h and q̈ (under the actuation
+--tau, default 0), at K seeded
 random states (q uniform within joint limits, or ±π / ±0.5 m without; q̇ uniform in ±V rad/s,
 default V = 2), or at the one state given by --q/--qd. Both models must have the same number of
 generalized coordinates. Prints max and median over the states.
@@ -49,7 +50,7 @@ VecX random_posture(const Model& m, std::mt19937& rng) {
 
 int cmd_compare(int argc, char** argv) {
   const Args a = parse_args(argc, argv, 2, {"help", "json"},
-                            {"states", "seed", "qd-scale", "q", "qd", "gravity"});
+                            {"states", "seed", "qd-scale", "q", "qd", "tau", "gravity"});
   if (a.has("help")) {
     std::cout << kHelp;
     return 0;
@@ -78,7 +79,7 @@ int cmd_compare(int argc, char** argv) {
   Workspace wa(A), wb(B);
   std::mt19937 rng(seed);
   std::vector<double> eM, eh, eqdd;
-  const VecX zero = VecX::Zero(A.n());
+  const VecX tau = state_vector(a, "tau", A);
   for (int k = 0; k < K; ++k) {
     VecX q, qd;
     if (a.has("q")) {
@@ -89,7 +90,7 @@ int cmd_compare(int argc, char** argv) {
       qd = VecX(A.n());
       for (int i = 0; i < A.n(); ++i) qd[i] = std::uniform_real_distribution<double>(-vscale, vscale)(rng);
     }
-    const Status sa = forward_dynamics(A, wa, q, qd, zero), sb = forward_dynamics(B, wb, q, qd, zero);
+    const Status sa = forward_dynamics(A, wa, q, qd, tau), sb = forward_dynamics(B, wb, q, qd, tau);
     if (!sa.ok || !sb.ok) throw CliError("M^s singular at a sampled state: " + (sa.ok ? sb : sa).message);
     eM.push_back(rel(wa.Ms, wb.Ms));
     eh.push_back(qd.isZero(0) ? 0.0 : rel(wa.h, wb.h));

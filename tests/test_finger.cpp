@@ -67,6 +67,24 @@ TEST_CASE("the paper's N_m and diagonal system mass are reproduced entry by entr
   const double s1 = std::sin(q[0]), c1 = std::cos(q[0]), s2 = std::sin(q[1]), c2 = std::cos(q[1]);
   const Vec3 p(((a[1] * s2 + a[0]) * c1), (a[1] * s2 + a[0]) * s1, a[1] * c2);
   for (int k = 0; k < 3; ++k) CHECK(std::abs(translation_value(m, ws, 4 + k) - p[k]) < 1e-15);
+  // u13..u15, the fingertip, with the paper's u15 corrected (it prints a2 c2 twice):
+  // ((a4 s234 + a3 s23 + a2 s2 + a1) c1, (…) s1, a2 c2 + a3 c23 + a4 c234).
+  const double t23 = q[1] + q[2], t234 = t23 + q[3];
+  const double r = a[3] * std::sin(t234) + a[2] * std::sin(t23) + a[1] * s2 + a[0];
+  const Vec3 tip(r * c1, r * s1, a[1] * c2 + a[2] * std::cos(t23) + a[3] * std::cos(t234));
+  for (int k = 0; k < 3; ++k) CHECK(std::abs(translation_value(m, ws, 12 + k) - tip[k]) < 1e-15);
+  // The paper's force vector F = [M1,0,0,M2,0,0,0,M3,0,0,0,M4,0,0,0,M4] puts the torques on
+  // absolute angles: Q = TᵀF = (M1, M2 + M3 + 2 M4, M3 + 2 M4, 2 M4), not the joint torques.
+  VecX F = VecX::Zero(16);
+  const double M1 = 0.1, M2 = 0.2, M3 = 0.3, M4 = 0.4;
+  F[0] = M1;
+  F[3] = M2;
+  F[7] = M3;
+  F[11] = M4;
+  F[15] = M4;
+  VecX Q(4);
+  Q << M1, M2 + M3 + 2 * M4, M3 + 2 * M4, 2 * M4;
+  CHECK(rel_error(ws.T.transpose() * F, Q) < 1e-15);
 }
 
 TEST_CASE("finger with θ1 fixed: the flexion block is a planar 3-link arm", "[finger]") {
