@@ -34,5 +34,6 @@ int cmd_info(int argc, char** argv);
 int cmd_equations(int argc, char** argv);
 int cmd_compare(int argc, char** argv);
 int cmd_track(int argc, char** argv);
+int cmd_validate(int argc, char** argv);  // only with FEMDYN_WITH_SIMBODY
 
 }  // namespace femdyn::cli

@@ -9,6 +9,7 @@
 
 #include "cli/commands.hpp"
 #include "core/equations.hpp"
+#include "core/sampling.hpp"
 #include "io/output.hpp"
 
 namespace femdyn::cli {
@@ -28,22 +29,6 @@ double rel(const MatX& a, const MatX& b) {
   const double nb = b.cwiseAbs().maxCoeff();
   const double d = (a - b).cwiseAbs().maxCoeff();
   return nb > 0 ? d / nb : d;
-}
-
-// Uniform q within the limits of each coordinate's joint.
-VecX random_posture(const Model& m, std::mt19937& rng) {
-  VecX q(m.n());
-  for (int a = 0; a < m.n(); ++a) {
-    const Joint* joint = nullptr;
-    for (const Body& b : m.bodies)
-      if (b.joint.name == m.coordinate_names[a]) joint = &b.joint;
-    double lo = joint && joint->type == JointType::Prismatic ? -0.5 : -3.14159265358979;
-    double hi = -lo;
-    if (joint && std::isfinite(joint->lower)) lo = joint->lower;
-    if (joint && std::isfinite(joint->upper)) hi = joint->upper;
-    q[a] = std::uniform_real_distribution<double>(lo, hi)(rng);
-  }
-  return q;
 }
 
 }  // namespace

@@ -15,6 +15,7 @@ commands:
   equations   M^s, h, Q and q̈ at a state (D with --tensor)
   compare     relative error of one model's equations against another's
   track       computed-torque feed-forward along a smooth motion, replayed in simulation
+  validate    the model against its Simbody twin, pointwise and along a trajectory
 
 every command takes --help, and --gravity gx,gy,gz to override the model's gravity (m/s^2).
 models: JSON files, see docs/model-format.md.
@@ -35,6 +36,11 @@ int main(int argc, char** argv) {
     if (cmd == "equations") return cmd_equations(argc, argv);
     if (cmd == "compare") return cmd_compare(argc, argv);
     if (cmd == "track") return cmd_track(argc, argv);
+#ifdef FEMDYN_WITH_SIMBODY
+    if (cmd == "validate") return cmd_validate(argc, argv);
+#else
+    if (cmd == "validate") throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
+#endif
     throw CliError("unknown command '" + cmd + "' (try femdyn --help)");
   } catch (const CliError& e) {
     std::cerr << "femdyn " << cmd << ": " << e.what() << "\n";

@@ -99,6 +99,8 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
     if (!coupled.emplace(it->second, &c).second)
       throw ModelError(c.where + "/joint", "joint '" + c.joint + "' is coupled twice");
     check_finite(c.offset, c.where + "/offset", "offset");
+    if (c.terms.empty())
+      throw ModelError(c.where + "/follows", "names no joint (to fix a joint, make it fixed)");
     for (const auto& [name, ratio] : c.terms) {
       if (!theta_of.count(name))
         throw ModelError(c.where + "/follows", "unknown or fixed joint '" + name + "'");
@@ -113,6 +115,8 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
       m.coordinate_names.push_back(m.bodies[m.theta_joint[t]].joint.name);
     }
   const int n = static_cast<int>(m.coordinate_names.size());
+  if (nt == 0) throw ModelError(m.where, "has no movable joint: there is no motion to compute");
+  // (n = 0 with nθ > 0 would need every joint coupled, i.e. a cycle: reported below.)
   m.C = MatX::Zero(nt, n);
   m.theta0 = VecX::Zero(nt);
   std::vector<int> state(nt, 0);  // 0 new, 1 in progress, 2 done

@@ -141,8 +141,8 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
       const auto nodes = e.element->nodes();
       std::vector<int> used, all;
       for (std::size_t l = 0; l < nodes.size(); ++l) {
-        const std::string label =
-            l < es.node_labels.size() ? es.node_labels[l] : m.bodies[b].name + "/node";
+        std::string label = l < es.node_labels.size() ? es.node_labels[l] : "node";
+        if (label.find('/') == std::string::npos) label = m.bodies[b].name + "/" + label;
         if (!nodes[l].position.allFinite())
           throw ModelError(es.where, "element node position is NaN or Inf");
         const int node = find_or_add_node(m, b, nodes[l].position, label);
@@ -167,6 +167,7 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
   struct LoadAt {
     int node, body;
     Vec3 force, torque;
+    std::string where;
   };
   std::vector<LoadAt> loads;
   for (const LoadSpec& ls : spec.loads) {
@@ -181,7 +182,8 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
       for (int k = 0; k < 3; ++k) cand.add(DofKind::Translation, node, k, true);
     if (!ls.torque.isZero(0))
       for (int k = 0; k < 3; ++k) cand.add(DofKind::Rotation, b, k, true);
-    loads.push_back({node, b, ls.force, ls.torque});
+    loads.push_back({node, b, ls.force, ls.torque, ls.where});
+    if (!ls.force.isZero(0)) m.point_loads.push_back({b, ls.point, ls.force});
   }
 
   // Which candidates move at all.
@@ -258,6 +260,18 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
     for (std::size_t e = 0; e < m.elements.size(); ++e) m.elements[e].table_row = cs.rows[e];
   }
   set_dofs(m, dofs);
+  // A table that leaves out a moving DOF a load pushes on would drop the load silently.
+  for (const LoadAt& l : loads)
+    for (int k = 0; k < 3; ++k) {
+      const auto check = [&](DofKind kind, int carrier, int dof, double push) {
+        const int c = cand.index.at(std::make_tuple(static_cast<int>(kind), carrier, k));
+        if (push != 0 && dof < 0 && moves(Ts, c, tol))
+          throw ModelError(l.where, "the load pushes on " + m.dof_name_of(cand.list[c]) +
+                                        ", which the correlation table leaves out");
+      };
+      if (l.force[k] != 0) check(DofKind::Translation, l.node, m.node_dof[l.node][k], l.force[k]);
+      if (!l.torque.isZero(0)) check(DofKind::Rotation, l.body, m.body_rot_dof[l.body][k], 1.0);
+    }
 
   // Assembly: M = Σ_e scatter(m_e) through N_m.
   const int N = m.n_u();

@@ -12,10 +12,10 @@ std::optional<std::string> inertia_problem(const Mat3& I) {
   const Vec3 p = Eigen::SelfAdjointEigenSolver<Mat3>(I).eigenvalues();  // ascending
   const double tol = 1e-9 * std::max(scale, 1e-300);
   if (p[0] < -tol)
-    return "inertia has a negative principal moment (" + std::to_string(p[0]) + ")";
+    return "inertia has a negative principal moment (" + format_number(p[0]) + ")";
   if (p[0] + p[1] < p[2] - tol)
-    return "inertia violates the triangle inequality (principal moments " + std::to_string(p[0]) +
-           ", " + std::to_string(p[1]) + ", " + std::to_string(p[2]) + ")";
+    return "inertia violates the triangle inequality (principal moments " + format_number(p[0]) +
+           ", " + format_number(p[1]) + ", " + format_number(p[2]) + ")";
   return std::nullopt;
 }
 

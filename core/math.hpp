@@ -1,6 +1,8 @@
 // Small 3D helpers shared by the kinematic levels and the elements.
 #pragma once
 #include <Eigen/Dense>
+#include <cstdio>
+#include <string>
 
 namespace femdyn {
 
@@ -27,6 +29,13 @@ inline Mat3 rpy_to_rotation(const Vec3& rpy) {
 // Rotation by angle about a unit axis (Rodrigues).
 inline Mat3 axis_rotation(const Vec3& unit_axis, double angle) {
   return Eigen::AngleAxisd(angle, unit_axis).toRotationMatrix();
+}
+
+// A number for messages: 6 significant digits (std::to_string would print 1e-9 as 0.000000).
+inline std::string format_number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
 }
 
 }  // namespace femdyn

@@ -67,6 +67,13 @@ struct BodyTorque {
   Vec3 torque;  // world frame
 };
 
+// A constant external force as given (kept for twins and reports; F_constant holds it on nodes).
+struct PointLoad {
+  int body;
+  Vec3 point;  // body frame
+  Vec3 force;  // world frame
+};
+
 struct Model {
   std::string name;
   std::string where;  // the source, for messages
@@ -94,6 +101,7 @@ struct Model {
   SpMat M;           // system lumped mass, N_u x N_u
   VecX F_constant;   // nodal forces that do not depend on the state (gravity, point loads)
   std::vector<BodyTorque> torques;
+  std::vector<PointLoad> point_loads;
   bool has_nodal_forces = false;     // gravity or loads present
   bool has_velocity_forces = false;  // some element has a gyroscopic term
 

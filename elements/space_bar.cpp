@@ -64,8 +64,8 @@ void SpaceBar::from_params(const Params& p, ElementSink& sink) {
   Mat3 J;
   if (p.has("mass")) {
     if (lumping != "exact") p.fail("lumping", "the paper's lumping is given by density and section");
-    if (p.has("density") || p.has("area"))
-      p.fail("mass", "give either mass and inertia or density, area, Iy, Iz");
+    for (const char* key : {"density", "area", "Iy", "Iz", "section_y"})
+      if (p.has(key)) p.fail(key, "give either mass and inertia or density, area, Iy, Iz");
     m = p.positive("mass");
     const Mat3 Ic = p.inertia("inertia");
     if (auto problem = inertia_problem(Ic)) p.fail("inertia", *problem);

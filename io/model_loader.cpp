@@ -28,7 +28,7 @@ JointType joint_type(const Params& p) {
   if (t == "revolute" || t == "continuous") return JointType::Revolute;
   if (t == "prismatic") return JointType::Prismatic;
   if (t == "fixed") return JointType::Fixed;
-  p.fail("type", "unknown joint type '" + t + "' (expected revolute, prismatic or fixed)");
+  p.fail("type", "unknown joint type '" + t + "' (expected revolute, continuous, prismatic or fixed)");
 }
 
 JointSpec read_joint(const Params& p) {
@@ -44,6 +44,9 @@ JointSpec read_joint(const Params& p) {
     j.rpy = o.vec3_or("rpy", Vec3::Zero());
   }
   if (j.type != JointType::Fixed) j.axis = p.vec3("axis");
+  if (j.type == JointType::Fixed)
+    for (const char* key : {"axis", "limits", "spring", "damping"})
+      if (p.has(key)) p.fail(key, "a fixed joint has no motion: no axis, limits, spring or damping");
   if (p.has("limits")) {
     const Json& l = p.json().at("limits");
     if (!l.is_array() || l.size() != 2) p.fail("limits", "expected [lower, upper]");
@@ -123,6 +126,7 @@ LoadSpec read_load(const Params& p, const Json& bodies) {
   LoadSpec l;
   l.where = p.where();
   l.body = p.string("body");
+  if (p.has("node") && p.has("point")) p.fail("point", "give either point or node, not both");
   if (p.has("node")) {
     std::map<std::string, Vec3> nodes;
     for (const Json& b : bodies)

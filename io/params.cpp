@@ -42,13 +42,13 @@ double Params::number_or(const char* key, double fallback) const {
 
 double Params::positive(const char* key) const {
   const double x = number(key);
-  if (!(x > 0)) fail(key, "must be positive, got " + std::to_string(x));
+  if (!(x > 0)) fail(key, "must be positive, got " + format_number(x));
   return x;
 }
 
 double Params::non_negative(const char* key) const {
   const double x = number(key);
-  if (x < 0) fail(key, "must not be negative, got " + std::to_string(x));
+  if (x < 0) fail(key, "must not be negative, got " + format_number(x));
   return x;
 }
 

@@ -6,9 +6,11 @@
 namespace femdyn {
 namespace {
 
+enum class Sign { Positive, NonNegative, Any };
+
 template <std::size_t N>
 std::array<double, N> numbers_or(const Params& p, const char* key, std::array<double, N> fallback,
-                                 bool positive) {
+                                 Sign sign) {
   if (!p.has(key)) return fallback;
   const Json& v = p.json().at(key);
   std::array<double, N> out;
@@ -19,9 +21,10 @@ std::array<double, N> numbers_or(const Params& p, const char* key, std::array<do
       p.fail(key, "expected a number or an array of " + std::to_string(N) + " numbers");
     for (std::size_t i = 0; i < N; ++i) out[i] = json_number(v[i], p.path(key) + "/" + std::to_string(i));
   }
-  for (double x : out)
-    if (positive ? !(x > 0) : x < 0)
-      p.fail(key, positive ? "must be positive" : "must not be negative");
+  for (double x : out) {
+    if (sign == Sign::Positive && !(x > 0)) p.fail(key, "must be positive");
+    if (sign == Sign::NonNegative && x < 0) p.fail(key, "must not be negative");
+  }
   return out;
 }
 
@@ -39,13 +42,13 @@ FingerParams FingerParams::from(const Params& p) {
   p.allow_only({"lengths", "width", "height", "density", "limits", "stiffness", "rest",
                 "damping", "coupling", "tip_force", "lumping"});
   FingerParams f;
-  f.length = numbers_or<4>(p, "lengths", f.length, true);
-  f.width = numbers_or<4>(p, "width", f.width, true);
-  f.height = numbers_or<4>(p, "height", f.height, true);
+  f.length = numbers_or<4>(p, "lengths", f.length, Sign::Positive);
+  f.width = numbers_or<4>(p, "width", f.width, Sign::Positive);
+  f.height = numbers_or<4>(p, "height", f.height, Sign::Positive);
   if (p.has("density")) f.density = p.positive("density");
-  f.stiffness = numbers_or<4>(p, "stiffness", f.stiffness, false);
-  f.rest = numbers_or<4>(p, "rest", f.rest, false);
-  f.damping = numbers_or<4>(p, "damping", f.damping, false);
+  f.stiffness = numbers_or<4>(p, "stiffness", f.stiffness, Sign::NonNegative);
+  f.rest = numbers_or<4>(p, "rest", f.rest, Sign::Any);
+  f.damping = numbers_or<4>(p, "damping", f.damping, Sign::NonNegative);
   if (p.has("limits")) {
     const Json& l = p.json().at("limits");
     if (!l.is_array() || l.size() != 4) p.fail("limits", "expected 4 pairs [lower, upper]");

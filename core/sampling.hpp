@@ -1,0 +1,13 @@
+// Seeded random states for studies and validation: q uniform within each coordinate's joint
+// limits (±π rad for a revolute joint without limits, ±0.5 m for a prismatic one).
+#pragma once
+#include <random>
+
+#include "core/model.hpp"
+
+namespace femdyn {
+
+VecX random_posture(const Model& model, std::mt19937& rng);
+VecX random_uniform(int n, double scale, std::mt19937& rng);  // each entry in ±scale
+
+}  // namespace femdyn

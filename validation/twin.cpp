@@ -1,0 +1,258 @@
+// The Simbody twin (twin.hpp). Compiled without NDEBUG: Debian's Simbody 3.7 is built without
+// it and some of its header classes change layout with it (see CMakeLists.txt).
+#include "validation/twin.hpp"
+
+#include <Simbody.h>
+
+#include <cmath>
+#include <stdexcept>
+
+namespace femdyn::validation {
+
+namespace {
+
+SimTK::Vec3 to_simtk(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+SimTK::Rotation to_simtk(const Mat3& R) {
+  SimTK::Mat33 m;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) m(i, j) = R(i, j);
+  return SimTK::Rotation(m, true);  // R is orthonormal (built from rpy)
+}
+
+SimTK::MassProperties mass_properties(const TwinBody& p) {
+  const Mat3& I = p.inertia_origin;  // Simbody wants the inertia about the body origin
+  return SimTK::MassProperties(p.mass, to_simtk(p.com),
+                               SimTK::Inertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)));
+}
+
+}  // namespace
+
+int independent_theta(const TwinModel& model, int k) {
+  for (int j = 0; j < model.n_theta(); ++j) {
+    bool unit = model.theta0[j] == 0;
+    for (int c = 0; c < model.n() && unit; ++c) unit = model.C(j, c) == (c == k ? 1.0 : 0.0);
+    if (unit) return j;
+  }
+  return -1;
+}
+
+struct SimbodyTwin::Impl {
+  const TwinModel model;
+  SimTK::MultibodySystem system;
+  SimTK::SimbodyMatterSubsystem matter{system};
+  SimTK::GeneralForceSubsystem forces{system};
+  std::vector<SimTK::MobilizedBody> mobod;  // per femdyn body
+  std::vector<int> theta_q, theta_u;        // θ index -> Simbody q / u index
+  std::vector<int> independent;             // q index -> θ index, -1 if none
+  bool couplers = true;
+  SimTK::State state;
+  SimTK::Matrix M_theta;
+  SimTK::Vector zero_mobility, residual, mobility, udot;
+  SimTK::Vector_<SimTK::SpatialVec> zero_body, A_GB;
+
+  explicit Impl(TwinModel tm) : model(std::move(tm)) {
+    using namespace SimTK;
+    const TwinModel& m = model;
+    const int nb = static_cast<int>(m.bodies.size());
+    mobod.reserve(nb);
+    for (int b = 0; b < nb; ++b) {
+      const TwinBody& j = m.bodies[b];
+      MobilizedBody& parent = j.parent < 0 ? static_cast<MobilizedBody&>(matter.updGround())
+                                                 : mobod[j.parent];
+      const SimTK::Body::Rigid rigid(mass_properties(j));
+      const Rotation R_pj = to_simtk(j.R_pj);
+      const SimTK::Vec3 p_pj = to_simtk(j.p_pj);
+      switch (j.joint) {
+        case TwinBody::Joint::Revolute: {
+          const Rotation R_a(UnitVec3(to_simtk(j.axis)), ZAxis);  // Pin turns about z
+          mobod.push_back(MobilizedBody::Pin(parent, Transform(R_pj * R_a, p_pj), rigid,
+                                             Transform(R_a, SimTK::Vec3(0))));
+          break;
+        }
+        case TwinBody::Joint::Prismatic: {
+          const Rotation R_a(UnitVec3(to_simtk(j.axis)), XAxis);  // Slider moves along x
+          mobod.push_back(MobilizedBody::Slider(parent, Transform(R_pj * R_a, p_pj), rigid,
+                                                Transform(R_a, SimTK::Vec3(0))));
+          break;
+        }
+        case TwinBody::Joint::Fixed:
+          mobod.push_back(MobilizedBody::Weld(parent, Transform(R_pj, p_pj), rigid, Transform()));
+          break;
+      }
+      if (j.theta >= 0) {
+        if (j.stiffness != 0)
+          Force::MobilityLinearSpring(forces, mobod.back(), MobilizerQIndex(0), j.stiffness, j.rest);
+        if (j.damping != 0)
+          Force::MobilityLinearDamper(forces, mobod.back(), MobilizerUIndex(0), j.damping);
+      }
+    }
+    if (m.gravity.norm() > 0)
+      Force::Gravity(forces, matter, UnitVec3(to_simtk(m.gravity)), m.gravity.norm());
+    for (const TwinModel::Load& l : m.loads) {
+      if (!l.force.isZero(0))
+        Force::ConstantForce(forces, mobod[l.body], to_simtk(l.point), to_simtk(l.force));
+      if (!l.torque.isZero(0)) Force::ConstantTorque(forces, mobod[l.body], to_simtk(l.torque));
+    }
+
+    // Couplings θ_j = Σ_k C_jk q_k + θ0_j as constraints among the mobilities, for trajectories.
+    independent.resize(m.n());
+    for (int k = 0; k < m.n(); ++k) {
+      independent[k] = independent_theta(m, k);
+      if (independent[k] < 0) couplers = false;
+    }
+    if (couplers) {
+      for (int j = 0; j < m.n_theta(); ++j) {
+        bool is_independent = false;
+        for (int k = 0; k < m.n(); ++k) is_independent |= independent[k] == j;
+        if (is_independent) continue;
+        // f(θ_j, θ_ind(k)...) = θ_j − Σ_k C_jk θ_ind(k) − θ0_j = 0
+        std::vector<MobilizedBodyIndex> bodies{mobod[m.theta_body[j]].getMobilizedBodyIndex()};
+        std::vector<MobilizerQIndex> which{MobilizerQIndex(0)};
+        std::vector<double> coeff{1.0};
+        for (int k = 0; k < m.n(); ++k) {
+          if (m.C(j, k) == 0) continue;
+          bodies.push_back(mobod[m.theta_body[independent[k]]].getMobilizedBodyIndex());
+          which.push_back(MobilizerQIndex(0));
+          coeff.push_back(-m.C(j, k));
+        }
+        coeff.push_back(-m.theta0[j]);
+        Vector a(static_cast<int>(coeff.size()));
+        for (int i = 0; i < a.size(); ++i) a[i] = coeff[i];
+        auto f = std::make_unique<Function::Linear>(a);
+        Constraint::CoordinateCoupler(matter, f.release(), bodies, which);  // Simbody owns f
+      }
+    }
+
+    state = system.realizeTopology();
+    system.realizeModel(state);
+    theta_q.resize(m.n_theta());
+    theta_u.resize(m.n_theta());
+    for (int j = 0; j < m.n_theta(); ++j) {
+      theta_q[j] = mobod[m.theta_body[j]].getFirstQIndex(state);
+      theta_u[j] = mobod[m.theta_body[j]].getFirstUIndex(state);
+    }
+    const int nu = state.getNU();
+    zero_mobility = Vector(nu, 0.0);
+    zero_body = Vector_<SpatialVec>(matter.getNumBodies(), SpatialVec(SimTK::Vec3(0), SimTK::Vec3(0)));
+  }
+
+  // Sets θ = C q + θ0, θ̇ = C q̇ and realizes `stage`.
+  void set_state(const VecX& q, const VecX& qd, SimTK::Stage stage) {
+    const VecX theta = model.C * q + model.theta0;
+    const VecX theta_dot = model.C * qd;
+    for (int j = 0; j < model.n_theta(); ++j) {
+      state.updQ()[theta_q[j]] = theta[j];
+      state.updU()[theta_u[j]] = theta_dot[j];
+    }
+    system.realize(state, stage);
+  }
+
+  VecX reduce(const SimTK::Vector& f_theta) const {  // Cᵀ f_θ
+    VecX f(model.n_theta());
+    for (int j = 0; j < model.n_theta(); ++j) f[j] = f_theta[theta_u[j]];
+    return model.C.transpose() * f;
+  }
+
+  SimTK::Vector expand(const VecX& x) const {  // C x on Simbody's u layout
+    SimTK::Vector out(state.getNU(), 0.0);
+    const VecX y = model.C * x;
+    for (int j = 0; j < model.n_theta(); ++j) out[theta_u[j]] = y[j];
+    return out;
+  }
+};
+
+SimbodyTwin::SimbodyTwin(TwinModel model) : impl_(std::make_unique<Impl>(std::move(model))) {}
+SimbodyTwin::~SimbodyTwin() = default;
+
+TwinEquations SimbodyTwin::equations(const VecX& q, const VecX& qd, const VecX& tau) {
+  Impl& s = *impl_;
+  const TwinModel& m = s.model;
+  const int n = m.n(), nt = m.n_theta();
+  TwinEquations out;
+  s.set_state(q, qd, SimTK::Stage::Dynamics);
+
+  // M = Cᵀ M_θ C
+  s.matter.calcM(s.state, s.M_theta);
+  MatX Mt(nt, nt);
+  for (int a = 0; a < nt; ++a)
+    for (int b = 0; b < nt; ++b) Mt(a, b) = s.M_theta(s.theta_u[a], s.theta_u[b]);
+  out.M = m.C.transpose() * Mt * m.C;
+
+  // h: residual with no applied force and θ̈ = 0 is the velocity (Coriolis, gyroscopic) term.
+  s.matter.calcResidualForceIgnoringConstraints(s.state, s.zero_mobility, s.zero_body,
+                                                s.zero_mobility, s.residual);
+  out.h = s.reduce(s.residual);
+
+  // Q: what Simbody's force elements apply, as generalized forces, plus τ on q.
+  const SimTK::Vector& mob = s.system.getMobilityForces(s.state, SimTK::Stage::Dynamics);
+  const SimTK::Vector_<SimTK::SpatialVec>& body =
+      s.system.getRigidBodyForces(s.state, SimTK::Stage::Dynamics);
+  SimTK::Vector with_forces;
+  s.matter.calcResidualForceIgnoringConstraints(s.state, mob, body, s.zero_mobility, with_forces);
+  out.Q = s.reduce(s.residual - with_forces) + tau;
+
+  bool plain = m.n() == nt;  // C = I, θ0 = 0: Simbody's own O(n) forward dynamics applies
+  for (int k = 0; k < n && plain; ++k) plain = s.independent[k] == k;
+  if (plain) {
+    SimTK::Vector applied = mob;
+    for (int j = 0; j < nt; ++j) applied[s.theta_u[j]] += tau[j];
+    s.matter.calcAccelerationIgnoringConstraints(s.state, applied, body, s.udot, s.A_GB);
+    out.qdd.resize(n);
+    for (int j = 0; j < nt; ++j) out.qdd[j] = s.udot[s.theta_u[j]];
+  } else {
+    out.qdd = out.M.llt().solve(out.Q - out.h);
+  }
+  return out;
+}
+
+VecX SimbodyTwin::inverse_dynamics(const VecX& q, const VecX& qd, const VecX& qdd) {
+  Impl& s = *impl_;
+  s.set_state(q, qd, SimTK::Stage::Dynamics);
+  const SimTK::Vector& mob = s.system.getMobilityForces(s.state, SimTK::Stage::Dynamics);
+  const SimTK::Vector_<SimTK::SpatialVec>& body =
+      s.system.getRigidBodyForces(s.state, SimTK::Stage::Dynamics);
+  // residual = M_θ θ̈ + h_θ − Q_θ with θ̈ = C q̈;  τ = Cᵀ residual
+  s.matter.calcResidualForceIgnoringConstraints(s.state, mob, body, s.expand(qdd), s.residual);
+  return s.reduce(s.residual);
+}
+
+bool SimbodyTwin::can_simulate(std::string* why_not) const {
+  if (!impl_->couplers && why_not)
+    *why_not = "a coordinate drives no joint directly, so the coupling is not a set of "
+               "coordinate couplers";
+  return impl_->couplers;
+}
+
+std::vector<TwinSample> SimbodyTwin::simulate(const VecX& q0, const VecX& qd0,
+                                              const std::vector<double>& times, double accuracy) {
+  Impl& s = *impl_;
+  std::vector<TwinSample> out;
+  if (!s.couplers) return out;
+  s.set_state(q0, qd0, SimTK::Stage::Velocity);
+  s.state.setTime(0);
+  SimTK::RungeKuttaMersonIntegrator integ(s.system);
+  integ.setAccuracy(accuracy);
+  integ.setConstraintTolerance(accuracy);
+  SimTK::TimeStepper stepper(s.system, integ);
+  stepper.initialize(s.state);
+  const int nt = s.model.n_theta();
+  for (double t : times) {
+    if (t > 0) stepper.stepTo(t);
+    const SimTK::State& st = integ.getState();
+    s.system.realize(st, SimTK::Stage::Dynamics);
+    TwinSample sample;
+    sample.t = st.getTime();
+    sample.theta.resize(nt);
+    sample.theta_dot.resize(nt);
+    for (int j = 0; j < nt; ++j) {
+      sample.theta[j] = st.getQ()[s.theta_q[j]];
+      sample.theta_dot[j] = st.getU()[s.theta_u[j]];
+    }
+    sample.energy = s.system.calcEnergy(st);
+    out.push_back(std::move(sample));
+  }
+  return out;
+}
+
+}  // namespace femdyn::validation

@@ -1,0 +1,98 @@
+// SimbodyTwin: the same mechanism built in Simbody from a compiled femdyn Model, evaluated at
+// femdyn's coordinates q. This header does not include Simbody (the twin lives in twin.cpp,
+// the only translation unit that does), so callers may be compiled with any flags.
+//
+// twin.cpp is compiled as C++17 without NDEBUG (Simbody 3.7's headers do not compile as C++20,
+// and must see the NDEBUG setting the library was built with), so this header and what the
+// twin reads of a model (TwinModel) use Eigen and the standard library only.
+//
+// Mapping (docs/validation.md):
+//   femdyn body b, joint (R_pj, p_pj, axis)  ->  MobilizedBody::Pin (revolute, turns about z),
+//       ::Slider (prismatic, moves along x) or ::Weld (fixed), with
+//       X_PF = (R_pj·R_a, p_pj), X_BM = (R_a, 0), R_a taking the mobilizer axis onto `axis`;
+//   body mass properties = Σ of the body's equivalent elements' Element::mass_properties();
+//   gravity -> Force::Gravity; springs/dampers -> MobilityLinearSpring / MobilityLinearDamper;
+//   point loads and torques -> Force::ConstantForce / ConstantTorque; τ -> applied mobility
+//   forces; coupling θ = C q + θ0 -> exact reduction (pointwise) and
+//   Constraint::CoordinateCoupler (trajectories).
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+namespace femdyn::validation {
+
+using MatX = Eigen::MatrixXd;
+using VecX = Eigen::VectorXd;
+using Mat3 = Eigen::Matrix3d;
+using Vec3 = Eigen::Vector3d;
+
+// What the twin needs of a femdyn Model (built by twin_model() in validate.cpp).
+struct TwinBody {
+  int parent = -1;               // -1: the ground
+  enum class Joint { Revolute, Prismatic, Fixed } joint = Joint::Fixed;
+  Mat3 R_pj = Mat3::Identity();  // joint frame in the parent body frame
+  Vec3 p_pj = Vec3::Zero();
+  Vec3 axis = Vec3::UnitZ();     // unit, joint frame
+  int theta = -1;                // index in θ
+  double stiffness = 0, rest = 0, damping = 0;
+  double mass = 0;               // Σ of the body's equivalent elements:
+  Vec3 com = Vec3::Zero();       //   centre of mass (body frame)
+  Mat3 inertia_origin = Mat3::Zero();  // inertia about the body origin (body frame)
+};
+
+struct TwinModel {
+  std::vector<TwinBody> bodies;  // parents first
+  std::vector<int> theta_body;   // θ index -> body
+  MatX C;                        // θ = C q + θ0
+  VecX theta0;
+  Vec3 gravity = Vec3::Zero();
+  struct Load {
+    int body;
+    Vec3 point, force, torque;  // point in the body frame; force, torque in the world frame
+  };
+  std::vector<Load> loads;
+  int n() const { return static_cast<int>(C.cols()); }
+  int n_theta() const { return static_cast<int>(theta_body.size()); }
+};
+
+// Simbody's equations reduced to q: M = Cᵀ M_θ C, h = Cᵀ h_θ(C q̇), Q = Cᵀ Q_θ + τ.
+struct TwinEquations {
+  MatX M;
+  VecX h, Q, qdd;
+};
+
+struct TwinSample {
+  double t = 0;
+  VecX theta, theta_dot;  // all joint coordinates θ and rates
+  double energy = 0;      // Simbody's kinetic + potential energy
+};
+
+class SimbodyTwin {
+ public:
+  explicit SimbodyTwin(TwinModel model);
+  ~SimbodyTwin();
+  SimbodyTwin(const SimbodyTwin&) = delete;
+  SimbodyTwin& operator=(const SimbodyTwin&) = delete;
+
+  TwinEquations equations(const VecX& q, const VecX& qd, const VecX& tau);
+  VecX inverse_dynamics(const VecX& q, const VecX& qd, const VecX& qdd);
+
+  // Passive motion (τ = 0) from (q0, q̇0) by RungeKuttaMersonIntegrator at `accuracy`, sampled
+  // at `times`. Empty with `why_not` set if the coupling cannot be posed as coordinate
+  // couplers (each q_k must drive some θ_j = q_k directly).
+  bool can_simulate(std::string* why_not = nullptr) const;
+  std::vector<TwinSample> simulate(const VecX& q0, const VecX& qd0,
+                                   const std::vector<double>& times, double accuracy);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// θ_j that carries q_k directly (row j of C is e_k and θ0_j = 0), or -1.
+int independent_theta(const TwinModel& model, int k);
+
+}  // namespace femdyn::validation
