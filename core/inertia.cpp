@@ -5,9 +5,9 @@
 
 namespace femdyn {
 
-std::optional<std::string> inertia_problem(const Mat3& I) {
+std::optional<std::string> inertia_problem(const Mat3& I, double reference) {
   if (!I.allFinite()) return "inertia has NaN or Inf";
-  const double scale = I.cwiseAbs().maxCoeff();
+  const double scale = std::max(I.cwiseAbs().maxCoeff(), reference);
   if ((I - I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) return "inertia is not symmetric";
   const Vec3 p = Eigen::SelfAdjointEigenSolver<Mat3>(I).eigenvalues();  // ascending
   const double tol = 1e-9 * std::max(scale, 1e-300);

@@ -9,8 +9,10 @@
 namespace femdyn {
 
 // Empty when I (about the centre of mass) is physical: symmetric, principal moments >= 0 and
-// satisfying the triangle inequality I1 + I2 >= I3. Otherwise what is wrong.
-std::optional<std::string> inertia_problem(const Mat3& I);
+// satisfying the triangle inequality I1 + I2 >= I3. Otherwise what is wrong. Tolerances are
+// relative to the larger of |I| and `reference` (e.g. the inertia I was computed from by the
+// parallel-axis theorem, whose round-off it carries).
+std::optional<std::string> inertia_problem(const Mat3& I, double reference = 0);
 
 // Pseudo-inertia P = ∫[r;1][r;1]ᵀ dm = [[Σ, m c],[m cᵀ, m]], Σ = ½ tr(I_c) 1 − I_c + m c cᵀ.
 Eigen::Matrix4d pseudo_inertia(double mass, const Vec3& com, const Mat3& I_com);

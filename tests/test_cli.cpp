@@ -94,7 +94,7 @@ TEST_CASE("bad command lines and bad models: one line, non-zero exit", "[cli]") 
 }
 
 TEST_CASE("every command has --help; info lists the correlation table", "[cli]") {
-  for (const char* cmd : {"info", "equations", "compare", "track"}) {
+  for (const char* cmd : {"info", "equations", "compare", "track", "validate"}) {
     const Run r = run(std::string(cmd) + " --help");
     CHECK(r.code == 0);
     CHECK_THAT(r.out, Catch::StartsWith("usage: femdyn " + std::string(cmd)));
@@ -150,3 +150,32 @@ TEST_CASE("compare: a model against itself is exact; the paper's finger is not",
   CHECK(r.code == 2);
   CHECK(r.out == "femdyn compare: the models have 4 and 3 coordinates; compare needs the same\n");
 }
+
+#ifdef FEMDYN_WITH_SIMBODY
+TEST_CASE("validate: table and exit 0 on a good model, JSON, exit 1 when it cannot match",
+          "[cli][validation]") {
+  const Run text = run("validate " + model_path("finger.json") + " --states 5 --t-end 0.1");
+  CHECK(text.code == 0);
+  for (const char* row : {"M^s", "h ", "Q ", "qdd", "tau", "trajectory"})
+    CHECK_THAT(text.out, Catch::Contains(row));
+  CHECK_THAT(text.out, Catch::EndsWith("PASS\n"));
+
+  const Run js = run("validate " + model_path("finger_coupled.json") +
+                     " --states 4 --seed 3 --t-end 0.05 --json");
+  REQUIRE(js.code == 0);
+  const auto j = nlohmann::json::parse(js.out);
+  CHECK(j.at("states") == 4);
+  CHECK(j.at("pass") == true);
+  for (const char* q : {"M", "h", "Q", "qdd", "tau"}) CHECK(j.at("max_rel_error").at(q).get<double>() < 1e-10);
+  CHECK(j.at("trajectory").at("t_end") == 0.05);
+  CHECK(j.at("trajectory").at("max_state_error").get<double>() < 1e-6);
+
+  const Run paper = run("validate " + model_path("finger_paper.json") + " --states 2");
+  CHECK(paper.code == 1);
+  CHECK_THAT(paper.out, Catch::Contains("its elements sum to no rigid body"));
+
+  const Run wrong_tol = run("validate " + model_path("pendulum.json") + " --states 0");
+  CHECK(wrong_tol.code == 2);
+  CHECK_THAT(wrong_tol.out, Catch::Contains("--states expects one integer >= 1"));
+}
+#endif

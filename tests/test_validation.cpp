@@ -1,0 +1,209 @@
+// femdyn against Simbody (validation/): every bundled model, seeded random trees, one body in
+// every element description, loads/couplings, and a deliberately wrong element that must fail.
+#include <catch2/catch.hpp>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include "core/inertia.hpp"
+#include "elements/rotary_node.hpp"
+#include "tests/helpers.hpp"
+#include "validation/validate.hpp"
+
+using namespace femdyn;
+using namespace femdyn::test;
+using validation::ValidationOptions;
+using validation::ValidationReport;
+
+namespace {
+
+ValidationOptions quick(int states = 8, double t_end = 0.1) {
+  ValidationOptions o;
+  o.states = states;
+  o.t_end = t_end;
+  return o;
+}
+
+void require_pass(const ValidationReport& r, const std::string& label) {
+  INFO(label << (r.failure.empty() ? "" : ": " + r.failure));
+  REQUIRE(r.failure.empty());
+  for (const auto& q : r.quantities) {
+    INFO(q.name << " max rel error " << q.max_rel);
+    CHECK(q.max_rel < 1e-10);
+  }
+  INFO("trajectory: " << r.trajectory.skipped << " error " << r.trajectory.max_state_error
+                      << " tolerance " << r.trajectory.tolerance);
+  CHECK(r.trajectory.run);
+  CHECK(r.trajectory.resolved);
+  CHECK(r.trajectory.max_state_error <= r.trajectory.tolerance);
+  CHECK(r.pass());
+}
+
+// The middle body of a spatial 3-link chain, given by `elements`; loads, springs, dampers.
+std::string chain_with(const std::string& elements) {
+  return R"({"name": "variants", "gravity": [0.3, -1.0, -9.81], "bodies": [
+    {"name": "a", "parent": "world", "joint": {"type": "revolute", "axis": [0, 0, 1],
+     "damping": 0.05},
+     "elements": [{"type": "rigid_body", "mass": 1.0, "com": [0.2, 0, 0],
+                   "inertia": {"ixx": 0.01, "iyy": 0.02, "izz": 0.025}}]},
+    {"name": "b", "parent": "a", "joint": {"type": "revolute", "axis": [0, 1, 0.2],
+     "origin": {"xyz": [0.4, 0, 0], "rpy": [0.1, 0.2, 0.3]}, "spring": {"stiffness": 2, "rest": 0.3}},
+     "elements": )" + elements + R"(},
+    {"name": "c", "parent": "b", "joint": {"type": "prismatic", "axis": [1, 0.2, 0],
+     "origin": {"xyz": [0.5, 0.05, 0.02]}},
+     "elements": [{"type": "lumped_point", "node": [0.1, 0.02, 0.0], "mass": 0.3},
+                  {"type": "rotary_node", "node": [0.1, 0.02, 0.0],
+                   "inertia": [[0.002, 0.0003, 0], [0.0003, 0.001, 0.0001], [0, 0.0001, 0.0025]]}]}],
+    "loads": [{"body": "c", "point": [0.1, 0, 0.05], "force": [1, -2, 0.5], "torque": [0.1, 0, -0.2]},
+              {"body": "b", "point": [0.2, 0.1, 0], "force": [0, 0, 3]}]})";
+}
+
+std::string v3(const Vec3& v) {
+  std::ostringstream o;
+  o.precision(17);
+  o << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]";
+  return o.str();
+}
+
+// A rotary node that forgets its gyroscopic term ω × (J ω): the classic error of the paper.
+class RotaryWithoutGyroscopic final : public Element {
+ public:
+  explicit RotaryWithoutGyroscopic(std::unique_ptr<Element> e) : e_(std::move(e)) {}
+  std::string_view type_name() const override { return "rotary_node_without_gyroscopic"; }
+  std::span<const ElementNode> nodes() const override { return e_->nodes(); }
+  MatX local_mass() const override { return e_->local_mass(); }
+
+ private:
+  std::unique_ptr<Element> e_;
+};
+
+}  // namespace
+
+TEST_CASE("every bundled model matches Simbody (the paper's discretisation cannot)",
+          "[validation]") {
+  for (const std::string& name : bundled_models()) {
+    const Model m = load_model(model_path(name));
+    const ValidationReport r = validation::validate(m, quick(10, 0.2));
+    if (name == "finger_paper.json") {
+      // Its lumping is the paper's: no rigid body has these element sums (docs/finger.md).
+      CHECK_FALSE(r.pass());
+      CHECK_THAT(r.failure, Catch::Contains("its elements sum to no rigid body"));
+      continue;
+    }
+    require_pass(r, name);
+  }
+}
+
+TEST_CASE("seeded random 3D trees up to 20 DOF match Simbody", "[validation]") {
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    const int bodies = 3 + static_cast<int>(seed * 17 % 18);  // 3..20
+    const Model m = load_text(random_tree_json(seed, bodies, 0.4, true));
+    require_pass(validation::validate(m, quick(5, 0.05)),
+                 "seed " + std::to_string(seed) + ", " + std::to_string(bodies) + " bodies");
+  }
+}
+
+TEST_CASE("one body in every element description matches Simbody, with the same mass "
+          "properties", "[validation]") {
+  // The middle body: mass, centroid, centroidal inertia, and a bar along (a, b).
+  const double m = 0.8;
+  const Vec3 a(0.02, 0.01, -0.01), b(0.47, 0.06, 0.03), c = 0.5 * (a + b);
+  Mat3 Ic;
+  Ic << 0.004, 0.0002, -0.0001, 0.0002, 0.015, 0.0003, -0.0001, 0.0003, 0.016;
+  const std::string I = "[" + v3(Ic.row(0).transpose()) + ", " + v3(Ic.row(1).transpose()) +
+                        ", " + v3(Ic.row(2).transpose()) + "]";
+  const std::string M = std::to_string(m);
+  // Two points of m/2 at c ± d and the rotary inertia they leave: J = I_c − m (|d|² 1 − d dᵀ).
+  const Vec3 d(0.01, 0.004, -0.002);
+  const Mat3 pair = m * (d.squaredNorm() * Mat3::Identity() - d * d.transpose());
+  const Mat3 J = Ic - pair;
+  const std::string Js = "[" + v3(J.row(0).transpose()) + ", " + v3(J.row(1).transpose()) + ", " +
+                         v3(J.row(2).transpose()) + "]";
+  const std::pair<const char*, std::string> variants[] = {
+      {"rigid body", R"([{"type": "rigid_body", "mass": )" + M + R"(, "com": )" + v3(c) +
+                         R"(, "inertia": )" + I + "}]"},
+      {"four points", R"([{"type": "rigid_body", "equivalent": "four_points", "mass": )" + M +
+                          R"(, "com": )" + v3(c) + R"(, "inertia": )" + I + "}]"},
+      {"space bar", R"([{"type": "space_bar", "nodes": [)" + v3(a) + ", " + v3(b) +
+                        R"(], "mass": )" + M + R"(, "inertia": )" + I + "}]"},
+      {"points and rotary node",
+       R"([{"type": "lumped_point", "node": )" + v3(c - d) + R"(, "mass": )" + std::to_string(m / 2) +
+           R"(}, {"type": "lumped_point", "node": )" + v3(c + d) + R"(, "mass": )" +
+           std::to_string(m / 2) + R"(}, {"type": "rotary_node", "node": )" + v3(c) +
+           R"(, "inertia": )" + Js + "}]"}};
+  for (const auto& [label, elements] : variants) {
+    INFO(label);
+    const Model model = load_text(chain_with(elements));
+    // Σ of the middle body's elements is the rigid body (what the twin is built from).
+    MassProperties sum;
+    Vec3 first = Vec3::Zero();
+    for (const ElementEntry& e : model.elements)
+      if (model.bodies[e.body].name == "b") {
+        const MassProperties p = e.element->mass_properties();
+        sum.mass += p.mass, first += p.mass * p.com, sum.inertia_origin += p.inertia_origin;
+      }
+    sum.com = first / sum.mass;
+    CHECK(std::abs(sum.mass - m) < 1e-12);
+    CHECK((sum.com - c).norm() < 1e-12);
+    CHECK((sum.inertia_com() - Ic).norm() < 1e-12 * Ic.norm());
+    require_pass(validation::validate(model, quick(6, 0.1)), label);
+  }
+}
+
+TEST_CASE("couplings with several terms and an offset match Simbody's coordinate couplers",
+          "[validation]") {
+  const Model m = load_text(R"({"name": "coupled", "gravity": [0, 0, -9.81], "bodies": [
+    {"name": "a", "parent": "world", "joint": {"name": "j1", "type": "revolute", "axis": [0, 0, 1]},
+     "elements": [{"type": "rigid_body", "mass": 1, "com": [0.2, 0.01, 0],
+                   "inertia": {"ixx": 0.01, "iyy": 0.02, "izz": 0.025}}]},
+    {"name": "b", "parent": "a", "joint": {"name": "j2", "type": "revolute", "axis": [0, 1, 0],
+     "origin": {"xyz": [0.4, 0, 0]}},
+     "elements": [{"type": "rigid_body", "mass": 0.7, "com": [0.15, 0, 0.02],
+                   "inertia": {"ixx": 0.004, "iyy": 0.01, "izz": 0.012, "ixy": 0.001}}]},
+    {"name": "c", "parent": "b", "joint": {"name": "j3", "type": "revolute", "axis": [0, 1, 0.3],
+     "origin": {"xyz": [0.3, 0, 0]}},
+     "elements": [{"type": "rigid_body", "mass": 0.4, "com": [0.1, 0, 0],
+                   "inertia": {"ixx": 0.002, "iyy": 0.004, "izz": 0.005}}]},
+    {"name": "d", "parent": "c", "joint": {"name": "j4", "type": "prismatic", "axis": [1, 0, 0],
+     "origin": {"xyz": [0.2, 0, 0]}},
+     "elements": [{"type": "lumped_point", "node": [0.05, 0, 0], "mass": 0.2}]}],
+    "couplings": [{"joint": "j3", "follows": [{"joint": "j1", "ratio": 0.5},
+                                              {"joint": "j2", "ratio": -0.8}], "offset": 0.2},
+                  {"joint": "j4", "follows": [{"joint": "j3", "ratio": 0.05}], "offset": 0.1}]})");
+  REQUIRE(m.n() == 2);
+  require_pass(validation::validate(m, quick(8, 0.2)), "coupled");
+}
+
+TEST_CASE("a rotary node without its gyroscopic term fails validation", "[validation]") {
+  Model m = load_model(model_path("spatial_double_pendulum.json"));
+  int replaced = 0;
+  for (ElementEntry& e : m.elements)
+    if (e.element->type_name() == "rotary_node") {
+      e.element = std::make_unique<RotaryWithoutGyroscopic>(std::move(e.element));
+      ++replaced;
+    }
+  REQUIRE(replaced > 0);
+  const ValidationReport r = validation::validate(m, quick(8, 0.2));
+  CHECK_FALSE(r.pass());
+  for (const auto& q : r.quantities) {
+    INFO(q.name << " " << q.max_rel);
+    if (q.name == "M" || q.name == "Q") CHECK(q.max_rel < 1e-10);  // inertia itself is right
+    if (q.name == "h") CHECK(q.max_rel > 1e-3);                      // the velocity term is not
+  }
+  CHECK(r.trajectory.max_state_error > r.trajectory.tolerance);
+}
+
+TEST_CASE("docs/validation.md lists every bundled model with its current result",
+          "[validation][docs]") {
+  std::ifstream in(std::string(FEMDYN_SOURCE_DIR) + "/docs/validation.md");
+  REQUIRE(in);
+  const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const std::string& name : bundled_models()) {
+    const std::string key = "| `models/" + name + "` |";
+    const auto at = doc.find(key);
+    INFO(name << " (regenerate with ./build/femdyn validate models/*.json --markdown)");
+    REQUIRE(at != std::string::npos);
+    const std::string row = doc.substr(at, doc.find('\n', at) - at);
+    CHECK_THAT(row, Catch::Contains(name == "finger_paper.json" ? "| FAIL" : "| PASS |"));
+  }
+}
