@@ -73,6 +73,7 @@ Model load(const Args& a, std::size_t count) {
 
 LoadOptions load_options(const Args& a) {
   LoadOptions opt;
+  opt.warn = [](const std::string& w) { std::cerr << "femdyn: warning: " << w << "\n"; };
   if (a.has("gravity")) {
     const std::vector<double> g = parse_numbers("gravity", a.options.at("gravity"));
     if (g.size() != 3) throw CliError("--gravity expects 3 values gx,gy,gz");
@@ -86,6 +87,7 @@ Args parse_args(int argc, char** argv, int first, const std::vector<std::string>
   Args a;
   for (int i = first; i < argc; ++i) {
     std::string s = argv[i];
+    if (s == "-o") s = "--output";  // the one short option
     if (s.rfind("--", 0) != 0) {
       a.positional.push_back(s);
       continue;

@@ -34,6 +34,7 @@ int cmd_info(int argc, char** argv);
 int cmd_equations(int argc, char** argv);
 int cmd_compare(int argc, char** argv);
 int cmd_track(int argc, char** argv);
-int cmd_validate(int argc, char** argv);  // only with FEMDYN_WITH_SIMBODY
+int cmd_validate(int argc, char** argv);
+int cmd_import(int argc, char** argv);  // only with FEMDYN_WITH_SIMBODY
 
 }  // namespace femdyn::cli

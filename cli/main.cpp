@@ -16,9 +16,11 @@ commands:
   compare     relative error of one model's equations against another's
   track       computed-torque feed-forward along a smooth motion, replayed in simulation
   validate    the model against its Simbody twin, pointwise and along a trajectory
+  import      a URDF robot (or a plugin model) as femdyn JSON
 
 every command takes --help, and --gravity gx,gy,gz to override the model's gravity (m/s^2).
-models: JSON files, see docs/model-format.md.
+models: JSON files (docs/model-format.md) or URDF files (*.urdf; gravity (0, 0, -9.81) unless
+--gravity; docs/tutorial.md).
 )";
 
 }  // namespace
@@ -36,6 +38,7 @@ int main(int argc, char** argv) {
     if (cmd == "equations") return cmd_equations(argc, argv);
     if (cmd == "compare") return cmd_compare(argc, argv);
     if (cmd == "track") return cmd_track(argc, argv);
+    if (cmd == "import") return cmd_import(argc, argv);
 #ifdef FEMDYN_WITH_SIMBODY
     if (cmd == "validate") return cmd_validate(argc, argv);
 #else

@@ -72,6 +72,7 @@ void SpaceBar::from_params(const Params& p, ElementSink& sink) {
     J = Ic - 0.25 * m * l * l * (Mat3::Identity() - x * x.transpose());
     J = 0.5 * (J + J.transpose()).eval();
   } else {
+    if (p.has("inertia")) p.fail("inertia", "give either mass and inertia or density, area, Iy, Iz");
     const double rho = p.positive("density"), A = p.positive("area");
     const double Iy = p.positive("Iy"), Iz = p.positive("Iz");
     Vec3 hint;

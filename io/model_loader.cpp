@@ -1,11 +1,13 @@
 #include "io/model_loader.hpp"
 
+#include <cctype>
 #include <fstream>
 #include <sstream>
 
 #include "elements/registry.hpp"
-#include "models/plugins.hpp"
 #include "io/params.hpp"
+#include "io/urdf_loader.hpp"
+#include "models/plugins.hpp"
 
 namespace femdyn {
 namespace {
@@ -254,23 +256,78 @@ MechanismSpec parse_spec(const std::string& text, const std::string& source) {
     throw ModelError(source, "malformed JSON: " +
                                  (bracket == std::string::npos ? what : what.substr(bracket + 2)));
   }
+  return parse_model_json(root, source);
+}
+
+MechanismSpec parse_model_json(const Json& root, const std::string& source) {
   if (!root.is_object()) throw ModelError(source, "expected a JSON object at the top level");
   if (root.contains("model")) return parse_document(expand_plugin(root, source), source);
   return parse_document(root, source);
 }
 
-MechanismSpec read_spec(const std::string& path) {
+namespace {
+
+std::string read_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ModelError(path, "cannot open file");
   std::stringstream ss;
   ss << in.rdbuf();
-  return parse_spec(ss.str(), path);
+  return ss.str();
+}
+
+// Errors found after conversion name the URDF's link and joint, not the generated JSON path:
+// "robot.urdf: /bodies/3/joint: …" becomes "robot.urdf: joint 'elbow' (link 'forearm'): …".
+[[noreturn]] void rethrow_for_urdf(const ModelError& e, const Json& doc, const std::string& path) {
+  std::string msg = e.what();
+  const std::string prefix = path + ": /bodies/";
+  if (msg.rfind(prefix, 0) == 0) {
+    std::size_t i = prefix.size(), end = i;
+    while (end < msg.size() && std::isdigit(static_cast<unsigned char>(msg[end]))) ++end;
+    const std::size_t rest = msg.find(": ", end);
+    if (end > i && rest != std::string::npos) {
+      const Json& body = doc["bodies"][std::stoul(msg.substr(i, end - i))];
+      msg = path + ": joint '" + body["joint"]["name"].get<std::string>() + "' (link '" +
+            body["name"].get<std::string>() + "')" + msg.substr(rest);
+    }
+  }
+  throw ModelError("", msg);
+}
+
+}  // namespace
+
+Json model_document(const std::string& path, const LoadOptions& options) {
+  if (is_urdf_path(path)) {
+    UrdfResult r = read_urdf(path);
+    if (options.warn)
+      for (const std::string& w : r.warnings) options.warn(w);
+    return std::move(r.model);
+  }
+  Json root;
+  const std::string text = read_text(path);
+  (void)parse_spec(text, path);  // reports malformed JSON and every model error with its path
+  root = Json::parse(text);
+  return root.contains("model") ? expand_plugin(root, path) : root;
+}
+
+MechanismSpec read_spec(const std::string& path, const LoadOptions& options) {
+  if (!is_urdf_path(path)) return parse_spec(read_text(path), path);
+  const Json doc = model_document(path, options);
+  try {
+    return parse_model_json(doc, path);
+  } catch (const ModelError& e) {
+    rethrow_for_urdf(e, doc, path);
+  }
 }
 
 Model load_model(const std::string& path, const LoadOptions& options) {
-  MechanismSpec spec = read_spec(path);
+  MechanismSpec spec = read_spec(path, options);
   if (options.gravity) spec.gravity = *options.gravity;
-  return compile(std::move(spec));
+  if (!is_urdf_path(path)) return compile(std::move(spec));
+  try {
+    return compile(std::move(spec));
+  } catch (const ModelError& e) {
+    rethrow_for_urdf(e, model_document(path), path);
+  }
 }
 
 }  // namespace femdyn

@@ -1,19 +1,29 @@
 // Loading a mechanism from a file: JSON (docs/model-format.md) into a MechanismSpec,
 // then compile() into a Model. Errors are ModelError: "file: /json/pointer: problem".
 #pragma once
+#include <functional>
 #include <optional>
 #include <string>
 
 #include "core/model.hpp"
+#include "io/params.hpp"
 
 namespace femdyn {
 
 struct LoadOptions {
   std::optional<Vec3> gravity;  // overrides the model's gravity
+  std::function<void(const std::string&)> warn;  // non-fatal notes (e.g. URDF friction ignored)
 };
 
-MechanismSpec read_spec(const std::string& path);
+// A model file: femdyn JSON, or URDF by its extension .urdf (io/urdf_loader.hpp).
+MechanismSpec read_spec(const std::string& path, const LoadOptions& options = {});
 MechanismSpec parse_spec(const std::string& text, const std::string& source_name);
+// A parsed JSON model document (plain or {"model": plugin, "params": …}).
+MechanismSpec parse_model_json(const Json& root, const std::string& source_name);
 Model load_model(const std::string& path, const LoadOptions& options = {});
+
+// The model document a file describes (a URDF converted, a plugin expanded), as JSON that
+// loads back to the same equations: what `femdyn import` writes.
+Json model_document(const std::string& path, const LoadOptions& options = {});
 
 }  // namespace femdyn

@@ -199,4 +199,84 @@ void write_file_atomic(const std::string& path, const std::string& content) {
   }
 }
 
+namespace {
+
+bool is_flat(const Json& a) {  // numbers, strings, or arrays of numbers: one line
+  for (const Json& x : a)
+    if (x.is_object() || (x.is_array() && !std::all_of(x.begin(), x.end(), [](const Json& y) {
+                            return y.is_primitive();
+                          })))
+      return false;
+  return true;
+}
+
+int key_rank(const std::string& k) {
+  static const char* order[] = {"$schema", "name", "description", "model", "gravity", "params",
+                                "type", "parent", "joint", "origin", "xyz", "rpy", "axis",
+                                "limits", "spring", "damping", "nodes", "elements", "mass", "com",
+                                "inertia", "bodies", "couplings", "loads", "correlation_table"};
+  for (std::size_t i = 0; i < std::size(order); ++i)
+    if (k == order[i]) return static_cast<int>(i);
+  return static_cast<int>(std::size(order));
+}
+
+void write_json(std::ostringstream& o, const Json& j, int indent) {
+  const std::string pad(indent + 2, ' ');
+  if (j.is_object()) {
+    std::vector<std::string> keys;
+    for (auto it = j.begin(); it != j.end(); ++it) keys.push_back(it.key());
+    std::stable_sort(keys.begin(), keys.end(),
+                     [](const auto& a, const auto& b) { return key_rank(a) < key_rank(b); });
+    if (keys.empty()) {
+      o << "{}";
+      return;
+    }
+    // A small object of vectors and numbers on one line: {"xyz": [..], "rpy": [..]}.
+    bool small = true;
+    for (const auto& k : keys) small = small && (j.at(k).is_primitive() || (j.at(k).is_array() && is_flat(j.at(k))));
+    if (small && j.dump().size() < 72) {
+      o << "{";
+      for (std::size_t i = 0; i < keys.size(); ++i) {
+        o << (i ? ", " : "") << Json(keys[i]).dump() << ": ";
+        write_json(o, j.at(keys[i]), indent);
+      }
+      o << "}";
+      return;
+    }
+    o << "{\n";
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      o << pad << Json(keys[i]).dump() << ": ";
+      write_json(o, j.at(keys[i]), indent + 2);
+      o << (i + 1 < keys.size() ? ",\n" : "\n");
+    }
+    o << std::string(indent, ' ') << "}";
+  } else if (j.is_array() && !is_flat(j)) {
+    o << "[\n";
+    for (std::size_t i = 0; i < j.size(); ++i) {
+      o << pad;
+      write_json(o, j[i], indent + 2);
+      o << (i + 1 < j.size() ? ",\n" : "\n");
+    }
+    o << std::string(indent, ' ') << "]";
+  } else if (j.is_array()) {
+    o << "[";
+    for (std::size_t i = 0; i < j.size(); ++i) {
+      o << (i ? ", " : "");
+      write_json(o, j[i], indent);
+    }
+    o << "]";
+  } else {
+    o << j.dump();
+  }
+}
+
+}  // namespace
+
+std::string model_json_text(const Json& doc) {
+  std::ostringstream o;
+  write_json(o, doc, 0);
+  o << "\n";
+  return o.str();
+}
+
 }  // namespace femdyn

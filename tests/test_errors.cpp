@@ -158,3 +158,26 @@ TEST_CASE("a mechanism without motion, an empty coupling, and a load a table dro
              Equals("bad.json: /loads/0: the load pushes on a/(0.5,0,0).y, which the correlation "
                     "table leaves out"));
 }
+
+TEST_CASE("keys that would be ignored are refused", "[errors]") {
+  CHECK_THAT(error_of(chain(R"({"type": "fixed", "axis": [0, 0, 1]})")),
+             Equals("bad.json: /bodies/1/joint/axis: a fixed joint has no motion: no axis, "
+                    "limits, spring or damping"));
+  CHECK_THAT(error_of(chain(R"({"type": "revolute", "axis": [0, 1, 0]})",
+                            R"([{"type": "space_bar", "nodes": [[0, 0, 0], [0.3, 0, 0]],
+                                 "mass": 1, "inertia": {"ixx": 0, "iyy": 0.01, "izz": 0.01},
+                                 "Iy": 1e-8}])")),
+             Equals("bad.json: /bodies/1/elements/0/Iy: give either mass and inertia or "
+                    "density, area, Iy, Iz"));
+  CHECK_THAT(error_of(chain(R"({"type": "revolute", "axis": [0, 1, 0]})",
+                            R"([{"type": "space_bar", "nodes": [[0, 0, 0], [0.3, 0, 0]],
+                                 "density": 2700, "area": 1e-4, "Iy": 1e-9, "Iz": 1e-9,
+                                 "inertia": {"ixx": 0, "iyy": 0.01, "izz": 0.01}}])")),
+             Equals("bad.json: /bodies/1/elements/0/inertia: give either mass and inertia or "
+                    "density, area, Iy, Iz"));
+  CHECK_THAT(error_of(R"({"bodies": [{"name": "a", "parent": "world",
+      "joint": {"type": "revolute", "axis": [0, 0, 1]}, "nodes": {"tip": [0.5, 0, 0]},
+      "elements": [{"type": "lumped_point", "node": "tip", "mass": 1}]}],
+      "loads": [{"body": "a", "node": "tip", "point": [0.5, 0, 0], "force": [0, 1, 0]}]})"),
+             Equals("bad.json: /loads/0/point: give either point or node, not both"));
+}

@@ -1,0 +1,247 @@
+#include "io/urdf_loader.hpp"
+
+#include <tinyxml2.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "core/inertia.hpp"
+
+namespace femdyn {
+namespace {
+
+using tinyxml2::XMLElement;
+
+struct Ctx {
+  std::string source;
+  [[noreturn]] void fail(const std::string& what_element, const std::string& problem) const {
+    throw ModelError(source, what_element + ": " + problem);
+  }
+};
+
+double number_attr(const Ctx& c, const XMLElement* e, const char* attr, double fallback,
+                   const std::string& who, bool required = false) {
+  const char* s = e ? e->Attribute(attr) : nullptr;
+  if (!s) {
+    if (required) c.fail(who, std::string("<") + (e ? e->Name() : "?") + "> has no " + attr);
+    return fallback;
+  }
+  char* end = nullptr;
+  const double x = std::strtod(s, &end);
+  while (end && *end == ' ') ++end;
+  if (end == s || (end && *end)) c.fail(who, std::string(attr) + "=\"" + s + "\" is not a number");
+  if (!std::isfinite(x)) c.fail(who, std::string(attr) + " is NaN or Inf");
+  return x;
+}
+
+Vec3 vec_attr(const Ctx& c, const XMLElement* e, const char* attr, const Vec3& fallback,
+              const std::string& who) {
+  const char* s = e ? e->Attribute(attr) : nullptr;
+  if (!s) return fallback;
+  std::istringstream in(s);
+  Vec3 v;
+  std::string tok[3], extra;
+  for (int i = 0; i < 3; ++i) {
+    if (!(in >> tok[i])) c.fail(who, std::string(attr) + "=\"" + s + "\" needs 3 numbers");
+    char* end = nullptr;
+    v[i] = std::strtod(tok[i].c_str(), &end);
+    if (*end) c.fail(who, std::string(attr) + "=\"" + s + "\" is not 3 numbers");
+    if (!std::isfinite(v[i])) c.fail(who, std::string(attr) + " is NaN or Inf");
+  }
+  if (in >> extra) c.fail(who, std::string(attr) + "=\"" + s + "\" has more than 3 numbers");
+  return v;
+}
+
+Json vec(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+struct Origin {
+  Vec3 xyz = Vec3::Zero(), rpy = Vec3::Zero();
+};
+
+Origin origin_of(const Ctx& c, const XMLElement* parent, const std::string& who) {
+  const XMLElement* o = parent ? parent->FirstChildElement("origin") : nullptr;
+  return {vec_attr(c, o, "xyz", Vec3::Zero(), who), vec_attr(c, o, "rpy", Vec3::Zero(), who)};
+}
+
+// <inertial> -> rigid_body element (inertia about the COM in the link frame), or null.
+Json inertial_element(const Ctx& c, const XMLElement* link, const std::string& who) {
+  const XMLElement* in = link->FirstChildElement("inertial");
+  if (!in) return nullptr;
+  const XMLElement* mass = in->FirstChildElement("mass");
+  if (!mass) c.fail(who, "<inertial> has no <mass>");
+  const double m = number_attr(c, mass, "value", 0, who, true);
+  if (m < 0) c.fail(who, "negative mass " + format_number(m));
+  const XMLElement* ie = in->FirstChildElement("inertia");
+  if (!ie) c.fail(who, "<inertial> has no <inertia>");
+  const double ixx = number_attr(c, ie, "ixx", 0, who), iyy = number_attr(c, ie, "iyy", 0, who),
+               izz = number_attr(c, ie, "izz", 0, who), ixy = number_attr(c, ie, "ixy", 0, who),
+               ixz = number_attr(c, ie, "ixz", 0, who), iyz = number_attr(c, ie, "iyz", 0, who);
+  Mat3 I;
+  I << ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz;
+  if (auto problem = inertia_problem(I)) c.fail(who, *problem);
+  if (m == 0) {
+    if (I.cwiseAbs().maxCoeff() > 0) c.fail(who, "zero mass with a non-zero inertia");
+    return nullptr;
+  }
+  // The inertia is expressed in the <inertial> origin frame: rotate it into the link frame.
+  const Origin o = origin_of(c, in, who);
+  const Mat3 R = rpy_to_rotation(o.rpy);
+  const Mat3 I_link = R * I * R.transpose();
+  Json rows = Json::array();
+  for (int r = 0; r < 3; ++r) rows.push_back(vec(I_link.row(r).transpose()));
+  return {{"type", "rigid_body"}, {"mass", m}, {"com", vec(o.xyz)}, {"inertia", rows}};
+}
+
+}  // namespace
+
+bool is_urdf_path(const std::string& path) {
+  return path.size() >= 5 && path.compare(path.size() - 5, 5, ".urdf") == 0;
+}
+
+UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
+  const Ctx c{source};
+  if (text.find("xmlns:xacro") != std::string::npos || text.find("<xacro:") != std::string::npos)
+    throw ModelError(source, "xacro is not supported: expand it first (xacro robot.urdf.xacro > "
+                             "robot.urdf)");
+  tinyxml2::XMLDocument doc;
+  if (doc.Parse(text.c_str(), text.size()) != tinyxml2::XML_SUCCESS)
+    throw ModelError(source, std::string("malformed XML at line ") +
+                                 std::to_string(doc.ErrorLineNum()) + ": " + doc.ErrorName());
+  const XMLElement* robot = doc.FirstChildElement("robot");
+  if (!robot) throw ModelError(source, "no <robot> element");
+
+  UrdfResult out;
+  // Links.
+  std::map<std::string, const XMLElement*> links;
+  std::vector<std::string> link_order;
+  for (const XMLElement* l = robot->FirstChildElement("link"); l; l = l->NextSiblingElement("link")) {
+    const char* name = l->Attribute("name");
+    if (!name || !*name) c.fail("a <link>", "has no name");
+    if (!links.emplace(name, l).second) c.fail(std::string("link '") + name + "'", "is defined twice");
+    link_order.push_back(name);
+  }
+  if (links.empty()) throw ModelError(source, "no <link> elements");
+
+  // Joints: the tree.
+  struct JointInfo {
+    const XMLElement* e;
+    std::string name, parent, child;
+  };
+  std::vector<JointInfo> joints;
+  std::map<std::string, std::string> parent_joint;  // child link -> joint name
+  std::set<std::string> joint_names;
+  for (const XMLElement* j = robot->FirstChildElement("joint"); j; j = j->NextSiblingElement("joint")) {
+    const char* name = j->Attribute("name");
+    if (!name || !*name) c.fail("a <joint>", "has no name");
+    const std::string who = std::string("joint '") + name + "'";
+    if (!joint_names.insert(name).second) c.fail(who, "is defined twice");
+    const XMLElement* p = j->FirstChildElement("parent");
+    const XMLElement* ch = j->FirstChildElement("child");
+    const char* pl = p ? p->Attribute("link") : nullptr;
+    const char* cl = ch ? ch->Attribute("link") : nullptr;
+    if (!pl) c.fail(who, "has no <parent link=…>");
+    if (!cl) c.fail(who, "has no <child link=…>");
+    if (!links.count(pl)) c.fail(who, std::string("parent link '") + pl + "' does not exist");
+    if (!links.count(cl)) c.fail(who, std::string("child link '") + cl + "' does not exist");
+    if (std::string(pl) == cl) c.fail(who, "connects link '" + std::string(cl) + "' to itself");
+    auto [it, fresh] = parent_joint.emplace(cl, name);
+    if (!fresh)
+      c.fail(who, "link '" + std::string(cl) + "' is already the child of joint '" + it->second +
+                      "' (a loop: URDF describes trees)");
+    joints.push_back({j, name, pl, cl});
+  }
+  std::vector<std::string> roots;
+  for (const auto& name : link_order)
+    if (!parent_joint.count(name)) roots.push_back(name);
+  if (roots.size() != 1) {
+    std::string list;
+    for (const auto& r : roots) list += (list.empty() ? "'" : ", '") + r + "'";
+    throw ModelError(source, roots.empty() ? "no root link (the joints form a loop)"
+                                           : "more than one root link: " + list);
+  }
+  const std::string root = roots[0];
+  // Every link must hang from the root (a cycle elsewhere leaves links unreachable).
+  for (const auto& name : link_order) {
+    std::set<std::string> seen;
+    for (std::string l = name; l != root; l = [&] {
+           for (const JointInfo& ji : joints)
+             if (ji.child == l) return ji.parent;
+           return root;
+         }()) {
+      if (!seen.insert(l).second) c.fail("link '" + name + "'", "is on a loop of joints");
+    }
+  }
+
+  Json bodies = Json::array(), couplings = Json::array();
+  for (const JointInfo& ji : joints) {
+    const std::string who = "joint '" + ji.name + "'";
+    const char* type_c = ji.e->Attribute("type");
+    const std::string type = type_c ? type_c : "";
+    if (type == "floating" || type == "planar")
+      c.fail(who, "type '" + type + "' is not supported (revolute, continuous, prismatic, fixed)");
+    if (type != "revolute" && type != "continuous" && type != "prismatic" && type != "fixed")
+      c.fail(who, "unknown type '" + type + "'");
+    if (ji.child == "world") c.fail(who, "a link named 'world' can only be the root");
+    const Origin o = origin_of(c, ji.e, who);
+    Json joint = {{"name", ji.name},
+                  {"type", type == "continuous" ? "revolute" : type},
+                  {"origin", {{"xyz", vec(o.xyz)}, {"rpy", vec(o.rpy)}}}};
+    if (type != "fixed") {
+      const Vec3 axis = vec_attr(c, ji.e->FirstChildElement("axis"), "xyz", Vec3::UnitX(), who);
+      if (!(axis.norm() > 1e-12)) c.fail(who, "axis is zero");
+      joint["axis"] = vec(axis.normalized());
+      const XMLElement* lim = ji.e->FirstChildElement("limit");
+      if (type != "continuous" && lim && (lim->Attribute("lower") || lim->Attribute("upper"))) {
+        const double lo = number_attr(c, lim, "lower", 0, who), hi = number_attr(c, lim, "upper", 0, who);
+        if (lo > hi) c.fail(who, "limit lower > upper");
+        if (lo < hi) joint["limits"] = {lo, hi};
+      }
+      if (const XMLElement* dyn = ji.e->FirstChildElement("dynamics")) {
+        const double damping = number_attr(c, dyn, "damping", 0, who);
+        const double friction = number_attr(c, dyn, "friction", 0, who);
+        if (damping < 0) c.fail(who, "negative damping");
+        if (damping > 0) joint["damping"] = damping;
+        if (friction != 0)
+          out.warnings.push_back(source + ": " + who + ": friction " + format_number(friction) +
+                                 " ignored (femdyn models no joint friction)");
+      }
+      if (const XMLElement* mimic = ji.e->FirstChildElement("mimic")) {
+        const char* leader = mimic->Attribute("joint");
+        if (!leader) c.fail(who, "<mimic> has no joint");
+        if (!joint_names.count(leader)) c.fail(who, std::string("mimics unknown joint '") + leader + "'");
+        couplings.push_back({{"joint", ji.name},
+                             {"follows", leader},
+                             {"ratio", number_attr(c, mimic, "multiplier", 1.0, who)},
+                             {"offset", number_attr(c, mimic, "offset", 0.0, who)}});
+      }
+    }
+    Json body = {{"name", ji.child},
+                 {"parent", ji.parent == root ? "world" : ji.parent},
+                 {"joint", joint}};
+    const Json element = inertial_element(c, links.at(ji.child), "link '" + ji.child + "'");
+    if (!element.is_null()) body["elements"] = Json::array({element});
+    bodies.push_back(body);
+  }
+  // The root link's own inertia never moves (it is welded to the world); still check it.
+  (void)inertial_element(c, links.at(root), "link '" + root + "'");
+  const char* name = robot->Attribute("name");
+  out.model = {{"name", name ? name : root},
+               {"description", "imported from " + source + "; root link '" + root + "' welded to the world"},
+               {"gravity", {0, 0, -9.81}},
+               {"bodies", bodies}};
+  if (!couplings.empty()) out.model["couplings"] = couplings;
+  return out;
+}
+
+UrdfResult read_urdf(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ModelError(path, "cannot open file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return urdf_to_model(ss.str(), path);
+}
+
+}  // namespace femdyn
