@@ -93,7 +93,7 @@ TEST_CASE("bad command lines and bad models: one line, non-zero exit", "[cli]") 
   std::remove(bad.c_str());
 }
 
-TEST_CASE("every command has --help; info lists the correlation table", "[cli]") {
+TEST_CASE("every command has --help, info lists the correlation table", "[cli]") {
   for (const char* cmd : {"info", "equations", "compare", "track", "validate"}) {
     const Run r = run(std::string(cmd) + " --help");
     CHECK(r.code == 0);
@@ -137,7 +137,7 @@ TEST_CASE("track: feed-forward torques from inverse dynamics reproduce the motio
   }
 }
 
-TEST_CASE("compare: a model against itself is exact; the paper's finger is not", "[cli]") {
+TEST_CASE("compare: a model against itself is exact, the paper's finger is not", "[cli]") {
   Run r = run("compare " + model_path("finger.json") + " " + model_path("finger.json") + " --states 5 --json");
   REQUIRE(r.code == 0);
   auto j = nlohmann::json::parse(r.out);

@@ -1,0 +1,245 @@
+// URDF import: closed forms for the conventions (inertial rpy, joint rpy, mimic, order),
+// round trip through `femdyn import`, real robots and bundled URDFs, every bad-URDF class.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+
+#include "core/errors.hpp"
+#include "io/urdf_loader.hpp"
+#include "tests/helpers.hpp"
+#ifdef FEMDYN_WITH_SIMBODY
+#include "validation/validate.hpp"
+#endif
+
+using namespace femdyn;
+using namespace femdyn::test;
+using Catch::Matchers::Equals;
+
+namespace {
+
+std::string write_temp(const std::string& name, const std::string& text) {
+  const auto dir = std::filesystem::temp_directory_path() / "femdyn_urdf_tests";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / name).string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+Model load_urdf_text(const std::string& text) {
+  return load_model(write_temp("robot.urdf", text));
+}
+
+std::string error_of(const std::string& text) {
+  const std::string path = write_temp("bad.urdf", text);
+  try {
+    load_model(path);
+  } catch (const ModelError& e) {
+    std::string msg = e.what();
+    return msg.substr(msg.find("bad.urdf"));  // drop the temporary directory
+  }
+  return "(no error)";
+}
+
+std::string inertial(double m, const std::string& xyz, const std::string& rpy, double ixx,
+                     double iyy, double izz) {
+  return "<inertial><origin xyz=\"" + xyz + "\" rpy=\"" + rpy + "\"/><mass value=\"" +
+         std::to_string(m) + "\"/><inertia ixx=\"" + std::to_string(ixx) + "\" iyy=\"" +
+         std::to_string(iyy) + "\" izz=\"" + std::to_string(izz) +
+         "\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>";
+}
+
+// A base and one link on a revolute joint; the pieces replaceable.
+std::string one_link(const std::string& link_inertial, const std::string& joint_extra = "",
+                     const std::string& axis = "1 0 0", const std::string& type = "revolute") {
+  return R"(<robot name="r"><link name="base"/><link name="l">)" + link_inertial +
+         R"(</link><joint name="j" type=")" + type + R"("><parent link="base"/><child link="l"/>
+         <axis xyz=")" + axis + R"("/>)" + joint_extra + "</joint></robot>";
+}
+
+std::vector<std::string> urdf_files() {
+  std::vector<std::string> out;
+  for (const char* dir : {"/models/urdf", "/tests/robots"})
+    for (const auto& e : std::filesystem::directory_iterator(std::string(FEMDYN_SOURCE_DIR) + dir))
+      if (e.path().extension() == ".urdf") out.push_back(e.path().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("URDF <inertial> rpy rotates the inertia into the link frame", "[urdf]") {
+  // Inertia (ixx, iyy, izz) = (1, 2, 3) turned by yaw π/2: about the link's x it is iyy = 2.
+  const double pi = std::numbers::pi;
+  for (const auto& [rpy, expected] : {std::pair{std::string("0 0 0"), 1.0},
+                                      std::pair{"0 0 " + std::to_string(pi / 2), 2.0},
+                                      std::pair{"0 " + std::to_string(pi / 2) + " 0", 3.0}}) {
+    INFO("inertial rpy " << rpy);
+    const Model m = load_urdf_text(one_link(inertial(2.0, "0 0.1 0", rpy, 1, 2, 3)));
+    Workspace ws(m);
+    evaluate(m, ws, VecX::Zero(1), VecX::Zero(1), VecX::Zero(1));
+    // M^s about x through the origin = I_xx(link) + m (0.1)².
+    CHECK(ws.Ms(0, 0) == Approx(expected + 2.0 * 0.01).epsilon(1e-6));
+  }
+}
+
+TEST_CASE("URDF joint origin rpy is R = Rz(yaw) Ry(pitch) Rx(roll), axis in the joint frame",
+          "[urdf]") {
+  // A point mass at the link origin's x = 0.5; joint at rpy (0.3, -0.4, 1.1) about axis z'.
+  const Model m = load_urdf_text(
+      R"(<robot name="r"><link name="base"/><link name="l">)" +
+      inertial(1.5, "0.5 0 0", "0 0 0", 0, 0, 0) +
+      R"(</link><joint name="j" type="revolute"><parent link="base"/><child link="l"/>
+         <origin xyz="0.1 0.2 0.3" rpy="0.3 -0.4 1.1"/><axis xyz="0 0 2"/>
+         <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>)");
+  const auto R = [](int axis, double a) { return Mat3(Eigen::AngleAxisd(a, Vec3::Unit(axis))); };
+  const Mat3 Rj = R(2, 1.1) * R(1, -0.4) * R(0, 0.3);
+  const Vec3 w = Rj * Vec3::UnitZ();          // world axis of the joint (unit: axis normalised)
+  const Vec3 r = Rj * Vec3(0.5, 0, 0);        // point from the joint at q = 0
+  Workspace ws(m);
+  const VecX q = VecX::Zero(1), qd = VecX::Constant(1, 2.0);
+  evaluate(m, ws, q, qd, VecX::Zero(1));
+  CHECK(ws.Ms(0, 0) == Approx(1.5 * w.cross(r).squaredNorm()).epsilon(1e-12));
+  // Gravity torque about the axis: τ = w · (r × m g).
+  CHECK(ws.Q[0] == Approx(w.dot(r.cross(1.5 * Vec3(0, 0, -9.81)))).epsilon(1e-12));
+  CHECK(m.bodies[0].joint.lower == -1.0);
+  CHECK(m.bodies[0].joint.upper == 1.0);
+}
+
+TEST_CASE("URDF mimic becomes θ = C q + θ0, coordinates in depth-first file order", "[urdf]") {
+  const std::string urdf = R"(<robot name="tree">
+    <link name="root"/>
+    <link name="a">)" + inertial(1, "0.2 0 0", "0 0 0", 0.01, 0.01, 0.01) + R"(</link>
+    <link name="b">)" + inertial(1, "0.2 0 0", "0 0 0", 0.01, 0.01, 0.01) + R"(</link>
+    <link name="c">)" + inertial(1, "0.2 0 0", "0 0 0", 0.01, 0.01, 0.01) + R"(</link>
+    <link name="d">)" + inertial(1, "0.2 0 0", "0 0 0", 0.01, 0.01, 0.01) + R"(</link>
+    <joint name="j_d" type="revolute"><parent link="a"/><child link="d"/><axis xyz="0 1 0"/>
+      <origin xyz="0.4 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/>
+      <mimic joint="j_b" multiplier="-0.5" offset="0.1"/></joint>
+    <joint name="j_c" type="continuous"><parent link="root"/><child link="c"/><axis xyz="0 0 1"/></joint>
+    <joint name="j_a" type="continuous"><parent link="root"/><child link="a"/><axis xyz="0 0 1"/></joint>
+    <joint name="j_b" type="prismatic"><parent link="a"/><child link="b"/><axis xyz="1 0 0"/>
+      <limit lower="0" upper="0.2" effort="1" velocity="1"/></joint>
+  </robot>)";
+  const Model m = load_urdf_text(urdf);
+  // Depth first from the root, children in the order their joints appear: root's children
+  // are c (j_c) then a (j_a); a's are d (j_d, mimic) then b (j_b).
+  REQUIRE(m.coordinate_names == std::vector<std::string>{"j_c", "j_a", "j_b"});
+  REQUIRE(m.n_theta() == 4);
+  for (int t = 0; t < 4; ++t) {
+    const std::string& joint = m.bodies[m.theta_joint[t]].joint.name;
+    INFO(joint);
+    if (joint == "j_d") {
+      CHECK(m.C.row(t).isApprox(Eigen::RowVector3d(0, 0, -0.5)));
+      CHECK(m.theta0[t] == 0.1);
+    } else {
+      CHECK(m.theta0[t] == 0.0);
+    }
+  }
+  CHECK(m.gravity.isApprox(Vec3(0, 0, -9.81)));  // URDF has none: femdyn's default
+  LoadOptions o;
+  o.gravity = Vec3(0, 0, 0);
+  CHECK(load_model(write_temp("tree.urdf", urdf), o).gravity.isZero(0));
+}
+
+TEST_CASE("every URDF: import writes JSON that loads back to the same equations", "[urdf]") {
+  for (const std::string& path : urdf_files()) {
+    INFO(path);
+    const Model direct = load_model(path);
+    const Json doc = model_document(path);
+    const Model back = load_model(write_temp("round_trip.json", doc.dump()));
+    REQUIRE(back.n() == direct.n());
+    CHECK(back.coordinate_names == direct.coordinate_names);
+    Workspace wa(direct), wb(back);
+    std::mt19937 rng(7);
+    for (int k = 0; k < 3; ++k) {
+      const VecX q = random_vector(rng, direct.n(), 1.0), qd = random_vector(rng, direct.n(), 2.0),
+                 tau = random_vector(rng, direct.n(), 1.0);
+      REQUIRE(forward_dynamics(direct, wa, q, qd, tau).ok);
+      REQUIRE(forward_dynamics(back, wb, q, qd, tau).ok);
+      CHECK(rel_error(wb.Ms, wa.Ms) < 1e-12);
+      CHECK(rel_error(wb.h, wa.h) < 1e-12);
+      CHECK(rel_error(wb.Q, wa.Q) < 1e-12);
+      CHECK(rel_error(wb.qdd, wa.qdd) < 1e-12);
+    }
+  }
+}
+
+#ifdef FEMDYN_WITH_SIMBODY
+TEST_CASE("every URDF (bundled and the real robots) matches Simbody", "[urdf][validation]") {
+  for (const std::string& path : urdf_files()) {
+    INFO(path);
+    validation::ValidationOptions o;
+    o.states = 6;
+    o.t_end = 0.1;
+    const validation::ValidationReport r = validation::validate(load_model(path), o);
+    REQUIRE(r.failure.empty());
+    for (const auto& q : r.quantities) {
+      INFO(q.name);
+      CHECK(q.max_rel < 1e-10);
+    }
+    CHECK(r.trajectory.run);
+    CHECK(r.pass());
+  }
+}
+#endif
+
+TEST_CASE("bundled URDFs: the arm has 7 DOF, the hand 16 joints and 12 coordinates, the "
+          "gantry 3 prismatic axes", "[urdf]") {
+  const Model arm = load_model(model_path("urdf/arm7.urdf"));
+  CHECK(arm.n() == 7);
+  const Model hand = load_model(model_path("urdf/hand16.urdf"));
+  CHECK(hand.n_theta() == 16);
+  CHECK(hand.n() == 12);
+  const Model gantry = load_model(model_path("urdf/gantry.urdf"));
+  int prismatic = 0;
+  for (const Body& b : gantry.bodies) prismatic += b.joint.type == JointType::Prismatic;
+  CHECK(prismatic == 3);
+  CHECK(read_urdf(model_path("urdf/gantry.urdf")).warnings.size() == 2);  // rail friction
+}
+
+TEST_CASE("bad URDF: one line naming the file, the link or joint, and the problem", "[urdf]") {
+  const std::string ok_inertial = inertial(1, "0.1 0 0", "0 0 0", 0.01, 0.01, 0.01);
+  CHECK(error_of(one_link(ok_inertial)) == "(no error)");
+  CHECK_THAT(error_of("<robot name=\"r\"><link name=\"a\"></robot>"),
+             Catch::StartsWith("bad.urdf: malformed XML at line 1"));
+  CHECK_THAT(error_of(R"(<robot name="r"><link name="base"/><link name="l"/>
+      <joint name="j" type="revolute"><parent link="nowhere"/><child link="l"/></joint></robot>)"),
+             Equals("bad.urdf: joint 'j': parent link 'nowhere' does not exist"));
+  CHECK_THAT(error_of(R"(<robot name="r"><link name="base"/>
+      <joint name="j" type="revolute"><parent link="base"/><child link="l"/></joint></robot>)"),
+             Equals("bad.urdf: joint 'j': child link 'l' does not exist"));
+  CHECK_THAT(error_of(R"(<robot name="r"><link name="a"/><link name="b"/>
+      <joint name="j1" type="revolute"><parent link="a"/><child link="b"/></joint>
+      <joint name="j2" type="revolute"><parent link="b"/><child link="a"/></joint></robot>)"),
+             Equals("bad.urdf: no root link (the joints form a loop)"));
+  CHECK_THAT(error_of(R"(<robot name="r"><link name="a"/><link name="b"/><link name="c"/>
+      <joint name="j1" type="revolute"><parent link="a"/><child link="b"/></joint>
+      <joint name="j2" type="revolute"><parent link="a"/><child link="b"/></joint></robot>)"),
+             Equals("bad.urdf: joint 'j2': link 'b' is already the child of joint 'j1' (a loop: "
+                    "URDF describes trees)"));
+  CHECK_THAT(error_of(R"(<robot name="r"><link name="a"/><link name="b"/><link name="c"/>
+      <joint name="j1" type="revolute"><parent link="a"/><child link="b"/></joint></robot>)"),
+             Equals("bad.urdf: more than one root link: 'a', 'c'"));
+  CHECK_THAT(error_of(one_link(inertial(-1, "0 0 0", "0 0 0", 0.01, 0.01, 0.01))),
+             Equals("bad.urdf: link 'l': negative mass -1"));
+  CHECK_THAT(error_of(one_link(inertial(1, "0 0 0", "0 0 0", 0.01, 0.01, 0.05))),
+             Equals("bad.urdf: link 'l': inertia violates the triangle inequality (principal "
+                    "moments 0.01, 0.01, 0.05)"));
+  CHECK_THAT(error_of(one_link(
+                 "<inertial><mass value=\"nan\"/><inertia ixx=\"1\" iyy=\"1\" izz=\"1\"/></inertial>")),
+             Equals("bad.urdf: link 'l': value is NaN or Inf"));
+  CHECK_THAT(error_of(one_link(ok_inertial, "", "0 0 0")), Equals("bad.urdf: joint 'j': axis is zero"));
+  CHECK_THAT(error_of(one_link(ok_inertial, "", "1 0 0", "floating")),
+             Equals("bad.urdf: joint 'j': type 'floating' is not supported (revolute, continuous, "
+                    "prismatic, fixed)"));
+  CHECK_THAT(error_of(one_link(ok_inertial, "", "1 0 0", "planar")),
+             Catch::StartsWith("bad.urdf: joint 'j': type 'planar' is not supported"));
+  CHECK_THAT(error_of(R"(<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:macro name="m"/></robot>)"),
+             Catch::StartsWith("bad.urdf: xacro is not supported"));
+  CHECK_THAT(error_of(one_link(ok_inertial, "<mimic joint=\"ghost\"/>")),
+             Equals("bad.urdf: joint 'j': mimics unknown joint 'ghost'"));
+  // A movable massless leaf: M^s singular, named by the URDF joint and link, not a JSON path.
+  CHECK_THAT(error_of(one_link("")), Catch::StartsWith("bad.urdf: joint 'j' (link 'l'): "));
+}
