@@ -147,7 +147,7 @@ int cmd_equations(int argc, char** argv) {
     evaluate(m, ws, q, qd, tau);  // the tensor sweep reuses the workspace
   }
   if (a.has("json"))
-    std::cout << equations_json(m, ws, q, qd, tau, st.ok, D).dump(2) << "\n";
+    std::cout << readable_json(equations_json(m, ws, q, qd, tau, st.ok, D));
   else
     std::cout << equations_text(m, ws, q, qd, tau, st.ok, D);
   if (!st.ok) {

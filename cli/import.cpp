@@ -31,7 +31,7 @@ int cmd_import(int argc, char** argv) {
   Json doc = model_document(a.positional[0], opt);
   if (opt.gravity) doc["gravity"] = {opt.gravity->x(), opt.gravity->y(), opt.gravity->z()};
   (void)load_model(a.positional[0], opt);  // the model must compile before anything is written
-  write_file_atomic(a.options.at("output"), model_json_text(doc));
+  write_file_atomic(a.options.at("output"), readable_json(doc));
   std::cerr << "femdyn import: wrote " << a.options.at("output") << "\n";
   return 0;
 }

@@ -201,20 +201,25 @@ void write_file_atomic(const std::string& path, const std::string& content) {
 
 namespace {
 
-bool is_flat(const Json& a) {  // numbers, strings, or arrays of numbers: one line
+bool all_primitive(const Json& a) {
+  return std::all_of(a.begin(), a.end(), [](const Json& x) { return x.is_primitive(); });
+}
+
+// One line: a vector, or a small matrix (e.g. a 3x3 inertia); a larger matrix gets a row a line.
+bool is_flat(const Json& a) {
+  if (all_primitive(a)) return true;
   for (const Json& x : a)
-    if (x.is_object() || (x.is_array() && !std::all_of(x.begin(), x.end(), [](const Json& y) {
-                            return y.is_primitive();
-                          })))
-      return false;
-  return true;
+    if (!x.is_array() || !all_primitive(x)) return false;
+  return a.dump().size() < 90;
 }
 
 int key_rank(const std::string& k) {
   static const char* order[] = {"$schema", "name", "description", "model", "gravity", "params",
                                 "type", "parent", "joint", "origin", "xyz", "rpy", "axis",
                                 "limits", "spring", "damping", "nodes", "elements", "mass", "com",
-                                "inertia", "bodies", "couplings", "loads", "correlation_table"};
+                                "inertia", "bodies", "couplings", "loads", "correlation_table",
+                                // equations --json
+                                "coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd", "D"};
   for (std::size_t i = 0; i < std::size(order); ++i)
     if (k == order[i]) return static_cast<int>(i);
   return static_cast<int>(std::size(order));
@@ -272,7 +277,7 @@ void write_json(std::ostringstream& o, const Json& j, int indent) {
 
 }  // namespace
 
-std::string model_json_text(const Json& doc) {
+std::string readable_json(const Json& doc) {
   std::ostringstream o;
   write_json(o, doc, 0);
   o << "\n";

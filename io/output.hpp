@@ -24,9 +24,10 @@ Json info_json(const Model& model);
 // The paper-style correlation table N_m: one row per element, 6 entries per node.
 std::string correlation_table_text(const Model& model);
 
-// A model document as people write it: keys in the format's order (name, gravity, bodies, …),
-// arrays of numbers (vectors, matrix rows) on one line, two-space indent.
-std::string model_json_text(const Json& doc);
+// JSON as people write it: keys in the order of the formats (a model: name, gravity, bodies, …;
+// the equations: coordinates, q, qd, tau, M, h, Q, qdd, D), arrays of numbers (vectors, matrix
+// rows) on one line, two-space indent. Numbers keep full (round-trip) precision.
+std::string readable_json(const Json& doc);
 
 // Writes content to path via path.tmp + rename, so readers never see a half-written file.
 void write_file_atomic(const std::string& path, const std::string& content);
