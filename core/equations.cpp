@@ -67,6 +67,9 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
   // M^s = Tᵀ (M T)
   ws.MT.noalias() = model.M * ws.T;
   ws.Ms.noalias() = ws.T.transpose() * ws.MT;
+  // Symmetric in exact arithmetic; mirror the upper triangle so it is in floating point too.
+  for (Eigen::Index j = 0; j < ws.Ms.cols(); ++j)
+    for (Eigen::Index i = j + 1; i < ws.Ms.rows(); ++i) ws.Ms(i, j) = ws.Ms(j, i);
 
   // h = Tᵀ (M T'[q̇,q̇] + g(u̇,u̇)); zero at rest.
   if (moving) {
