@@ -279,16 +279,20 @@ std::string read_text(const std::string& path) {
 // "robot.urdf: /bodies/3/joint: …" becomes "robot.urdf: joint 'elbow' (link 'forearm'): …".
 [[noreturn]] void rethrow_for_urdf(const ModelError& e, const Json& doc, const std::string& path) {
   std::string msg = e.what();
-  const std::string prefix = path + ": /bodies/";
-  if (msg.rfind(prefix, 0) == 0) {
+  // "/bodies/N…" names a joint and its child link; "/couplings/N…" a joint's <mimic>.
+  for (const std::string section : {"bodies", "couplings"}) {
+    const std::string prefix = path + ": /" + section + "/";
+    if (msg.rfind(prefix, 0) != 0) continue;
     std::size_t i = prefix.size(), end = i;
     while (end < msg.size() && std::isdigit(static_cast<unsigned char>(msg[end]))) ++end;
     const std::size_t rest = msg.find(": ", end);
-    if (end > i && rest != std::string::npos) {
-      const Json& body = doc["bodies"][std::stoul(msg.substr(i, end - i))];
-      msg = path + ": joint '" + body["joint"]["name"].get<std::string>() + "' (link '" +
-            body["name"].get<std::string>() + "')" + msg.substr(rest);
-    }
+    if (end == i || rest == std::string::npos) break;
+    const Json& item = doc[section][std::stoul(msg.substr(i, end - i))];
+    const std::string who =
+        section == "bodies" ? "joint '" + item["joint"]["name"].get<std::string>() + "' (link '" +
+                                  item["name"].get<std::string>() + "')"
+                            : "joint '" + item["joint"].get<std::string>() + "' <mimic>";
+    msg = path + ": " + who + msg.substr(rest);
   }
   throw ModelError("", msg);
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <numbers>
 
 #include "core/errors.hpp"
@@ -242,4 +243,54 @@ TEST_CASE("bad URDF: one line naming the file, the link or joint, and the proble
              Equals("bad.urdf: joint 'j': mimics unknown joint 'ghost'"));
   // A movable massless leaf: M^s singular, named by the URDF joint and link, not a JSON path.
   CHECK_THAT(error_of(one_link("")), Catch::StartsWith("bad.urdf: joint 'j' (link 'l'): "));
+}
+
+TEST_CASE("a mimic of a fixed joint is named by the URDF joint", "[urdf]") {
+  const std::string urdf = R"(<robot name="r"><link name="base"/><link name="a">)" +
+                           inertial(1, "0.1 0 0", "0 0 0", 0.01, 0.01, 0.01) + R"(</link>
+    <link name="b">)" + inertial(1, "0.1 0 0", "0 0 0", 0.01, 0.01, 0.01) + R"(</link>
+    <joint name="weld" type="fixed"><parent link="base"/><child link="a"/></joint>
+    <joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>
+      <mimic joint="weld"/></joint></robot>)";
+  CHECK_THAT(error_of(urdf), Equals("bad.urdf: joint 'j' <mimic>: unknown or fixed joint 'weld'"));
+}
+
+TEST_CASE("mutated URDFs load or fail with one line, never crash", "[urdf][fuzz]") {
+  // Replace attribute values and drop elements of the bundled URDFs at random.
+  const char* values[] = {"nan", "-1", "", "1e400", "0 0 0", "abc", "1 2", "0", "inf", "-0.5 2 1"};
+  std::mt19937 rng(11);
+  int loaded = 0, refused = 0;
+  for (const char* name : {"urdf/arm7.urdf", "urdf/hand16.urdf", "urdf/gantry.urdf"}) {
+    std::ifstream in(model_path(name));
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    for (int k = 0; k < 150; ++k) {
+      std::string t = text;
+      for (int edits = 1 + static_cast<int>(rng() % 3); edits > 0; --edits) {
+        if (rng() % 4 == 0) {  // drop one element <tag …/> or <tag …>…</tag> opening line
+          const std::size_t at = t.find('<', rng() % t.size());
+          const std::size_t end = at == std::string::npos ? at : t.find('>', at);
+          if (end != std::string::npos) t.erase(at, end - at + 1);
+        } else {  // replace one attribute value
+          const std::size_t at = t.find("=\"", rng() % t.size());
+          const std::size_t end = at == std::string::npos ? at : t.find('"', at + 2);
+          if (end != std::string::npos) t.replace(at + 2, end - at - 2, values[rng() % std::size(values)]);
+        }
+      }
+      try {
+        const Model m = load_urdf_text(t);
+        Workspace ws(m);
+        const VecX q = VecX::Constant(m.n(), 0.2);
+        const Status st = forward_dynamics(m, ws, q, q, q);
+        CHECK((st.ok ? ws.qdd.allFinite() : !st.message.empty()));
+        ++loaded;
+      } catch (const ModelError& e) {
+        const std::string msg = e.what();
+        CHECK(msg.find('\n') == std::string::npos);
+        CHECK(msg.find("robot.urdf") != std::string::npos);
+        ++refused;
+      }
+    }
+  }
+  CHECK(loaded > 0);
+  CHECK(refused > 0);
 }
