@@ -6,26 +6,27 @@ namespace femdyn {
 
 Status rk4_step(const Model& model, Workspace& ws, double t, double dt, VecX& q, VecX& qd,
                 const Actuation& tau) {
-  const int n = model.n();
-  VecX u(n), k1v(n), k2v(n), k3v(n), k4v(n), k1a(n), k2a(n), k3a(n), k4a(n);
-  auto accel = [&](double tt, const VecX& qq, const VecX& vv, VecX& a) {
-    tau(tt, u);
-    Status st = forward_dynamics(model, ws, qq, vv, u);
-    a = ws.qdd;
-    return st;
-  };
-  Status st;
-  k1v = qd;
-  if (!(st = accel(t, q, k1v, k1a)).ok) return st;
-  k2v = qd + 0.5 * dt * k1a;
-  if (!(st = accel(t + 0.5 * dt, q + 0.5 * dt * k1v, k2v, k2a)).ok) return st;
-  k3v = qd + 0.5 * dt * k2a;
-  if (!(st = accel(t + 0.5 * dt, q + 0.5 * dt * k2v, k3v, k3a)).ok) return st;
-  k4v = qd + dt * k3a;
-  if (!(st = accel(t + dt, q + dt * k3v, k4v, k4a)).ok) return st;
-  q += dt / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
-  qd += dt / 6 * (k1a + 2 * k2a + 2 * k3a + k4a);
-  return st;
+  // Stage i at time t + c_i dt from the state (q, q̇) + a_i dt (k_q, k_q̇) of the previous stage:
+  //   k_q = q̇_stage, k_q̇ = q̈(t_stage, q_stage, q̇_stage);   c = a = (0, ½, ½, 1).
+  // All buffers live in the workspace: a step allocates nothing.
+  static constexpr double c[4] = {0, 0.5, 0.5, 1};
+  for (int i = 0; i < 4; ++i) {
+    if (i == 0) {
+      ws.stage_q = q;
+      ws.stage_qd = qd;
+    } else {
+      ws.stage_q = q + (c[i] * dt) * ws.k_q[i - 1];
+      ws.stage_qd = qd + (c[i] * dt) * ws.k_qd[i - 1];
+    }
+    tau(t + c[i] * dt, ws.stage_tau);
+    const Status st = forward_dynamics(model, ws, ws.stage_q, ws.stage_qd, ws.stage_tau);
+    if (!st.ok) return st;
+    ws.k_q[i] = ws.stage_qd;
+    ws.k_qd[i] = ws.qdd;
+  }
+  q += (dt / 6) * (ws.k_q[0] + 2 * ws.k_q[1] + 2 * ws.k_q[2] + ws.k_q[3]);
+  qd += (dt / 6) * (ws.k_qd[0] + 2 * ws.k_qd[1] + 2 * ws.k_qd[2] + ws.k_qd[3]);
+  return {};
 }
 
 void quintic(const VecX& q0, const VecX& q1, double T, double t, VecX& q, VecX& qd, VecX& qdd) {

@@ -1,6 +1,6 @@
 #include "core/mass_solver.hpp"
 
-#include <Eigen/CholmodSupport>
+#include <cholmod.h>
 #include <algorithm>
 
 namespace femdyn {
@@ -45,12 +45,31 @@ SolverKind choose_solver(const Model& model) {
                                                            : SolverKind::Dense;
 }
 
+// CHOLMOD is driven directly (not through Eigen's wrapper) so that, after the first call, a
+// factorisation and a solve reuse every buffer: the sparse M^s (pattern fixed, values
+// overwritten), the factor L (symbolic analysis once), and the solve's X, Y, E workspaces
+// (cholmod_solve2).
 struct MassSolver::Impl {
   Eigen::LLT<MatX> dense;
-  SpMat sparse_Ms;                                   // pattern fixed at construction
-  std::vector<std::pair<int, int>> entries;          // (row, col) of each stored value
-  Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower> cholmod;
-  bool analyzed = false;
+  std::vector<std::pair<int, int>> entries;  // M^s (row, col) of each stored value of A
+  cholmod_common common;
+  cholmod_sparse* A = nullptr;  // lower triangle of M^s (stype -1)
+  cholmod_factor* L = nullptr;
+  cholmod_dense *X = nullptr, *Y = nullptr, *E = nullptr;
+  cholmod_dense B;  // header over b
+  VecX b;           // the right-hand side in CHOLMOD's order
+  std::vector<int> perm;  // position k of the factorised matrix holds coordinate perm[k]
+  bool started = false;
+
+  ~Impl() {
+    if (!started) return;
+    cholmod_free_dense(&X, &common);
+    cholmod_free_dense(&Y, &common);
+    cholmod_free_dense(&E, &common);
+    cholmod_free_factor(&L, &common);
+    cholmod_free_sparse(&A, &common);
+    cholmod_finish(&common);
+  }
 };
 
 MassSolver::MassSolver(const Model& model) : MassSolver(model, choose_solver(model)) {}
@@ -58,18 +77,67 @@ MassSolver::MassSolver(const Model& model) : MassSolver(model, choose_solver(mod
 MassSolver::MassSolver(const Model& model, SolverKind kind)
     : kind_(kind), names_(model.coordinate_names), impl_(std::make_unique<Impl>()) {
   if (kind_ == SolverKind::Sparse) {
-    const auto p = coordinate_pattern(model);
+    const auto pattern = coordinate_pattern(model);
     const int n = model.n();
-    std::vector<Eigen::Triplet<double>> trip;
-    for (int c = 0; c < n; ++c)
-      for (int r = c; r < n; ++r)
-        if (p[r][c] || r == c) trip.emplace_back(r, c, 1.0);
-    impl_->sparse_Ms.resize(n, n);
-    impl_->sparse_Ms.setFromTriplets(trip.begin(), trip.end());
-    impl_->sparse_Ms.makeCompressed();
-    for (int c = 0; c < n; ++c)
-      for (SpMat::InnerIterator it(impl_->sparse_Ms, c); it; ++it)
-        impl_->entries.emplace_back(static_cast<int>(it.row()), c);
+    Impl& s = *impl_;
+    cholmod_start(&s.common);
+    s.common.print = 0;  // failures are reported as a Status, not printed
+    s.common.supernodal = CHOLMOD_SIMPLICIAL;
+    s.common.final_asis = 1;  // keep L as factorised: no per-call repacking
+    s.common.final_pack = 0;
+    s.common.final_monotonic = 0;
+    s.started = true;
+    // 1. A fill-reducing ordering P of the pattern (CHOLMOD's choice, on a pattern-only copy).
+    const auto lower_pattern = [&](const std::vector<int>& order) {
+      std::vector<int> where(n);  // original index -> position in `order`
+      for (int k = 0; k < n; ++k) where[order[k]] = k;
+      std::vector<std::pair<int, int>> e;  // (row, col) in the ordered matrix, upper triangle
+      for (int c = 0; c < n; ++c)
+        for (int r = 0; r < n; ++r)
+          if ((pattern[r][c] || r == c) && where[r] <= where[c]) e.emplace_back(where[r], where[c]);
+      std::sort(e.begin(), e.end(), [](auto a, auto b) { return std::pair(a.second, a.first) < std::pair(b.second, b.first); });
+      return e;
+    };
+    const auto build = [&](const std::vector<std::pair<int, int>>& e) {
+      cholmod_sparse* A = cholmod_allocate_sparse(n, n, e.size(), 1, 1, /*stype: upper*/ 1,
+                                                  CHOLMOD_REAL, &s.common);
+      auto* Ap = static_cast<int*>(A->p);
+      auto* Ai = static_cast<int*>(A->i);
+      auto* Ax = static_cast<double*>(A->x);
+      for (std::size_t k = 0; k < e.size(); ++k) {
+        Ai[k] = e[k].first;
+        Ax[k] = e[k].first == e[k].second ? 1.0 : 0.0;
+      }
+      for (int c = 0, k = 0; c <= n; ++c) {
+        while (k < static_cast<int>(e.size()) && e[k].second < c) ++k;
+        Ap[c] = k;
+      }
+      return A;
+    };
+    std::vector<int> identity(n);
+    for (int k = 0; k < n; ++k) identity[k] = k;
+    cholmod_sparse* A0 = build(lower_pattern(identity));
+    cholmod_factor* L0 = cholmod_analyze(A0, &s.common);
+    s.perm.assign(static_cast<int*>(L0->Perm), static_cast<int*>(L0->Perm) + n);
+    cholmod_free_factor(&L0, &s.common);
+    cholmod_free_sparse(&A0, &s.common);
+    // 2. A = P M^s Pᵀ stored once in that order, analysed with the natural ordering, so that
+    //    factorize and solve need no permuted copies (which CHOLMOD would allocate per call).
+    const auto e = lower_pattern(s.perm);
+    s.A = build(e);
+    for (const auto& [r, c] : e) s.entries.emplace_back(s.perm[r], s.perm[c]);
+    s.common.nmethods = 1;
+    s.common.method[0].ordering = CHOLMOD_NATURAL;
+    s.common.postorder = false;
+    s.L = cholmod_analyze(s.A, &s.common);
+    s.B = cholmod_dense{};
+    s.B.nrow = s.B.d = static_cast<std::size_t>(n);
+    s.B.ncol = 1;
+    s.B.nzmax = static_cast<std::size_t>(n);
+    s.B.xtype = CHOLMOD_REAL;
+    s.B.dtype = CHOLMOD_DOUBLE;
+    s.b = VecX::Zero(n);
+    s.B.x = s.b.data();
   }
 }
 
@@ -99,31 +167,33 @@ Status MassSolver::factorize(const MatX& Ms) {
                 static_cast<int>(a)};
     return {};
   }
-  double* values = impl_->sparse_Ms.valuePtr();
-  for (std::size_t k = 0; k < impl_->entries.size(); ++k)
-    values[k] = Ms(impl_->entries[k].first, impl_->entries[k].second);
-  if (!impl_->analyzed) {
-    impl_->cholmod.analyzePattern(impl_->sparse_Ms);
-    impl_->analyzed = true;
-  }
-  impl_->cholmod.factorize(impl_->sparse_Ms);
-  if (impl_->cholmod.info() != Eigen::Success)
-    return {false, "the mass matrix M^s is not positive definite (CHOLMOD)"};
+  Impl& s = *impl_;
+  auto* Ax = static_cast<double*>(s.A->x);
+  for (std::size_t k = 0; k < s.entries.size(); ++k) Ax[k] = Ms(s.entries[k].first, s.entries[k].second);
+  cholmod_factorize(s.A, s.L, &s.common);
+  if (s.common.status == CHOLMOD_NOT_POSDEF || s.L->minor < s.L->n)
+    return {false, "the mass matrix M^s is not positive definite (CHOLMOD, at coordinate '" +
+                       names_.at(s.perm.at(std::min<std::size_t>(s.L->minor, s.L->n - 1))) + "')"};
+  if (s.common.status < CHOLMOD_OK) return {false, "CHOLMOD failed to factorize M^s"};
   return {};
 }
 
 void MassSolver::solve_in_place(VecX& x) const {
-  if (kind_ == SolverKind::Dense)
+  if (kind_ == SolverKind::Dense) {
     impl_->dense.solveInPlace(x);
-  else
-    x = impl_->cholmod.solve(x);
+    return;
+  }
+  Impl& s = *impl_;
+  const auto n = static_cast<Eigen::Index>(s.perm.size());
+  for (Eigen::Index k = 0; k < n; ++k) s.b[k] = x[s.perm[k]];
+  cholmod_solve2(CHOLMOD_A, s.L, &s.B, nullptr, &s.X, nullptr, &s.Y, &s.E, &s.common);
+  const auto* X = static_cast<const double*>(s.X->x);
+  for (Eigen::Index k = 0; k < n; ++k) x[s.perm[k]] = X[k];
 }
 
 void MassSolver::solve(const VecX& y, VecX& x) const {
-  if (kind_ == SolverKind::Dense)
-    x = impl_->dense.solve(y);
-  else
-    x = impl_->cholmod.solve(y);
+  x = y;
+  solve_in_place(x);
 }
 
 }  // namespace femdyn

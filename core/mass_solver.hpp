@@ -27,7 +27,7 @@ class MassSolver {
   SolverKind kind() const { return kind_; }
   Status factorize(const MatX& Ms);
   void solve(const VecX& y, VecX& x) const;
-  void solve_in_place(VecX& x) const;  // dense: no allocation; CHOLMOD allocates internally
+  void solve_in_place(VecX& x) const;  // no allocation after the first call
 
  private:
   struct Impl;

@@ -154,6 +154,26 @@ struct SimbodyTwin::Impl {
     return model.C.transpose() * f;
   }
 
+  // Buffers of the timing entry points (time_*).
+  SimTK::Vector bench_applied, bench_udot, bench_theta_ddot, bench_out;
+  SimTK::Vector_<SimTK::SpatialVec> bench_A_GB;
+
+  // set_state without temporaries, for the timing entry points.
+  void set_state_in_place(const VecX& q, const VecX& qd, SimTK::Stage stage) {
+    SimTK::Vector& sq = state.updQ();
+    SimTK::Vector& su = state.updU();
+    for (int j = 0; j < model.n_theta(); ++j) {
+      double theta = model.theta0[j], theta_dot = 0;
+      for (int k = 0; k < model.n(); ++k) {
+        theta += model.C(j, k) * q[k];
+        theta_dot += model.C(j, k) * qd[k];
+      }
+      sq[theta_q[j]] = theta;
+      su[theta_u[j]] = theta_dot;
+    }
+    system.realize(state, stage);
+  }
+
   SimTK::Vector expand(const VecX& x) const {  // C x on Simbody's u layout
     SimTK::Vector out(state.getNU(), 0.0);
     const VecX y = model.C * x;
@@ -215,6 +235,54 @@ VecX SimbodyTwin::inverse_dynamics(const VecX& q, const VecX& qd, const VecX& qd
   // residual = M_θ θ̈ + h_θ − Q_θ with θ̈ = C q̈;  τ = Cᵀ residual
   s.matter.calcResidualForceIgnoringConstraints(s.state, mob, body, s.expand(qdd), s.residual);
   return s.reduce(s.residual);
+}
+
+void SimbodyTwin::time_mass_and_bias(const VecX& q, const VecX& qd) {
+  Impl& s = *impl_;
+  s.set_state_in_place(q, qd, SimTK::Stage::Dynamics);
+  s.matter.calcM(s.state, s.M_theta);
+  s.matter.calcResidualForceIgnoringConstraints(
+      s.state, s.system.getMobilityForces(s.state, SimTK::Stage::Dynamics),
+      s.system.getRigidBodyForces(s.state, SimTK::Stage::Dynamics), s.zero_mobility, s.bench_out);
+}
+
+void SimbodyTwin::time_bias(const VecX& q, const VecX& qd) {
+  Impl& s = *impl_;
+  s.set_state_in_place(q, qd, SimTK::Stage::Velocity);
+  s.matter.calcResidualForceIgnoringConstraints(s.state, s.zero_mobility, s.zero_body,
+                                                s.zero_mobility, s.bench_out);
+}
+
+void SimbodyTwin::time_forward(const VecX& q, const VecX& qd, const VecX& tau) {
+  Impl& s = *impl_;
+  s.set_state_in_place(q, qd, SimTK::Stage::Dynamics);
+  const SimTK::Vector& mob = s.system.getMobilityForces(s.state, SimTK::Stage::Dynamics);
+  s.bench_applied = mob;  // allocates on the first call only
+  for (int k = 0; k < s.model.n(); ++k)
+    if (s.independent[k] >= 0) s.bench_applied[s.theta_u[s.independent[k]]] += tau[k];
+  const SimTK::Vector_<SimTK::SpatialVec>& body =
+      s.system.getRigidBodyForces(s.state, SimTK::Stage::Dynamics);
+  if (s.matter.getNumConstraints() == 0)
+    s.matter.calcAccelerationIgnoringConstraints(s.state, s.bench_applied, body, s.bench_udot,
+                                                 s.bench_A_GB);
+  else  // the coupling as coordinate couplers: the constrained (coupled) motion
+    s.matter.calcAcceleration(s.state, s.bench_applied, body, s.bench_udot, s.bench_A_GB);
+}
+
+void SimbodyTwin::time_inverse(const VecX& q, const VecX& qd, const VecX& qdd) {
+  Impl& s = *impl_;
+  s.set_state_in_place(q, qd, SimTK::Stage::Dynamics);
+  const int nu = s.state.getNU();
+  if (s.bench_theta_ddot.size() != nu) s.bench_theta_ddot = SimTK::Vector(nu, 0.0);
+  for (int j = 0; j < s.model.n_theta(); ++j) {
+    double theta_ddot = 0;
+    for (int k = 0; k < s.model.n(); ++k) theta_ddot += s.model.C(j, k) * qdd[k];
+    s.bench_theta_ddot[s.theta_u[j]] = theta_ddot;
+  }
+  s.matter.calcResidualForceIgnoringConstraints(
+      s.state, s.system.getMobilityForces(s.state, SimTK::Stage::Dynamics),
+      s.system.getRigidBodyForces(s.state, SimTK::Stage::Dynamics), s.bench_theta_ddot,
+      s.bench_out);
 }
 
 bool SimbodyTwin::can_simulate(std::string* why_not) const {

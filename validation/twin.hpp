@@ -87,6 +87,24 @@ class SimbodyTwin {
   std::vector<TwinSample> simulate(const VecX& q0, const VecX& qd0,
                                    const std::vector<double>& times, double accuracy);
 
+  // Timing entry points (validation/benchmark.cpp): Simbody's own work only, on buffers
+  // allocated by the first call. Each sets θ = C q + θ0, θ̇ = C q̇ (a plain loop) and realizes
+  // the stage it needs; nothing is reduced to q or converted to Eigen, and the results stay
+  // inside the twin. With a coupling (n < nθ) Simbody's M, h and τ are those of the tree of
+  // nθ joints (the reduction by C is not timed).
+  //   mass_and_bias: realize Dynamics (forces), calcM, and the residual with the applied forces
+  //                  and θ̈ = 0 (that is h − Q), the counterpart of femdyn's evaluate();
+  //   bias:          realize Velocity, the residual with no force and θ̈ = 0 (h);
+  //   forward:       realize Dynamics, τ_k added on the joint q_k drives directly
+  //                  (independent_theta), then calcAccelerationIgnoringConstraints (O(n)
+  //                  articulated body), or calcAcceleration when the coupling is posed as
+  //                  coordinate couplers (the coupled motion, as femdyn's);
+  //   inverse:       realize Dynamics, the residual with the applied forces and θ̈ = C q̈.
+  void time_mass_and_bias(const VecX& q, const VecX& qd);
+  void time_bias(const VecX& q, const VecX& qd);
+  void time_forward(const VecX& q, const VecX& qd, const VecX& tau);
+  void time_inverse(const VecX& q, const VecX& qd, const VecX& qdd);
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

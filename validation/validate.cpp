@@ -14,8 +14,6 @@
 
 namespace femdyn::validation {
 
-namespace {
-
 // What the twin reads of the model; each body's mass properties are the sum of its elements'.
 TwinModel twin_model(const Model& m) {
   TwinModel t;
@@ -52,6 +50,8 @@ TwinModel twin_model(const Model& m) {
   for (const BodyTorque& q : m.torques) t.loads.push_back({q.body, Vec3::Zero(), Vec3::Zero(), q.torque});
   return t;
 }
+
+namespace {
 
 double max_abs(const MatX& x) { return x.size() ? x.cwiseAbs().maxCoeff() : 0.0; }
 

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/model.hpp"
+#include "validation/twin.hpp"
 
 namespace femdyn::validation {
 
@@ -58,5 +59,9 @@ struct ValidationReport {
 };
 
 ValidationReport validate(const Model& model, const ValidationOptions& options = {});
+
+// What the Simbody twin reads of a model; each body's mass properties are the sum of its
+// elements'. Used by validate() and femdyn_bench.
+TwinModel twin_model(const Model& model);
 
 }  // namespace femdyn::validation

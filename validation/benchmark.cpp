@@ -1,0 +1,198 @@
+// femdyn_bench: femdyn's equations against Simbody's on the same mechanisms (docs/benchmarks.md).
+//
+// For each bundled model (and a seeded random 20-DOF chain), at one seeded random state:
+//   femdyn/evaluate/M   evaluate(): M^s, h, Q          simbody/evaluate/M  calcM + residual (h − Q)
+//   femdyn/bias/M       evaluate_bias(): h             simbody/bias/M      residual, no forces (h)
+//   femdyn/forward/M    forward_dynamics(): q̈          simbody/forward/M   calcAccelerationIgnoringConstraints
+//   femdyn/inverse/M    inverse_dynamics(): τ          simbody/inverse/M   residual with θ̈
+// Simbody's side is SimbodyTwin::time_* (validation/twin.hpp): its own work only. This file
+// does not include Simbody, so it is compiled like the rest of femdyn (C++20, NDEBUG).
+//
+// Heap allocations are counted by interposing malloc (glibc) and reported per iteration as the
+// counter `allocs`; femdyn's hot path is documented allocation-free and must show 0.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/equations.hpp"
+#include "core/math.hpp"
+#include "core/sampling.hpp"
+#include "io/model_loader.hpp"
+#include "validation/twin.hpp"
+#include "validation/validate.hpp"
+
+extern "C" void* __libc_malloc(std::size_t);
+extern "C" void* __libc_calloc(std::size_t, std::size_t);
+extern "C" void* __libc_realloc(void*, std::size_t);
+
+namespace {
+thread_local bool g_counting = false;
+thread_local long g_allocs = 0;
+}  // namespace
+
+extern "C" void* malloc(std::size_t n) {
+  if (g_counting) ++g_allocs;
+  return __libc_malloc(n);
+}
+extern "C" void* calloc(std::size_t n, std::size_t size) {
+  if (g_counting) ++g_allocs;
+  return __libc_calloc(n, size);
+}
+extern "C" void* realloc(void* p, std::size_t n) {
+  if (g_counting) ++g_allocs;
+  return __libc_realloc(p, n);
+}
+
+namespace {
+
+using namespace femdyn;
+namespace fv = femdyn::validation;
+
+struct Case {
+  std::string name;
+  Model model;
+  std::unique_ptr<Workspace> ws;
+  std::unique_ptr<fv::SimbodyTwin> twin;
+  VecX q, qd, tau, qdd;
+};
+
+std::vector<std::unique_ptr<Case>>& cases() {
+  static std::vector<std::unique_ptr<Case>> all;
+  return all;
+}
+
+std::string vec(double a, double b, double c) {
+  std::ostringstream o;
+  o.precision(17);
+  o << "[" << a << ", " << b << ", " << c << "]";
+  return o.str();
+}
+
+// A seeded random serial chain as model JSON (after tests/helpers.cpp random_tree_json):
+// random axes, offsets and rpy, full physical inertia tensors, one prismatic joint in four.
+std::string random_chain_json(unsigned seed, int bodies) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), pos(0.2, 1.0);
+  std::ostringstream o;
+  o.precision(17);
+  o << "{\"name\": \"random chain " << seed << "\", \"gravity\": " << vec(0.1, -0.2, -9.81)
+    << ", \"bodies\": [";
+  for (int b = 0; b < bodies; ++b) {
+    const bool slide = rng() % 4 == 0;
+    const double sa = pos(rng), sb = pos(rng), sc = pos(rng), mass = pos(rng);
+    const Vec3 principal(sb + sc, sa + sc, sa + sb);
+    const Mat3 R = rpy_to_rotation(Vec3(u(rng), u(rng), u(rng)) * 3);
+    const Mat3 I = 0.05 * mass * R * principal.asDiagonal() * R.transpose();
+    o << (b ? ", " : "") << "{\"name\": \"b" << b << "\", \"parent\": \"";
+    if (b == 0)
+      o << "world";
+    else
+      o << "b" << b - 1;
+    o << "\", \"joint\": {\"type\": \"" << (slide ? "prismatic" : "revolute") << "\", "
+      << "\"axis\": " << vec(u(rng), u(rng), u(rng)) << ", \"origin\": {\"xyz\": "
+      << vec(0.5 * u(rng), 0.5 * u(rng), 0.5 * u(rng)) << ", \"rpy\": "
+      << vec(u(rng), u(rng), u(rng)) << "}}, \"elements\": [{\"type\": \"rigid_body\", "
+      << "\"mass\": " << mass << ", \"com\": " << vec(0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng))
+      << ", \"inertia\": [" << vec(I(0, 0), I(0, 1), I(0, 2)) << ", "
+      << vec(I(1, 0), I(1, 1), I(1, 2)) << ", " << vec(I(2, 0), I(2, 1), I(2, 2)) << "]}]}";
+  }
+  o << "]}";
+  return o.str();
+}
+
+double rel_diff(const MatX& a, const MatX& b) {
+  return (a - b).cwiseAbs().maxCoeff() / std::max(b.cwiseAbs().maxCoeff(), 1e-6);
+}
+
+// The state of femdyn validate's first sample: seed 1, q within the joint limits,
+// q̇ in ±2, τ in ±1, q̈ in ±5. Checks once, outside the timing, that both sides agree.
+void add_case(std::string name, Model model) {
+  auto c = std::make_unique<Case>();
+  c->name = std::move(name);
+  c->model = std::move(model);
+  const Model& m = c->model;
+  c->ws = std::make_unique<Workspace>(m);
+  c->twin = std::make_unique<fv::SimbodyTwin>(fv::twin_model(m));
+  std::mt19937 rng(1);
+  c->q = random_posture(m, rng);
+  c->qd = random_uniform(m.n(), 2, rng);
+  c->tau = random_uniform(m.n(), 1, rng);
+  c->qdd = random_uniform(m.n(), 5, rng);
+
+  const fv::TwinEquations s = c->twin->equations(c->q, c->qd, c->tau);
+  const bool ok = forward_dynamics(m, *c->ws, c->q, c->qd, c->tau).ok;
+  const double e = std::max({rel_diff(c->ws->Ms, s.M), rel_diff(c->ws->h, s.h),
+                             rel_diff(c->ws->Q, s.Q), ok ? rel_diff(c->ws->qdd, s.qdd) : INFINITY});
+  if (!(e < 1e-8))
+    std::fprintf(stderr, "warning: %s: femdyn and Simbody differ (relative %.3g)\n",
+                 c->name.c_str(), e);
+  cases().push_back(std::move(c));
+}
+
+// Runs `body` in the timing loop with allocation counting on; `allocs` = heap allocations per
+// iteration (a warm-up call first, so buffers sized on first use are not counted).
+template <class Body>
+void timed(benchmark::State& state, const Case& c, Body&& body) {
+  body();
+  long allocs = 0;
+  for (auto _ : state) {
+    g_allocs = 0;
+    g_counting = true;
+    body();
+    g_counting = false;
+    allocs += g_allocs;
+    benchmark::ClobberMemory();
+  }
+  state.counters["n"] = c.model.n();
+  state.counters["allocs"] =
+      state.iterations() ? static_cast<double>(allocs) / static_cast<double>(state.iterations()) : 0;
+}
+
+void register_case(Case* c) {
+  const std::string& name = c->name;
+  auto reg = [&](const std::string& lib, const std::string& op, auto fn) {
+    benchmark::RegisterBenchmark((lib + "/" + op + "/" + name).c_str(),
+                                 [c, fn](benchmark::State& st) { timed(st, *c, [&] { fn(*c); }); })
+        ->Unit(benchmark::kMicrosecond);
+  };
+  // femdyn and Simbody alternate, so drifts of a noisy machine hit both alike.
+  reg("femdyn", "evaluate", [](Case& c) { evaluate(c.model, *c.ws, c.q, c.qd, c.tau); });
+  reg("simbody", "evaluate", [](Case& c) { c.twin->time_mass_and_bias(c.q, c.qd); });
+  reg("femdyn", "bias", [](Case& c) { evaluate_bias(c.model, *c.ws, c.q, c.qd); });
+  reg("simbody", "bias", [](Case& c) { c.twin->time_bias(c.q, c.qd); });
+  reg("femdyn", "forward", [](Case& c) {
+    benchmark::DoNotOptimize(forward_dynamics(c.model, *c.ws, c.q, c.qd, c.tau).ok);
+  });
+  reg("simbody", "forward", [](Case& c) { c.twin->time_forward(c.q, c.qd, c.tau); });
+  reg("femdyn", "inverse", [](Case& c) { inverse_dynamics(c.model, *c.ws, c.q, c.qd, c.qdd); });
+  reg("simbody", "inverse", [](Case& c) { c.twin->time_inverse(c.q, c.qd, c.qdd); });
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string dir = std::string(FEMDYN_SOURCE_DIR) + "/models/";
+  try {
+    for (const char* name : {"pendulum", "spatial_double_pendulum", "branched_tree", "finger",
+                             "finger_coupled", "hand"})
+      add_case(name, load_model(dir + name + ".json"));
+    add_case("random_chain20", compile(parse_spec(random_chain_json(20, 20), "random_chain20")));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "femdyn_bench: %s\n", e.what());
+    return 1;
+  }
+  for (const auto& c : cases()) register_case(c.get());
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
