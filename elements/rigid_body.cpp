@@ -20,8 +20,9 @@ void RigidBodyShorthand::from_params(const Params& p, ElementSink& sink) {
     const auto pts = equimomental_points(m, c, I);
     if (!pts) p.fail("inertia", "four equimomental points need a strictly physical inertia "
                                 "(positive definite pseudo-inertia); use point_rotary");
+    static const char* const labels[4] = {"p1", "p2", "p3", "p4"};
     for (int i = 0; i < 4; ++i)
-      sink.add(std::make_unique<LumpedPoint>((*pts)[i], m / 4), {"p" + std::to_string(i + 1)});
+      sink.add(std::make_unique<LumpedPoint>((*pts)[i], m / 4), {labels[i]});
   } else {
     p.fail("equivalent", "expected \"point_rotary\" or \"four_points\", got \"" + how + "\"");
   }

@@ -207,3 +207,35 @@ TEST_CASE("docs/validation.md lists every bundled model with its current result"
     CHECK_THAT(row, Catch::Contains(name == "finger_paper.json" ? "| FAIL" : "| PASS |"));
   }
 }
+
+TEST_CASE("extreme scales (mass ratio 1e6, length ratio 1e3, a stiff spring) match Simbody",
+          "[validation][stiff]") {
+  // Alternating 1000 kg / 1 m and 1 g / 1 mm links on random axes, revolute and prismatic.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::ostringstream j;
+  j.precision(17);
+  j << R"({"name": "extreme", "gravity": [0, 0, -9.81], "bodies": [)";
+  for (int i = 0; i < 10; ++i) {
+    const bool heavy = i % 2 == 0;
+    const double m = heavy ? 1e3 : 1e-3, L = heavy ? 1.0 : 1e-3, I = m * L * L / 12;
+    j << (i ? ", " : "") << R"({"name": "b)" << i << R"(", "parent": ")"
+      << (i ? "b" + std::to_string(i - 1) : std::string("world")) << R"(", "joint": {"type": ")"
+      << (i % 3 ? "revolute" : "prismatic") << R"(", "axis": [)" << u(rng) << ", " << u(rng)
+      << ", " << u(rng) << R"(], "origin": {"xyz": [)" << L << ", " << 0.1 * L << R"(, 0],
+         "rpy": [)" << 3 * u(rng) << ", " << 3 * u(rng) << ", " << 3 * u(rng) << "]}"
+      << (i == 5 ? R"(, "spring": {"stiffness": 1e4, "rest": 0.1})" : "")
+      << R"(}, "elements": [{"type": "rigid_body", "mass": )" << m << R"(, "com": [)" << L / 2
+      << ", " << 0.01 * L << R"(, 0], "inertia": {"ixx": )" << 0.1 * I << R"(, "iyy": )" << I
+      << R"(, "izz": )" << 1.05 * I << R"(, "ixy": )" << 0.01 * I << "}}]}";
+  }
+  j << "]}";
+  const Model m = load_text(j.str());
+  ValidationOptions o = quick(20, 0);  // pointwise only
+  const ValidationReport r = validation::validate(m, o);
+  for (const auto& q : r.quantities) {
+    INFO(q.name << " " << q.max_rel);
+    CHECK(q.max_rel < 1e-10);
+  }
+  CHECK(r.pass());
+}
