@@ -87,10 +87,10 @@ void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX&
     ws.h.setZero();
     return;
   }
-  propagate(model, ws, q, qd, {.jacobian = true, .bias = true});
+  propagate(model, ws, q, qd, {.jacobian = false, .bias = true});
   ws.nodal.noalias() = model.M * ws.bias;
   if (model.has_velocity_forces) add_velocity_forces(model, ws, ws.u_dot, ws.u_dot, ws.nodal);
-  ws.h.noalias() = ws.T.transpose() * ws.nodal;
+  apply_transpose(model, ws, ws.nodal, ws.h);  // h = Tᵀ (M T'[q̇,q̇] + g), T not formed
 }
 
 Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
@@ -105,10 +105,22 @@ Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const 
 
 void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                       const VecX& qdd) {
-  // τ = M^s q̈ + h − Q(τ = 0)
-  evaluate(model, ws, q, qd, VecX());
-  ws.tau.noalias() = ws.Ms * qdd;
-  ws.tau += ws.h - ws.Q;
+  // τ = M^s q̈ + h − Q(τ = 0) = Tᵀ (M (T q̈ + T'[q̇,q̇]) + g(u̇,u̇) − F) − Cᵀ(spring + damper),
+  // by two kinematic sweeps and one sweep of Tᵀ: O(N_u + bodies), neither T nor M^s formed.
+  propagate(model, ws, q, qdd, {.jacobian = false, .bias = true});
+  ws.u_acc = ws.u_dot;  // T q̈
+  propagate(model, ws, q, qd, {.jacobian = false, .bias = true});
+  ws.u_acc += ws.bias;  // + T'[q̇,q̇]
+  ws.nodal.noalias() = model.M * ws.u_acc;
+  if (model.has_velocity_forces && !is_zero(qd))
+    add_velocity_forces(model, ws, ws.u_dot, ws.u_dot, ws.nodal);
+  if (model.has_nodal_forces) ws.nodal -= model.F_constant;
+  apply_transpose(model, ws, ws.nodal, ws.tau, model.has_nodal_forces ? -1.0 : 0.0);
+  for (int j = 0; j < model.n_theta(); ++j) {  // springs and dampers on θ, through Cᵀ
+    const Joint& J = model.bodies[model.theta_joint[j]].joint;
+    const double f = -J.stiffness * (ws.theta[j] - J.rest) - J.damping * ws.theta_dot[j];
+    if (f != 0) ws.tau.noalias() -= f * model.C.row(j).transpose();
+  }
 }
 
 std::vector<MatX> transform_hessian(const Model& model, Workspace& ws, const VecX& q) {

@@ -122,4 +122,39 @@ void propagate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
   propagate_bilinear(model, ws, q, qd, qd, request);
 }
 
+void apply_transpose(const Model& model, Workspace& ws, const VecX& f, VecX& y,
+                     double torque_scale) {
+  const int nb = static_cast<int>(model.bodies.size());
+  for (int b = 0; b < nb; ++b) ws.force[b].setZero(), ws.moment[b].setZero();
+  for (int i = 0; i < model.n_u(); ++i) {
+    if (f[i] == 0) continue;
+    const SystemDof& d = model.dofs[i];
+    if (d.kind == DofKind::Translation) {
+      const SystemNode& node = model.nodes[d.carrier];
+      const BodyState& B = ws.body[node.body];
+      const Vec3 F = f[i] * Vec3::Unit(d.axis);
+      ws.force[node.body] += F;
+      ws.moment[node.body] += (B.R * node.r).cross(F);
+    } else {
+      ws.moment[d.carrier] += f[i] * ws.body[d.carrier].R.col(d.axis);
+    }
+  }
+  if (torque_scale != 0)
+    for (const BodyTorque& t : model.torques) ws.moment[t.body] += torque_scale * t.torque;
+  for (int b = nb - 1; b >= 0; --b) {  // children after parents in the list: leaves first
+    const Body& body = model.bodies[b];
+    const Joint& j = body.joint;
+    if (j.theta >= 0) {
+      const Vec3 s = ws.body[b].R * j.axis;  // the body frame is the joint frame after motion
+      ws.tau_theta[j.theta] = s.dot(j.type == JointType::Revolute ? ws.moment[b] : ws.force[b]);
+    }
+    if (body.parent >= 0) {
+      const Vec3 r = ws.body[b].p - ws.body[body.parent].p;
+      ws.force[body.parent] += ws.force[b];
+      ws.moment[body.parent] += ws.moment[b] + r.cross(ws.force[b]);
+    }
+  }
+  y.noalias() = model.C.transpose() * ws.tau_theta;
+}
+
 }  // namespace femdyn

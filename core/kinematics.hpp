@@ -38,4 +38,15 @@ void propagate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
 void propagate_bilinear(const Model& model, Workspace& ws, const VecX& q, const VecX& x,
                         const VecX& y, KinematicsRequest request);
 
+// y = Tᵀ f (+ the generalized force of body torques × torque_scale) without forming T, by the
+// principle of virtual work on the tree: each nodal force is gathered into its carrier body's
+// wrench (force F_b and moment N_b about the body origin, world frame: a translation DOF of
+// node x pushes e_k f_i at x, a rotation DOF turns by f_i about the body axis R_b e_k), the
+// wrenches are accumulated from the leaves to the root,
+//     F_p += F_b,   N_p += N_b + (p_b − p_p) × F_b,
+// and projected on each joint's world axis s: τ_θ = sᵀ N_b (revolute), sᵀ F_b (prismatic);
+// then y = Cᵀ τ_θ. O(N_u + bodies). Uses the body poses of the last propagate.
+void apply_transpose(const Model& model, Workspace& ws, const VecX& f, VecX& y,
+                     double torque_scale = 0);
+
 }  // namespace femdyn

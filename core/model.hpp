@@ -75,6 +75,12 @@ struct PointLoad {
 };
 
 struct Model {
+  Model() = default;
+  // Movable into containers. Eigen 3.4's SparseMatrix has no move constructor, so moving M
+  // copies it: an out-of-memory there terminates rather than throws.
+  Model(Model&&) noexcept = default;
+  Model& operator=(Model&&) noexcept = default;
+
   std::string name;
   std::string where;  // the source, for messages
   Vec3 gravity = Vec3::Zero();

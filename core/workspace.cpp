@@ -16,6 +16,10 @@ Workspace::Workspace(const Model& model) : solver(model) {
   u_dot = VecX::Zero(N);
   nodal = VecX::Zero(N);
   MT = MatX::Zero(N, n);
+  u_acc = VecX::Zero(N);
+  force.assign(nb, Vec3::Zero());
+  moment.assign(nb, Vec3::Zero());
+  tau_theta = VecX::Zero(nt);
   for (const ElementEntry& e : model.elements) {
     const auto k = static_cast<Eigen::Index>(e.table_row.size());
     local_x.emplace_back(VecX::Zero(k));

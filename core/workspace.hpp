@@ -30,6 +30,9 @@ struct Workspace {
   VecX u_dot;                      // u̇ = T q̇
   VecX nodal;                      // M T'[q̇,q̇] + g, then nodal forces F (N_u)
   MatX MT;                         // M T (N_u x n)
+  VecX u_acc;                      // T q̈ + T'[q̇,q̇] (inverse dynamics)
+  std::vector<Vec3> force, moment; // per body: wrench of Tᵀ f (world; moment about the origin)
+  VecX tau_theta;                  // Tᵀ f on the joint coordinates θ
   std::vector<VecX> local_x, local_y, local_g;  // per element local DOF buffers (6k)
 
   // System equations M^s q̈ + h = Q at the last evaluated state.
