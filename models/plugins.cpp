@@ -4,6 +4,7 @@
 
 #include "models/dexterous_finger.hpp"
 #include "models/hand.hpp"
+#include "models/random_tree.hpp"
 
 namespace femdyn {
 
@@ -13,6 +14,8 @@ static const std::array kPlugins = {
                 "the paper's 4-joint finger of space bars (lumping exact or the paper's)"},
     ModelPlugin{"dexterous_hand", &dexterous_hand,
                 "a palm on a 2-DOF wrist with four fingers and a thumb"},
+    ModelPlugin{"random_tree", &random_tree,
+                "a seeded random tree or chain of rigid bodies (tests, studies, benchmarks)"},
 };
 
 std::span<const ModelPlugin> model_plugins() { return kPlugins; }

@@ -181,3 +181,13 @@ TEST_CASE("keys that would be ignored are refused", "[errors]") {
       "loads": [{"body": "a", "node": "tip", "point": [0.5, 0, 0], "force": [0, 1, 0]}]})"),
              Equals("bad.json: /loads/0/point: give either point or node, not both"));
 }
+
+TEST_CASE("random_tree plugin parameters are checked", "[errors]") {
+  CHECK_THAT(error_of(R"({"model": "random_tree", "params": {"bodies": 0}})"),
+             Equals("bad.json: /params/bodies: expected an integer from 1 to 10000"));
+  CHECK_THAT(error_of(R"({"model": "random_tree", "params": {"branching": 2}})"),
+             Equals("bad.json: /params/branching: expected a number in [0, 1]"));
+  CHECK_THAT(error_of(R"({"model": "random_tree", "params": {"seed": 1.5}})"),
+             Equals("bad.json: /params/seed: expected an integer >= 0"));
+  CHECK(error_of(R"({"model": "random_tree", "params": {"seed": 3, "bodies": 30}})") == "(no error)");
+}

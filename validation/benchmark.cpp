@@ -69,45 +69,6 @@ std::vector<std::unique_ptr<Case>>& cases() {
   return all;
 }
 
-std::string vec(double a, double b, double c) {
-  std::ostringstream o;
-  o.precision(17);
-  o << "[" << a << ", " << b << ", " << c << "]";
-  return o.str();
-}
-
-// A seeded random serial chain as model JSON (after tests/helpers.cpp random_tree_json):
-// random axes, offsets and rpy, full physical inertia tensors, one prismatic joint in four.
-std::string random_chain_json(unsigned seed, int bodies) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0), pos(0.2, 1.0);
-  std::ostringstream o;
-  o.precision(17);
-  o << "{\"name\": \"random chain " << seed << "\", \"gravity\": " << vec(0.1, -0.2, -9.81)
-    << ", \"bodies\": [";
-  for (int b = 0; b < bodies; ++b) {
-    const bool slide = rng() % 4 == 0;
-    const double sa = pos(rng), sb = pos(rng), sc = pos(rng), mass = pos(rng);
-    const Vec3 principal(sb + sc, sa + sc, sa + sb);
-    const Mat3 R = rpy_to_rotation(Vec3(u(rng), u(rng), u(rng)) * 3);
-    const Mat3 I = 0.05 * mass * R * principal.asDiagonal() * R.transpose();
-    o << (b ? ", " : "") << "{\"name\": \"b" << b << "\", \"parent\": \"";
-    if (b == 0)
-      o << "world";
-    else
-      o << "b" << b - 1;
-    o << "\", \"joint\": {\"type\": \"" << (slide ? "prismatic" : "revolute") << "\", "
-      << "\"axis\": " << vec(u(rng), u(rng), u(rng)) << ", \"origin\": {\"xyz\": "
-      << vec(0.5 * u(rng), 0.5 * u(rng), 0.5 * u(rng)) << ", \"rpy\": "
-      << vec(u(rng), u(rng), u(rng)) << "}}, \"elements\": [{\"type\": \"rigid_body\", "
-      << "\"mass\": " << mass << ", \"com\": " << vec(0.3 * u(rng), 0.3 * u(rng), 0.3 * u(rng))
-      << ", \"inertia\": [" << vec(I(0, 0), I(0, 1), I(0, 2)) << ", "
-      << vec(I(1, 0), I(1, 1), I(1, 2)) << ", " << vec(I(2, 0), I(2, 1), I(2, 2)) << "]}]}";
-  }
-  o << "]}";
-  return o.str();
-}
-
 double rel_diff(const MatX& a, const MatX& b) {
   return (a - b).cwiseAbs().maxCoeff() / std::max(b.cwiseAbs().maxCoeff(), 1e-6);
 }
@@ -184,7 +145,10 @@ int main(int argc, char** argv) {
     for (const char* name : {"pendulum", "spatial_double_pendulum", "branched_tree", "finger",
                              "finger_coupled", "hand"})
       add_case(name, load_model(dir + name + ".json"));
-    add_case("random_chain20", compile(parse_spec(random_chain_json(20, 20), "random_chain20")));
+    add_case("random_chain20",
+             compile(parse_spec(R"({"model": "random_tree", "params": {"seed": 20, "bodies": 20},
+                                    "gravity": [0.1, -0.2, -9.81]})",
+                                "random_chain20")));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "femdyn_bench: %s\n", e.what());
     return 1;
