@@ -5,6 +5,7 @@
 #include <map>
 #include <set>
 
+#include "core/body_inertia.hpp"
 #include "core/correlation.hpp"
 #include "core/errors.hpp"
 #include "core/model.hpp"
@@ -177,6 +178,7 @@ Model compile(MechanismSpec spec) {
   }
   compile_coupling(spec, m);
   build_node_level(spec, body_of_spec, m);
+  condense_body_inertia(m);
   check_mass_matrix(m);
   return m;
 }

@@ -30,20 +30,13 @@ void add_velocity_forces(const Model& model, Workspace& ws, const X& x, const Y&
   }
 }
 
-// Q = Tᵀ F + Cᵀ(spring + damper) + τ, with F = F_constant + body torques (R_bᵀ τ_w).
+// Q = Tᵀ F + Cᵀ(spring + damper) + τ, with F = F_constant + body torques. Tᵀ F by the
+// backward sweep (T need not be formed).
 void assemble_forces(const Model& model, Workspace& ws, const VecX& tau, bool with_rates) {
-  // No gravity, no loads: no nodal forces to map.
-  if (model.has_nodal_forces) {
-    ws.nodal = model.F_constant;
-    for (const BodyTorque& t : model.torques) {
-      const Vec3 tb = ws.body[t.body].R.transpose() * t.torque;
-      for (int k = 0; k < 3; ++k)
-        if (model.body_rot_dof[t.body][k] >= 0) ws.nodal[model.body_rot_dof[t.body][k]] += tb[k];
-    }
-    ws.Q.noalias() = ws.T.transpose() * ws.nodal;
-  } else {
+  if (model.has_nodal_forces)  // no gravity, no loads: no nodal forces to map
+    apply_transpose(model, ws, model.F_constant, ws.Q, 1.0);
+  else
     ws.Q.setZero();
-  }
   // Joint springs and dampers act on θ; the coupling level maps them to q by Cᵀ.
   for (int j = 0; j < model.n_theta(); ++j) {
     const Joint& J = model.bodies[model.theta_joint[j]].joint;
@@ -55,18 +48,51 @@ void assemble_forces(const Model& model, Workspace& ws, const VecX& tau, bool wi
   if (tau.size() == ws.Q.size()) ws.Q += tau;
 }
 
+// M^s = Σ_b J_bᵀ Λ_b^w J_b over the coordinates P_b that move body b (core/body_inertia.hpp),
+// Λ_b^w = diag(R_b, R_b) Λ_b diag(R_b, R_b)ᵀ. Needs the body Jacobians of the last propagate.
+void condensed_mass(const Model& model, Workspace& ws) {
+  ws.Ms.setZero();
+  for (std::size_t b = 0; b < model.bodies.size(); ++b) {
+    const std::vector<int>& P = model.body_coords[b];
+    const Mat6& L = model.body_inertia[b];
+    const auto p = static_cast<Eigen::Index>(P.size());
+    if (p == 0 || L.isZero(0)) continue;
+    const Mat3& R = ws.body[b].R;
+    Mat6 Lw;
+    Lw.topLeftCorner<3, 3>() = R * L.topLeftCorner<3, 3>() * R.transpose();
+    Lw.topRightCorner<3, 3>() = R * L.topRightCorner<3, 3>() * R.transpose();
+    Lw.bottomLeftCorner<3, 3>() = R * L.bottomLeftCorner<3, 3>() * R.transpose();
+    Lw.bottomRightCorner<3, 3>() = R * L.bottomRightCorner<3, 3>() * R.transpose();
+    auto J = ws.Jb.leftCols(p);
+    for (Eigen::Index c = 0; c < p; ++c) {
+      J.col(c).head<3>() = ws.Jw.block<3, 1>(3 * b, P[c]);
+      J.col(c).tail<3>() = ws.Jv.block<3, 1>(3 * b, P[c]);
+    }
+    auto LJ = ws.LJb.leftCols(p);
+    LJ.noalias() = Lw * J;
+    auto Mb = ws.Mb.topLeftCorner(p, p);
+    Mb.noalias() = J.transpose() * LJ;
+    for (Eigen::Index c = 0; c < p; ++c)
+      for (Eigen::Index r = 0; r < p; ++r) ws.Ms(P[r], P[c]) += Mb(r, c);
+  }
+}
+
 bool is_zero(const VecX& v) { return v.size() == 0 || v.cwiseAbs().maxCoeff() == 0.0; }
 
 }  // namespace
 
 void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau) {
   const bool moving = !is_zero(qd);
-  propagate(model, ws, q, qd, {.jacobian = true, .bias = moving});
+  propagate(model, ws, q, qd, {.jacobian = true, .bias = moving, .rows = !model.condensed});
   if (!moving) ws.theta_dot.setZero();
 
-  // M^s = Tᵀ (M T)
-  ws.MT.noalias() = model.M * ws.T;
-  ws.Ms.noalias() = ws.T.transpose() * ws.MT;
+  if (model.condensed) {
+    condensed_mass(model, ws);  // M^s body by body; T is not formed
+  } else {
+    // M^s = Tᵀ (M T)
+    ws.MT.noalias() = model.M * ws.T;
+    ws.Ms.noalias() = ws.T.transpose() * ws.MT;
+  }
   // Symmetric in exact arithmetic; mirror the upper triangle so it is in floating point too.
   for (Eigen::Index j = 0; j < ws.Ms.cols(); ++j)
     for (Eigen::Index i = j + 1; i < ws.Ms.rows(); ++i) ws.Ms(i, j) = ws.Ms(j, i);
@@ -75,7 +101,7 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
   if (moving) {
     ws.nodal.noalias() = model.M * ws.bias;
     if (model.has_velocity_forces) add_velocity_forces(model, ws, ws.u_dot, ws.u_dot, ws.nodal);
-    ws.h.noalias() = ws.T.transpose() * ws.nodal;
+    apply_transpose(model, ws, ws.nodal, ws.h);
   } else {
     ws.h.setZero();
   }

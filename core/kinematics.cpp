@@ -52,6 +52,8 @@ void propagate_tree(const Model& model, Workspace& ws, KinematicsRequest req) {
 
 // Node level: rows of T, T'[q̇,q̇] and u̇ for every kept transition coordinate.
 void propagate_nodes(const Model& model, Workspace& ws, KinematicsRequest req) {
+  req.jacobian = req.jacobian && req.rows;
+  if (!req.jacobian && !req.bias) return;
   for (std::size_t n = 0; n < model.nodes.size(); ++n) {
     const auto& idx = model.node_dof[n];
     if (idx[0] < 0 && idx[1] < 0 && idx[2] < 0) continue;
@@ -109,7 +111,7 @@ void propagate_bilinear(const Model& model, Workspace& ws, const VecX& q, const 
   propagate_tree(model, ws, request);
   propagate_nodes(model, ws, request);
   for (const auto& [copy, original] : model.dof_alias) {
-    if (request.jacobian) ws.T.row(copy) = ws.T.row(original);
+    if (request.jacobian && request.rows) ws.T.row(copy) = ws.T.row(original);
     if (request.bias) {
       ws.bias[copy] = ws.bias[original];
       ws.u_dot[copy] = ws.u_dot[original];

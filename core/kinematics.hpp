@@ -25,8 +25,9 @@
 namespace femdyn {
 
 struct KinematicsRequest {
-  bool jacobian = true;  // T (needed for M^s, Q)
+  bool jacobian = true;  // body Jacobians Jω, Jv, and with `rows` the rows of T
   bool bias = true;      // T'[x, y] and u̇ = T x (needed for h)
+  bool rows = true;      // form T itself (not needed when M^s is condensed by body)
 };
 
 // Fills ws.theta, ws.theta_dot, ws.body, and per request ws.T / ws.bias / ws.u_dot, with

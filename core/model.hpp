@@ -18,6 +18,7 @@
 namespace femdyn {
 
 using SpMat = Eigen::SparseMatrix<double>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
 
 struct Joint {
   std::string name;
@@ -108,6 +109,12 @@ struct Model {
   VecX F_constant;   // nodal forces that do not depend on the state (gravity, point loads)
   std::vector<BodyTorque> torques;
   std::vector<PointLoad> point_loads;
+  // Body level (core/body_inertia.hpp): M^s = Σ_b J_bᵀ Λ_b J_b when `condensed`.
+  std::vector<Mat6> body_inertia;             // Λ_b: Σ X_eᵀ m_e X_e, twist (ω, v) in body axes
+  std::vector<std::vector<int>> body_coords;  // coordinates that move body b, ascending
+  bool condensable = false;  // the body-level form is exact for this model
+  bool condensed = false;    // ... and cheaper than the dense Tᵀ M T: evaluate() uses it
+
   bool has_nodal_forces = false;     // gravity or loads present
   bool has_velocity_forces = false;  // some element has a gyroscopic term
 

@@ -1,5 +1,7 @@
 #include "core/workspace.hpp"
 
+#include <algorithm>
+
 namespace femdyn {
 
 Workspace::Workspace(const Model& model) : solver(model) {
@@ -17,6 +19,10 @@ Workspace::Workspace(const Model& model) : solver(model) {
   nodal = VecX::Zero(N);
   MT = MatX::Zero(N, n);
   u_acc = VecX::Zero(N);
+  std::size_t p = 0;
+  for (const auto& c : model.body_coords) p = std::max(p, c.size());
+  Jb = LJb = MatX::Zero(6, static_cast<Eigen::Index>(p));
+  Mb = MatX::Zero(static_cast<Eigen::Index>(p), static_cast<Eigen::Index>(p));
   force.assign(nb, Vec3::Zero());
   moment.assign(nb, Vec3::Zero());
   tau_theta = VecX::Zero(nt);

@@ -58,7 +58,7 @@ TEST_CASE("the paper's N_m and diagonal system mass are reproduced entry by entr
   Workspace ws(m);
   VecX q(4);
   q << 0.3, 0.4, 0.5, 0.6;
-  evaluate(m, ws, q, VecX::Zero(4), VecX());
+  propagate(m, ws, q, VecX::Zero(4), {.jacobian = true, .bias = false});  // forms T
   MatX Trot(5, 4);
   Trot << 1, 0, 0, 0, 0, 1, 0, 0, 0, 1, 1, 0, 0, 1, 1, 1, 0, 1, 1, 1;
   const int rot_rows[5] = {0, 3, 7, 11, 15};
