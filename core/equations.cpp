@@ -30,11 +30,31 @@ void add_velocity_forces(const Model& model, Workspace& ws, const X& x, const Y&
   }
 }
 
-// Q = Tᵀ F + Cᵀ(spring + damper) + τ, with F = F_constant + body torques. Tᵀ F by the
-// backward sweep (T need not be formed).
+// y = Tᵀ f (+ the body torques): after evaluate(), by the formed T where evaluate formed it
+// (small models: one dense product is cheapest), otherwise by the backward sweep.
+void generalized_force(const Model& model, Workspace& ws, const VecX& f, VecX& y,
+                       bool with_torques) {
+  if (model.condensed) {
+    apply_transpose(model, ws, f, y, with_torques ? 1.0 : 0.0);
+    return;
+  }
+  if (!with_torques || model.torques.empty()) {
+    y.noalias() = ws.T.transpose() * f;
+    return;
+  }
+  ws.u_acc = f;  // + R_bᵀ τ on the body's rotation DOFs (body axes)
+  for (const BodyTorque& t : model.torques) {
+    const Vec3 tb = ws.body[t.body].R.transpose() * t.torque;
+    for (int k = 0; k < 3; ++k)
+      if (model.body_rot_dof[t.body][k] >= 0) ws.u_acc[model.body_rot_dof[t.body][k]] += tb[k];
+  }
+  y.noalias() = ws.T.transpose() * ws.u_acc;
+}
+
+// Q = Tᵀ F + Cᵀ(spring + damper) + τ, with F = F_constant + body torques.
 void assemble_forces(const Model& model, Workspace& ws, const VecX& tau, bool with_rates) {
   if (model.has_nodal_forces)  // no gravity, no loads: no nodal forces to map
-    apply_transpose(model, ws, model.F_constant, ws.Q, 1.0);
+    generalized_force(model, ws, model.F_constant, ws.Q, true);
   else
     ws.Q.setZero();
   // Joint springs and dampers act on θ; the coupling level maps them to q by Cᵀ.
@@ -101,7 +121,7 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
   if (moving) {
     ws.nodal.noalias() = model.M * ws.bias;
     if (model.has_velocity_forces) add_velocity_forces(model, ws, ws.u_dot, ws.u_dot, ws.nodal);
-    apply_transpose(model, ws, ws.nodal, ws.h);
+    generalized_force(model, ws, ws.nodal, ws.h, false);
   } else {
     ws.h.setZero();
   }
