@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 #include <array>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -179,3 +180,25 @@ TEST_CASE("validate: table and exit 0 on a good model, JSON, exit 1 when it cann
   CHECK_THAT(wrong_tol.out, Catch::Contains("--states expects one integer >= 1"));
 }
 #endif
+
+TEST_CASE("import writes JSON that loads back, atomically, or nothing at all", "[cli][urdf]") {
+  const std::string out = (std::filesystem::temp_directory_path() / "femdyn_cli_arm7.json").string();
+  std::filesystem::remove(out);
+  const Run ok = run("import " + model_path("urdf/arm7.urdf") + " -o " + out);
+  REQUIRE(ok.code == 0);
+  const Run a = run("equations " + model_path("urdf/arm7.urdf") + " --q 0.1,0.2,0.3,0.4,0.5,0.6,0.7 --json");
+  const Run b = run("equations " + out + " --q 0.1,0.2,0.3,0.4,0.5,0.6,0.7 --json");
+  REQUIRE(a.code == 0);
+  CHECK(a.out == b.out);  // the same equations, digit for digit
+  CHECK(nlohmann::json::parse(b.out).at("coordinates").at(0) == "joint1");
+  // A URDF that does not load writes nothing.
+  const std::string bad = (std::filesystem::temp_directory_path() / "femdyn_cli_bad.urdf").string();
+  std::ofstream(bad) << "<robot name=\"r\"><link name=\"a\"/><link name=\"b\"/></robot>";
+  const std::string bad_out = out + ".bad.json";
+  std::filesystem::remove(bad_out);
+  const Run no = run("import " + bad + " -o " + bad_out);
+  CHECK(no.code == 1);
+  CHECK_THAT(no.out, Catch::Contains("more than one root link"));
+  CHECK_FALSE(std::filesystem::exists(bad_out));
+  CHECK(run("import " + model_path("urdf/arm7.urdf")).code == 2);  // no -o
+}
