@@ -23,7 +23,8 @@ state for T seconds (default 0.25; 0 skips): femdyn by RK4 (step 1 ms, halved un
 error estimate is below 1e-9), Simbody by RungeKuttaMerson at accuracy 1e-10 and 1e-12, and
 compares the joint states (θ, θ̇) over time against 10x the sum of both error estimates.
 Exit 1 if any check fails. --json: one object per model (an array for several models);
---markdown: one table row per model (docs/validation.md).
+--markdown: one table row per model (docs/validation.md). The JSON has the whole series: the
+trajectory's sample times "t", "state_error" and the energy of both runs.
 )";
 
 std::string sci(double x) {
@@ -44,7 +45,9 @@ Json report_json(const std::string& path, const validation::ValidationReport& r)
                {"simbody_error_estimate", t.simbody_error_estimate}, {"resolved", t.resolved},
                {"tolerance", t.tolerance},
                {"energy_change", {{"femdyn", t.energy_change_femdyn}, {"simbody", t.energy_change_simbody}}},
-               {"pass", t.pass()}};
+               {"pass", t.pass()},
+               {"t", t.t}, {"state_error", t.error},
+               {"energy", {{"femdyn", t.energy_femdyn}, {"simbody", t.energy_simbody}}}};
   if (!t.run) traj["skipped"] = t.skipped;
   return {{"model", path}, {"states", r.states}, {"coordinates", r.n},
           {"tolerance", r.quantities.empty() ? 0.0 : r.quantities[0].tolerance},
@@ -77,6 +80,14 @@ void print_text(const std::string& path, const validation::ValidationReport& r) 
               << sci(t.energy_change_simbody) << " J)\n";
   else
     std::cout << "trajectory not compared: " << t.skipped << "\n";
+  if (t.run && !t.error.empty()) {  // the state error over time, at five of the samples
+    std::cout << "  state error over time:";
+    for (std::size_t k = 0; k < 5; ++k) {
+      const std::size_t i = k * (t.t.size() - 1) / 4;
+      std::cout << "  t=" << t.t[i] << " s " << sci(t.error[i]);
+    }
+    std::cout << "\n";
+  }
   if (t.run && !t.resolved)
     std::cout << "trajectory unresolved: the integrators' own error estimates exceed 1e-6 of the "
                  "state; the motion is too fast or chaotic over this time (try a shorter --t-end)\n";

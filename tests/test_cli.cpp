@@ -170,6 +170,12 @@ TEST_CASE("validate: table and exit 0 on a good model, JSON, exit 1 when it cann
   for (const char* q : {"M", "h", "Q", "qdd", "tau"}) CHECK(j.at("max_rel_error").at(q).get<double>() < 1e-10);
   CHECK(j.at("trajectory").at("t_end") == 0.05);
   CHECK(j.at("trajectory").at("max_state_error").get<double>() < 1e-6);
+  const auto& traj = j.at("trajectory");
+  REQUIRE(traj.at("t").size() == traj.at("state_error").size());
+  REQUIRE(traj.at("energy").at("femdyn").size() == traj.at("t").size());
+  for (std::size_t i = 0; i < traj.at("t").size(); ++i)  // the same energy in both engines
+    CHECK(traj.at("energy").at("femdyn")[i].get<double>() ==
+          Approx(traj.at("energy").at("simbody")[i].get<double>()).margin(1e-12));
 
   const Run paper = run("validate " + model_path("finger_paper.json") + " --states 2");
   CHECK(paper.code == 1);

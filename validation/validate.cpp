@@ -132,6 +132,8 @@ TrajectoryReport compare_trajectory(const Model& m, SimbodyTwin& twin, const Vec
     const double err = max_abs(x_half[i] - xt);  // the finer runs of both
     r.t.push_back(times[i]);
     r.error.push_back(err);
+    r.energy_femdyn.push_back(e_half[i]);
+    r.energy_simbody.push_back(tight[i].energy);
     r.max_state_error = std::max(r.max_state_error, err);
     // RK4 is 4th order: x_dt − x_exact ≈ 16/15 (x_dt − x_dt/2); the finer run is 16x better.
     r.rk4_error_estimate = std::max(r.rk4_error_estimate, max_abs(x[i] - x_half[i]) / 15);

@@ -45,6 +45,7 @@ struct TrajectoryReport {
   double tolerance = 0;
   double energy_change_femdyn = 0, energy_change_simbody = 0;  // max |E(t) − E(0)|
   std::vector<double> t, error;  // the state error over time
+  std::vector<double> energy_femdyn, energy_simbody;  // E(t) of both runs (J; each with its own zero)
   bool pass() const { return !run || (resolved && max_state_error <= tolerance); }
 };
 
