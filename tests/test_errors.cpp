@@ -111,12 +111,12 @@ TEST_CASE("a massless chain end makes M^s singular: named at its joint", "[error
   // Body b has no elements: its joint moves nothing.
   CHECK_THAT(error_of(chain(R"({"name": "wrist", "type": "revolute", "axis": [0, 1, 0]})", "[]")),
              Equals("bad.json: /bodies/1/joint: the mass matrix M^s is singular: coordinate "
-                    "'wrist' moves no inertia (massless chain end?)"));
+                    "'wrist' moves no inertia (a massless chain end, or all its mass on the joint axis?)"));
   // A point mass on the joint axis also moves no inertia with that joint.
   CHECK_THAT(error_of(chain(R"({"name": "spin", "type": "revolute", "axis": [1, 0, 0]})",
                             R"([{"type": "lumped_point", "node": [0.3, 0, 0], "mass": 1}])")),
              Equals("bad.json: /bodies/1/joint: the mass matrix M^s is singular: coordinate "
-                    "'spin' moves no inertia (massless chain end?)"));
+                    "'spin' moves no inertia (a massless chain end, or all its mass on the joint axis?)"));
 }
 
 TEST_CASE("explicit correlation tables are checked", "[errors]") {
