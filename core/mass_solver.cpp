@@ -153,7 +153,8 @@ Status MassSolver::factorize(const MatX& Ms) {
   for (Eigen::Index a = 0; a < n; ++a)
     if (!(Ms(a, a) > 1e-13 * scale))
       return {false, "the mass matrix M^s is singular: coordinate '" + names_.at(a) +
-                         "' moves no inertia (a massless chain end, or all its mass on the joint axis?)",
+                         "' moves no inertia (a massless chain end, or all its mass on the "
+                         "joint axis?)",
               static_cast<int>(a)};
   if (kind_ == SolverKind::Dense) {
     impl_->dense.compute(Ms);
