@@ -72,12 +72,21 @@ void set_dofs(Model& m, const std::vector<SystemDof>& dofs) {
 
 // Rows of T at seeded random states: a row that is zero at all of them is a DOF that never
 // moves (T is analytic in q, so a non-zero row vanishes only on a set of measure zero).
-std::vector<MatX> sample_T(const Model& m) {
-  std::vector<MatX> out;
+// `row_max` is the largest |T_ia| of each row over the samples; the samples themselves are kept
+// only when an explicit table must be checked motion by motion (they are N_u x n each).
+struct TSamples {
+  VecX row_max;
+  std::vector<MatX> T;
+};
+
+TSamples sample_T(const Model& m, bool keep) {
+  TSamples out;
+  out.row_max = VecX::Zero(m.n_u());
   Workspace ws(m);
   for (const VecX& q : sample_states(m, 3)) {
     propagate(m, ws, q, VecX::Zero(m.n()), {.jacobian = true, .bias = false});
-    out.push_back(ws.T);
+    if (m.n() > 0) out.row_max = out.row_max.cwiseMax(ws.T.cwiseAbs().rowwise().maxCoeff());
+    if (keep) out.T.push_back(ws.T);
   }
   return out;
 }
@@ -89,14 +98,10 @@ double length_scale(const Model& m) {
   return L;
 }
 
-bool moves(const std::vector<MatX>& Ts, int i, double tol) {
-  for (const MatX& T : Ts)
-    if (T.row(i).cwiseAbs().maxCoeff() > tol) return true;
-  return false;
-}
+bool moves(const TSamples& Ts, int i, double tol) { return Ts.row_max[i] > tol; }
 
-bool same_motion(const std::vector<MatX>& Ts, int i, int j, double tol) {
-  for (const MatX& T : Ts)
+bool same_motion(const TSamples& Ts, int i, int j, double tol) {
+  for (const MatX& T : Ts.T)
     if ((T.row(i) - T.row(j)).cwiseAbs().maxCoeff() > tol) return false;
   return true;
 }
@@ -188,7 +193,7 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
 
   // Which candidates move at all.
   set_dofs(m, cand.list);
-  const std::vector<MatX> Ts = sample_T(m);
+  const TSamples Ts = sample_T(m, spec.correlation.has_value());
   const double tol = 1e-10 * length_scale(m);
   const int nc = static_cast<int>(cand.list.size());
 

@@ -110,6 +110,8 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
     condensed_mass(model, ws);  // M^s body by body; T is not formed
   } else {
     // M^s = Tᵀ (M T)
+    if (ws.MT.rows() != ws.T.rows() || ws.MT.cols() != ws.T.cols())
+      ws.MT.resize(ws.T.rows(), ws.T.cols());  // first use only
     ws.MT.noalias() = model.M * ws.T;
     ws.Ms.noalias() = ws.T.transpose() * ws.MT;
   }

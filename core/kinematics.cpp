@@ -54,6 +54,8 @@ void propagate_tree(const Model& model, Workspace& ws, KinematicsRequest req) {
 void propagate_nodes(const Model& model, Workspace& ws, KinematicsRequest req) {
   req.jacobian = req.jacobian && req.rows;
   if (!req.jacobian && !req.bias) return;
+  if (req.jacobian && (ws.T.rows() != model.n_u() || ws.T.cols() != model.n()))
+    ws.T.setZero(model.n_u(), model.n());  // first use only
   for (std::size_t n = 0; n < model.nodes.size(); ++n) {
     const auto& idx = model.node_dof[n];
     if (idx[0] < 0 && idx[1] < 0 && idx[2] < 0) continue;

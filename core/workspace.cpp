@@ -13,11 +13,11 @@ Workspace::Workspace(const Model& model) : solver(model) {
   body.assign(nb, BodyState{});
   Jw = MatX::Zero(3 * nb, n);
   Jv = MatX::Zero(3 * nb, n);
-  T = MatX::Zero(N, n);
+  // T (N_u x n) and M T are sized on first use: a model whose M^s is condensed by body never
+  // forms them in evaluate(), and at thousands of bodies they are the largest buffers.
   bias = VecX::Zero(N);
   u_dot = VecX::Zero(N);
   nodal = VecX::Zero(N);
-  MT = MatX::Zero(N, n);
   u_acc = VecX::Zero(N);
   std::size_t p = 0;
   for (const auto& c : model.body_coords) p = std::max(p, c.size());

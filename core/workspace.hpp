@@ -25,11 +25,11 @@ struct Workspace {
   VecX theta, theta_dot, theta_dot_y;  // θ, θ̇ (= C x), C y
   std::vector<BodyState> body;     // per body
   MatX Jw, Jv;                     // body Jacobians in q: rows 3b..3b+2 of body b (3nb x n)
-  MatX T;                          // T = ∂u/∂q (N_u x n)
+  MatX T;                          // T = ∂u/∂q (N_u x n), sized when first formed
   VecX bias;                       // T'[q̇,q̇] (N_u)
   VecX u_dot;                      // u̇ = T q̇
   VecX nodal;                      // M T'[q̇,q̇] + g, then nodal forces F (N_u)
-  MatX MT;                         // M T (N_u x n)
+  MatX MT;                         // M T (N_u x n), sized when first formed
   VecX u_acc;                      // T q̈ + T'[q̇,q̇] (inverse dynamics)
   MatX Jb, LJb, Mb;                // body level: J_b (6 x p), Λ_b J_b, J_bᵀ Λ_b J_b (p x p)
   std::vector<Vec3> force, moment; // per body: wrench of Tᵀ f (world; moment about the origin)
