@@ -1,0 +1,38 @@
+// An independent Simbody model of a URDF file, built from the XML directly — not from femdyn's
+// import (io/urdf_loader) — so that comparing it with femdyn's equations of the same file checks
+// the import itself: the rpy convention (Simbody's own space-fixed X-Y-Z sequence), the rotation
+// of the inertia out of the <inertial> frame (Inertia::reexpress) and its shift to the link
+// origin, the tree, fixed joints, axes, mimic couplings, damping and gravity (0, 0, −9.81).
+// Like twin.hpp, this header uses only Eigen; urdf_twin.cpp is C++17 without NDEBUG.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+namespace femdyn::validation {
+
+struct UrdfTwinEquations {
+  Eigen::MatrixXd M;
+  Eigen::VectorXd h, Q;  // Q: gravity and joint damping (no actuation)
+};
+
+class UrdfTwin {
+ public:
+  explicit UrdfTwin(const std::string& urdf_path);  // throws std::runtime_error
+  ~UrdfTwin();
+  UrdfTwin(const UrdfTwin&) = delete;
+  UrdfTwin& operator=(const UrdfTwin&) = delete;
+
+  // The equations in the coordinates `names` (movable, non-mimic joints by name, in any order):
+  // Simbody's over all joints, reduced by the mimic relations θ_j = k θ_leader + offset.
+  UrdfTwinEquations equations(const std::vector<std::string>& names, const Eigen::VectorXd& q,
+                              const Eigen::VectorXd& qd);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace femdyn::validation
