@@ -84,6 +84,17 @@ TEST_CASE("URDF <inertial> rpy rotates the inertia into the link frame", "[urdf]
     // M^s about x through the origin = I_xx(link) + m (0.1)².
     CHECK(ws.Ms(0, 0) == Approx(expected + 2.0 * 0.01).epsilon(1e-6));
   }
+  // A general rpy, where R I Rᵀ and Rᵀ I R differ: about the joint axis x,
+  // M^s = e_xᵀ (R I Rᵀ) e_x + m (0.1)², R = Rz(1.1) Ry(-0.4) Rx(0.3).
+  const auto Rot = [](int axis, double a) { return Mat3(Eigen::AngleAxisd(a, Vec3::Unit(axis))); };
+  const Mat3 R = Rot(2, 1.1) * Rot(1, -0.4) * Rot(0, 0.3);
+  const Mat3 I = Vec3(1, 2, 3).asDiagonal();
+  const double expected = (R * I * R.transpose())(0, 0) + 2.0 * 0.01;
+  REQUIRE(std::abs((R.transpose() * I * R)(0, 0) + 2.0 * 0.01 - expected) > 0.1);  // tells them apart
+  const Model m = load_urdf_text(one_link(inertial(2.0, "0 0.1 0", "0.3 -0.4 1.1", 1, 2, 3)));
+  Workspace ws(m);
+  evaluate(m, ws, VecX::Zero(1), VecX::Zero(1), VecX::Zero(1));
+  CHECK(ws.Ms(0, 0) == Approx(expected).epsilon(1e-12));
 }
 
 TEST_CASE("URDF joint origin rpy is R = Rz(yaw) Ry(pitch) Rx(roll), axis in the joint frame",
