@@ -177,6 +177,10 @@ TEST_CASE("validate: table and exit 0 on a good model, JSON, exit 1 when it cann
     CHECK(traj.at("energy").at("femdyn")[i].get<double>() ==
           Approx(traj.at("energy").at("simbody")[i].get<double>()).margin(1e-12));
 
+  const Run urdf = run("validate " + model_path("urdf/arm7.urdf") + " --states 3 --t-end 0.05");
+  CHECK(urdf.code == 0);
+  CHECK_THAT(urdf.out, Catch::Contains("import "));  // the import against the XML twin
+
   const Run paper = run("validate " + model_path("finger_paper.json") + " --states 2");
   CHECK(paper.code == 1);
   CHECK_THAT(paper.out, Catch::Contains("its elements sum to no rigid body"));

@@ -11,6 +11,7 @@
 #include "core/integrate.hpp"
 #include "core/sampling.hpp"
 #include "validation/twin.hpp"
+#include "validation/urdf_twin.hpp"
 
 namespace femdyn::validation {
 
@@ -218,6 +219,30 @@ ValidationReport validate(const Model& m, const ValidationOptions& o) {
   }
   if (o.states > 0) r.trajectory = compare_trajectory(m, twin, q0, qd0, o);
   return r;
+}
+
+QuantityError validate_urdf_import(const Model& m, const std::string& path,
+                                   const ValidationOptions& o, std::string& failure) {
+  QuantityError e{"import", 0, 0, o.tolerance};
+  std::unique_ptr<UrdfTwin> twin;
+  try {
+    twin = std::make_unique<UrdfTwin>(path);
+  } catch (const std::exception& ex) {
+    failure = std::string("the independent URDF twin could not be built: ") + ex.what();
+    return e;
+  }
+  Workspace ws(m);
+  std::mt19937 rng(o.seed);
+  for (int k = 0; k < o.states; ++k) {
+    const VecX q = random_posture(m, rng);
+    const VecX qd = random_uniform(m.n(), o.qd_scale, rng);
+    evaluate(m, ws, q, qd, VecX());
+    const UrdfTwinEquations s = twin->equations(m.coordinate_names, q, qd);
+    accumulate(e, ws.Ms, s.M);
+    accumulate(e, ws.h, s.h);
+    accumulate(e, ws.Q, s.Q);
+  }
+  return e;
 }
 
 }  // namespace femdyn::validation
