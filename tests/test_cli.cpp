@@ -180,6 +180,8 @@ TEST_CASE("validate: table and exit 0 on a good model, JSON, exit 1 when it cann
   const Run urdf = run("validate " + model_path("urdf/arm7.urdf") + " --states 3 --t-end 0.05");
   CHECK(urdf.code == 0);
   CHECK_THAT(urdf.out, Catch::Contains("import "));  // the import against the XML twin
+  CHECK(run("validate " + model_path("urdf/arm7.urdf") +
+            " --states 2 --t-end 0 --gravity 0,-9.81,0").code == 0);
 
   const Run paper = run("validate " + model_path("finger_paper.json") + " --states 2");
   CHECK(paper.code == 1);

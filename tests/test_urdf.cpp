@@ -207,7 +207,7 @@ TEST_CASE("the import itself: femdyn's equations of a URDF equal an independent 
   for (const std::string& path : urdf_files()) {
     INFO(path);
     const Model m = load_model(path);
-    validation::UrdfTwin twin(path);
+    validation::UrdfTwin twin(path, Vec3(0, 0, -9.81));
     Workspace ws(m);
     std::mt19937 rng(21);
     for (int k = 0; k < 4; ++k) {

@@ -66,12 +66,14 @@ struct UrdfTwin::Impl {
   State state;
 };
 
-UrdfTwin::UrdfTwin(const std::string& path) : impl_(std::make_unique<Impl>()) {
+UrdfTwin::UrdfTwin(const std::string& path, const Eigen::Vector3d& gravity)
+    : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   tinyxml2::XMLDocument doc;
   if (doc.LoadFile(path.c_str()) != tinyxml2::XML_SUCCESS)
     throw std::runtime_error(path + ": cannot read");
   const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
+  if (!robot) throw std::runtime_error(path + ": no <robot>");
   std::map<std::string, const tinyxml2::XMLElement*> links, joint_to_child;
   for (auto* l = robot->FirstChildElement("link"); l; l = l->NextSiblingElement("link"))
     links[l->Attribute("name")] = l;
@@ -117,7 +119,9 @@ UrdfTwin::UrdfTwin(const std::string& path) : impl_(std::make_unique<Impl>()) {
       todo.emplace_back(child, mb);
     }
   }
-  Force::Gravity(s.forces, s.matter, -ZAxis, 9.81);
+  if (gravity.norm() > 0)
+    Force::Gravity(s.forces, s.matter, UnitVec3(Vec3(gravity.x(), gravity.y(), gravity.z())),
+                   gravity.norm());
   s.state = s.system.realizeTopology();
 }
 

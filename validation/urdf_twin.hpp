@@ -2,7 +2,8 @@
 // import (io/urdf_loader) — so that comparing it with femdyn's equations of the same file checks
 // the import itself: the rpy convention (Simbody's own space-fixed X-Y-Z sequence), the rotation
 // of the inertia out of the <inertial> frame (Inertia::reexpress) and its shift to the link
-// origin, the tree, fixed joints, axes, mimic couplings, damping and gravity (0, 0, −9.81).
+// origin, the tree, fixed joints, axes, mimic couplings and damping. Gravity is given (URDF has
+// none; femdyn's default for URDF is (0, 0, −9.81)).
 // Like twin.hpp, this header uses only Eigen; urdf_twin.cpp is C++17 without NDEBUG.
 #pragma once
 #include <memory>
@@ -20,7 +21,7 @@ struct UrdfTwinEquations {
 
 class UrdfTwin {
  public:
-  explicit UrdfTwin(const std::string& urdf_path);  // throws std::runtime_error
+  UrdfTwin(const std::string& urdf_path, const Eigen::Vector3d& gravity);  // throws on bad XML
   ~UrdfTwin();
   UrdfTwin(const UrdfTwin&) = delete;
   UrdfTwin& operator=(const UrdfTwin&) = delete;

@@ -226,7 +226,7 @@ QuantityError validate_urdf_import(const Model& m, const std::string& path,
   QuantityError e{"import", 0, 0, o.tolerance};
   std::unique_ptr<UrdfTwin> twin;
   try {
-    twin = std::make_unique<UrdfTwin>(path);
+    twin = std::make_unique<UrdfTwin>(path, m.gravity);
   } catch (const std::exception& ex) {
     failure = std::string("the independent URDF twin could not be built: ") + ex.what();
     return e;
