@@ -82,16 +82,16 @@ Json inertial_element(const Ctx& c, const XMLElement* link, const std::string& w
   Mat3 I;
   I << ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz;
   if (auto problem = inertia_problem(I)) c.fail(who, *problem);
-  if (m == 0) {
-    if (I.cwiseAbs().maxCoeff() > 0) c.fail(who, "zero mass with a non-zero inertia");
-    return nullptr;
-  }
+  if (m == 0 && I.cwiseAbs().maxCoeff() == 0) return nullptr;  // massless link
   // The inertia is expressed in the <inertial> origin frame: rotate it into the link frame.
   const Origin o = origin_of(c, in, who);
   const Mat3 R = rpy_to_rotation(o.rpy);
   const Mat3 I_link = R * I * R.transpose();
   Json rows = Json::array();
   for (int r = 0; r < 3; ++r) rows.push_back(vec(I_link.row(r).transpose()));
+  // Zero mass with an inertia (some exporters' placeholder links, or a pure rotor): a rotary
+  // inertia alone.
+  if (m == 0) return {{"type", "rotary_node"}, {"node", vec(o.xyz)}, {"inertia", rows}};
   return {{"type", "rigid_body"}, {"mass", m}, {"com", vec(o.xyz)}, {"inertia", rows}};
 }
 

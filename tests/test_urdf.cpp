@@ -330,3 +330,21 @@ TEST_CASE("mutated URDFs load or fail with one line, never crash", "[urdf][fuzz]
   CHECK(loaded > 0);
   CHECK(refused > 0);
 }
+
+TEST_CASE("a URDF link with inertia but zero mass is a pure rotary inertia", "[urdf]") {
+  // Some exporters write placeholder links (or rotors) this way; Simbody cannot hold them, so
+  // the closed form checks it: a rotor on an x axis has M^s = e_xᵀ (R J Rᵀ) e_x.
+  const Model m = load_urdf_text(
+      R"(<robot name="r"><link name="base"/><link name="rotor"><inertial>
+           <origin xyz="0 0 0" rpy="0.3 0.2 0.1"/><mass value="0"/>
+           <inertia ixx="0.002" iyy="0.003" izz="0.004" ixy="0" ixz="0" iyz="0"/></inertial></link>
+         <joint name="spin" type="continuous"><parent link="base"/><child link="rotor"/>
+           <axis xyz="1 0 0"/></joint></robot>)");
+  const auto Rot = [](int axis, double a) { return Mat3(Eigen::AngleAxisd(a, Vec3::Unit(axis))); };
+  const Mat3 R = Rot(2, 0.1) * Rot(1, 0.2) * Rot(0, 0.3);
+  const Mat3 J = R * Vec3(0.002, 0.003, 0.004).asDiagonal() * R.transpose();
+  Workspace ws(m);
+  evaluate(m, ws, VecX::Constant(1, 0.7), VecX::Constant(1, 3.0), VecX());
+  CHECK(ws.Ms(0, 0) == Approx(J(0, 0)).epsilon(1e-12));
+  CHECK(std::abs(ws.h[0]) < 1e-15);  // spinning about a fixed axis: no velocity force on it
+}

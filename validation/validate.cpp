@@ -176,6 +176,12 @@ ValidationReport validate(const Model& m, const ValidationOptions& o) {
     const TwinBody& tb = tm.bodies[b];
     const Mat3 I_com = tb.inertia_origin - tb.mass * (tb.com.squaredNorm() * Mat3::Identity() -
                                                       tb.com * tb.com.transpose());
+    if (tb.mass == 0 && !tb.inertia_origin.isZero(0)) {
+      r.failure += (r.failure.empty() ? "" : "; ") +
+                   ("body '" + m.bodies[b].name + "' has a rotary inertia but no mass, which a "
+                    "Simbody body cannot have");
+      continue;
+    }
     if (const auto problem = inertia_problem(I_com, tb.inertia_origin.cwiseAbs().maxCoeff()))
       r.failure += (r.failure.empty() ? "" : "; ") + ("body '" + m.bodies[b].name +
                    "': its elements sum to no rigid body (" + *problem + ")");
