@@ -10,11 +10,12 @@ namespace {
 constexpr const char* kHelp = R"(usage: femdyn import MODEL -o OUT.json [--gravity gx,gy,gz]     (-o is --output)
 
 Writes the femdyn JSON document of MODEL: a URDF robot converted (each link with an <inertial>
-becomes a body with one rigid_body element, its inertia rotated out of the <inertial> frame;
-links without one are massless (one with an inertia but zero mass becomes a rotary_node); joints keep their names, origins, axes, limits and damping,
-fixed joints are kept as fixed joints; <mimic> becomes a coupling; the root link is welded to
-the world; gravity (0, 0, -9.81) m/s^2 unless --gravity), or a plugin model expanded. The file
-loads back to the same equations. It is written atomically: a failure leaves no partial file.
+becomes a body with one rigid_body element, its inertia rotated out of the <inertial> frame; a
+link with an inertia but zero mass gets a rotary_node; links without <inertial> are massless;
+joints keep their names, origins, axes, limits and damping, fixed joints are kept as fixed
+joints; <mimic> becomes a coupling; the root link is welded to the world; gravity (0, 0, -9.81)
+m/s^2 unless --gravity), or a plugin model expanded. The file loads back to the same
+equations. It is written atomically: a failure leaves no partial file.
 )";
 
 }  // namespace
