@@ -72,8 +72,7 @@ int cmd_compare(int argc, char** argv) {
       qd = state_vector(a, "qd", A);
     } else {
       q = random_posture(A, rng);
-      qd = VecX(A.n());
-      for (int i = 0; i < A.n(); ++i) qd[i] = std::uniform_real_distribution<double>(-vscale, vscale)(rng);
+      qd = random_uniform(A.n(), vscale, rng);
     }
     const Status sa = forward_dynamics(A, wa, q, qd, tau), sb = forward_dynamics(B, wb, q, qd, tau);
     if (!sa.ok || !sb.ok) throw CliError("M^s singular at a sampled state: " + (sa.ok ? sb : sa).message);

@@ -51,20 +51,26 @@ void generalized_force(const Model& model, Workspace& ws, const VecX& f, VecX& y
   y.noalias() = ws.T.transpose() * ws.u_acc;
 }
 
+// y += sign · Cᵀ(−k (θ − θ_rest) − c θ̇): joint springs and dampers act on θ; the coupling
+// level maps them to q. Uses θ, θ̇ of the last propagate.
+void add_joint_forces(const Model& model, const Workspace& ws, bool with_rates, double sign,
+                      VecX& y) {
+  for (int j = 0; j < model.n_theta(); ++j) {
+    const Joint& J = model.bodies[model.theta_joint[j]].joint;
+    double f = 0;
+    if (J.stiffness != 0) f -= J.stiffness * (ws.theta[j] - J.rest);
+    if (with_rates && J.damping != 0) f -= J.damping * ws.theta_dot[j];
+    if (f != 0) y.noalias() += (sign * f) * model.C.row(j).transpose();
+  }
+}
+
 // Q = Tᵀ F + Cᵀ(spring + damper) + τ, with F = F_constant + body torques.
 void assemble_forces(const Model& model, Workspace& ws, const VecX& tau, bool with_rates) {
   if (model.has_nodal_forces)  // no gravity, no loads: no nodal forces to map
     generalized_force(model, ws, model.F_constant, ws.Q, true);
   else
     ws.Q.setZero();
-  // Joint springs and dampers act on θ; the coupling level maps them to q by Cᵀ.
-  for (int j = 0; j < model.n_theta(); ++j) {
-    const Joint& J = model.bodies[model.theta_joint[j]].joint;
-    double f = 0;
-    if (J.stiffness != 0) f -= J.stiffness * (ws.theta[j] - J.rest);
-    if (with_rates && J.damping != 0) f -= J.damping * ws.theta_dot[j];
-    if (f != 0) ws.Q.noalias() += f * model.C.row(j).transpose();
-  }
+  add_joint_forces(model, ws, with_rates, 1.0, ws.Q);
   if (tau.size() == ws.Q.size()) ws.Q += tau;
 }
 
@@ -164,11 +170,7 @@ void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const Ve
     add_velocity_forces(model, ws, ws.u_dot, ws.u_dot, ws.nodal);
   if (model.has_nodal_forces) ws.nodal -= model.F_constant;
   apply_transpose(model, ws, ws.nodal, ws.tau, model.has_nodal_forces ? -1.0 : 0.0);
-  for (int j = 0; j < model.n_theta(); ++j) {  // springs and dampers on θ, through Cᵀ
-    const Joint& J = model.bodies[model.theta_joint[j]].joint;
-    const double f = -J.stiffness * (ws.theta[j] - J.rest) - J.damping * ws.theta_dot[j];
-    if (f != 0) ws.tau.noalias() -= f * model.C.row(j).transpose();
-  }
+  add_joint_forces(model, ws, true, -1.0, ws.tau);
 }
 
 std::vector<MatX> transform_hessian(const Model& model, Workspace& ws, const VecX& q) {

@@ -137,17 +137,6 @@ struct SimbodyTwin::Impl {
     zero_body = Vector_<SpatialVec>(matter.getNumBodies(), SpatialVec(SimTK::Vec3(0), SimTK::Vec3(0)));
   }
 
-  // Sets θ = C q + θ0, θ̇ = C q̇ and realizes `stage`.
-  void set_state(const VecX& q, const VecX& qd, SimTK::Stage stage) {
-    const VecX theta = model.C * q + model.theta0;
-    const VecX theta_dot = model.C * qd;
-    for (int j = 0; j < model.n_theta(); ++j) {
-      state.updQ()[theta_q[j]] = theta[j];
-      state.updU()[theta_u[j]] = theta_dot[j];
-    }
-    system.realize(state, stage);
-  }
-
   VecX reduce(const SimTK::Vector& f_theta) const {  // Cᵀ f_θ
     VecX f(model.n_theta());
     for (int j = 0; j < model.n_theta(); ++j) f[j] = f_theta[theta_u[j]];
@@ -158,8 +147,9 @@ struct SimbodyTwin::Impl {
   SimTK::Vector bench_applied, bench_udot, bench_theta_ddot, bench_out;
   SimTK::Vector_<SimTK::SpatialVec> bench_A_GB;
 
-  // set_state without temporaries, for the timing entry points.
-  void set_state_in_place(const VecX& q, const VecX& qd, SimTK::Stage stage) {
+  // Sets θ = C q + θ0, θ̇ = C q̇ (without temporaries: the timing entry points use it too) and
+  // realizes `stage`.
+  void set_state(const VecX& q, const VecX& qd, SimTK::Stage stage) {
     SimTK::Vector& sq = state.updQ();
     SimTK::Vector& su = state.updU();
     for (int j = 0; j < model.n_theta(); ++j) {
@@ -239,7 +229,7 @@ VecX SimbodyTwin::inverse_dynamics(const VecX& q, const VecX& qd, const VecX& qd
 
 void SimbodyTwin::time_mass_and_bias(const VecX& q, const VecX& qd) {
   Impl& s = *impl_;
-  s.set_state_in_place(q, qd, SimTK::Stage::Dynamics);
+  s.set_state(q, qd, SimTK::Stage::Dynamics);
   s.matter.calcM(s.state, s.M_theta);
   s.matter.calcResidualForceIgnoringConstraints(
       s.state, s.system.getMobilityForces(s.state, SimTK::Stage::Dynamics),
@@ -248,14 +238,14 @@ void SimbodyTwin::time_mass_and_bias(const VecX& q, const VecX& qd) {
 
 void SimbodyTwin::time_bias(const VecX& q, const VecX& qd) {
   Impl& s = *impl_;
-  s.set_state_in_place(q, qd, SimTK::Stage::Velocity);
+  s.set_state(q, qd, SimTK::Stage::Velocity);
   s.matter.calcResidualForceIgnoringConstraints(s.state, s.zero_mobility, s.zero_body,
                                                 s.zero_mobility, s.bench_out);
 }
 
 void SimbodyTwin::time_forward(const VecX& q, const VecX& qd, const VecX& tau) {
   Impl& s = *impl_;
-  s.set_state_in_place(q, qd, SimTK::Stage::Dynamics);
+  s.set_state(q, qd, SimTK::Stage::Dynamics);
   const SimTK::Vector& mob = s.system.getMobilityForces(s.state, SimTK::Stage::Dynamics);
   s.bench_applied = mob;  // allocates on the first call only
   for (int k = 0; k < s.model.n(); ++k)
@@ -271,7 +261,7 @@ void SimbodyTwin::time_forward(const VecX& q, const VecX& qd, const VecX& tau) {
 
 void SimbodyTwin::time_inverse(const VecX& q, const VecX& qd, const VecX& qdd) {
   Impl& s = *impl_;
-  s.set_state_in_place(q, qd, SimTK::Stage::Dynamics);
+  s.set_state(q, qd, SimTK::Stage::Dynamics);
   const int nu = s.state.getNU();
   if (s.bench_theta_ddot.size() != nu) s.bench_theta_ddot = SimTK::Vector(nu, 0.0);
   for (int j = 0; j < s.model.n_theta(); ++j) {
