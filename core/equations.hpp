@@ -1,4 +1,4 @@
-// System equations of motion at a state (paper §III, corrected — docs/formulation.md):
+// System equations of motion at a state (paper §III, corrected — docs/design.md):
 //
 //   M^s q̈ + h = Q,     M^s = Tᵀ M T,
 //   h = D[q̇,q̇] = Tᵀ (M T'[q̇,q̇] + g(u̇,u̇)),        g: element velocity (gyroscopic) forces
