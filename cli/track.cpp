@@ -5,7 +5,8 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
-#include "core/integrate.hpp"
+#include "core/fixed_step.hpp"
+#include "core/quintic.hpp"
 #include "io/output.hpp"
 
 namespace femdyn::cli {
@@ -46,7 +47,7 @@ int cmd_track(int argc, char** argv) {
     N = static_cast<int>(v[0]);
   }
   const int n = m.n();
-  Workspace ws(m), wref(m);
+  Workspace wref(m);
   VecX qr(n), qdr(n), qddr(n);
   // τ(t) by inverse dynamics of the reference.
   const Actuation tau = [&](double t, VecX& out) {
@@ -54,8 +55,10 @@ int cmd_track(int argc, char** argv) {
     inverse_dynamics(m, wref, qr, qdr, qddr);
     out = wref.tau;
   };
-  VecX q = q0, qd = VecX::Zero(n), u(n);
+  VecX u(n);
   const double dt = T / N;
+  Rk4 rk4(m, {.dt = dt}, tau);
+  rk4.reset(0, q0, VecX::Zero(n), T);
   double max_err = 0, max_tau = 0;
   std::ostringstream csv;
   csv.precision(12);
@@ -67,16 +70,16 @@ int cmd_track(int argc, char** argv) {
   for (int k = 0; k <= N; ++k) {
     const double t = k * dt;
     tau(t, u);
-    max_err = std::max(max_err, (q - qr).cwiseAbs().maxCoeff());
+    max_err = std::max(max_err, (rk4.q() - qr).cwiseAbs().maxCoeff());
     max_tau = std::max(max_tau, u.cwiseAbs().maxCoeff());
     csv << t;
     for (int i = 0; i < n; ++i) csv << "," << qr[i];
     for (int i = 0; i < n; ++i) csv << "," << u[i];
-    for (int i = 0; i < n; ++i) csv << "," << q[i];
+    for (int i = 0; i < n; ++i) csv << "," << rk4.q()[i];
     csv << "\n";
     if (k == N) break;
-    const Status st = rk4_step(m, ws, t, dt, q, qd, tau);
-    if (!st.ok) throw CliError("at t = " + std::to_string(t) + ": " + st.message);
+    const Status st = rk4.advance_to((k + 1) * dt);
+    if (!st.ok) throw CliError(st.message);
   }
   if (a.has("csv")) write_file_atomic(a.options.at("csv"), csv.str());
   if (a.has("json")) {

@@ -34,8 +34,6 @@ Workspace::Workspace(const Model& model) : solver(model) {
   }
   Ms = MatX::Zero(n, n);
   h = Q = qdd = tau = VecX::Zero(n);
-  stage_q = stage_qd = stage_tau = VecX::Zero(n);
-  for (int i = 0; i < 4; ++i) k_q[i] = k_qd[i] = VecX::Zero(n);
 }
 
 }  // namespace femdyn

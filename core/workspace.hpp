@@ -40,11 +40,6 @@ struct Workspace {
   MatX Ms;
   VecX h, Q, qdd, tau;
   MassSolver solver;  // factorisation of M^s (dense or CHOLMOD, chosen for the model)
-
-  // RK4 stages (core/integrate.hpp): the stage state and actuation, and the slopes k1..k4 of
-  // q and q̇.
-  VecX stage_q, stage_qd, stage_tau;
-  std::array<VecX, 4> k_q, k_qd;
 };
 
 }  // namespace femdyn

@@ -8,7 +8,7 @@
 #include "core/equations.hpp"
 #include "core/model.hpp"
 #include "core/inertia.hpp"
-#include "core/integrate.hpp"
+#include "core/fixed_step.hpp"
 #include "core/sampling.hpp"
 #include "validation/twin.hpp"
 #include "validation/urdf_twin.hpp"
@@ -63,21 +63,18 @@ void accumulate(QuantityError& e, const MatX& femdyn, const MatX& simbody) {
   e.max_rel = std::max(e.max_rel, scale > 0 ? d / scale : d);
 }
 
-// femdyn's passive motion by RK4 at step dt, sampled at `times` (multiples of dt).
-// Returns false if M^s turned singular on the way.
-bool integrate(const Model& m, Workspace& ws, VecX q, VecX qd, const std::vector<double>& times,
+// femdyn's passive motion by RK4 (core/fixed_step.hpp) at step dt, sampled at `times`
+// (multiples of dt). Returns false if the integration failed (M^s singular on the way).
+bool integrate(const Model& m, const VecX& q0, const VecX& qd0, const std::vector<double>& times,
                double dt, std::vector<VecX>& state, std::vector<double>& energy) {
-  const Actuation passive = [](double, VecX& tau) { tau.setZero(); };
-  double t = 0;
+  Rk4 rk4(m, {.dt = dt});
+  rk4.reset(0, q0, qd0);
   for (double target : times) {
-    const int steps = static_cast<int>(std::lround((target - t) / dt));
-    for (int s = 0; s < steps; ++s, t += dt)
-      if (!rk4_step(m, ws, t, dt, q, qd, passive).ok) return false;
-    t = target;
+    if (!rk4.advance_to(target).ok) return false;
     VecX x(2 * m.n_theta());
-    x << m.C * q + m.theta0, m.C * qd;
+    x << m.C * rk4.q() + m.theta0, m.C * rk4.qd();
     state.push_back(std::move(x));
-    energy.push_back(femdyn::energy(m, ws, q, qd).total());
+    energy.push_back(rk4.motion().energy_at(rk4.y().data()).total());
   }
   return true;
 }
@@ -94,20 +91,19 @@ TrajectoryReport compare_trajectory(const Model& m, SimbodyTwin& twin, const Vec
   const int samples = std::max(1, o.samples);
   // Halve femdyn's RK4 step until its own error estimate (dt against dt/2) is below the target,
   // within a budget of steps; sample times lie on the grid.
-  Workspace ws(m);
   std::vector<double> times;
   std::vector<VecX> x, x_half;
   std::vector<double> e, e_half;
   double dt = o.t_end / std::max(1.0, std::round(o.t_end / o.rk4_step));
   for (int i = 0; i <= samples; ++i) times.push_back(dt * std::round(o.t_end * i / samples / dt));
   const char* singular = "femdyn's mass matrix turned singular along the trajectory";
-  if (!integrate(m, ws, q0, qd0, times, dt, x, e)) {
+  if (!integrate(m, q0, qd0, times, dt, x, e)) {
     r.skipped = singular;
     return r;
   }
   for (;; dt /= 2) {
     x_half.clear(), e_half.clear();
-    if (!integrate(m, ws, q0, qd0, times, dt / 2, x_half, e_half)) {
+    if (!integrate(m, q0, qd0, times, dt / 2, x_half, e_half)) {
       r.skipped = singular;
       return r;
     }

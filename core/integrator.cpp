@@ -1,0 +1,109 @@
+#include "core/integrator.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "core/fixed_step.hpp"
+#include "core/sundials_integrators.hpp"
+
+namespace femdyn {
+namespace {
+
+std::string bad(const char* field, const std::string& what, double value) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g", value);
+  return std::string(field) + ": " + what + ", got " + buf;
+}
+
+}  // namespace
+
+const char* integrator_name(IntegratorKind kind) {
+  switch (kind) {
+    case IntegratorKind::Rk4: return "rk4";
+    case IntegratorKind::Euler: return "euler";
+    case IntegratorKind::Dopri: return "dopri";
+    case IntegratorKind::Bdf: return "bdf";
+  }
+  return "?";
+}
+
+bool parse_integrator(std::string_view name, IntegratorKind& kind) {
+  for (IntegratorKind k : {IntegratorKind::Rk4, IntegratorKind::Euler, IntegratorKind::Dopri,
+                           IntegratorKind::Bdf})
+    if (name == integrator_name(k)) {
+      kind = k;
+      return true;
+    }
+  return false;
+}
+
+bool is_adaptive(IntegratorKind kind) {
+  return kind == IntegratorKind::Dopri || kind == IntegratorKind::Bdf;
+}
+
+std::string FixedStepOptions::check() const {
+  if (!(dt > 0) || !std::isfinite(dt)) return bad("dt", "the step must be a positive number", dt);
+  if (max_steps < 1) return bad("max_steps", "must be at least 1", static_cast<double>(max_steps));
+  return {};
+}
+
+std::string AdaptiveOptions::check() const {
+  if (!(rtol > 0 && rtol < 1)) return bad("rtol", "the relative tolerance must be in (0, 1)", rtol);
+  if (rtol < 1e-15) return bad("rtol", "below double round-off (1e-15)", rtol);
+  if (!(atol > 0) || !std::isfinite(atol))
+    return bad("atol", "the absolute tolerance must be a positive number", atol);
+  if (!(h_max >= 0) || !std::isfinite(h_max)) return bad("h_max", "must be >= 0 (0: no limit)", h_max);
+  if (max_steps < 1) return bad("max_steps", "must be at least 1", static_cast<double>(max_steps));
+  return {};
+}
+
+std::string IntegratorOptions::check() const {
+  return is_adaptive(kind) ? adaptive.check() : fixed.check();
+}
+
+Integrator::Integrator(const Model& model, Actuation tau)
+    : motion_(model, std::move(tau)), y_(VecX::Zero(2 * model.n() + 1)) {}
+
+void Integrator::reset(double t0, const VecX& q0, const VecX& qd0, double t_stop) {
+  const int n = motion_.n();
+  if (q0.size() != n || qd0.size() != n)
+    throw std::invalid_argument("Integrator::reset: expected q0, qd0 of size " +
+                                std::to_string(n));
+  y_ << q0, qd0, 0.0;
+  t_ = t0;
+  t_stop_ = t_stop;
+  stats_ = {};
+  start();
+}
+
+Status Integrator::advance_to(double t_out) {
+  const auto begin = std::chrono::steady_clock::now();
+  Status st = t_out > t_ ? advance(t_out) : Status{};
+  stats_.wall_time += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  return st;
+}
+
+Status Integrator::step() {
+  if (t_ >= t_stop_) return {};
+  const auto begin = std::chrono::steady_clock::now();
+  Status st = one_step();
+  stats_.wall_time += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  return st;
+}
+
+std::unique_ptr<Integrator> make_integrator(const Model& model, const IntegratorOptions& o,
+                                            Actuation tau) {
+  if (const std::string why = o.check(); !why.empty()) throw std::invalid_argument(why);
+  switch (o.kind) {
+    case IntegratorKind::Rk4: return std::make_unique<Rk4>(model, o.fixed, std::move(tau));
+    case IntegratorKind::Euler:
+      return std::make_unique<SymplecticEuler>(model, o.fixed, std::move(tau));
+    case IntegratorKind::Dopri:
+      return std::make_unique<DormandPrince>(model, o.adaptive, std::move(tau));
+    case IntegratorKind::Bdf: return std::make_unique<Bdf>(model, o.adaptive, std::move(tau));
+  }
+  return nullptr;
+}
+
+}  // namespace femdyn

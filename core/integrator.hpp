@@ -1,0 +1,102 @@
+// Integrators of M^s q̈ + h = Q in time (docs/simulation.md). Each is an object that owns its
+// buffers and its right-hand side (core/motion.hpp), takes a plain options struct with defaults
+// and a check that names the bad field, and after the first step allocates nothing per step.
+//
+//   Rk4             classical fixed-step Runge–Kutta, order 4, 4 evaluations a step
+//   SymplecticEuler semi-implicit Euler, order 1, 1 evaluation a step:
+//                     q̇ₖ₊₁ = q̇ₖ + dt q̈(tₖ, qₖ, q̇ₖ),  qₖ₊₁ = qₖ + dt q̇ₖ₊₁
+//   DormandPrince   adaptive explicit 5(4) with error control and dense output (SUNDIALS ARKODE)
+//   Bdf             adaptive implicit BDF 1–5 with a Newton solver for stiff models (SUNDIALS
+//                   CVODE), Jacobian ∂f/∂y = [[0, I], [∂q̈/∂q, ∂q̈/∂q̇]] by finite differences
+//
+// The state is y = (q, q̇, W), W the work of the non-conservative forces. A failure (step-size
+// underflow, NaN in the state, M^s losing definiteness, a Newton solver that does not converge)
+// is a failed Status naming the time, the quantity and the likely cause; the integrator keeps
+// its last good state.
+#pragma once
+#include <limits>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "core/motion.hpp"
+
+namespace femdyn {
+
+enum class IntegratorKind { Rk4, Euler, Dopri, Bdf };
+const char* integrator_name(IntegratorKind kind);     // "rk4", "euler", "dopri", "bdf"
+bool parse_integrator(std::string_view name, IntegratorKind& kind);
+bool is_adaptive(IntegratorKind kind);
+
+struct FixedStepOptions {
+  double dt = 1e-3;               // s
+  long max_steps = 1'000'000'000;  // a run of more steps stops with a message
+  std::string check() const;      // "" if valid, else "dt: …" naming the field
+};
+
+struct AdaptiveOptions {
+  double rtol = 1e-6;   // relative tolerance on each component of y
+  double atol = 1e-8;   // absolute tolerance (rad, m, rad/s, m/s, J)
+  double h_max = 0;     // largest step (s); 0: no limit
+  long max_steps = 10'000'000;  // per advance_to
+  std::string check() const;
+};
+
+struct IntegratorStats {
+  long steps = 0, rejected = 0;  // accepted steps; steps rejected by error or Newton failure
+  long rhs_evals = 0;            // evaluations of forward dynamics (incl. Jacobian columns)
+  long jac_evals = 0;            // Jacobian evaluations (BDF)
+  double wall_time = 0;          // s, inside advance_to
+};
+
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+  virtual IntegratorKind kind() const = 0;
+  const char* name() const { return integrator_name(kind()); }
+
+  // Starts a run at (t0, q0, q̇0) with W = 0; clears the statistics. An adaptive method never
+  // steps past t_stop (τ(t) may not be defined there); by default it may overshoot t_out and
+  // interpolate back.
+  void reset(double t0, const VecX& q0, const VecX& qd0,
+             double t_stop = std::numeric_limits<double>::infinity());
+  // Advances to t_out ≥ t(): fixed-step methods take steps of dt and shorten the last one to
+  // land on t_out; adaptive ones stop at t_out by dense output. On failure the state stays at
+  // the last good step (t() < t_out) and the Status says why.
+  Status advance_to(double t_out);
+  // One step: dt for a fixed-step method, one internal (error-controlled) step for an adaptive
+  // one; never past t_stop.
+  Status step();
+
+  double t() const { return t_; }
+  auto q() const { return y_.head(motion_.n()); }
+  auto qd() const { return y_.segment(motion_.n(), motion_.n()); }
+  double work() const { return y_[2 * motion_.n()]; }
+  const VecX& y() const { return y_; }
+  const IntegratorStats& stats() const { return stats_; }
+  Motion& motion() { return motion_; }
+
+ protected:
+  Integrator(const Model& model, Actuation tau);
+  virtual void start() = 0;  // after reset: (re)initialise the method at (t_, y_, t_stop_)
+  virtual Status advance(double t_out) = 0;  // the method's own advance_to
+  virtual Status one_step() = 0;             // the method's own step
+  Motion motion_;
+  VecX y_;
+  double t_ = 0, t_stop_ = 0;
+  IntegratorStats stats_;
+};
+
+struct IntegratorOptions {  // what make_integrator reads: the one that applies to `kind`
+  IntegratorKind kind = IntegratorKind::Dopri;
+  FixedStepOptions fixed;
+  AdaptiveOptions adaptive;
+  std::string check() const;
+};
+
+// The integrator of options.kind for the model under τ(t). Throws std::invalid_argument with
+// options.check()'s message if the options are invalid.
+std::unique_ptr<Integrator> make_integrator(const Model& model, const IntegratorOptions& options,
+                                            Actuation tau = {});
+
+}  // namespace femdyn

@@ -1,0 +1,56 @@
+// The equations of motion as a first-order system, the right-hand side every integrator drives
+// (core/integrator.hpp):
+//
+//   y = (q, q̇, W),   ẏ = f(t, y) = (q̇,  q̈ = (M^s)⁻¹ (Q(q, q̇, τ(t)) − h(q, q̇)),  P_nc),
+//
+// with W the work done by the non-conservative forces (actuation τ, joint dampers, body torques)
+// and P_nc its power, so that E(t) − E(0) = W(t) for the mechanical energy E of
+// core/equations.hpp (docs/simulation.md). Every evaluation goes through forward_dynamics and is
+// checked: a singular or indefinite M^s, or a NaN/Inf in q̈, is a failed Status naming the time,
+// the quantity and the coordinate, never a NaN handed on.
+#pragma once
+#include <functional>
+
+#include "core/equations.hpp"
+
+namespace femdyn {
+
+// τ(t) on the generalized coordinates. An empty Actuation is the passive motion (τ = 0).
+using Actuation = std::function<void(double t, VecX& tau)>;
+
+class Motion {
+ public:
+  Motion(const Model& model, Actuation tau = {});
+
+  const Model& model() const { return model_; }
+  int n() const { return model_.n(); }
+  int size() const { return 2 * model_.n() + 1; }  // dim y
+
+  // ẏ = f(t, y) into ydot (both of size(); may be SUNDIALS' arrays). Counts the evaluation.
+  Status rhs(double t, const double* y, double* ydot);
+  long evaluations() const { return evaluations_; }
+
+  // The first non-finite entry of y as a failed Status ("q_name", "qd_name" or "W"), or ok.
+  Status check_state(double t, const double* y) const;
+
+  // Mechanical energy at y (kinetic, potential; the work W is y's last entry).
+  Energy energy_at(const double* y);
+
+ private:
+  const Model& model_;
+  Actuation tau_;
+  Workspace ws_;
+  VecX q_, qd_, u_;  // buffers: q, q̇, τ at the evaluated state
+  long evaluations_ = 0;
+};
+
+// Power of the non-conservative forces at the state of the last evaluate(model, ws, q, q̇, τ):
+//   P_nc = q̇ᵀ τ − Σ_j c_j θ̇_j² + Σ_b τ_b · ω_b      (actuation, dampers, body torques).
+// Gravity, constant point loads and springs are conservative: they are in E's potential.
+double nonconservative_power(const Model& model, const Workspace& ws, const VecX& qd,
+                             const VecX& tau);
+
+// "at t = 0.125 s: " with the time printed to the digits that matter.
+std::string at_time(double t);
+
+}  // namespace femdyn

@@ -1,0 +1,241 @@
+#include "core/sundials_integrators.hpp"
+
+#include <arkode/arkode_erkstep.h>
+#include <cvode/cvode.h>
+#include <nvector/nvector_serial.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunmatrix/sunmatrix_dense.h>
+
+#include <cmath>
+#include <cstdio>
+
+namespace femdyn {
+
+// One run's SUNDIALS objects; y wraps the integrator's own y_ (no copy).
+struct SundialsRun {
+  SUNContext ctx = nullptr;
+  N_Vector y = nullptr;
+  SUNMatrix A = nullptr;
+  SUNLinearSolver LS = nullptr;
+  void* arkode = nullptr;
+  void* cvode = nullptr;
+  ~SundialsRun() {
+    if (arkode) ERKStepFree(&arkode);
+    if (cvode) CVodeFree(&cvode);
+    if (LS) SUNLinSolFree(LS);
+    if (A) SUNMatDestroy(A);
+    if (y) N_VDestroy(y);
+    if (ctx) SUNContext_Free(&ctx);
+  }
+};
+
+namespace {
+
+Adaptive& self(void* user_data) { return *static_cast<Adaptive*>(user_data); }
+
+int rhs_callback(double t, N_Vector y, N_Vector ydot, void* user_data) {
+  return self(user_data).rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
+}
+
+void error_handler(int, const char* module, const char* function, char* msg, void* user_data) {
+  self(user_data).record(std::string(module) + "/" + function + ": " + msg);
+}
+
+int jacobian_callback(double t, N_Vector y, N_Vector fy, SUNMatrix J, void* user_data, N_Vector,
+                      N_Vector, N_Vector) {
+  return static_cast<Bdf*>(user_data)->jacobian(t, N_VGetArrayPointer(y),
+                                                N_VGetArrayPointer(fy), SUNDenseMatrix_Data(J));
+}
+
+std::string seconds(double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.3g s", x);
+  return buf;
+}
+
+// Creates the context and wraps y (both methods).
+void open(SundialsRun& r, VecX& y) {
+  if (SUNContext_Create(nullptr, &r.ctx) != 0) throw std::runtime_error("SUNContext_Create failed");
+  r.y = N_VMake_Serial(static_cast<sunindextype>(y.size()), y.data(), r.ctx);
+}
+
+}  // namespace
+
+Adaptive::Adaptive(const Model& model, const AdaptiveOptions& options, Actuation tau)
+    : Integrator(model, std::move(tau)), options_(options) {}
+
+Adaptive::~Adaptive() = default;
+
+int Adaptive::rhs(double t, const double* y, double* ydot) {
+  Status st = motion_.rhs(t, y, ydot);
+  if (st.ok) return 0;
+  rhs_failure_ = std::move(st);
+  return -1;  // unrecoverable: a singular M^s or a NaN is not cured by a smaller step
+}
+
+Status Adaptive::failure(int flag) {
+  if (!rhs_failure_.ok) {  // f itself failed (directly, or in the Jacobian's differences)
+    Status st = rhs_failure_;
+    if (st.message.find("NaN") != std::string::npos)
+      st.message += "; likely cause: the state overflowed (forces or speeds beyond double range)";
+    else
+      st.message += "; likely cause: M^s lost positive definiteness along the motion";
+    return st;
+  }
+  const std::string at = at_time(t_), h = seconds(std::abs(current_step()));
+  switch (flag) {
+    case CV_TOO_MUCH_WORK:
+      return {false, at + "more than " + std::to_string(options_.max_steps) +
+                         " steps (max_steps) before the next output, at step size " + h +
+                         "; likely cause: a stiff model for an explicit method (use bdf), or "
+                         "a motion too fast for the tolerances"};
+    case CV_TOO_MUCH_ACC:
+      return {false, at + "the tolerances cannot be met in double precision; loosen rtol/atol"};
+    case CV_ERR_FAILURE:
+    case CV_TOO_CLOSE:
+      return {false, at + "step-size underflow: the error test failed repeatedly down to step " +
+                         h + "; likely cause: a singularity in the motion (M^s nearly "
+                         "singular, a discontinuous actuation) or tolerances below round-off"};
+    case CV_CONV_FAILURE:
+    case CV_LSETUP_FAIL:
+    case CV_LSOLVE_FAIL:
+      return {false, at + "the Newton iteration failed to converge repeatedly down to step " + h +
+                         "; likely cause: a Jacobian too poor for this stiffness, or a "
+                         "singularity in the motion"};
+    default:
+      return {false, at + "the integrator failed (SUNDIALS flag " + std::to_string(flag) +
+                         "): " + sundials_message_};
+  }
+}
+
+Status Adaptive::advance(double t_out) {
+  double t_reached = t_;
+  const int flag = evolve(t_out, t_reached, false);
+  return finish(flag, t_reached, t_out);
+}
+
+Status Adaptive::one_step() {
+  double t_reached = t_;
+  const int flag = evolve(std::isfinite(t_stop_) ? t_stop_ : t_ + 1, t_reached, true);
+  return finish(flag, t_reached, t_reached);
+}
+
+Status Adaptive::finish(int flag, double t_reached, double t_target) {
+  read_stats();
+  stats_.rhs_evals = motion_.evaluations();
+  if (flag >= 0) {  // CV_SUCCESS, CV_TSTOP_RETURN
+    t_ = t_target;
+    if (Status bad = motion_.check_state(t_, y_.data()); !bad.ok) return bad;
+    return {};
+  }
+  t_ = t_reached;  // SUNDIALS returns the last good state with the time it reached
+  return failure(flag);
+}
+
+// ---- Dormand–Prince (ARKODE ERKStep) -------------------------------------------------------
+
+DormandPrince::DormandPrince(const Model& model, const AdaptiveOptions& options, Actuation tau)
+    : Adaptive(model, options, std::move(tau)) {}
+
+void DormandPrince::start() {
+  run_ = std::make_unique<SundialsRun>();
+  SundialsRun& r = *run_;
+  open(r, y_);
+  r.arkode = ERKStepCreate(rhs_callback, t_, r.y, r.ctx);
+  if (!r.arkode) throw std::runtime_error("ERKStepCreate failed");
+  ERKStepSetErrHandlerFn(r.arkode, error_handler, this);
+  ERKStepSetUserData(r.arkode, this);
+  ERKStepSetTableNum(r.arkode, ARKODE_DORMAND_PRINCE_7_4_5);
+  ERKStepSStolerances(r.arkode, options_.rtol, options_.atol);
+  ERKStepSetMaxNumSteps(r.arkode, options_.max_steps);
+  if (options_.h_max > 0) ERKStepSetMaxStep(r.arkode, options_.h_max);
+  if (std::isfinite(t_stop_)) ERKStepSetStopTime(r.arkode, t_stop_);
+  rhs_failure_ = {};
+}
+
+int DormandPrince::evolve(double t_out, double& t_reached, bool one_step) {
+  return ERKStepEvolve(run_->arkode, t_out, run_->y, &t_reached, one_step ? ARK_ONE_STEP : ARK_NORMAL);
+}
+
+void DormandPrince::read_stats() {
+  long v = 0;
+  ERKStepGetNumSteps(run_->arkode, &v);
+  stats_.steps = v;
+  ERKStepGetNumErrTestFails(run_->arkode, &v);
+  stats_.rejected = v;
+}
+
+double DormandPrince::current_step() const {
+  double h = 0;
+  ERKStepGetCurrentStep(run_->arkode, &h);
+  return h;
+}
+
+// ---- BDF (CVODE) ---------------------------------------------------------------------------
+
+Bdf::Bdf(const Model& model, const AdaptiveOptions& options, Actuation tau)
+    : Adaptive(model, options, std::move(tau)),
+      y_pert_(VecX::Zero(y_.size())),
+      f_pert_(VecX::Zero(y_.size())) {}
+
+void Bdf::start() {
+  run_ = std::make_unique<SundialsRun>();
+  SundialsRun& r = *run_;
+  open(r, y_);
+  const auto N = static_cast<sunindextype>(y_.size());
+  r.cvode = CVodeCreate(CV_BDF, r.ctx);
+  if (!r.cvode) throw std::runtime_error("CVodeCreate failed");
+  CVodeSetErrHandlerFn(r.cvode, error_handler, this);
+  CVodeInit(r.cvode, rhs_callback, t_, r.y);
+  CVodeSetUserData(r.cvode, this);
+  CVodeSStolerances(r.cvode, options_.rtol, options_.atol);
+  r.A = SUNDenseMatrix(N, N, r.ctx);
+  r.LS = SUNLinSol_Dense(r.y, r.A, r.ctx);
+  CVodeSetLinearSolver(r.cvode, r.LS, r.A);
+  CVodeSetJacFn(r.cvode, jacobian_callback);
+  CVodeSetMaxNumSteps(r.cvode, options_.max_steps);
+  if (options_.h_max > 0) CVodeSetMaxStep(r.cvode, options_.h_max);
+  if (std::isfinite(t_stop_)) CVodeSetStopTime(r.cvode, t_stop_);
+  rhs_failure_ = {};
+}
+
+int Bdf::jacobian(double t, const double* y, const double* fy, double* J) {
+  const int n = motion_.n(), N = 2 * n + 1;
+  Eigen::Map<MatX> Jm(J, N, N);  // column-major, as SUNDIALS' dense matrix
+  Jm.setZero();
+  for (int i = 0; i < n; ++i) Jm(i, n + i) = 1;  // ∂q̇/∂q̇ = I
+  const Eigen::Map<const VecX> y0(y, N), f0(fy, N);
+  y_pert_ = y0;
+  // Columns of q and q̇: forward differences of (q̈, P_nc); W moves nothing (its column is 0).
+  for (int j = 0; j < 2 * n; ++j) {
+    const double delta = 1.5e-8 * std::max(1.0, std::abs(y0[j]));
+    y_pert_[j] = y0[j] + delta;
+    if (rhs(t, y_pert_.data(), f_pert_.data()) != 0) return -1;
+    Jm.col(j).tail(n + 1) = (f_pert_.tail(n + 1) - f0.tail(n + 1)) / delta;
+    y_pert_[j] = y0[j];
+  }
+  return 0;
+}
+
+int Bdf::evolve(double t_out, double& t_reached, bool one_step) {
+  return CVode(run_->cvode, t_out, run_->y, &t_reached, one_step ? CV_ONE_STEP : CV_NORMAL);
+}
+
+void Bdf::read_stats() {
+  long v = 0, w = 0;
+  CVodeGetNumSteps(run_->cvode, &v);
+  stats_.steps = v;
+  CVodeGetNumErrTestFails(run_->cvode, &v);
+  CVodeGetNumNonlinSolvConvFails(run_->cvode, &w);
+  stats_.rejected = v + w;
+  CVodeGetNumJacEvals(run_->cvode, &v);
+  stats_.jac_evals = v;
+}
+
+double Bdf::current_step() const {
+  double h = 0;
+  CVodeGetCurrentStep(run_->cvode, &h);
+  return h;
+}
+
+}  // namespace femdyn

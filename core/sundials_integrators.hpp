@@ -1,0 +1,76 @@
+// Adaptive integrators from SUNDIALS 6.4 (core/integrator.hpp):
+//   DormandPrince  ARKODE ERKStep with the Dormand–Prince 7-stage 5(4) table (first same as
+//                  last), local error control on y, Hermite dense output at t_out.
+//   Bdf            CVODE variable-order BDF (1–5) with CVODE's Newton iteration and a dense
+//                  direct linear solver; the Jacobian of f is
+//                    ∂f/∂y = [[0, I, 0], [∂q̈/∂q, ∂q̈/∂q̇, 0], [∂P/∂q, ∂P/∂q̇, 0]]
+//                  with the lower rows by forward differences of forward dynamics (2n
+//                  evaluations, buffers owned here).
+// The SUNDIALS memory is created by reset() (per run, not per step); SUNDIALS' own messages are
+// captured and folded into the Status, never printed.
+#pragma once
+#include <string>
+
+#include "core/integrator.hpp"
+
+namespace femdyn {
+
+// SUNDIALS handles owned by an adaptive integrator (opaque here: the SUNDIALS headers stay in
+// the .cpp).
+struct SundialsRun;
+
+class Adaptive : public Integrator {
+ public:
+  ~Adaptive() override;
+
+ protected:
+  Adaptive(const Model& model, const AdaptiveOptions& options, Actuation tau);
+  Status advance(double t_out) override;
+  Status one_step() override;
+  Status finish(int flag, double t_reached, double t_target);
+  // What SUNDIALS' return code means for the user, with the step size where it failed.
+  Status failure(int flag);
+  // One call to ARKODE / CVODE: to t_out (dense output), or one internal step.
+  virtual int evolve(double t_out, double& t_reached, bool one_step) = 0;
+  virtual void read_stats() = 0;
+  virtual double current_step() const = 0;
+
+ public:  // reached from the C callbacks
+  int rhs(double t, const double* y, double* ydot);  // 0, or < 0 after recording rhs_failure_
+  void record(const std::string& sundials_message) { sundials_message_ = sundials_message; }
+
+ protected:
+  AdaptiveOptions options_;
+  std::unique_ptr<SundialsRun> run_;
+  Status rhs_failure_;           // the last failed evaluation of f
+  std::string sundials_message_;  // the last message SUNDIALS sent to its error handler
+};
+
+class DormandPrince final : public Adaptive {
+ public:
+  DormandPrince(const Model& model, const AdaptiveOptions& options, Actuation tau = {});
+  IntegratorKind kind() const override { return IntegratorKind::Dopri; }
+
+ private:
+  void start() override;
+  int evolve(double t_out, double& t_reached, bool one_step) override;
+  void read_stats() override;
+  double current_step() const override;
+};
+
+class Bdf final : public Adaptive {
+ public:
+  Bdf(const Model& model, const AdaptiveOptions& options, Actuation tau = {});
+  IntegratorKind kind() const override { return IntegratorKind::Bdf; }
+  // ∂f/∂y by forward differences into the column-major (2n+1)² array J, f(y) = fy given.
+  int jacobian(double t, const double* y, const double* fy, double* J);
+
+ private:
+  void start() override;
+  int evolve(double t_out, double& t_reached, bool one_step) override;
+  void read_stats() override;
+  double current_step() const override;
+  VecX y_pert_, f_pert_;  // Jacobian buffers
+};
+
+}  // namespace femdyn
