@@ -64,6 +64,20 @@ VecX state_vector(const Args& a, const std::string& opt, const Model& m) {
   return Eigen::Map<const VecX>(v.data(), m.n());
 }
 
+double number_option(const Args& a, const std::string& opt, double fallback) {
+  if (!a.has(opt)) return fallback;
+  const std::vector<double> v = parse_numbers(opt, a.options.at(opt));
+  if (v.size() != 1) throw CliError("--" + opt + " expects one number");
+  return v[0];
+}
+
+double integer_option(const Args& a, const std::string& opt, double fallback, double min) {
+  const double v = number_option(a, opt, fallback);
+  if (v != std::floor(v) || v < min || v > 1e15)
+    throw CliError("--" + opt + " expects an integer >= " + std::to_string(static_cast<long>(min)));
+  return v;
+}
+
 Model load(const Args& a, std::size_t count) {
   if (a.positional.size() != count)
     throw CliError(count == 1 ? "expected one MODEL file (try --help)"

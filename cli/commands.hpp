@@ -28,6 +28,8 @@ Args parse_args(int argc, char** argv, int first, const std::vector<std::string>
 std::vector<double> parse_numbers(const std::string& opt, const std::string& text);
 VecX state_vector(const Args& a, const std::string& opt, const Model& m);  // zero if absent
 LoadOptions load_options(const Args& a);                                   // --gravity
+double number_option(const Args& a, const std::string& opt, double fallback);  // one number
+double integer_option(const Args& a, const std::string& opt, double fallback, double min);
 Model load(const Args& a, std::size_t count = 1);  // the first positional; expects `count`
 
 int cmd_info(int argc, char** argv);
@@ -35,6 +37,7 @@ int cmd_equations(int argc, char** argv);
 int cmd_compare(int argc, char** argv);
 int cmd_track(int argc, char** argv);
 int cmd_validate(int argc, char** argv);
-int cmd_import(int argc, char** argv);  // only with FEMDYN_WITH_SIMBODY
+int cmd_import(int argc, char** argv);
+int cmd_simulate(int argc, char** argv);  // only with FEMDYN_WITH_SIMBODY
 
 }  // namespace femdyn::cli

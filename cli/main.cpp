@@ -14,6 +14,7 @@ commands:
   info        coordinates, bodies, elements, DOFs kept and left out, the correlation table
   equations   M^s, h, Q and q̈ at a state (D with --tensor)
   compare     relative error of one model's equations against another's
+  simulate    the motion from a state under an actuation: trajectory CSV, energy balance
   track       computed-torque feed-forward along a smooth motion, replayed in simulation
   validate    the model against its Simbody twin, pointwise and along a trajectory
   import      a URDF robot (or a plugin model) as femdyn JSON
@@ -38,6 +39,7 @@ int main(int argc, char** argv) {
     if (cmd == "equations") return cmd_equations(argc, argv);
     if (cmd == "compare") return cmd_compare(argc, argv);
     if (cmd == "track") return cmd_track(argc, argv);
+    if (cmd == "simulate") return cmd_simulate(argc, argv);
     if (cmd == "import") return cmd_import(argc, argv);
 #ifdef FEMDYN_WITH_SIMBODY
     if (cmd == "validate") return cmd_validate(argc, argv);

@@ -1,5 +1,7 @@
 #include "io/output.hpp"
 
+#include "io/atomic_file.hpp"
+
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
@@ -180,23 +182,9 @@ Json info_json(const Model& model) {
 }
 
 void write_file_atomic(const std::string& path, const std::string& content) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) throw std::runtime_error(path + ": cannot write");
-    f << content;
-    f.flush();
-    if (!f) {
-      std::remove(tmp.c_str());
-      throw std::runtime_error(path + ": write failed");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": cannot rename into place: " + ec.message());
-  }
+  AtomicFile f(path, true);
+  f.stream() << content;
+  f.commit();
 }
 
 namespace {

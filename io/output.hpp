@@ -29,7 +29,8 @@ std::string correlation_table_text(const Model& model);
 // rows) on one line, two-space indent. Numbers keep full (round-trip) precision.
 std::string readable_json(const Json& doc);
 
-// Writes content to path via path.tmp + rename, so readers never see a half-written file.
+// Writes content to path through an AtomicFile (io/atomic_file.hpp): readers never see a
+// half-written file. Replaces an existing file.
 void write_file_atomic(const std::string& path, const std::string& content);
 
 }  // namespace femdyn

@@ -1,5 +1,9 @@
 #include "tests/helpers.hpp"
 
+#include <array>
+#include <cstdio>
+#include <stdexcept>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -30,6 +34,18 @@ std::string random_tree_json(unsigned seed, int bodies, double branching, bool p
                     {"gravity", {0.1, -0.2, -gravity}}};
   return doc.dump();
 }
+
+Run run_shell(const std::string& command) {
+  FILE* p = popen((command + " 2>&1").c_str(), "r");
+  if (!p) throw std::runtime_error("popen failed: " + command);
+  std::string out;
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
+  const int status = pclose(p);
+  return {WEXITSTATUS(status), out};
+}
+
+Run run(const std::string& args) { return run_shell(std::string(FEMDYN_BINARY) + " " + args); }
 
 VecX random_vector(std::mt19937& rng, int n, double scale) {
   std::uniform_real_distribution<double> u(-scale, scale);

@@ -28,6 +28,15 @@ double rel_error(const MatX& a, const MatX& b, double floor = 1e-12);
 // World position of translation DOF i's node component, for finite differences of u(q).
 double translation_value(const Model& m, const Workspace& ws, int i);
 
+// The femdyn command (FEMDYN_BINARY) run by the shell with `args`: exit code and the output
+// (stdout and stderr together unless args redirect them).
+struct Run {
+  int code;
+  std::string out;
+};
+Run run(const std::string& args);
+Run run_shell(const std::string& command);  // any shell command
+
 // Body rotation R_WB after propagate().
 Mat3 body_rotation(const Workspace& ws, int body);
 

@@ -14,22 +14,6 @@ using namespace femdyn::test;
 
 namespace {
 
-struct Run {
-  int code;
-  std::string out;
-};
-
-Run run(const std::string& args) {
-  const std::string cmd = std::string(FEMDYN_BINARY) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  REQUIRE(p);
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int status = pclose(p);
-  return {WEXITSTATUS(status), out};
-}
-
 VecX vec(const nlohmann::json& j) {
   VecX v(j.size());
   for (std::size_t i = 0; i < j.size(); ++i) v[i] = j[i].get<double>();
@@ -95,7 +79,7 @@ TEST_CASE("bad command lines and bad models: one line, non-zero exit", "[cli]") 
 }
 
 TEST_CASE("every command has --help, info lists the correlation table", "[cli]") {
-  for (const char* cmd : {"info", "equations", "compare", "track", "validate", "import"}) {
+  for (const char* cmd : {"info", "equations", "compare", "track", "validate", "import", "simulate"}) {
     const Run r = run(std::string(cmd) + " --help");
     CHECK(r.code == 0);
     CHECK_THAT(r.out, Catch::StartsWith("usage: femdyn " + std::string(cmd)));

@@ -1,0 +1,231 @@
+// femdyn simulate: the motion of a model from an initial state under an actuation, by any of
+// the integrators of core/integrator.hpp, written as a trajectory CSV with the energy balance.
+#include <cmath>
+#include <csignal>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+
+#include "cli/commands.hpp"
+#include "cli/progress.hpp"
+#include "core/integrator.hpp"
+#include "io/actuation_table.hpp"
+#include "io/atomic_file.hpp"
+#include "io/trajectory_csv.hpp"
+
+namespace femdyn::cli {
+namespace {
+
+constexpr const char* kHelp = R"(usage: femdyn simulate MODEL --t-end T [--integrator rk4|euler|dopri|bdf]
+                        [--dt h | --rtol r --atol a] [--q0 …] [--qd0 …] [--tau … | --tau-csv FILE]
+                        [--out traj.csv] [--every k] [--force] [--json] [--gravity gx,gy,gz]
+
+Integrates M^s q̈ + h = Q from (q0, q̇0) (default 0) over [0, T] and prints a summary:
+integrator, steps, rejected steps, evaluations of forward dynamics, Jacobians, wall time,
+real-time factor (simulated time / integration wall time), and the energy balance: the largest
+|E(t) − E(0) − W(t)| over the output rows, W the work of the non-conservative forces (τ,
+dampers, body torques); for a conservative model that is the energy drift.
+
+integrators (docs/simulation.md):
+  rk4    classical Runge–Kutta 4, fixed step --dt (default 1e-3 s)
+  euler  semi-implicit (symplectic) Euler, fixed step --dt (default 1e-3 s)
+  dopri  Dormand–Prince 5(4), adaptive (SUNDIALS ARKODE), --rtol (1e-6) --atol (1e-8); default
+  bdf    BDF orders 1–5 with Newton (SUNDIALS CVODE), for stiff models; --rtol --atol
+--tau a,b,… is a constant actuation on the coordinates; --tau-csv FILE a time table with the
+header t,<coordinate>,… (or tau_<coordinate>), interpolated linearly; it must cover [0, T].
+--out writes t, q_*, qd_*, kinetic, potential, total, work every k-th step (--every, default 1;
+the first and last rows always). The file appears whole when the run ends: an existing file is
+kept unless --force, and a failed or interrupted run never leaves half a file (a run stopped by
+a numerical fault writes the rows up to the last good step and says so). --json prints the
+summary as one object. Exit 1 on a numerical fault (the message names the time, the quantity
+and the likely cause), 130 when interrupted.
+)";
+
+volatile std::sig_atomic_t g_interrupted = 0;
+extern "C" void on_interrupt(int) { g_interrupted = 1; }
+
+// SIGINT and SIGTERM set a flag the run checks after every step; restored on exit.
+class InterruptGuard {
+ public:
+  InterruptGuard() {
+    g_interrupted = 0;
+    struct sigaction sa {};
+    sa.sa_handler = on_interrupt;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~InterruptGuard() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+
+ private:
+  struct sigaction old_int_ {}, old_term_ {};
+};
+
+std::string number_text(double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.4g", x);
+  return buf;
+}
+
+}  // namespace
+
+IntegratorOptions integrator_options(const Args& a) {
+  IntegratorOptions o;
+  if (a.has("integrator") && !parse_integrator(a.options.at("integrator"), o.kind))
+    throw CliError("--integrator: '" + a.options.at("integrator") +
+                   "' is not one of rk4, euler, dopri, bdf");
+  if (is_adaptive(o.kind)) {
+    if (a.has("dt"))
+      throw CliError(std::string("--dt sets the step of rk4 and euler; ") +
+                     integrator_name(o.kind) + " is adaptive: use --rtol and --atol");
+    o.adaptive.rtol = number_option(a, "rtol", o.adaptive.rtol);
+    o.adaptive.atol = number_option(a, "atol", o.adaptive.atol);
+  } else {
+    if (a.has("rtol") || a.has("atol"))
+      throw CliError(std::string("--rtol/--atol apply to dopri and bdf; ") +
+                     integrator_name(o.kind) + " has a fixed step: use --dt");
+    o.fixed.dt = number_option(a, "dt", o.fixed.dt);
+  }
+  if (const std::string why = o.check(); !why.empty()) throw CliError("--" + why);
+  return o;
+}
+
+int cmd_simulate(int argc, char** argv) {
+  const Args a = parse_args(argc, argv, 2, {"help", "json", "force"},
+                            {"gravity", "t-end", "integrator", "dt", "rtol", "atol", "q0", "qd0",
+                             "tau", "tau-csv", "out", "every"});
+  if (a.has("help")) {
+    std::cout << kHelp;
+    return 0;
+  }
+  const Model m = load(a);
+  if (!a.has("t-end")) throw CliError("--t-end is required (try --help)");
+  const double t_end = number_option(a, "t-end", 0);
+  if (!(t_end > 0) || t_end > 1e9) throw CliError("--t-end expects a time in (0, 1e9] s");
+  const IntegratorOptions o = integrator_options(a);
+  const VecX q0 = state_vector(a, "q0", m), qd0 = state_vector(a, "qd0", m);
+  const long every = static_cast<long>(integer_option(a, "every", 1, 1));
+
+  // τ: constant, a table, or none (passive).
+  if (a.has("tau") && a.has("tau-csv")) throw CliError("--tau and --tau-csv exclude each other");
+  Actuation tau;
+  std::optional<ActuationTable> table;
+  bool driven = false;
+  if (a.has("tau")) {
+    const VecX u = state_vector(a, "tau", m);
+    driven = !u.isZero(0);
+    if (driven) tau = [u](double, VecX& out) { out = u; };
+  } else if (a.has("tau-csv")) {
+    table.emplace(a.options.at("tau-csv"), m);
+    if (table->t_first() > 0 || table->t_last() < t_end)
+      throw CliError("--tau-csv " + table->path() + " covers t in [" +
+                     number_text(table->t_first()) + ", " + number_text(table->t_last()) +
+                     "] s; it must cover [0, " + number_text(t_end) + "] s");
+    tau = [&table](double t, VecX& out) { (*table)(t, out); };
+    driven = true;
+  }
+  bool conservative = !driven && m.torques.empty();
+  for (const Body& b : m.bodies) conservative = conservative && b.joint.damping == 0;
+
+  // Output: refused before any work if it would clobber a file.
+  std::optional<AtomicFile> out;
+  if (a.has("out")) {
+    const std::string& path = a.options.at("out");
+    std::error_code ec;
+    if (std::filesystem::equivalent(path, a.positional[0], ec))
+      throw CliError("--out " + path + " is the model file itself");
+    try {
+      out.emplace(path, a.has("force"));
+    } catch (const std::runtime_error& e) {
+      throw CliError(std::string("--out ") + e.what());
+    }
+    write_trajectory_header(out->stream(), m);
+  }
+
+  std::unique_ptr<Integrator> integ = make_integrator(m, o, tau);
+  integ->reset(0, q0, qd0, t_end);
+  InterruptGuard guard;
+  Progress progress(t_end, "s");
+  const Energy E0 = integ->motion().energy_at(integ->y().data());
+  double max_balance = 0, scale = std::max(std::abs(E0.total()), std::abs(E0.kinetic));
+  long rows = 0, step = 0;
+  const auto output = [&] {
+    const Energy E = integ->motion().energy_at(integ->y().data());
+    max_balance = std::max(max_balance, std::abs(E.total() - E0.total() - integ->work()));
+    scale = std::max({scale, std::abs(E.total()), E.kinetic});
+    if (out) write_trajectory_row(out->stream(), integ->t(), integ->y(), E);
+    ++rows;
+  };
+  const auto begin = std::chrono::steady_clock::now();
+  Status st;
+  if (!q0.allFinite() || !qd0.allFinite()) throw CliError("--q0/--qd0 must be finite");
+  output();
+  while (integ->t() < t_end) {
+    st = integ->step();
+    if (!st.ok) break;
+    if (++step % every == 0 || integ->t() >= t_end) output();
+    progress.update(integ->t());
+    if (g_interrupted) {
+      progress.finish();
+      std::cerr << "femdyn simulate: interrupted at t = " << integ->t() << " s"
+                << (out ? "; " + out->path() + " was not written" : std::string()) << "\n";
+      return 130;  // `out` discards its temporary file
+    }
+  }
+  progress.finish();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  if (out) out->commit();
+
+  const IntegratorStats& s = integ->stats();
+  const double simulated = integ->t();
+  const double rtf = s.wall_time > 0 ? simulated / s.wall_time : 0;
+  const std::string balance_name = conservative ? "energy drift" : "energy-balance error";
+  if (a.has("json")) {
+    Json j = {{"model", m.name}, {"coordinates", m.n()}, {"integrator", integ->name()},
+              {"t_end", t_end}, {"t_reached", simulated}, {"steps", s.steps},
+              {"rejected", s.rejected}, {"rhs_evals", s.rhs_evals}, {"jac_evals", s.jac_evals},
+              {"wall_time", wall}, {"integration_time", s.wall_time}, {"real_time_factor", rtf},
+              {"conservative", conservative}, {"energy_initial", E0.total()},
+              {"energy_balance_error", max_balance},
+              {"energy_balance_relative", scale > 0 ? max_balance / scale : 0.0}, {"rows", rows},
+              {"ok", st.ok}};
+    if (is_adaptive(o.kind))
+      j["options"] = {{"rtol", o.adaptive.rtol}, {"atol", o.adaptive.atol}};
+    else
+      j["options"] = {{"dt", o.fixed.dt}};
+    if (out) j["out"] = out->path();
+    if (!st.ok) j["failure"] = st.message;
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << "model: " << m.name << " (" << m.n() << " coordinates)\n"
+              << "integrator: " << integ->name() << " ("
+              << (is_adaptive(o.kind) ? "rtol " + number_text(o.adaptive.rtol) + ", atol " +
+                                            number_text(o.adaptive.atol)
+                                      : "dt " + number_text(o.fixed.dt) + " s")
+              << ")\n"
+              << "simulated " << number_text(simulated) << " of " << number_text(t_end)
+              << " s: " << s.steps << " steps (" << s.rejected << " rejected), " << s.rhs_evals
+              << " evaluations of forward dynamics, " << s.jac_evals << " Jacobians\n"
+              << "wall time " << number_text(wall) << " s (integration "
+              << number_text(s.wall_time) << " s), real-time factor " << number_text(rtf) << "\n"
+              << balance_name << ": max |E(t) - E(0) - W(t)| = " << number_text(max_balance)
+              << " J (" << number_text(scale > 0 ? max_balance / scale : 0)
+              << " of the energy scale) over " << rows << " rows\n";
+    if (out) std::cout << "wrote " << out->path() << " (" << rows << " rows)\n";
+  }
+  if (!st.ok) {
+    std::cerr << "femdyn simulate: " << a.positional[0] << ": " << st.message
+              << (out ? "; the rows up to t = " + number_text(simulated) + " s are in " +
+                            out->path()
+                      : std::string())
+              << "\n";
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace femdyn::cli

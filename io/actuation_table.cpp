@@ -1,0 +1,105 @@
+#include "io/actuation_table.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "core/errors.hpp"
+
+namespace femdyn {
+namespace {
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> cells;
+  std::string cell;
+  std::istringstream s(line);
+  while (std::getline(s, cell, ',')) {
+    const auto b = cell.find_first_not_of(" \t\r"), e = cell.find_last_not_of(" \t\r");
+    cells.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
+  }
+  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  return cells;
+}
+
+}  // namespace
+
+ActuationTable::ActuationTable(const std::string& path, const Model& m) : path_(path) {
+  std::ifstream in(path);
+  if (!in) throw ModelError(path, "cannot read the actuation file");
+  const int n = m.n();
+  std::string line;
+  int lineno = 1;
+  if (!std::getline(in, line)) throw ModelError(path, "empty file (expected a header t,<coordinates>)");
+  const std::vector<std::string> head = split(line);
+  if (head.empty() || head[0] != "t")
+    throw ModelError(path + ":1", "the first column must be 't' (time in s)");
+  std::vector<int> column_of(n, -1);  // coordinate -> CSV column
+  for (std::size_t c = 1; c < head.size(); ++c) {
+    std::string name = head[c];
+    auto it = std::find(m.coordinate_names.begin(), m.coordinate_names.end(), name);
+    if (it == m.coordinate_names.end() && name.rfind("tau_", 0) == 0)
+      it = std::find(m.coordinate_names.begin(), m.coordinate_names.end(), name.substr(4));
+    if (it == m.coordinate_names.end())
+      throw ModelError(path + ":1", "column " + std::to_string(c + 1) + " '" + name +
+                                        "' is not a coordinate of " + m.name);
+    const auto k = it - m.coordinate_names.begin();
+    if (column_of[k] >= 0)
+      throw ModelError(path + ":1", "coordinate '" + *it + "' has two columns");
+    column_of[k] = static_cast<int>(c);
+  }
+  for (int k = 0; k < n; ++k)
+    if (column_of[k] < 0)
+      throw ModelError(path + ":1", "no column for coordinate '" + m.coordinate_names[k] + "'");
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    ++lineno;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const std::vector<std::string> cells = split(line);
+    const std::string where = path + ":" + std::to_string(lineno);
+    if (cells.size() != head.size())
+      throw ModelError(where, std::to_string(cells.size()) + " columns, the header has " +
+                                  std::to_string(head.size()));
+    std::vector<double> v(cells.size());
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      std::size_t used = 0;
+      try {
+        v[c] = std::stod(cells[c], &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (cells[c].empty() || used != cells[c].size())
+        throw ModelError(where, "column " + std::to_string(c + 1) + ": '" + cells[c] +
+                                    "' is not a number");
+      if (!std::isfinite(v[c]))
+        throw ModelError(where, "column " + std::to_string(c + 1) + " is NaN or Inf");
+    }
+    if (!rows.empty() && !(v[0] > rows.back()[0]))
+      throw ModelError(where, "t must increase strictly from row to row");
+    rows.push_back(std::move(v));
+  }
+  if (rows.empty()) throw ModelError(path, "no rows after the header");
+  t_.resize(rows.size());
+  tau_.resize(n, static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    t_[r] = rows[r][0];
+    for (int k = 0; k < n; ++k) tau_(k, static_cast<Eigen::Index>(r)) = rows[r][column_of[k]];
+  }
+}
+
+void ActuationTable::operator()(double t, VecX& tau) const {
+  // τ(t) = τ_r + (t − t_r)/(t_{r+1} − t_r) (τ_{r+1} − τ_r) for t_r ≤ t < t_{r+1}; held outside.
+  if (t <= t_.front()) {
+    tau = tau_.col(0);
+    return;
+  }
+  if (t >= t_.back()) {
+    tau = tau_.col(tau_.cols() - 1);
+    return;
+  }
+  const auto r = std::upper_bound(t_.begin(), t_.end(), t) - t_.begin() - 1;
+  const double s = (t - t_[r]) / (t_[r + 1] - t_[r]);
+  tau = (1 - s) * tau_.col(r) + s * tau_.col(r + 1);
+}
+
+}  // namespace femdyn

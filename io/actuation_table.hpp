@@ -1,0 +1,29 @@
+// τ(t) from a CSV file (femdyn simulate --tau-csv): a header line "t,<c1>,<c2>,…" naming every
+// generalized coordinate once, each as "<name>" or "tau_<name>", in any order; then one row per
+// sample time, strictly increasing. τ is interpolated linearly between rows and held at the
+// last row's value after it. Errors name the file, the line and the column.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "core/model.hpp"
+
+namespace femdyn {
+
+class ActuationTable {
+ public:
+  // Throws ModelError ("FILE:LINE: …") on a malformed file.
+  ActuationTable(const std::string& path, const Model& model);
+
+  void operator()(double t, VecX& tau) const;  // no allocation
+  double t_first() const { return t_.front(); }
+  double t_last() const { return t_.back(); }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::vector<double> t_;
+  MatX tau_;  // n x samples
+};
+
+}  // namespace femdyn

@@ -1,0 +1,53 @@
+#include "io/atomic_file.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+namespace femdyn {
+
+AtomicFile::AtomicFile(std::string path, bool replace) : path_(std::move(path)) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (path_.empty()) throw std::runtime_error("the output path is empty");
+  if (fs::is_directory(path_, ec)) throw std::runtime_error(path_ + ": is a directory");
+  if (!replace && fs::exists(fs::symlink_status(path_, ec)))
+    throw std::runtime_error(path_ + ": exists (use --force to replace it)");
+  const fs::path target(path_);
+  tmp_ = (target.parent_path() / ("." + target.filename().string() + ".tmp-" +
+                                  std::to_string(::getpid())))
+             .string();
+  out_.open(tmp_, std::ios::binary | std::ios::trunc);
+  if (!out_) throw std::runtime_error(path_ + ": cannot write (directory missing or not writable)");
+  open_ = true;
+}
+
+AtomicFile::~AtomicFile() { discard(); }
+
+void AtomicFile::discard() {
+  if (!open_) return;
+  out_.close();
+  std::remove(tmp_.c_str());
+  open_ = false;
+}
+
+void AtomicFile::commit() {
+  out_.flush();
+  const bool written = static_cast<bool>(out_);
+  out_.close();
+  if (!written || out_.fail()) {
+    discard();
+    throw std::runtime_error(path_ + ": write failed (disk full?); nothing was written");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp_, path_, ec);
+  if (ec) {
+    discard();
+    throw std::runtime_error(path_ + ": cannot rename into place: " + ec.message());
+  }
+  open_ = false;
+}
+
+}  // namespace femdyn
