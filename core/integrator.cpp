@@ -28,9 +28,18 @@ const char* integrator_name(IntegratorKind kind) {
   return "?";
 }
 
+const char* integrator_method(IntegratorKind kind) {
+  switch (kind) {
+    case IntegratorKind::Rk4: return "classical Runge-Kutta 4, fixed step";
+    case IntegratorKind::Euler: return "semi-implicit (symplectic) Euler, fixed step";
+    case IntegratorKind::Dopri: return "Dormand-Prince 5(4), adaptive, SUNDIALS ARKODE";
+    case IntegratorKind::Bdf: return "BDF 1-5 with Newton, adaptive, SUNDIALS CVODE";
+  }
+  return "?";
+}
+
 bool parse_integrator(std::string_view name, IntegratorKind& kind) {
-  for (IntegratorKind k : {IntegratorKind::Rk4, IntegratorKind::Euler, IntegratorKind::Dopri,
-                           IntegratorKind::Bdf})
+  for (IntegratorKind k : kIntegrators)
     if (name == integrator_name(k)) {
       kind = k;
       return true;

@@ -24,7 +24,10 @@
 namespace femdyn {
 
 enum class IntegratorKind { Rk4, Euler, Dopri, Bdf };
-const char* integrator_name(IntegratorKind kind);     // "rk4", "euler", "dopri", "bdf"
+const char* integrator_name(IntegratorKind kind);  // "rk4", "euler", "dopri", "bdf"
+const char* integrator_method(IntegratorKind kind);  // e.g. "Dormand–Prince 5(4), SUNDIALS ARKODE"
+inline constexpr IntegratorKind kIntegrators[] = {IntegratorKind::Rk4, IntegratorKind::Euler,
+                                                  IntegratorKind::Dopri, IntegratorKind::Bdf};
 bool parse_integrator(std::string_view name, IntegratorKind& kind);
 bool is_adaptive(IntegratorKind kind);
 
@@ -39,6 +42,11 @@ struct AdaptiveOptions {
   double atol = 1e-8;   // absolute tolerance (rad, m, rad/s, m/s, J)
   double h_max = 0;     // largest step (s); 0: no limit
   long max_steps = 10'000'000;  // per advance_to
+  // advance_to(t_out) interpolates (dense output: ARKODE's Hermite interpolant of degree 4 for
+  // the explicit methods, CVODE's Nordsieck history for BDF), which costs no step but adds an
+  // interpolation error ~10x the step's own on the examples measured (docs/simulation.md).
+  // With stop_at_outputs the method lands on each t_out with a shortened step instead.
+  bool stop_at_outputs = false;
   std::string check() const;
 };
 

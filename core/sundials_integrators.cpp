@@ -132,12 +132,16 @@ Status Adaptive::finish(int flag, double t_reached, double t_target) {
   return failure(flag);
 }
 
-// ---- Dormand–Prince (ARKODE ERKStep) -------------------------------------------------------
+// ---- explicit Runge–Kutta (ARKODE ERKStep) -------------------------------------------------
+
+ExplicitRungeKutta::ExplicitRungeKutta(const Model& model, const AdaptiveOptions& options,
+                                       Actuation tau, int arkode_table)
+    : Adaptive(model, options, std::move(tau)), table_(arkode_table) {}
 
 DormandPrince::DormandPrince(const Model& model, const AdaptiveOptions& options, Actuation tau)
-    : Adaptive(model, options, std::move(tau)) {}
+    : ExplicitRungeKutta(model, options, std::move(tau), ARKODE_DORMAND_PRINCE_7_4_5) {}
 
-void DormandPrince::start() {
+void ExplicitRungeKutta::start() {
   run_ = std::make_unique<SundialsRun>();
   SundialsRun& r = *run_;
   open(r, y_);
@@ -145,7 +149,7 @@ void DormandPrince::start() {
   if (!r.arkode) throw std::runtime_error("ERKStepCreate failed");
   ERKStepSetErrHandlerFn(r.arkode, error_handler, this);
   ERKStepSetUserData(r.arkode, this);
-  ERKStepSetTableNum(r.arkode, ARKODE_DORMAND_PRINCE_7_4_5);
+  ERKStepSetTableNum(r.arkode, static_cast<ARKODE_ERKTableID>(table_));
   ERKStepSStolerances(r.arkode, options_.rtol, options_.atol);
   ERKStepSetMaxNumSteps(r.arkode, options_.max_steps);
   if (options_.h_max > 0) ERKStepSetMaxStep(r.arkode, options_.h_max);
@@ -153,11 +157,12 @@ void DormandPrince::start() {
   rhs_failure_ = {};
 }
 
-int DormandPrince::evolve(double t_out, double& t_reached, bool one_step) {
+int ExplicitRungeKutta::evolve(double t_out, double& t_reached, bool one_step) {
+  if (options_.stop_at_outputs && !one_step) ERKStepSetStopTime(run_->arkode, t_out);
   return ERKStepEvolve(run_->arkode, t_out, run_->y, &t_reached, one_step ? ARK_ONE_STEP : ARK_NORMAL);
 }
 
-void DormandPrince::read_stats() {
+void ExplicitRungeKutta::read_stats() {
   long v = 0;
   ERKStepGetNumSteps(run_->arkode, &v);
   stats_.steps = v;
@@ -165,7 +170,7 @@ void DormandPrince::read_stats() {
   stats_.rejected = v;
 }
 
-double DormandPrince::current_step() const {
+double ExplicitRungeKutta::current_step() const {
   double h = 0;
   ERKStepGetCurrentStep(run_->arkode, &h);
   return h;
@@ -218,6 +223,7 @@ int Bdf::jacobian(double t, const double* y, const double* fy, double* J) {
 }
 
 int Bdf::evolve(double t_out, double& t_reached, bool one_step) {
+  if (options_.stop_at_outputs && !one_step) CVodeSetStopTime(run_->cvode, t_out);
   return CVode(run_->cvode, t_out, run_->y, &t_reached, one_step ? CV_ONE_STEP : CV_NORMAL);
 }
 

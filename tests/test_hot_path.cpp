@@ -49,8 +49,7 @@ TEST_CASE("no heap allocation per step after the first, for every integrator", "
     std::mt19937 rng(5);
     const VecX q = random_vector(rng, m.n(), 0.5), qd = random_vector(rng, m.n(), 0.5),
                tau = random_vector(rng, m.n(), 0.1);
-    for (IntegratorKind kind : {IntegratorKind::Rk4, IntegratorKind::Euler,
-                                IntegratorKind::Dopri, IntegratorKind::Bdf}) {
+    for (IntegratorKind kind : kIntegrators) {
       INFO(name << " " << integrator_name(kind));
       IntegratorOptions o{.kind = kind, .fixed = {.dt = 1e-4}, .adaptive = {.rtol = 1e-8}};
       auto integ = make_integrator(m, o, [&tau](double, VecX& out) { out = tau; });

@@ -115,6 +115,17 @@ TEST_CASE("convergence orders on a spatial double pendulum", "[integrators]") {
     CHECK(hi / lo <= 10);
     CHECK(hi <= 1000);  // the global error stays within ~10² of the local tolerance
   }
+  SECTION("Dormand–Prince landing on the outputs: no interpolation error") {
+    for (double tol : {1e-6, 1e-8, 1e-10}) {
+      IntegratorOptions o = adaptive(IntegratorKind::Dopri, tol, tol);
+      const double dense = error(o);
+      o.adaptive.stop_at_outputs = true;
+      const double landed = error(o);
+      INFO("tol " << tol << ": dense output " << dense << ", landing " << landed);
+      CHECK(landed < dense);
+      CHECK(landed < 100 * tol);
+    }
+  }
   SECTION("BDF converges") {
     double last = INFINITY;
     for (double tol : {1e-4, 1e-6, 1e-8, 1e-10}) {
