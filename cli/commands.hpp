@@ -38,6 +38,7 @@ int cmd_compare(int argc, char** argv);
 int cmd_track(int argc, char** argv);
 int cmd_validate(int argc, char** argv);
 int cmd_import(int argc, char** argv);
-int cmd_simulate(int argc, char** argv);  // only with FEMDYN_WITH_SIMBODY
+int cmd_simulate(int argc, char** argv);
+int cmd_study(int argc, char** argv);     // only with FEMDYN_WITH_SIMBODY  // only with FEMDYN_WITH_SIMBODY
 
 }  // namespace femdyn::cli

@@ -15,6 +15,7 @@ commands:
   equations   M^s, h, Q and q̈ at a state (D with --tensor)
   compare     relative error of one model's equations against another's
   simulate    the motion from a state under an actuation: trajectory CSV, energy balance
+  study       error against run time of every femdyn and Simbody integrator (work-precision)
   track       computed-torque feed-forward along a smooth motion, replayed in simulation
   validate    the model against its Simbody twin, pointwise and along a trajectory
   import      a URDF robot (or a plugin model) as femdyn JSON
@@ -43,7 +44,9 @@ int main(int argc, char** argv) {
     if (cmd == "import") return cmd_import(argc, argv);
 #ifdef FEMDYN_WITH_SIMBODY
     if (cmd == "validate") return cmd_validate(argc, argv);
+    if (cmd == "study") return cmd_study(argc, argv);
 #else
+    if (cmd == "study") throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
     if (cmd == "validate") throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
 #endif
     throw CliError("unknown command '" + cmd + "' (try femdyn --help)");

@@ -30,7 +30,7 @@ Status FixedStep::advance(double t_out) {
     // Land on t_out: the last step is shortened (or stretched by round-off, at most 1e-9 dt).
     const bool last = t_out - t_ <= dt * (1 + 1e-9);
     const double h = last ? t_out - t_ : dt;
-    Status st = step(h);
+    Status st = take_step(h);
     stats_.rhs_evals = motion_.evaluations();
     if (!st.ok) {
       // A NaN met inside the step came from the step itself: say so.
@@ -51,7 +51,7 @@ Rk4::Rk4(const Model& model, const FixedStepOptions& options, Actuation tau)
   for (VecX& k : k_) k = VecX::Zero(y_.size());
 }
 
-Status Rk4::step(double h) {
+Status Rk4::take_step(double h) {
   static constexpr double c[4] = {0, 0.5, 0.5, 1};
   for (int i = 0; i < 4; ++i) {
     if (i == 0)
@@ -68,7 +68,7 @@ SymplecticEuler::SymplecticEuler(const Model& model, const FixedStepOptions& opt
                                  Actuation tau)
     : FixedStep(model, options, std::move(tau)), f_(VecX::Zero(y_.size())) {}
 
-Status SymplecticEuler::step(double h) {
+Status SymplecticEuler::take_step(double h) {
   const int n = motion_.n();
   if (Status st = motion_.rhs(t_, y_.data(), f_.data()); !st.ok) return st;
   y_next_.segment(n, n) = y_.segment(n, n) + h * f_.segment(n, n);  // q̇ first

@@ -15,7 +15,7 @@ class FixedStep : public Integrator {
   Status advance(double t_out) override;
   Status one_step() override { return advance(std::min(t_ + options_.dt, t_stop_)); }
   // One step of length h from (t_, y_) into y_next; y_ is replaced only if the step succeeds.
-  virtual Status step(double h) = 0;
+  virtual Status take_step(double h) = 0;
   FixedStepOptions options_;
   VecX y_next_;
 };
@@ -28,7 +28,7 @@ class Rk4 final : public FixedStep {
   IntegratorKind kind() const override { return IntegratorKind::Rk4; }
 
  private:
-  Status step(double h) override;
+  Status take_step(double h) override;
   std::array<VecX, 4> k_;
   VecX stage_;
 };
@@ -42,7 +42,7 @@ class SymplecticEuler final : public FixedStep {
   IntegratorKind kind() const override { return IntegratorKind::Euler; }
 
  private:
-  Status step(double h) override;
+  Status take_step(double h) override;
   VecX f_;
 };
 

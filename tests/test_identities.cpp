@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "core/fixed_step.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;
@@ -134,26 +135,16 @@ TEST_CASE("energy is conserved by a conservative model (RK4, tight step)", "[ide
   // Spring + gravity, no damping: E = ½ q̇ᵀ M^s q̇ + V must stay constant.
   for (unsigned seed : {21u, 22u}) {
     const Model m = load_text(random_tree_json(seed, 5, 0.5, true));
-    Workspace ws(m);
     const int n = m.n();
     std::mt19937 rng(seed);
-    VecX q = random_vector(rng, n, 1.0), v = random_vector(rng, n, 1.0);
-    const VecX zero = VecX::Zero(n);
-    auto f = [&](const VecX& qq, const VecX& vv) {
-      REQUIRE(forward_dynamics(m, ws, qq, vv, zero).ok);
-      return VecX(ws.qdd);
-    };
-    const double E0 = energy(m, ws, q, v).total();
-    const double dt = 2e-4;
+    const VecX q0 = random_vector(rng, n, 1.0), v0 = random_vector(rng, n, 1.0);
+    Rk4 rk4(m, {.dt = 2e-4});
+    rk4.reset(0, q0, v0);
+    const double E0 = rk4.motion().energy_at(rk4.y().data()).total();
     double drift = 0, scale = 0;
     for (int step = 0; step < 2500; ++step) {  // 0.5 s
-      const VecX a1 = f(q, v);
-      const VecX a2 = f(q + 0.5 * dt * v, v + 0.5 * dt * a1);
-      const VecX a3 = f(q + 0.5 * dt * (v + 0.5 * dt * a1), v + 0.5 * dt * a2);
-      const VecX a4 = f(q + dt * (v + 0.5 * dt * a2), v + dt * a3);
-      q += dt * (v + dt / 6 * (a1 + a2 + a3));
-      v += dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4);
-      const Energy E = energy(m, ws, q, v);
+      REQUIRE(rk4.step().ok);
+      const Energy E = rk4.motion().energy_at(rk4.y().data());
       drift = std::max(drift, std::abs(E.total() - E0));
       scale = std::max(scale, E.kinetic);
     }

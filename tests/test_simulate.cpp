@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 
 #include "tests/helpers.hpp"
@@ -219,5 +220,49 @@ TEST_CASE("simulate matches Simbody's trajectory on a random tree", "[simulate][
   INFO(c.rows.size() << " rows; max state difference " << err << ", energy change gap " << energy_gap);
   CHECK(err < 1e-7);
   CHECK(energy_gap < 1e-8);
+}
+#endif
+
+#ifdef FEMDYN_WITH_SIMBODY
+TEST_CASE("study: a quick work-precision run writes the CSV, plot and summary", "[simulate][study]") {
+  Scratch s("study");
+  const std::string dir = s / "out";
+  Run r = run("study " + model_path("spatial_double_pendulum.json") + " --quick --out " + dir);
+  INFO(r.out);
+  REQUIRE(r.code == 0);
+  CHECK_THAT(r.out, Catch::Contains("| target error | fastest femdyn |"));
+  for (const char* f : {"study.csv", "study.md", "study.gp", "study.png"})
+    CHECK(fs::file_size(fs::path(dir) / f) > 0);
+  CHECK(std::distance(fs::directory_iterator(dir), {}) == 4);  // no temporary left behind
+  std::ifstream csv(fs::path(dir) / "study.csv");
+  std::string line;
+  std::getline(csv, line);
+  CHECK(line.rfind("engine,integrator,setting,value,error,final_error,energy_drift,wall_time", 0) == 0);
+  std::set<std::string> integrators;
+  double smallest_resolved = INFINITY;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> cells;
+    std::istringstream l(line);
+    std::string cell;
+    while (std::getline(l, cell, ',')) cells.push_back(cell);
+    integrators.insert(cells[0] + " " + cells[1]);
+    if (cells[12] == "1") smallest_resolved = std::min(smallest_resolved, std::stod(cells[4]));
+  }
+  for (const char* name : {"femdyn rk4", "femdyn euler", "femdyn dopri", "femdyn bdf",
+                           "Simbody RungeKuttaMerson", "Simbody RungeKutta3"})
+    CHECK(integrators.count(name) == 1);
+  // The reference's own error is at least 100x below every error plotted.
+  const std::string md = slurp(fs::path(dir) / "study.md");
+  const auto at = md.find("its estimated error ");
+  REQUIRE(at != std::string::npos);
+  const double reference_error = std::stod(md.substr(at + 20));
+  INFO("reference error " << reference_error << ", smallest resolved error " << smallest_resolved);
+  CHECK(reference_error < 1e-11);
+  CHECK(100 * reference_error <= smallest_resolved);
+  for (const char* target : {"| 1e-03 |", "| 1e-06 |", "| 1e-09 |"}) CHECK_THAT(md, Catch::Contains(target));
+  // Existing outputs are kept without --force.
+  r = run("study " + model_path("pendulum.json") + " --quick --out " + dir);
+  CHECK(r.code == 2);
+  CHECK_THAT(r.out, Catch::Contains("study.csv: exists (use --force to replace it)"));
 }
 #endif

@@ -3,8 +3,12 @@
 #include "validation/twin.hpp"
 
 #include <Simbody.h>
+#include <dlfcn.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 namespace femdyn::validation {
@@ -18,6 +22,74 @@ SimTK::Rotation to_simtk(const Mat3& R) {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) m(i, j) = R(i, j);
   return SimTK::Rotation(m, true);  // R is orthonormal (built from rpy)
+}
+
+// The integrator `which` on `system`, in its default error-controlled (variable-step) mode.
+std::unique_ptr<SimTK::Integrator> make_integrator(SimbodyIntegrator which,
+                                                   const SimTK::System& system) {
+  switch (which) {
+    case SimbodyIntegrator::RungeKuttaMerson:
+      return std::make_unique<SimTK::RungeKuttaMersonIntegrator>(system);
+    case SimbodyIntegrator::RungeKutta3:
+      return std::make_unique<SimTK::RungeKutta3Integrator>(system);
+    case SimbodyIntegrator::RungeKuttaFeldberg:
+      return std::make_unique<SimTK::RungeKuttaFeldbergIntegrator>(system);
+    case SimbodyIntegrator::Verlet:  // the constructor without a step size: variable step
+      return std::make_unique<SimTK::VerletIntegrator>(system);
+    case SimbodyIntegrator::SemiExplicitEuler2:
+      return std::make_unique<SimTK::SemiExplicitEuler2Integrator>(system);
+    case SimbodyIntegrator::CPodes:  // the constructor's default: BDF with Newton iteration
+      return std::make_unique<SimTK::CPodesIntegrator>(system);
+  }
+  throw std::invalid_argument("unknown SimbodyIntegrator");
+}
+
+// The file of the library the dynamic linker binds `symbol` to for the whole process, or "".
+std::string defining_library(const char* symbol) {
+  void* address = dlsym(RTLD_DEFAULT, symbol);
+  Dl_info info;
+  if (!address || !dladdr(address, &info) || !info.dli_fname) return {};
+  return info.dli_fname;
+}
+
+// Why CPodes cannot run in this process, or "". Simbody's CPodes is its own copy of SUNDIALS
+// CVODES, which exports the SUNDIALS names (N_VSpace, N_VClone, DenseGETRF, ...) unprefixed.
+// A process that also links the system's SUNDIALS (femdyn_core does, for ARKODE and CVODE)
+// binds each such name once, to whichever library comes first; if that is not Simbody's,
+// CPodes calls SUNDIALS 6 on its own vectors and aborts in an assert (nvector_SimTK.h) — not
+// an exception, so it must be refused before it starts. Checked once per process.
+const std::string& cpodes_conflict() {
+  static const std::string why = [] {
+    const std::string simbody = defining_library("CPodeCreate");  // only in libSimTKmath
+    for (const char* name : {"N_VSpace", "N_VClone", "N_VLinearSum", "N_VWrmsNorm",
+                             "DenseGETRF", "newDenseMat"}) {
+      const std::string where = defining_library(name);
+      if (!simbody.empty() && where == simbody) continue;
+      return std::string("CPodes cannot run in this process: its SUNDIALS symbol ") + name +
+             " binds to " + (where.empty() ? std::string("nothing") : where) +
+             ", not to Simbody's " + (simbody.empty() ? std::string("libSimTKmath") : simbody) +
+             " (the system SUNDIALS linked by femdyn shadows Simbody's bundled copy)";
+    }
+    return std::string();
+  }();
+  return why;
+}
+
+// A message on one line: its lines joined by spaces, without SimTK's "SimTK Exception thrown
+// at file:line:" headers. (The first line alone would often be such a header, or
+// "Integrator step failed at time 0 apparently because:", with the cause on the next lines.)
+std::string one_line(const std::string& text) {
+  std::istringstream in(text);
+  std::string out, line;
+  while (std::getline(in, line)) {
+    const auto begin = line.find_first_not_of(" \t\r");
+    if (begin == std::string::npos) continue;
+    const auto end = line.find_last_not_of(" \t\r");
+    line = line.substr(begin, end + 1 - begin);
+    if (line.rfind("SimTK Exception thrown at ", 0) == 0) continue;
+    out += (out.empty() ? "" : " ") + line;
+  }
+  return out;
 }
 
 SimTK::MassProperties mass_properties(const TwinBody& p) {
@@ -164,6 +236,22 @@ struct SimbodyTwin::Impl {
     system.realize(state, stage);
   }
 
+  // θ, θ̇ and the energy of an integrator's state.
+  TwinSample sample(const SimTK::State& st) const {
+    system.realize(st, SimTK::Stage::Dynamics);
+    const int nt = model.n_theta();
+    TwinSample out;
+    out.t = st.getTime();
+    out.theta.resize(nt);
+    out.theta_dot.resize(nt);
+    for (int j = 0; j < nt; ++j) {
+      out.theta[j] = st.getQ()[theta_q[j]];
+      out.theta_dot[j] = st.getU()[theta_u[j]];
+    }
+    out.energy = system.calcEnergy(st);
+    return out;
+  }
+
   SimTK::Vector expand(const VecX& x) const {  // C x on Simbody's u layout
     SimTK::Vector out(state.getNU(), 0.0);
     const VecX y = model.C * x;
@@ -282,35 +370,133 @@ bool SimbodyTwin::can_simulate(std::string* why_not) const {
   return impl_->couplers;
 }
 
+const char* simbody_integrator_name(SimbodyIntegrator which) {
+  switch (which) {
+    case SimbodyIntegrator::RungeKuttaMerson: return "RungeKuttaMerson";
+    case SimbodyIntegrator::RungeKutta3: return "RungeKutta3";
+    case SimbodyIntegrator::RungeKuttaFeldberg: return "RungeKuttaFeldberg";
+    case SimbodyIntegrator::Verlet: return "Verlet";
+    case SimbodyIntegrator::SemiExplicitEuler2: return "SemiExplicitEuler2";
+    case SimbodyIntegrator::CPodes: return "CPodes";
+  }
+  return "unknown";
+}
+
+// Simbody 3.7 (Debian's libsimbody-dev) ships all six (simmath/*Integrator.h); CPodes only
+// where its bundled SUNDIALS is not shadowed (cpodes_conflict), which in femdyn's own
+// executables, linked with the system SUNDIALS, it is.
+std::vector<SimbodyIntegrator> simbody_integrators() {
+  std::vector<SimbodyIntegrator> out{
+      SimbodyIntegrator::RungeKuttaMerson, SimbodyIntegrator::RungeKutta3,
+      SimbodyIntegrator::RungeKuttaFeldberg, SimbodyIntegrator::Verlet,
+      SimbodyIntegrator::SemiExplicitEuler2};
+  if (cpodes_conflict().empty()) out.push_back(SimbodyIntegrator::CPodes);
+  return out;
+}
+
+// As before the integrator choice: empty without couplers, and a failed integration throws
+// (callers such as validate() index every sample).
 std::vector<TwinSample> SimbodyTwin::simulate(const VecX& q0, const VecX& qd0,
                                               const std::vector<double>& times, double accuracy) {
+  TwinRun run = simulate(q0, qd0, times, accuracy, SimbodyIntegrator::RungeKuttaMerson);
+  if (!run.stats.ok && can_simulate()) throw std::runtime_error(run.stats.failure);
+  return std::move(run.samples);
+}
+
+namespace {
+
+// Adds the wall time of its scope to `total`, also when the scope is left by an exception.
+struct Stopwatch {
+  using Clock = std::chrono::steady_clock;
+  double& total;
+  Clock::time_point start = Clock::now();
+  ~Stopwatch() { total += std::chrono::duration<double>(Clock::now() - start).count(); }
+};
+
+// Why `which` must not be run at `accuracy` to `times`, or "": Simbody would abort in an
+// assert (not throw) on these.
+std::string why_not_run(SimbodyIntegrator which, double accuracy,
+                        const std::vector<double>& times) {
+  if (!(accuracy > 0 && accuracy < 1))
+    return "accuracy must be in (0, 1), not " + std::to_string(accuracy);
+  for (std::size_t i = 0; i < times.size(); ++i)
+    if (!std::isfinite(times[i]) || !(times[i] >= (i ? times[i - 1] : 0.0)))
+      return "sample times must be finite, >= 0 and non-decreasing";
+  if (which == SimbodyIntegrator::CPodes) return cpodes_conflict();
+  return {};
+}
+
+// One line for an integrator that returned from stepTo(t) short of t.
+std::string stopped_early(SimbodyIntegrator which, const SimTK::Integrator& integ, double t) {
+  const std::string reason =
+      integ.isSimulationOver()
+          ? SimTK::Integrator::getTerminationReasonString(integ.getTerminationReason())
+          : std::string("no termination reason");
+  return std::string(simbody_integrator_name(which)) + " stopped at t = " +
+         std::to_string(integ.getTime()) + " short of " + std::to_string(t) + ": " +
+         one_line(reason);
+}
+
+void count(const SimTK::Integrator& integ, TwinRunStats& stats) {
+  stats.steps = integ.getNumStepsTaken();
+  stats.attempts = integ.getNumStepsAttempted();
+  stats.realizations = integ.getNumRealizations();
+  stats.error_test_failures = integ.getNumErrorTestFailures();
+  stats.convergence_failures = integ.getNumConvergenceTestFailures();
+}
+
+}  // namespace
+
+// Settings: setAccuracy and setConstraintTolerance at `accuracy`; Simbody's defaults otherwise,
+// set explicitly: setReturnEveryInternalStep(false) and setAllowInterpolation(true). The
+// interpolation is never used here, though: TimeStepper::stepTo(t) passes t to the integrator
+// as a scheduled event time too, so a step ends exactly at every sample time and each sample
+// is an integrator step's own state (the samples cap the step at their spacing). Only
+// initialize() and stepTo() are timed.
+TwinRun SimbodyTwin::simulate(const VecX& q0, const VecX& qd0, const std::vector<double>& times,
+                              double accuracy, SimbodyIntegrator which) {
   Impl& s = *impl_;
-  std::vector<TwinSample> out;
-  if (!s.couplers) return out;
-  s.set_state(q0, qd0, SimTK::Stage::Velocity);
-  s.state.setTime(0);
-  SimTK::RungeKuttaMersonIntegrator integ(s.system);
-  integ.setAccuracy(accuracy);
-  integ.setConstraintTolerance(accuracy);
-  SimTK::TimeStepper stepper(s.system, integ);
-  stepper.initialize(s.state);
-  const int nt = s.model.n_theta();
-  for (double t : times) {
-    if (t > 0) stepper.stepTo(t);
-    const SimTK::State& st = integ.getState();
-    s.system.realize(st, SimTK::Stage::Dynamics);
-    TwinSample sample;
-    sample.t = st.getTime();
-    sample.theta.resize(nt);
-    sample.theta_dot.resize(nt);
-    for (int j = 0; j < nt; ++j) {
-      sample.theta[j] = st.getQ()[s.theta_q[j]];
-      sample.theta_dot[j] = st.getU()[s.theta_u[j]];
-    }
-    sample.energy = s.system.calcEnergy(st);
-    out.push_back(std::move(sample));
+  TwinRun run;
+  TwinRunStats& stats = run.stats;
+  // Not run: no coordinate couplers, or what Simbody would abort on.
+  if (can_simulate(&stats.failure)) stats.failure = why_not_run(which, accuracy, times);
+  if (!stats.failure.empty()) {
+    stats.ok = false;
+    return run;
   }
-  return out;
+  std::unique_ptr<SimTK::Integrator> integ;
+  try {
+    s.set_state(q0, qd0, SimTK::Stage::Velocity);
+    s.state.setTime(0);
+    integ = make_integrator(which, s.system);
+    integ->setAccuracy(accuracy);
+    integ->setConstraintTolerance(accuracy);
+    integ->setReturnEveryInternalStep(false);
+    integ->setAllowInterpolation(true);
+    SimTK::TimeStepper stepper(s.system, *integ);
+    {
+      Stopwatch timed{stats.wall_time};
+      stepper.initialize(s.state);
+    }
+    for (double t : times) {
+      if (t > 0) {
+        Stopwatch timed{stats.wall_time};
+        stepper.stepTo(t);
+      }
+      if (std::abs(integ->getTime() - t) > 1e-12 * std::max(1.0, t)) {
+        stats.ok = false;
+        stats.failure = stopped_early(which, *integ, t);
+        break;
+      }
+      run.samples.push_back(s.sample(integ->getState()));
+    }
+  } catch (const std::exception& e) {
+    stats.ok = false;
+    stats.failure =
+        std::string(simbody_integrator_name(which)) + " failed: " + one_line(e.what());
+  }
+  if (integ) count(*integ, stats);
+  return run;
 }
 
 }  // namespace femdyn::validation

@@ -70,6 +70,43 @@ struct TwinSample {
   double energy = 0;      // Simbody's kinetic + potential energy
 };
 
+// Simbody's error-controlled integrators, for trajectories (SimbodyTwin::simulate) and the
+// work-precision study. Each is used in its default error-controlled (variable-step) mode at
+// the accuracy asked for, never with a fixed step; a step ends exactly at every sample time.
+enum class SimbodyIntegrator {
+  RungeKuttaMerson,    // 4th order, embedded error estimate (the twin's default)
+  RungeKutta3,         // 3rd order, embedded 2nd-order estimate
+  RungeKuttaFeldberg,  // 5th order (Fehlberg), embedded error estimate
+  Verlet,              // velocity Verlet, variable step (not symplectic in this mode)
+  SemiExplicitEuler2,  // 1st-order semi-explicit (symplectic) Euler, step-doubling estimate
+  CPodes               // implicit variable-order multistep (SUNDIALS CVODES): BDF, Newton
+};
+
+// Exactly the enumerator's name, e.g. "RungeKuttaMerson".
+const char* simbody_integrator_name(SimbodyIntegrator which);
+
+// The integrators that can run in this process, in enum order: Simbody 3.7 has all six, but
+// CPodes is left out where the system SUNDIALS shadows Simbody's bundled copy of it, as in
+// every femdyn executable (femdyn_core links SUNDIALS); simulate() refuses it there.
+std::vector<SimbodyIntegrator> simbody_integrators();
+
+// What one SimbodyTwin::simulate run cost, from Simbody's own counters.
+struct TwinRunStats {
+  long steps = 0;                 // Integrator::getNumStepsTaken()
+  long attempts = 0;              // getNumStepsAttempted()
+  long realizations = 0;          // getNumRealizations(): Simbody's right-hand-side evaluations
+  long error_test_failures = 0;   // getNumErrorTestFailures()
+  long convergence_failures = 0;  // getNumConvergenceTestFailures() (iterative methods; else 0)
+  double wall_time = 0;  // s in TimeStepper::initialize and stepTo only (not samples, energy)
+  bool ok = true;
+  std::string failure;   // one line: why the run stopped early, if it did (then ok = false)
+};
+
+struct TwinRun {
+  std::vector<TwinSample> samples;  // those reached (all of `times` when stats.ok)
+  TwinRunStats stats;
+};
+
 class SimbodyTwin {
  public:
   explicit SimbodyTwin(TwinModel model);
@@ -82,10 +119,16 @@ class SimbodyTwin {
 
   // Passive motion (τ = 0) from (q0, q̇0) by RungeKuttaMersonIntegrator at `accuracy`, sampled
   // at `times`. Empty with `why_not` set if the coupling cannot be posed as coordinate
-  // couplers (each q_k must drive some θ_j = q_k directly).
+  // couplers (each q_k must drive some θ_j = q_k directly). Throws std::runtime_error (one
+  // line) if the integration fails.
   bool can_simulate(std::string* why_not = nullptr) const;
   std::vector<TwinSample> simulate(const VecX& q0, const VecX& qd0,
                                    const std::vector<double>& times, double accuracy);
+  // The same by `which`, with its statistics and wall time. Never throws for a failed
+  // integration: stats.ok = false, stats.failure says why and `samples` holds those reached
+  // (none, with the reason, if the coupling cannot be posed as coordinate couplers).
+  TwinRun simulate(const VecX& q0, const VecX& qd0, const std::vector<double>& times,
+                   double accuracy, SimbodyIntegrator which);
 
   // Timing entry points (validation/benchmark.cpp): Simbody's own work only, on buffers
   // allocated by the first call. Each sets θ = C q + θ0, θ̇ = C q̇ (a plain loop) and realizes

@@ -1,0 +1,119 @@
+# femdyn study: dexterous hand (generated; gnuplot study.gp)
+set terminal pngcairo size 1000,650 font 'sans,11'
+set output 'study.png'
+set logscale xy
+set format x '10^{%L}'
+set format y '10^{%L}'
+set xlabel 'wall time (s)'
+set ylabel 'max state error ‖(θ, θ̇) − reference‖∞'
+set title 'Work-precision: dexterous hand, t = 0…0.25 s'
+set grid
+set key outside right top
+$d0 << EOD
+0.000966502 578.794
+0.00195582 8.52637
+0.0037701 0.224427
+0.00757713 0.0128368
+0.0149715 0.000926042
+0.0302693 6.91193e-05
+0.0650624 4.68145e-06
+0.122375 3.0369e-07
+0.250089 1.96893e-08
+EOD
+$d1 << EOD
+0.00644953 1.42959
+0.0111354 1.05507
+0.0166779 0.133272
+0.0268934 0.0196003
+0.0441217 0.00232175
+0.0780128 0.000289974
+0.130395 2.63773e-05
+0.230002 3.41797e-06
+0.373926 2.38019e-07
+EOD
+$d2 << EOD
+0.00109965 313.765
+0.00196011 86.4818
+0.00375245 41.4806
+0.00746987 31.3603
+0.0148774 16.2279
+0.0310709 7.93256
+0.0634776 3.88748
+0.123634 1.92045
+0.248337 0.953994
+0.494037 0.475391
+1.00709 0.237288
+1.95214 0.118542
+4.20063 0.0592451
+EOD
+$d3 << EOD
+0.00920415 5.81139
+0.018589 0.58796
+0.0368985 0.0351474
+0.0749457 0.00262541
+0.154927 0.000190591
+0.316576 3.28824e-05
+0.677079 3.21146e-06
+1.46394 3.28608e-07
+3.15258 3.23627e-08
+EOD
+$d4 << EOD
+0.00338881 7.98658
+0.00434221 0.403514
+0.0061927 0.0620653
+0.00951002 0.00165259
+0.0135028 0.000108367
+0.021287 1.03524e-05
+0.0329251 1.12001e-06
+0.0798877 5.45912e-08
+EOD
+$d5 << EOD
+0.00779987 25.9439
+0.00939407 25.0972
+0.0138049 0.741778
+0.0193328 0.139034
+0.0261418 0.00836799
+0.0389992 0.00295205
+0.0557195 0.000415963
+0.125815 6.64589e-05
+0.131887 8.1977e-06
+EOD
+$d6 << EOD
+0.00594093 8.97838
+0.00782573 3.90146
+0.011481 0.373589
+0.0133232 0.0949265
+0.0192789 0.00682784
+0.0279436 0.00164023
+0.0387949 0.000136383
+0.0846738 4.93312e-05
+0.0889214 7.55155e-06
+EOD
+$d7 << EOD
+0.00664557 124.732
+0.00890973 14.6828
+0.0171506 3.50046
+0.0308331 0.413155
+0.072199 0.0785914
+0.141171 0.0131872
+0.292191 0.00303337
+0.845026 0.00082269
+1.63446 0.000176457
+EOD
+$d8 << EOD
+0.0163362 87.1088
+0.0482815 40.687
+0.156809 12.5061
+0.560368 3.93048
+1.32009 1.19839
+4.30276 0.403247
+EOD
+plot $d0 using 1:2 with linespoints lw 2 pt 7 dt 1 lc rgb '#d62728' title 'femdyn rk4', \
+     $d1 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#1f77b4' title 'Simbody RungeKuttaMerson', \
+     $d2 using 1:2 with linespoints lw 2 pt 7 dt 1 lc rgb '#ff7f0e' title 'femdyn euler', \
+     $d3 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#2ca02c' title 'Simbody RungeKutta3', \
+     $d4 using 1:2 with linespoints lw 2 pt 7 dt 1 lc rgb '#8c564b' title 'femdyn dopri', \
+     $d5 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#17becf' title 'Simbody RungeKuttaFeldberg', \
+     $d6 using 1:2 with linespoints lw 2 pt 7 dt 1 lc rgb '#e377c2' title 'femdyn bdf', \
+     $d7 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#9467bd' title 'Simbody Verlet', \
+     $d8 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#7f7f7f' title 'Simbody SemiExplicitEuler2'
