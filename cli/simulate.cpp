@@ -162,7 +162,6 @@ int cmd_simulate(int argc, char** argv) {
   };
   const auto begin = std::chrono::steady_clock::now();
   Status st;
-  if (!q0.allFinite() || !qd0.allFinite()) throw CliError("--q0/--qd0 must be finite");
   output();
   while (integ->t() < t_end) {
     st = integ->step();

@@ -249,7 +249,7 @@ TEST_CASE("study: a quick work-precision run writes the CSV, plot and summary", 
     if (cells[12] == "1") smallest_resolved = std::min(smallest_resolved, std::stod(cells[4]));
   }
   for (const char* name : {"femdyn rk4", "femdyn euler", "femdyn dopri", "femdyn bdf",
-                           "Simbody RungeKuttaMerson", "Simbody RungeKutta3"})
+                           "Simbody RungeKuttaMerson", "Simbody RungeKutta3", "Simbody CPodes"})
     CHECK(integrators.count(name) == 1);
   // The reference's own error is at least 100x below every error plotted.
   const std::string md = slurp(fs::path(dir) / "study.md");

@@ -308,14 +308,7 @@ TEST_CASE("every Simbody integrator the twin offers follows a tight RungeKuttaMe
     CHECK(s.wall_time > 0);
   }
 
-  // CPodes is left out where the system SUNDIALS (linked by femdyn) shadows Simbody's bundled
-  // copy; asking for it anyway is refused with the reason instead of aborting in Simbody.
-  if (std::find(all.begin(), all.end(), SimbodyIntegrator::CPodes) == all.end()) {
-    const validation::TwinRun run = twin.simulate(q0, qd0, times, 1e-6, SimbodyIntegrator::CPodes);
-    INFO(run.stats.failure);
-    CHECK_FALSE(run.stats.ok);
-    CHECK_THAT(run.stats.failure, Catch::Contains("SUNDIALS"));
-    CHECK(run.stats.failure.find('\n') == std::string::npos);
-    CHECK(run.samples.empty());
-  }
+  // femdyn links its SUNDIALS statically with its symbols hidden (CMakeLists.txt), so Simbody's
+  // CPodes, which bundles an older SUNDIALS under the same names, runs in femdyn's processes.
+  CHECK(std::find(all.begin(), all.end(), SimbodyIntegrator::CPodes) != all.end());
 }

@@ -5,7 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(cmake g++ make libeigen3-dev libsuitesparse-dev nlohmann-json3-dev catch2
-          libsimbody-dev libtinyxml2-dev libbenchmark-dev libsundials-dev gnuplot-nox)
+          libsimbody-dev libtinyxml2-dev libbenchmark-dev libsundials-dev gnuplot-nox
+          fonts-dejavu-core)
 
 missing=()
 for p in "${packages[@]}"; do

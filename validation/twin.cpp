@@ -54,8 +54,9 @@ std::string defining_library(const char* symbol) {
 
 // Why CPodes cannot run in this process, or "". Simbody's CPodes is its own copy of SUNDIALS
 // CVODES, which exports the SUNDIALS names (N_VSpace, N_VClone, DenseGETRF, ...) unprefixed.
-// A process that also links the system's SUNDIALS (femdyn_core does, for ARKODE and CVODE)
-// binds each such name once, to whichever library comes first; if that is not Simbody's,
+// A process that also exports the system's SUNDIALS (femdyn_core links it statically and keeps
+// its symbols out of the dynamic table, see CMakeLists.txt, so femdyn's do not) binds each
+// such name once, to whichever library comes first; if that is not Simbody's,
 // CPodes calls SUNDIALS 6 on its own vectors and aborts in an assert (nvector_SimTK.h) — not
 // an exception, so it must be refused before it starts. Checked once per process.
 const std::string& cpodes_conflict() {
@@ -383,8 +384,7 @@ const char* simbody_integrator_name(SimbodyIntegrator which) {
 }
 
 // Simbody 3.7 (Debian's libsimbody-dev) ships all six (simmath/*Integrator.h); CPodes only
-// where its bundled SUNDIALS is not shadowed (cpodes_conflict), which in femdyn's own
-// executables, linked with the system SUNDIALS, it is.
+// where its bundled SUNDIALS is not shadowed (cpodes_conflict).
 std::vector<SimbodyIntegrator> simbody_integrators() {
   std::vector<SimbodyIntegrator> out{
       SimbodyIntegrator::RungeKuttaMerson, SimbodyIntegrator::RungeKutta3,

@@ -86,8 +86,9 @@ enum class SimbodyIntegrator {
 const char* simbody_integrator_name(SimbodyIntegrator which);
 
 // The integrators that can run in this process, in enum order: Simbody 3.7 has all six, but
-// CPodes is left out where the system SUNDIALS shadows Simbody's bundled copy of it, as in
-// every femdyn executable (femdyn_core links SUNDIALS); simulate() refuses it there.
+// CPodes is left out where another SUNDIALS in the process shadows Simbody's bundled copy of
+// it (femdyn links its own statically, symbols hidden, so it does not); simulate() refuses it
+// there.
 std::vector<SimbodyIntegrator> simbody_integrators();
 
 // What one SimbodyTwin::simulate run cost, from Simbody's own counters.
