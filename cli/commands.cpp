@@ -155,6 +155,23 @@ int cmd_equations(int argc, char** argv) {
              tau = state_vector(a, "tau", m);
   Workspace ws(m);
   const Status st = forward_dynamics(m, ws, q, qd, tau);
+  // A result that overflowed is a fault, never printed as an answer.
+  struct Result {
+    const char* what;
+    const double* data;
+    Eigen::Index size, rows;
+  };
+  for (const Result& x : {Result{"M^s", ws.Ms.data(), ws.Ms.size(), ws.Ms.rows()},
+                          Result{"h", ws.h.data(), ws.h.size(), ws.h.size()},
+                          Result{"Q", ws.Q.data(), ws.Q.size(), ws.Q.size()},
+                          Result{"q̈", ws.qdd.data(), st.ok ? ws.qdd.size() : 0, ws.qdd.size()}})
+    for (Eigen::Index i = 0; i < x.size; ++i) {
+      if (std::isfinite(x.data[i])) continue;
+      std::cerr << "femdyn equations: " << a.positional[0] << ": at this state " << x.what
+                << " of '" << m.coordinate_names[i % x.rows]
+                << "' is NaN or Inf (the forces or the state overflow double precision)\n";
+      return 1;
+    }
   std::vector<MatX> D;
   if (a.has("tensor")) {
     D = third_order_tensor(m, ws, q);

@@ -39,6 +39,8 @@ int cmd_track(int argc, char** argv);
 int cmd_validate(int argc, char** argv);
 int cmd_import(int argc, char** argv);
 int cmd_simulate(int argc, char** argv);
-int cmd_study(int argc, char** argv);     // only with FEMDYN_WITH_SIMBODY  // only with FEMDYN_WITH_SIMBODY
+int cmd_check(int argc, char** argv);
+int cmd_study(int argc, char** argv);
+int cmd_stress(int argc, char** argv);    // only with FEMDYN_WITH_SIMBODY     // only with FEMDYN_WITH_SIMBODY  // only with FEMDYN_WITH_SIMBODY
 
 }  // namespace femdyn::cli

@@ -15,6 +15,8 @@ commands:
   equations   M^s, h, Q and q̈ at a state (D with --tensor)
   compare     relative error of one model's equations against another's
   simulate    the motion from a state under an actuation: trajectory CSV, energy balance
+  check       numerical diagnosis: conditioning, stiffest mode, stable steps, suspicious bodies
+  stress      the stability suite on generated stiff and extreme cases (docs/stability.md)
   study       error against run time of every femdyn and Simbody integrator (work-precision)
   track       computed-torque feed-forward along a smooth motion, replayed in simulation
   validate    the model against its Simbody twin, pointwise and along a trajectory
@@ -41,11 +43,14 @@ int main(int argc, char** argv) {
     if (cmd == "compare") return cmd_compare(argc, argv);
     if (cmd == "track") return cmd_track(argc, argv);
     if (cmd == "simulate") return cmd_simulate(argc, argv);
+    if (cmd == "check") return cmd_check(argc, argv);
     if (cmd == "import") return cmd_import(argc, argv);
 #ifdef FEMDYN_WITH_SIMBODY
     if (cmd == "validate") return cmd_validate(argc, argv);
     if (cmd == "study") return cmd_study(argc, argv);
+    if (cmd == "stress") return cmd_stress(argc, argv);
 #else
+    if (cmd == "stress") throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
     if (cmd == "study") throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
     if (cmd == "validate") throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
 #endif

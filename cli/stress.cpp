@@ -1,0 +1,158 @@
+// femdyn stress: the stability suite on generated cases (cli/stress_cases.hpp,
+// validation/stress.hpp); writes stress.md and stress.csv (docs/stability.md is spliced from
+// stress.md by tools/update-stability-docs.sh).
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+#include <unistd.h>
+
+#include "cli/commands.hpp"
+#include "cli/stress_cases.hpp"
+#include "core/errors.hpp"
+#include "io/atomic_file.hpp"
+#include "io/model_loader.hpp"
+#include "validation/stress.hpp"
+
+namespace femdyn::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kHelp = R"(usage: femdyn stress [--out DIR] [--quick] [--class NAME] [--json] [--force]
+
+Runs the stability suite on generated cases (docs/stability.md): stiff joint springs
+(ω = 1e1…1e5 rad/s, damping ratio 0…100), mass ratios up to 1e6 and lengths 1e-4…10 m in one
+chain, joints and a gyroscopic rotor at 1e3 rad/s, slender bars with negative lumped rotary
+inertia, near-singular postures, a chain of 1000 links, zero gravity and 1000 g, and a
+zero-mass chain end. For each: cond(M^s) along the motion, symmetry and definiteness, the
+largest stable step of rk4 and euler (bisection of real runs), every integrator's error at a
+fixed step or tolerance, the energy balance, agreement with Simbody, and a verdict: stable,
+stable only with bdf, ill-conditioned, or refused with the reason.
+Writes DIR/stress.md and DIR/stress.csv (default DIR ./stress; existing files need --force).
+--quick: a subset of each class, smaller sizes. --class NAME: one class (springs, ratios,
+speeds, slender bars, postures, size, gravity, singular). --json: the results on stdout.
+)";
+
+std::string g(double x) {
+  if (x < 0) return "—";
+  std::ostringstream s;
+  s.precision(3);
+  s << x;
+  return s.str();
+}
+
+}  // namespace
+
+int cmd_stress(int argc, char** argv) {
+  const Args a = parse_args(argc, argv, 2, {"help", "quick", "json", "force"}, {"out", "class"});
+  if (a.has("help")) {
+    std::cout << kHelp;
+    return 0;
+  }
+  if (!a.positional.empty()) throw CliError("stress takes no MODEL (try --help)");
+  std::vector<StressCase> cases = stress_cases(a.has("quick"));
+  if (a.has("class")) {
+    std::erase_if(cases, [&](const StressCase& c) { return c.klass != a.options.at("class"); });
+    if (cases.empty()) throw CliError("--class: no class '" + a.options.at("class") + "' (try --help)");
+  }
+  const fs::path dir = a.has("out") ? fs::path(a.options.at("out")) : fs::path("stress");
+  const bool write = !a.has("json") || a.has("out");
+  if (write) {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (!fs::is_directory(dir)) throw CliError("--out " + dir.string() + ": cannot create the directory");
+    for (const char* f : {"stress.md", "stress.csv"})
+      if (fs::exists(dir / f) && !a.has("force"))
+        throw CliError((dir / f).string() + ": exists (use --force to replace it)");
+  }
+  const bool tty = isatty(STDERR_FILENO) == 1;
+
+  Json results = Json::array();
+  std::ostringstream md, csv;
+  md << "| class | case | n | cond(M^s) along the motion | SPD | stiffest mode (rad/s) | "
+        "largest stable step rk4 / euler (s) | relative error: rk4 / euler at the fixed step, "
+        "dopri / bdf at rtol 1e-6 | energy balance | Simbody (relative) | verdict |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+  csv << "class,case,n,cond_min,cond_max,positive_definite,stiffest,rk4_stable_step,"
+         "euler_stable_step,dt,rk4_error,euler_error,dopri_error,bdf_error,energy_error,"
+         "simbody_error,verdict\n";
+  for (const StressCase& c : cases) {
+    const auto begin = std::chrono::steady_clock::now();
+    validation::StressResult r;
+    try {
+      const Model m = compile(parse_model_json(c.model, "stress case '" + c.name + "'"));
+      validation::StressScenario s;
+      const auto state = [&](const std::vector<double>& v) -> VecX {
+        if (v.empty()) return VecX::Zero(m.n());
+        if (static_cast<int>(v.size()) != m.n())
+          throw std::logic_error("stress case '" + c.name + "': state of the wrong size");
+        return Eigen::Map<const VecX>(v.data(), m.n());
+      };
+      s.q0 = state(c.q0);
+      s.qd0 = state(c.qd0);
+      s.t_end = c.t_end;
+      s.dt = c.dt;
+      s.large = c.large;
+      r = validation::run_stress(m, s);
+    } catch (const ModelError& e) {
+      r = validation::refused_case(e.what());
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+    if (tty) std::cerr << "  " << c.name << ": " << r.verdict << " (" << g(seconds) << " s)\n";
+    const auto err = [&](std::size_t i) {
+      return i < r.integrators.size() ? r.integrators[i].error : -1.0;
+    };
+    const auto step = [&](std::size_t i) {
+      return i < r.integrators.size() ? r.integrators[i].largest_stable_step : -1.0;
+    };
+    Json j = {{"class", c.klass}, {"case", c.name}, {"description", c.description},
+              {"expected", c.expect}, {"verdict", r.verdict}, {"n", r.n},
+              {"seconds", seconds}};
+    if (r.refused.empty()) {
+      j.update({{"cond_min", r.cond_min}, {"cond_max", r.cond_max},
+                {"positive_definite", r.positive_definite}, {"asymmetry", r.asymmetry},
+                {"stiffest", r.stiffest}, {"reference", r.reference},
+                {"energy_error", r.energy_error}, {"simbody_error", r.simbody_error},
+                {"simbody_note", r.simbody_note}, {"dt", c.dt}});
+      Json its = Json::array();
+      for (const auto& it : r.integrators)
+        its.push_back({{"integrator", it.name}, {"largest_stable_step", it.largest_stable_step},
+                       {"error", it.error}, {"steps", it.steps}, {"failure", it.failure}});
+      j["integrators"] = its;
+    }
+    results.push_back(j);
+    md << "| " << c.klass << " | " << c.name << " | " << r.n << " | ";
+    if (r.refused.empty())
+      md << g(r.cond_min) << " … " << g(r.cond_max) << " | " << (r.positive_definite ? "yes" : "no")
+         << " | " << (r.stiffest > 0 ? g(r.stiffest) : "—") << " | " << g(step(0)) << " / "
+         << g(step(1)) << " | at " << g(c.dt) << " s: " << (err(0) < 0 ? "unstable" : g(err(0)))
+         << " / " << (err(1) < 0 ? "unstable" : g(err(1))) << "; rtol 1e-6: " << g(err(2))
+         << " / " << g(err(3)) << " | " << g(r.energy_error) << " | "
+         << (r.simbody_error >= 0 ? g(r.simbody_error) : r.simbody_note.empty() ? "—" : "not run")
+         << " | " << r.verdict << " |\n";
+    else
+      md << "— | — | — | — | — | — | — | " << r.verdict << " |\n";
+    std::string verdict = r.verdict;
+    std::replace(verdict.begin(), verdict.end(), ',', ';');
+    csv << c.klass << "," << c.name << "," << r.n << "," << r.cond_min << "," << r.cond_max << ","
+        << r.positive_definite << "," << r.stiffest << "," << step(0) << "," << step(1) << ","
+        << c.dt << "," << err(0) << "," << err(1) << "," << err(2) << "," << err(3) << ","
+        << r.energy_error << "," << r.simbody_error << ",\"" << verdict << "\"\n";
+  }
+  if (write) {
+    for (const auto& [name, text] : {std::pair{"stress.md", md.str()}, {"stress.csv", csv.str()}}) {
+      AtomicFile f((dir / name).string(), true);
+      f.stream() << text;
+      f.commit();
+    }
+  }
+  if (a.has("json"))
+    std::cout << results.dump(2) << "\n";
+  else
+    std::cout << md.str() << "wrote " << (dir / "stress.md").string() << ", stress.csv\n";
+  return 0;
+}
+
+}  // namespace femdyn::cli

@@ -1,0 +1,148 @@
+// The stability diagnosis (core/stability.hpp) against closed forms, the backward error of q̈ on
+// an ill-conditioned M^s, femdyn check on a model with a culprit body, and every class of
+// femdyn stress with its verdicts (docs/stability.md).
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/stability.hpp"
+#include "tests/helpers.hpp"
+
+using namespace femdyn;
+using namespace femdyn::test;
+
+namespace {
+
+// A 1 kg point on a 1 m arm about y: undamped spring of ω = √k, or a pendulum under gravity.
+Model arm(double k, double damping, double gravity) {
+  return load_text(R"({"name": "arm", "gravity": [0, 0, )" + std::to_string(-gravity) +
+                   R"(], "bodies": [{"name": "arm", "parent": "world", "joint": {"name": "theta",
+    "type": "revolute", "axis": [0, 1, 0], "spring": {"stiffness": )" + std::to_string(k) +
+                   R"(}, "damping": )" + std::to_string(damping) + R"(}, "elements": [
+    {"type": "lumped_point", "node": [1, 0, 0], "mass": 1.0}]}]})");
+}
+
+std::string number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
+}  // namespace
+
+TEST_CASE("linearisation and stable steps match the closed forms of an oscillator", "[stability]") {
+  const double w = 1e3;
+  const Model m = arm(w * w, 0, 0);
+  Workspace ws(m);
+  const Linearization lin = linearize(m, ws, VecX::Constant(1, 0.1), VecX::Zero(1), VecX::Zero(1));
+  REQUIRE(lin.status.ok);
+  CHECK(lin.A(1, 0) == Approx(-w * w).epsilon(1e-6));  // θ̈ = −ω² θ
+  CHECK(std::abs(lin.A(1, 1)) < 1e-6);
+  CHECK(std::abs(lin.stiffest) == Approx(w).epsilon(1e-6));
+  // RK4 on the imaginary axis: |R(iy)| ≤ 1 up to y = 2√2; symplectic Euler: ω h < 2.
+  CHECK(*largest_stable_step(lin, IntegratorKind::Rk4) * w == Approx(2 * std::sqrt(2.0)).epsilon(1e-4));
+  CHECK(*largest_stable_step(lin, IntegratorKind::Euler) * w == Approx(2).epsilon(1e-4));
+  CHECK(std::isinf(*largest_stable_step(lin, IntegratorKind::Bdf)));
+  // Overdamped (ζ = 100): the fast real mode λ ≈ −2ζω limits RK4 to h |λ| ≤ 2.785.
+  const Model damped = arm(w * w, 2 * 100 * w, 0);
+  Workspace wd(damped);
+  const Linearization fast = linearize(damped, wd, VecX::Constant(1, 0.1), VecX::Zero(1), VecX::Zero(1));
+  CHECK(*largest_stable_step(fast, IntegratorKind::Rk4) * std::abs(fast.stiffest) ==
+        Approx(2.785).epsilon(1e-3));
+  // The arm under gravity, horizontal at θ = 0 (θ̈ = g cos θ): A = [[0, 1], [−g sin θ, 0]].
+  const Model pendulum = arm(0, 0, 9.81);
+  Workspace wp(pendulum);
+  const Linearization p = linearize(pendulum, wp, VecX::Constant(1, 0.4), VecX::Zero(1), VecX::Zero(1));
+  CHECK(p.A(1, 0) == Approx(-9.81 * std::sin(0.4)).epsilon(1e-6));
+}
+
+TEST_CASE("at cond(M^s) = 1e10 the backward error of q̈ is below 1e-14", "[stability]") {
+  // Two links whose masses differ by the ratio that makes cond(M^s) ≈ 1e10.
+  for (double ratio : {1e9, 1e10}) {
+    const Model m = load_text(R"({"name": "ratio", "gravity": [0, 0, -9.81], "bodies": [
+      {"name": "heavy", "parent": "world", "joint": {"name": "j1", "type": "revolute", "axis": [0, 1, 0]},
+       "elements": [{"type": "lumped_point", "node": [0.5, 0, 0], "mass": 1.0}]},
+      {"name": "light", "parent": "heavy", "joint": {"name": "j2", "type": "revolute", "axis": [0, 0, 1],
+       "origin": {"xyz": [0.5, 0, 0]}}, "elements": [{"type": "lumped_point", "node": [0.3, 0, 0],
+       "mass": )" + number(1.0 / ratio) + R"(}]}]})");
+    Workspace ws(m);
+    const VecX q = Eigen::Vector2d(0.3, 0.7), qd = Eigen::Vector2d(1.0, -2.0), tau = Eigen::Vector2d(0.1, 1e-9);
+    REQUIRE(forward_dynamics(m, ws, q, qd, tau).ok);
+    const MassMatrixHealth h = mass_matrix_health(ws.Ms);
+    INFO("cond " << h.condition);
+    CHECK(h.condition > 1e9);
+    CHECK(h.condition < 1e12);
+    // ‖M q̈ − (Q − h)‖∞ / (‖M‖∞ ‖q̈‖∞ + ‖Q − h‖∞): Cholesky is backward stable.
+    const VecX r = ws.Ms * ws.qdd - (ws.Q - ws.h);
+    const double scale = ws.Ms.cwiseAbs().rowwise().sum().maxCoeff() * ws.qdd.cwiseAbs().maxCoeff() +
+                         (ws.Q - ws.h).cwiseAbs().maxCoeff();
+    INFO("backward error " << r.cwiseAbs().maxCoeff() / scale);
+    CHECK(r.cwiseAbs().maxCoeff() / scale <= 1e-14);
+  }
+}
+
+TEST_CASE("femdyn check names the culprit body of a model with a 1e-9 kg link", "[stability][cli]") {
+  const std::string path = (std::filesystem::temp_directory_path() / "femdyn_check_culprit.json").string();
+  std::ofstream(path) << R"({"name": "culprit", "gravity": [0, 0, -9.81], "bodies": [
+    {"name": "upper", "parent": "world", "joint": {"name": "j1", "type": "revolute", "axis": [0, 1, 0]},
+     "elements": [{"type": "rigid_body", "mass": 1.0, "com": [0.2, 0, 0], "inertia": {"ixx": 1e-3, "iyy": 1e-2, "izz": 1e-2}}]},
+    {"name": "feather", "parent": "upper", "joint": {"name": "j2", "type": "revolute", "axis": [0, 1, 0], "origin": {"xyz": [0.4, 0, 0]}},
+     "elements": [{"type": "rigid_body", "mass": 1e-9, "com": [0.2, 0, 0], "inertia": {"ixx": 1e-12, "iyy": 1e-11, "izz": 1e-11}}]},
+    {"name": "lower", "parent": "feather", "joint": {"name": "j3", "type": "revolute", "axis": [0, 1, 0], "origin": {"xyz": [0.4, 0, 0]}},
+     "elements": [{"type": "rigid_body", "mass": 0.8, "com": [0.2, 0, 0], "inertia": {"ixx": 1e-3, "iyy": 1e-2, "izz": 1e-2}}]}]})";
+  Run r = run("check " + path + " --states 4");
+  INFO(r.out);
+  CHECK(r.code == 1);
+  CHECK_THAT(r.out, Catch::Contains("suspicious body 'feather': near-zero mass: 1e-09 kg"));
+  CHECK_THAT(r.out, Catch::Contains("recommended: "));
+  CHECK(r.out.find("suspicious body 'upper'") == std::string::npos);
+  CHECK(r.out.find("suspicious body 'lower'") == std::string::npos);
+  r = run("check " + model_path("finger.json") + " --json");
+  REQUIRE(r.code == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  CHECK(j["suspicious_bodies"].empty());
+  CHECK(j["largest_stable_step"]["rk4"].get<double>() > 0);
+  std::remove(path.c_str());
+}
+
+#ifdef FEMDYN_WITH_SIMBODY
+// Each class of femdyn stress --quick: the verdicts hold and Simbody agrees wherever it runs.
+TEST_CASE("stress: every class of case gets its verdict", "[stability][stress]") {
+  for (const char* klass : {"springs", "ratios", "speeds", "slender bars", "postures", "size",
+                            "gravity", "singular"}) {
+    DYNAMIC_SECTION(klass) {
+      const Run r = run(std::string("stress --quick --json --class '") + klass + "'");
+      INFO(r.out.substr(0, 3000));
+      REQUIRE(r.code == 0);
+      const auto cases = nlohmann::json::parse(r.out);
+      REQUIRE(!cases.empty());
+      for (const auto& c : cases) {
+        INFO(c["case"] << ": " << c["verdict"]);
+        CHECK(c["verdict"].get<std::string>().rfind(c["expected"].get<std::string>(), 0) == 0);
+        if (c.contains("simbody_error") && c["simbody_error"].get<double>() >= 0)
+          CHECK(c["simbody_error"].get<double>() < 1e-6);
+        if (c.contains("positive_definite")) CHECK(c["positive_definite"] == true);
+      }
+      if (std::string(klass) == "singular")
+        CHECK(cases[0]["verdict"] ==
+              "refused: stress case 'zero-mass chain end': /bodies/1/joint: the mass matrix M^s is "
+              "singular: coordinate 'j2' moves no inertia (a massless chain end, or all its mass "
+              "on the joint axis?)");
+      if (std::string(klass) == "springs") {
+        // ω = 1e5 rad/s: RK4 at dt = 1e-4 is unstable, BDF is stable.
+        for (const auto& c : cases) {
+          if (c["case"] != "spring w=100000 zeta=0") continue;
+          CHECK(c["dt"] == 1e-4);
+          CHECK(c["integrators"][0]["integrator"] == "rk4");
+          CHECK(c["integrators"][0]["error"] == -1);
+          CHECK(c["integrators"][3]["integrator"] == "bdf");
+          CHECK(c["integrators"][3]["error"].get<double>() >= 0);
+          CHECK(c["integrators"][3]["error"].get<double>() < 1e-2);
+        }
+      }
+    }
+  }
+}
+#endif

@@ -1,0 +1,59 @@
+// The stability suite (femdyn stress, docs/stability.md): one generated case is a model plus a
+// scenario (initial state, time span, a fixed step), diagnosed as
+//   - cond(M^s) over the reference trajectory, symmetry, positive definiteness;
+//   - the reference motion: Dormand–Prince at rtol 1e-10, or BDF at 1e-10 when Dormand–Prince
+//     gives up (a stiff case), and its energy balance |E − E0 − W| relative to the energy;
+//   - for rk4 and euler the largest stable step, by bisection of real runs (a run is stable
+//     when it ends without a fault within 10x the state's size of the reference), started
+//     from the linearised estimate (core/stability.hpp); for every integrator the error at
+//     the scenario's step (rk4, euler) or at rtol 1e-6 (dopri, bdf);
+//   - agreement with Simbody's twin (RungeKuttaMerson at 1e-10) where Simbody can hold it;
+// and a verdict: stable; stable only with the implicit integrator; ill-conditioned (cond >
+// 1e12); or refused, with the reason.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "core/model.hpp"
+
+namespace femdyn::validation {
+
+struct StressScenario {
+  VecX q0, qd0;
+  double t_end = 1;
+  double dt = 1e-3;  // the fixed step at which rk4 and euler are scored
+  // Large models (a chain of 1000 links): no step search, no Simbody, and only the fixed-step
+  // integrators, against RK4 at half the step (one evaluation costs about a second there).
+  bool large = false;
+};
+
+struct StressIntegrator {
+  std::string name;
+  double largest_stable_step = -1;  // s; −1: not searched (adaptive, or not asked)
+  double error = -1;  // at the scenario's step or tolerance, relative to the state's size
+                      // max(1, max |x_ref|); −1: the run failed or was not made
+  long steps = 0;
+  std::string failure;
+};
+
+struct StressResult {
+  int n = 0;
+  std::string refused;  // why the case cannot be run (then nothing else is filled)
+  double cond_min = 0, cond_max = 0, asymmetry = 0;
+  bool positive_definite = true;
+  double stiffest = 0;  // |λ| of the linearisation at the initial state (rad/s)
+  std::string reference;
+  double energy_error = 0;  // max |E − E0 − W| / max(|E|, kinetic)
+  std::vector<StressIntegrator> integrators;
+  double simbody_error = -1;  // max ‖(θ, θ̇) − Simbody‖∞ over the samples, relative to the
+                              // state's size; −1: not compared
+  std::string simbody_note;
+  std::string verdict;
+};
+
+StressResult run_stress(const Model& model, const StressScenario& scenario);
+
+// One line for a refusal found while loading (a ModelError from the case's description).
+StressResult refused_case(const std::string& why);
+
+}  // namespace femdyn::validation
