@@ -2,6 +2,7 @@
 // sampled states: conditioning of M^s, the stiffest mode and the largest stable step of each
 // explicit integrator, suspicious bodies, and a recommended integrator and step.
 #include <cmath>
+#include <complex>
 #include <iostream>
 #include <limits>
 #include <random>
@@ -38,6 +39,16 @@ std::string g(double x) {
   return s.str();
 }
 
+// What an eigenvalue of the linearised dynamics is, in words.
+std::string mode_text(std::complex<double> l) {
+  const double r = std::abs(l);
+  if (r == 0) return "no dynamics";
+  if (std::abs(l.imag()) <= 1e-9 * r)
+    return l.real() > 0 ? "real, growing: a fall or an unstable equilibrium"
+                        : "real, decaying: overdamped";
+  return "oscillatory, damping ratio " + g(-l.real() / r);
+}
+
 }  // namespace
 
 int cmd_check(int argc, char** argv) {
@@ -57,7 +68,8 @@ int cmd_check(int argc, char** argv) {
   double cond_lo = std::numeric_limits<double>::infinity(), cond_hi = 0, asym = 0;
   int singular_states = 0;
   std::string singular_message;
-  double stiffest = 0, stiffest_zeta = 0;
+  double stiffest = 0;
+  std::complex<double> stiffest_lambda;
   const IntegratorKind explicit_kinds[] = {IntegratorKind::Rk4, IntegratorKind::Euler,
                                            IntegratorKind::Dopri};
   double h_max[3] = {INFINITY, INFINITY, INFINITY};
@@ -80,7 +92,7 @@ int cmd_check(int argc, char** argv) {
     if (!lin.status.ok) continue;
     if (std::abs(lin.stiffest) > stiffest) {
       stiffest = std::abs(lin.stiffest);
-      stiffest_zeta = -lin.stiffest.real() / std::abs(lin.stiffest);
+      stiffest_lambda = lin.stiffest;
     }
     for (int i = 0; i < 3; ++i) {
       const auto hs = largest_stable_step(lin, explicit_kinds[i]);
@@ -109,7 +121,7 @@ int cmd_check(int argc, char** argv) {
               {"condition", {{"min", cond_lo}, {"max", cond_hi}}},
               {"digits_lost", std::log10(cond_hi)}, {"asymmetry", asym},
               {"singular_states", singular_states}, {"stiffest_mode", stiffest},
-              {"stiffest_damping_ratio", stiffest_zeta}, {"recommendation", recommendation}};
+              {"stiffest_kind", mode_text(stiffest_lambda)}, {"recommendation", recommendation}};
     Json steps = Json::object();
     for (int i = 0; i < 3; ++i)
       steps[integrator_name(explicit_kinds[i])] =
@@ -130,9 +142,7 @@ int cmd_check(int argc, char** argv) {
       std::cout << "M^s: cond from " << g(cond_lo) << " to " << g(cond_hi) << " (q̈ loses up to "
                 << g(std::log10(cond_hi)) << " digits of 16), symmetric to " << g(asym)
                 << (singular_states ? "" : ", positive definite at every state") << "\n";
-    std::cout << "stiffest mode: |λ| = " << g(stiffest) << " rad/s ("
-              << (stiffest_zeta < 0.999 ? "oscillatory, damping ratio " + g(stiffest_zeta)
-                                        : std::string("overdamped"))
+    std::cout << "stiffest mode: |λ| = " << g(stiffest) << " rad/s (" << mode_text(stiffest_lambda)
               << ")\nlargest stable step:";
     for (int i = 0; i < 3; ++i)
       std::cout << " " << integrator_name(explicit_kinds[i]) << " "

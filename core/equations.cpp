@@ -1,5 +1,8 @@
 #include "core/equations.hpp"
 
+#include <cmath>
+#include <string>
+
 #include "core/kinematics.hpp"
 #include "core/mass_solver.hpp"
 
@@ -154,6 +157,12 @@ Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const 
   if (!st.ok) return st;
   ws.qdd = ws.Q - ws.h;
   ws.solver.solve_in_place(ws.qdd);
+  // A result that overflowed is a failure naming the coordinate, never a NaN handed on.
+  for (Eigen::Index a = 0; a < ws.qdd.size(); ++a)
+    if (!std::isfinite(ws.qdd[a]))
+      return {false, "q̈ of '" + model.coordinate_names[a] +
+                         "' is NaN or Inf (the forces or the state overflow double precision)",
+              static_cast<int>(a)};
   return st;
 }
 

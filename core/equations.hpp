@@ -20,7 +20,8 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
 // Velocity terms alone, h(q, q̇) (one kinematic sweep, T not formed).
 void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX& qd);
 
-// q̈ = (M^s)⁻¹ (Q − h) into ws.qdd; evaluates first. Fails on a singular M^s.
+// q̈ = (M^s)⁻¹ (Q − h) into ws.qdd; evaluates first. Fails on a singular or indefinite M^s
+// and on a q̈ that is not finite (naming the coordinate).
 Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                         const VecX& tau);
 

@@ -55,11 +55,6 @@ Status Motion::rhs(double t, const double* y, double* ydot) {
     st.message = at_time(t) + st.message;
     return st;
   }
-  for (int i = 0; i < n; ++i) {
-    if (std::isfinite(ws_.qdd[i])) continue;
-    return {false, at_time(t) + "q̈ of '" + model_.coordinate_names[i] +
-                       "' is NaN or Inf (the state or the forces overflowed)", i};
-  }
   Eigen::Map<VecX>(ydot, n) = qd_;
   Eigen::Map<VecX>(ydot + n, n) = ws_.qdd;
   ydot[2 * n] = nonconservative_power(model_, ws_, qd_, u_);

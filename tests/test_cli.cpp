@@ -79,7 +79,7 @@ TEST_CASE("bad command lines and bad models: one line, non-zero exit", "[cli]") 
 }
 
 TEST_CASE("every command has --help, info lists the correlation table", "[cli]") {
-  for (const char* cmd : {"info", "equations", "compare", "track", "validate", "import", "simulate"}) {
+  for (const char* cmd : {"info", "equations", "compare", "track", "validate", "import", "simulate", "check", "study", "stress"}) {
     const Run r = run(std::string(cmd) + " --help");
     CHECK(r.code == 0);
     CHECK_THAT(r.out, Catch::StartsWith("usage: femdyn " + std::string(cmd)));
