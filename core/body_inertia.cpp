@@ -46,15 +46,59 @@ void condense_body_inertia(Model& m) {
     for (int a = 0; a < m.n(); ++a)
       if (moves[a]) m.body_coords[b].push_back(a);
   }
-  // Choose by operation count: the dense M T and Tᵀ (M T), against 6 x 6 x p_b and 6 x p_b²
-  // per body (plus the gather and scatter, about as much again).
-  const double n = m.n(), dense = (m.n_u() * n + static_cast<double>(m.M.nonZeros())) * n;
-  double by_body = 0;
-  for (const auto& c : m.body_coords) {
-    const double p = static_cast<double>(c.size());
-    by_body += 2 * (36 * p + 6 * p * p);
-  }
+  m.identity_coupling = m.C.rows() == m.C.cols() && m.C.isIdentity(0);
+  // Choose by operation count: the dense M T and Tᵀ (M T), against the composite recursion
+  // (about 300 operations a body to move Λ_b, 12 per joint on its path) and, with a coupling,
+  // the reduction Cᵀ M_θ C.
+  const double n = m.n(), nt = m.n_theta();
+  const double dense = (m.n_u() * n + static_cast<double>(m.M.nonZeros())) * n;
+  double by_body = m.identity_coupling ? 0 : 2 * nt * nt * n;
+  for (const auto& c : m.body_coords) by_body += 300 + 12 * static_cast<double>(c.size());
   m.condensed = m.condensable && by_body < dense;
+}
+
+void composite_mass(const Model& m, Workspace& ws) {
+  const int nb = static_cast<int>(m.bodies.size());
+  // Λ_b^O into the composites, leaves to root (children come after their parents).
+  for (int b = 0; b < nb; ++b) ws.composite[b].setZero();
+  for (int b = nb - 1; b >= 0; --b) {
+    const Mat3& R = ws.body[b].R;
+    const Mat6& L = m.body_inertia[b];
+    const Mat3 A = R * L.topLeftCorner<3, 3>() * R.transpose();
+    const Mat3 B = R * L.topRightCorner<3, 3>() * R.transpose();
+    const Mat3 D = R * L.bottomRightCorner<3, 3>() * R.transpose();
+    const Mat3 P = skew(ws.body[b].p);
+    // Xᵀ [[A, B], [Bᵀ, D]] X with X = [[I, 0], [−P, I]] and Pᵀ = −P.
+    const Mat3 BP = B * P, DP = D * P;
+    Mat6& I = ws.composite[b];
+    I.topLeftCorner<3, 3>() += A - BP - BP.transpose() - P * DP;
+    I.topRightCorner<3, 3>() += B + P * D;
+    I.bottomLeftCorner<3, 3>() += B.transpose() - DP;
+    I.bottomRightCorner<3, 3>() += D;
+    if (m.bodies[b].parent >= 0) ws.composite[m.bodies[b].parent] += I;
+    // The joint's motion subspace (world axes, about the origin).
+    const Joint& j = m.bodies[b].joint;
+    Vec6& S = ws.subspace[b];
+    const Vec3 s = ws.body[b].R * j.axis;
+    if (j.type == JointType::Revolute)
+      S << s, ws.body[b].p.cross(s);
+    else
+      S << Vec3::Zero(), s;
+  }
+  // M_θ(i, k) = S_kᵀ I^c_b S_i along the path of b.
+  MatX& Mt = m.identity_coupling ? ws.Ms : ws.Mtheta;
+  Mt.setZero();
+  for (int b = 0; b < nb; ++b) {
+    const int i = m.bodies[b].joint.theta;
+    if (i < 0) continue;
+    const Vec6 F = ws.composite[b] * ws.subspace[b];
+    for (int a = b; a >= 0; a = m.bodies[a].parent) {
+      const int k = m.bodies[a].joint.theta;
+      if (k < 0) continue;
+      Mt(k, i) = Mt(i, k) = ws.subspace[a].dot(F);
+    }
+  }
+  if (!m.identity_coupling) ws.Ms.noalias() = m.C.transpose() * (ws.Mtheta * m.C);
 }
 
 }  // namespace femdyn

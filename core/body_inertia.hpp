@@ -14,11 +14,23 @@
 // moves), and when Λ_b does not depend on the body's orientation (translation inertia isotropic,
 // as for every physical element). compile() checks both (Model::condensable) and uses the form
 // where it takes fewer operations than the dense product (Model::condensed).
+//
+// At run time the same Λ_b give M^s by composite inertias (the composite-rigid-body recursion,
+// Featherstone ch. 6), O(bodies · depth) instead of O(Σ p_b²):
+//   Λ_b^O = Xᵀ Λ_b^w X,  X = [[I, 0], [−[p_b]×, I]]     (world axes, twist about the origin)
+//   I^c_b = Λ_b^O + Σ_{children c} I^c_c                (leaves to root)
+//   M_θ(i, k) = S_kᵀ I^c_{b(i)} S_i   for each joint k on the path of the body b(i) of joint i,
+//   S = (s, p_b × s) revolute, (0, s) prismatic          (s the world axis, p_b the joint origin)
+//   M^s = Cᵀ M_θ C   (M_θ itself when C = I).
 #pragma once
 #include "core/model.hpp"
+#include "core/workspace.hpp"
 
 namespace femdyn {
 
 void condense_body_inertia(Model& model);
+
+// ws.Ms from the body poses of the last propagate (no Jacobians needed).
+void composite_mass(const Model& model, Workspace& ws);
 
 }  // namespace femdyn

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/body_inertia.hpp"
 #include "core/kinematics.hpp"
 #include "core/mass_solver.hpp"
 
@@ -77,46 +78,19 @@ void assemble_forces(const Model& model, Workspace& ws, const VecX& tau, bool wi
   if (tau.size() == ws.Q.size()) ws.Q += tau;
 }
 
-// M^s = Σ_b J_bᵀ Λ_b^w J_b over the coordinates P_b that move body b (core/body_inertia.hpp),
-// Λ_b^w = diag(R_b, R_b) Λ_b diag(R_b, R_b)ᵀ. Needs the body Jacobians of the last propagate.
-void condensed_mass(const Model& model, Workspace& ws) {
-  ws.Ms.setZero();
-  for (std::size_t b = 0; b < model.bodies.size(); ++b) {
-    const std::vector<int>& P = model.body_coords[b];
-    const Mat6& L = model.body_inertia[b];
-    const auto p = static_cast<Eigen::Index>(P.size());
-    if (p == 0 || L.isZero(0)) continue;
-    const Mat3& R = ws.body[b].R;
-    Mat6 Lw;
-    Lw.topLeftCorner<3, 3>() = R * L.topLeftCorner<3, 3>() * R.transpose();
-    Lw.topRightCorner<3, 3>() = R * L.topRightCorner<3, 3>() * R.transpose();
-    Lw.bottomLeftCorner<3, 3>() = R * L.bottomLeftCorner<3, 3>() * R.transpose();
-    Lw.bottomRightCorner<3, 3>() = R * L.bottomRightCorner<3, 3>() * R.transpose();
-    auto J = ws.Jb.leftCols(p);
-    for (Eigen::Index c = 0; c < p; ++c) {
-      J.col(c).head<3>() = ws.Jw.block<3, 1>(3 * b, P[c]);
-      J.col(c).tail<3>() = ws.Jv.block<3, 1>(3 * b, P[c]);
-    }
-    auto LJ = ws.LJb.leftCols(p);
-    LJ.noalias() = Lw * J;
-    auto Mb = ws.Mb.topLeftCorner(p, p);
-    Mb.noalias() = J.transpose() * LJ;
-    for (Eigen::Index c = 0; c < p; ++c)
-      for (Eigen::Index r = 0; r < p; ++r) ws.Ms(P[r], P[c]) += Mb(r, c);
-  }
-}
-
 bool is_zero(const VecX& v) { return v.size() == 0 || v.cwiseAbs().maxCoeff() == 0.0; }
 
 }  // namespace
 
 void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau) {
   const bool moving = !is_zero(qd);
-  propagate(model, ws, q, qd, {.jacobian = true, .bias = moving, .rows = !model.condensed});
+  // The condensed route needs only the body poses; the dense one the rows of T.
+  propagate(model, ws, q, qd,
+            {.jacobian = !model.condensed, .bias = moving, .rows = !model.condensed});
   if (!moving) ws.theta_dot.setZero();
 
   if (model.condensed) {
-    condensed_mass(model, ws);  // M^s body by body; T is not formed
+    composite_mass(model, ws);  // M^s by composite inertias; T is not formed
   } else {
     // M^s = Tᵀ (M T)
     if (ws.MT.rows() != ws.T.rows() || ws.MT.cols() != ws.T.cols())

@@ -19,6 +19,7 @@ namespace femdyn {
 
 using SpMat = Eigen::SparseMatrix<double>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
+using Vec6 = Eigen::Matrix<double, 6, 1>;
 
 struct Joint {
   std::string name;
@@ -112,6 +113,7 @@ struct Model {
   // Body level (core/body_inertia.hpp): M^s = Σ_b J_bᵀ Λ_b J_b when `condensed`.
   std::vector<Mat6> body_inertia;             // Λ_b: Σ X_eᵀ m_e X_e, twist (ω, v) in body axes
   std::vector<std::vector<int>> body_coords;  // coordinates that move body b, ascending
+  bool identity_coupling = false;  // C = I (n = nθ): M^s = M_θ, no reduction needed
   bool condensable = false;  // the body-level form is exact for this model
   bool condensed = false;    // ... and cheaper than the dense Tᵀ M T: evaluate() uses it
 

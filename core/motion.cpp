@@ -13,6 +13,7 @@ std::string at_time(double t) {
 
 double nonconservative_power(const Model& model, const Workspace& ws, const VecX& qd,
                              const VecX& tau) {
+  if (qd.isZero(0)) return 0;  // at rest nothing does work (and ω, θ̇ were not propagated)
   double P = tau.size() == qd.size() ? qd.dot(tau) : 0.0;
   for (int j = 0; j < model.n_theta(); ++j) {
     const double c = model.bodies[model.theta_joint[j]].joint.damping;

@@ -19,10 +19,9 @@ Workspace::Workspace(const Model& model) : solver(model) {
   u_dot = VecX::Zero(N);
   nodal = VecX::Zero(N);
   u_acc = VecX::Zero(N);
-  std::size_t p = 0;
-  for (const auto& c : model.body_coords) p = std::max(p, c.size());
-  Jb = LJb = MatX::Zero(6, static_cast<Eigen::Index>(p));
-  Mb = MatX::Zero(static_cast<Eigen::Index>(p), static_cast<Eigen::Index>(p));
+  composite.assign(nb, Mat6::Zero());
+  subspace.assign(nb, Vec6::Zero());
+  if (!model.identity_coupling) Mtheta = MatX::Zero(nt, nt);
   force.assign(nb, Vec3::Zero());
   moment.assign(nb, Vec3::Zero());
   tau_theta = VecX::Zero(nt);

@@ -31,7 +31,9 @@ struct Workspace {
   VecX nodal;                      // M T'[q̇,q̇] + g, then nodal forces F (N_u)
   MatX MT;                         // M T (N_u x n), sized when first formed
   VecX u_acc;                      // T q̈ + T'[q̇,q̇] (inverse dynamics)
-  MatX Jb, LJb, Mb;                // body level: J_b (6 x p), Λ_b J_b, J_bᵀ Λ_b J_b (p x p)
+  std::vector<Mat6> composite;     // per body: composite inertia I^c_b (core/body_inertia.hpp)
+  std::vector<Vec6> subspace;      // per body: its joint's motion subspace S (world, origin)
+  MatX Mtheta;                     // M_θ (nθ x nθ), with a coupling only
   std::vector<Vec3> force, moment; // per body: wrench of Tᵀ f (world; moment about the origin)
   VecX tau_theta;                  // Tᵀ f on the joint coordinates θ
   std::vector<VecX> local_x, local_y, local_g;  // per element local DOF buffers (6k)

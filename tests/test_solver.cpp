@@ -102,7 +102,7 @@ TEST_CASE("O(n) inverse dynamics and bias (Tᵀ by a backward sweep) equal the m
   }
 }
 
-TEST_CASE("M^s condensed body by body equals Tᵀ M T", "[solver]") {
+TEST_CASE("M^s by composite inertias (condensed route) equals Tᵀ M T", "[solver]") {
   std::vector<Model> models;
   for (const std::string& name : bundled_models()) models.push_back(load_model(model_path(name)));
   for (const char* name : {"urdf/arm7.urdf", "urdf/hand16.urdf", "urdf/gantry.urdf"})
