@@ -6,6 +6,11 @@ namespace {
 // Tree level: body poses, rates and biases, parents first.
 void propagate_tree(const Model& model, Workspace& ws, KinematicsRequest req) {
   const BodyState root;
+  const auto nb = static_cast<Eigen::Index>(model.bodies.size());
+  if (req.jacobian && ws.Jw.rows() != 3 * nb) {  // first use only
+    ws.Jw.setZero(3 * nb, model.n());
+    ws.Jv.setZero(3 * nb, model.n());
+  }
   for (std::size_t b = 0; b < model.bodies.size(); ++b) {
     const Joint& j = model.bodies[b].joint;
     const int parent = model.bodies[b].parent;

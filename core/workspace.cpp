@@ -11,8 +11,8 @@ Workspace::Workspace(const Model& model) : solver(model) {
   theta_dot = VecX::Zero(nt);
   theta_dot_y = VecX::Zero(nt);
   body.assign(nb, BodyState{});
-  Jw = MatX::Zero(3 * nb, n);
-  Jv = MatX::Zero(3 * nb, n);
+  // The body Jacobians (3nb x n each) are sized on first use: the condensed route never forms
+  // them (a 1000-link chain would need 48 MB for nothing).
   // T (N_u x n) and M T are sized on first use: a model whose M^s is condensed by body never
   // forms them in evaluate(), and at thousands of bodies they are the largest buffers.
   bias = VecX::Zero(N);

@@ -24,7 +24,8 @@ struct Workspace {
 
   VecX theta, theta_dot, theta_dot_y;  // θ, θ̇ (= C x), C y
   std::vector<BodyState> body;     // per body
-  MatX Jw, Jv;                     // body Jacobians in q: rows 3b..3b+2 of body b (3nb x n)
+  MatX Jw, Jv;                     // body Jacobians in q: rows 3b..3b+2 of body b (3nb x n),
+                                   // sized when first formed
   MatX T;                          // T = ∂u/∂q (N_u x n), sized when first formed
   VecX bias;                       // T'[q̇,q̇] (N_u)
   VecX u_dot;                      // u̇ = T q̇
