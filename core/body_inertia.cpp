@@ -46,7 +46,6 @@ void condense_body_inertia(Model& m) {
     for (int a = 0; a < m.n(); ++a)
       if (moves[a]) m.body_coords[b].push_back(a);
   }
-  m.identity_coupling = m.C.rows() == m.C.cols() && m.C.isIdentity(0);
   // Choose by operation count: the dense M T and Tᵀ (M T), against the composite recursion
   // (about 300 operations a body to move Λ_b, 12 per joint on its path) and, with a coupling,
   // the reduction Cᵀ M_θ C.

@@ -142,6 +142,9 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
     state[t] = 2;
   };
   for (int t = 0; t < nt; ++t) resolve(t);
+  // The hot path's form of C (core/coupling.hpp).
+  m.identity_coupling = nt == n && m.C.isIdentity(0) && m.theta0.isZero(0);
+  m.C_sparse = m.C.sparseView();
 }
 
 }  // namespace

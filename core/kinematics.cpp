@@ -1,5 +1,7 @@
 #include "core/kinematics.hpp"
 
+#include "core/coupling.hpp"
+
 namespace femdyn {
 namespace {
 
@@ -49,8 +51,8 @@ void propagate_tree(const Model& model, Workspace& ws, KinematicsRequest req) {
         Jv = ws.Jv.middleRows<3>(3 * parent);
         Jv.noalias() -= skew(r) * ws.Jw.middleRows<3>(3 * parent);
       }
-      if (rev) Jw.noalias() += s * model.C.row(j.theta);
-      if (pri) Jv.noalias() += s * model.C.row(j.theta);
+      if (rev) coupling_add_row(model, j.theta, s, Jw);
+      if (pri) coupling_add_row(model, j.theta, s, Jv);
     }
   }
 }
@@ -109,11 +111,10 @@ void propagate_nodes(const Model& model, Workspace& ws, KinematicsRequest req) {
 void propagate_bilinear(const Model& model, Workspace& ws, const VecX& q, const VecX& x,
                         const VecX& y, KinematicsRequest request) {
   // Coupling level.
-  ws.theta.noalias() = model.C * q;
-  ws.theta += model.theta0;
+  coupling_apply(model, q, ws.theta, true);
   if (request.bias) {
-    ws.theta_dot.noalias() = model.C * x;
-    ws.theta_dot_y.noalias() = model.C * y;
+    coupling_apply(model, x, ws.theta_dot, false);
+    coupling_apply(model, y, ws.theta_dot_y, false);
   }
   propagate_tree(model, ws, request);
   propagate_nodes(model, ws, request);
@@ -163,7 +164,7 @@ void apply_transpose(const Model& model, Workspace& ws, const VecX& f, VecX& y,
       ws.moment[body.parent] += ws.moment[b] + r.cross(ws.force[b]);
     }
   }
-  y.noalias() = model.C.transpose() * ws.tau_theta;
+  coupling_apply_transpose(model, ws.tau_theta, y);
 }
 
 }  // namespace femdyn

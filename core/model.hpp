@@ -18,6 +18,7 @@
 namespace femdyn {
 
 using SpMat = Eigen::SparseMatrix<double>;
+using SpRowMat = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 
@@ -113,7 +114,8 @@ struct Model {
   // Body level (core/body_inertia.hpp): M^s = Σ_b J_bᵀ Λ_b J_b when `condensed`.
   std::vector<Mat6> body_inertia;             // Λ_b: Σ X_eᵀ m_e X_e, twist (ω, v) in body axes
   std::vector<std::vector<int>> body_coords;  // coordinates that move body b, ascending
-  bool identity_coupling = false;  // C = I (n = nθ): M^s = M_θ, no reduction needed
+  bool identity_coupling = false;  // C = I and θ0 = 0: the coupling level is nothing
+  SpRowMat C_sparse;               // C for the hot path (core/coupling.hpp)
   bool condensable = false;  // the body-level form is exact for this model
   bool condensed = false;    // ... and cheaper than the dense Tᵀ M T: evaluate() uses it
 

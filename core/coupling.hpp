@@ -1,0 +1,37 @@
+// The coupling level θ = C q + θ0 applied in the hot path: through the sparse copy of C
+// (Model::C_sparse, O(non-zeros)), or, for the identity (no couplings), as nothing at all.
+// The dense Model::C remains the description (twins, reports, M^s = Cᵀ M_θ C).
+#pragma once
+#include "core/model.hpp"
+
+namespace femdyn {
+
+// θ = C x (+ θ0 when `offset`).
+inline void coupling_apply(const Model& m, const VecX& x, VecX& theta, bool offset) {
+  if (m.identity_coupling) {
+    theta = x;
+    return;
+  }
+  theta.noalias() = m.C_sparse * x;
+  if (offset) theta += m.theta0;
+}
+
+// y = Cᵀ f.
+inline void coupling_apply_transpose(const Model& m, const VecX& f, VecX& y) {
+  if (m.identity_coupling)
+    y = f;
+  else
+    y.noalias() = m.C_sparse.transpose() * f;
+}
+
+// y += v · (row j of C)ᵀ, for a vector y of n entries or a block of n columns (v a column).
+template <class Y, class V>
+inline void coupling_add_row(const Model& m, int j, const V& v, Y&& y) {
+  if (m.identity_coupling) {
+    y.col(j) += v;
+    return;
+  }
+  for (SpRowMat::InnerIterator it(m.C_sparse, j); it; ++it) y.col(it.col()) += it.value() * v;
+}
+
+}  // namespace femdyn
