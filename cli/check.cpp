@@ -32,13 +32,6 @@ limits and q̇ in ±1):
 Exit 1 when M^s is singular at a sampled state or a body is flagged.
 )";
 
-std::string g(double x) {
-  std::ostringstream s;
-  s.precision(3);
-  s << x;
-  return s.str();
-}
-
 // What an eigenvalue of the linearised dynamics is, in words.
 std::string mode_text(std::complex<double> l) {
   const double r = std::abs(l);
@@ -46,7 +39,7 @@ std::string mode_text(std::complex<double> l) {
   if (std::abs(l.imag()) <= 1e-9 * r)
     return l.real() > 0 ? "real, growing: a fall or an unstable equilibrium"
                         : "real, decaying: overdamped";
-  return "oscillatory, damping ratio " + g(-l.real() / r);
+  return "oscillatory, damping ratio " + format_short(-l.real() / r);
 }
 
 }  // namespace
@@ -109,10 +102,10 @@ int cmd_check(int argc, char** argv) {
                      " of the states; repair the model first";
   else if (h_max[0] < 1e-4)
     recommendation = "bdf (e.g. --rtol 1e-6): the stiffest mode limits rk4 to dt < " +
-                     g(h_max[0]) + " s and dopri to steps < " + g(h_max[2]) + " s";
+                     format_short(h_max[0]) + " s and dopri to steps < " + format_short(h_max[2]) + " s";
   else if (std::isfinite(h_max[0]))
     recommendation = "dopri (--rtol 1e-6) for accuracy; for a fixed-rate loop rk4 with dt <= " +
-                     g(h_max[0] / 2) + " s (half its stability limit)";
+                     format_short(h_max[0] / 2) + " s (half its stability limit)";
   else
     recommendation = "dopri (--rtol 1e-6); no stiff mode was found";
 
@@ -139,15 +132,15 @@ int cmd_check(int argc, char** argv) {
       std::cout << "M^s: singular at " << singular_states << " of " << K
                 << " states: " << singular_message << "\n";
     if (singular_states < K)
-      std::cout << "M^s: cond from " << g(cond_lo) << " to " << g(cond_hi) << " (q̈ loses up to "
-                << g(std::log10(cond_hi)) << " digits of 16), symmetric to " << g(asym)
+      std::cout << "M^s: cond from " << format_short(cond_lo) << " to " << format_short(cond_hi) << " (q̈ loses up to "
+                << format_short(std::log10(cond_hi)) << " digits of 16), symmetric to " << format_short(asym)
                 << (singular_states ? "" : ", positive definite at every state") << "\n";
-    std::cout << "stiffest mode: |λ| = " << g(stiffest) << " rad/s (" << mode_text(stiffest_lambda)
+    std::cout << "stiffest mode: |λ| = " << format_short(stiffest) << " rad/s (" << mode_text(stiffest_lambda)
               << ")\nlargest stable step:";
     for (int i = 0; i < 3; ++i)
       std::cout << " " << integrator_name(explicit_kinds[i]) << " "
                 << (!h_known[i] ? std::string("n/a (n > 200)")
-                    : std::isfinite(h_max[i]) ? g(h_max[i]) + " s" : std::string("unlimited"))
+                    : std::isfinite(h_max[i]) ? format_short(h_max[i]) + " s" : std::string("unlimited"))
                 << (i < 2 ? "," : "");
     std::cout << " (bdf: unlimited)\n";
     if (bodies.empty()) std::cout << "suspicious bodies: none\n";

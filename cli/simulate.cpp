@@ -42,6 +42,8 @@ summary as one object. Exit 1 on a numerical fault (the message names the time, 
 and the likely cause), 130 when interrupted.
 )";
 
+std::string num(double x) { return format_number(x, "%.4g"); }
+
 volatile std::sig_atomic_t g_interrupted = 0;
 extern "C" void on_interrupt(int) { g_interrupted = 1; }
 
@@ -64,12 +66,6 @@ class InterruptGuard {
  private:
   struct sigaction old_int_ {}, old_term_ {};
 };
-
-std::string number_text(double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.4g", x);
-  return buf;
-}
 
 }  // namespace
 
@@ -123,8 +119,8 @@ int cmd_simulate(int argc, char** argv) {
     table.emplace(a.options.at("tau-csv"), m);
     if (table->t_first() > 0 || table->t_last() < t_end)
       throw CliError("--tau-csv " + table->path() + " covers t in [" +
-                     number_text(table->t_first()) + ", " + number_text(table->t_last()) +
-                     "] s; it must cover [0, " + number_text(t_end) + "] s");
+                     num(table->t_first()) + ", " + num(table->t_last()) +
+                     "] s; it must cover [0, " + num(t_end) + "] s");
     tau = [&table](double t, VecX& out) { (*table)(t, out); };
     driven = true;
   }
@@ -202,23 +198,23 @@ int cmd_simulate(int argc, char** argv) {
   } else {
     std::cout << "model: " << m.name << " (" << m.n() << " coordinates)\n"
               << "integrator: " << integ->name() << " ("
-              << (is_adaptive(o.kind) ? "rtol " + number_text(o.adaptive.rtol) + ", atol " +
-                                            number_text(o.adaptive.atol)
-                                      : "dt " + number_text(o.fixed.dt) + " s")
+              << (is_adaptive(o.kind) ? "rtol " + num(o.adaptive.rtol) + ", atol " +
+                                            num(o.adaptive.atol)
+                                      : "dt " + num(o.fixed.dt) + " s")
               << ")\n"
-              << "simulated " << number_text(simulated) << " of " << number_text(t_end)
+              << "simulated " << num(simulated) << " of " << num(t_end)
               << " s: " << s.steps << " steps (" << s.rejected << " rejected), " << s.rhs_evals
               << " evaluations of forward dynamics, " << s.jac_evals << " Jacobians\n"
-              << "wall time " << number_text(wall) << " s (integration "
-              << number_text(s.wall_time) << " s), real-time factor " << number_text(rtf) << "\n"
-              << balance_name << ": max |E(t) - E(0) - W(t)| = " << number_text(max_balance)
-              << " J (" << number_text(scale > 0 ? max_balance / scale : 0)
+              << "wall time " << num(wall) << " s (integration "
+              << num(s.wall_time) << " s), real-time factor " << num(rtf) << "\n"
+              << balance_name << ": max |E(t) - E(0) - W(t)| = " << num(max_balance)
+              << " J (" << num(scale > 0 ? max_balance / scale : 0)
               << " of the energy scale) over " << rows << " rows\n";
     if (out) std::cout << "wrote " << out->path() << " (" << rows << " rows)\n";
   }
   if (!st.ok) {
     std::cerr << "femdyn simulate: " << a.positional[0] << ": " << st.message
-              << (out ? "; the rows up to t = " + number_text(simulated) + " s are in " +
+              << (out ? "; the rows up to t = " + num(simulated) + " s are in " +
                             out->path()
                       : std::string())
               << "\n";

@@ -35,13 +35,8 @@ Writes DIR/stress.md and DIR/stress.csv (default DIR ./stress; existing files ne
 speeds, slender bars, postures, size, gravity, singular). --json: the results on stdout.
 )";
 
-std::string g(double x) {
-  if (x < 0) return "—";
-  std::ostringstream s;
-  s.precision(3);
-  s << x;
-  return s.str();
-}
+// A table cell: three digits, or a dash for "not measured" (−1).
+std::string g(double x) { return x < 0 ? "—" : format_short(x); }
 
 }  // namespace
 

@@ -6,12 +6,6 @@
 namespace femdyn::cli {
 namespace {
 
-std::string g(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", x);
-  return buf;
-}
-
 // A rigid link of length L and mass m along x: centre of mass at L/2, a solid rod of radius
 // r = L/20 (r = 0: a thin rod, no inertia about its axis).
 Json rod(double m, double L, double r) {
@@ -82,8 +76,8 @@ std::vector<StressCase> stress_cases(bool quick) {
   // Stiff joint springs: ω = 1e1 … 1e5 rad/s, ζ = 0 … 100.
   for (double w : quick ? std::vector<double>{1e1, 1e5} : std::vector<double>{1e1, 1e3, 1e5})
     for (double zeta : quick ? std::vector<double>{0, 100} : std::vector<double>{0, 1, 100}) {
-      StressCase s{"springs", "spring w=" + g(w) + " zeta=" + g(zeta),
-                   "1 kg·m² arm on a joint spring of ω = " + g(w) + " rad/s, damping ratio " + g(zeta),
+      StressCase s{"springs", "spring w=" + format_number(w, "%g") + " zeta=" + format_number(zeta, "%g"),
+                   "1 kg·m² arm on a joint spring of ω = " + format_number(w, "%g") + " rad/s, damping ratio " + format_number(zeta, "%g"),
                    spring(w, zeta), {0.1}, {0}};
       s.t_end = w >= 1e4 ? 0.02 : w >= 1e3 ? 0.2 : 2;
       s.dt = 1e-4;

@@ -50,11 +50,7 @@ unless --force. --quick: fewer sweep points and no repeats (seconds; for smoke t
 build refuses to time anything.
 )";
 
-std::string sci(double x, int digits = 2) {
-  std::ostringstream s;
-  s << std::scientific << std::setprecision(digits) << x;
-  return s.str();
-}
+std::string sci(double x) { return format_number(x, "%.2e"); }
 
 std::string seconds(double t) {
   char buf[32];
@@ -175,7 +171,7 @@ std::string markdown_text(const StudyReport& rep, const std::string& command) {
   for (double target : {1e-3, 1e-6, 1e-9}) {
     const StudyRun* f = validation::fastest(rep, "femdyn", target);
     const StudyRun* b = validation::fastest(rep, "Simbody", target);
-    s << "| " << sci(target, 0) << " | "
+    s << "| " << format_number(target, "%.0e") << " | "
       << (f ? label(*f) + " (error " + sci(f->error) + ")" : "none reached it") << " | "
       << (f ? seconds(f->wall_time) : "—") << " | "
       << (b ? label(*b) + " (error " + sci(b->error) + ")" : "none reached it") << " | "

@@ -29,11 +29,7 @@ Exit 1 if any check fails. --json: one object per model (an array for several mo
 trajectory's sample times "t", "state_error" and the energy of both runs.
 )";
 
-std::string sci(double x) {
-  std::ostringstream s;
-  s << std::scientific << std::setprecision(2) << x;
-  return s.str();
-}
+std::string sci(double x) { return format_number(x, "%.2e"); }
 
 Json report_json(const std::string& path, const validation::ValidationReport& r) {
   Json rel = Json::object(), abs = Json::object();

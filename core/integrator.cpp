@@ -11,9 +11,7 @@ namespace femdyn {
 namespace {
 
 std::string bad(const char* field, const std::string& what, double value) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%g", value);
-  return std::string(field) + ": " + what + ", got " + buf;
+  return std::string(field) + ": " + what + ", got " + format_number(value, "%g");
 }
 
 }  // namespace

@@ -31,11 +31,15 @@ inline Mat3 axis_rotation(const Vec3& unit_axis, double angle) {
   return Eigen::AngleAxisd(angle, unit_axis).toRotationMatrix();
 }
 
-// A number for messages: 6 significant digits (std::to_string would print 1e-9 as 0.000000).
-inline std::string format_number(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
+// A number for messages: 6 significant digits (std::to_string would print 1e-9 as 0.000000),
+// or any one-number printf conversion.
+inline std::string format_number(double x, const char* spec = "%.6g") {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, spec, x);
   return buf;
 }
+
+// Three significant digits, for reports and diagnoses.
+inline std::string format_short(double x) { return format_number(x, "%.3g"); }
 
 }  // namespace femdyn

@@ -8,12 +8,6 @@
 namespace femdyn {
 namespace {
 
-std::string g(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", x);
-  return buf;
-}
-
 // R(z) of the Runge–Kutta methods, as the polynomial Σ c_k z^k.
 std::complex<double> stability_function(IntegratorKind kind, std::complex<double> z) {
   const double rk4[] = {1, 1, 1.0 / 2, 1.0 / 6, 1.0 / 24};
@@ -148,9 +142,9 @@ std::vector<SuspiciousBody> suspicious_bodies(const Model& m) {
     }
     const double mass = p[b].mass;
     if (mass > 0 && heaviest > 0 && mass < 1e-6 * heaviest)
-      flag(b, "near-zero mass: " + g(mass) + " kg, " + g(mass / heaviest) + " of its neighbour '" +
-                  heaviest_name + "' (" + g(heaviest) + " kg); where nothing heavier hangs "
-                  "beyond it M^s loses about " + g(std::log10(heaviest / mass)) +
+      flag(b, "near-zero mass: " + format_short(mass) + " kg, " + format_short(mass / heaviest) + " of its neighbour '" +
+                  heaviest_name + "' (" + format_short(heaviest) + " kg); where nothing heavier hangs "
+                  "beyond it M^s loses about " + format_short(std::log10(heaviest / mass)) +
                   " digits: merge it into its neighbour or give it a realistic mass");
     if (mass <= 0) continue;
     const Mat3 Ic = p[b].inertia_com();
@@ -158,11 +152,11 @@ std::vector<SuspiciousBody> suspicious_bodies(const Model& m) {
     const Vec3 I = eig.eigenvalues();  // ascending
     if (I[2] <= 0) continue;           // a point mass: no rotational inertia by design
     if (I[0] < 1e-9 * I[2])
-      flag(b, "near-zero principal inertia: " + g(I[0]) + " kg·m² against " + g(I[2]) +
+      flag(b, "near-zero principal inertia: " + format_short(I[0]) + " kg·m² against " + format_short(I[2]) +
                   " (a thin rod or a point): rotations about that axis are ill-conditioned");
     else if (I[0] + I[1] - I[2] < 1e-6 * I[2])
       flag(b, "inertia nearly violates the triangle inequality (I1 + I2 − I3 = " +
-                  g(I[0] + I[1] - I[2]) + " kg·m², I3 = " + g(I[2]) +
+                  format_short(I[0] + I[1] - I[2]) + " kg·m², I3 = " + format_short(I[2]) +
                   "): a flat body at best, or a mistyped tensor");
   }
   return out;

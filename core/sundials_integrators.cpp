@@ -47,12 +47,6 @@ int jacobian_callback(double t, N_Vector y, N_Vector fy, SUNMatrix J, void* user
                                                 N_VGetArrayPointer(fy), SUNDenseMatrix_Data(J));
 }
 
-std::string seconds(double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.3g s", x);
-  return buf;
-}
-
 // Creates the context and wraps y (both methods).
 void open(SundialsRun& r, VecX& y) {
   if (SUNContext_Create(nullptr, &r.ctx) != 0) throw std::runtime_error("SUNContext_Create failed");
@@ -82,7 +76,7 @@ Status Adaptive::failure(int flag) {
       st.message += "; likely cause: M^s lost positive definiteness along the motion";
     return st;
   }
-  const std::string at = at_time(t_), h = seconds(std::abs(current_step()));
+  const std::string at = at_time(t_), h = format_short(std::abs(current_step())) + " s";
   switch (flag) {
     case CV_TOO_MUCH_WORK:
       return {false, at + "more than " + std::to_string(options_.max_steps) +

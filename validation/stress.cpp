@@ -46,12 +46,6 @@ double max_error(const std::vector<VecX>& x, const std::vector<VecX>& ref) {
   return std::isfinite(e) ? e : -1;
 }
 
-std::string g(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", x);
-  return buf;
-}
-
 }  // namespace
 
 StressResult refused_case(const std::string& why) {
@@ -188,10 +182,10 @@ StressResult run_stress(const Model& m, const StressScenario& s) {
   if (!r.positive_definite)
     r.verdict = "refused: M^s loses definiteness along the motion";
   else if (r.cond_max > 1e12)
-    r.verdict = "ill-conditioned: cond(M^s) up to " + g(r.cond_max) + ", q̈ loses about " +
-                g(std::log10(r.cond_max)) + " of 16 digits";
+    r.verdict = "ill-conditioned: cond(M^s) up to " + format_short(r.cond_max) + ", q̈ loses about " +
+                format_short(std::log10(r.cond_max)) + " of 16 digits";
   else if (stiff)
-    r.verdict = "stable only with bdf: rk4 needs dt < " + g(rk4.largest_stable_step) + " s";
+    r.verdict = "stable only with bdf: rk4 needs dt < " + format_short(rk4.largest_stable_step) + " s";
   else
     r.verdict = "stable";
   return r;

@@ -77,12 +77,6 @@ std::vector<double> decades(int from, int to) {  // 10^-from … 10^-to
   return v;
 }
 
-std::string format(const char* fmt, double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, x);
-  return buf;
-}
-
 }  // namespace
 
 StudyReport run_study(const Model& m, const StudyOptions& o,
@@ -202,8 +196,8 @@ StudyReport run_study(const Model& m, const StudyOptions& o,
       r.times = {r.wall_time};
       r.resolved = r.ok && r.error >= rep.resolution;
       if (log)
-        log(r.engine + " " + r.integrator + " " + r.setting + " " + format("%.3g", r.value) +
-            (r.ok ? ": error " + format("%.2e", r.error) + ", " + format("%.3g s", r.wall_time)
+        log(r.engine + " " + r.integrator + " " + r.setting + " " + format_number(r.value, "%.3g") +
+            (r.ok ? ": error " + format_number(r.error, "%.2e") + ", " + format_number(r.wall_time, "%.3g s")
                   : ": failed: " + r.failure));
       s->active = r.wall_time < budget && (!r.ok || r.error >= rep.resolution);
       rep.runs.push_back(std::move(r));
