@@ -56,6 +56,20 @@ void condense_body_inertia(Model& m) {
   m.condensed = m.condensable && by_body < dense;
 }
 
+MassProperties body_mass_properties(const Model& m, int body) {
+  MassProperties sum;
+  Vec3 first_moment = Vec3::Zero();
+  for (const ElementEntry& e : m.elements) {
+    if (e.body != body) continue;
+    const MassProperties p = e.element->mass_properties();
+    sum.mass += p.mass;
+    first_moment += p.mass * p.com;
+    sum.inertia_origin += p.inertia_origin;
+  }
+  if (sum.mass > 0) sum.com = first_moment / sum.mass;
+  return sum;
+}
+
 void composite_mass(const Model& m, Workspace& ws) {
   const int nb = static_cast<int>(m.bodies.size());
   // Λ_b^O into the composites, leaves to root (children come after their parents).

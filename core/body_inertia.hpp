@@ -30,6 +30,9 @@ namespace femdyn {
 
 void condense_body_inertia(Model& model);
 
+// The sum of the body's elements' mass properties (body frame).
+MassProperties body_mass_properties(const Model& model, int body);
+
 // ws.Ms from the body poses of the last propagate (no Jacobians needed).
 void composite_mass(const Model& model, Workspace& ws);
 

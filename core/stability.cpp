@@ -107,20 +107,6 @@ std::optional<double> largest_stable_step(const Linearization& lin, IntegratorKi
   return lo;
 }
 
-MassProperties body_mass_properties(const Model& m, int body) {
-  MassProperties sum;
-  Vec3 first_moment = Vec3::Zero();
-  for (const ElementEntry& e : m.elements) {
-    if (e.body != body) continue;
-    const MassProperties p = e.element->mass_properties();
-    sum.mass += p.mass;
-    first_moment += p.mass * p.com;
-    sum.inertia_origin += p.inertia_origin;
-  }
-  if (sum.mass > 0) sum.com = first_moment / sum.mass;
-  return sum;
-}
-
 std::vector<SuspiciousBody> suspicious_bodies(const Model& m) {
   std::vector<SuspiciousBody> out;
   const int nb = static_cast<int>(m.bodies.size());

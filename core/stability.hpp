@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "core/body_inertia.hpp"
 #include "core/equations.hpp"
 #include "core/integrator.hpp"
 
@@ -53,8 +54,5 @@ struct SuspiciousBody {
   std::string name, why;
 };
 std::vector<SuspiciousBody> suspicious_bodies(const Model& model);
-
-// The sum of the body's elements' mass properties (body frame).
-MassProperties body_mass_properties(const Model& model, int body);
 
 }  // namespace femdyn

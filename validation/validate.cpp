@@ -10,6 +10,7 @@
 #include "core/inertia.hpp"
 #include "core/fixed_step.hpp"
 #include "core/sampling.hpp"
+#include "core/body_inertia.hpp"
 #include "validation/twin.hpp"
 #include "validation/urdf_twin.hpp"
 
@@ -32,15 +33,10 @@ TwinModel twin_model(const Model& m) {
     tb.stiffness = j.stiffness;
     tb.rest = j.rest;
     tb.damping = j.damping;
-    Vec3 first_moment = Vec3::Zero();
-    for (const ElementEntry& e : m.elements) {
-      if (e.body != static_cast<int>(b)) continue;
-      const MassProperties p = e.element->mass_properties();
-      tb.mass += p.mass;
-      first_moment += p.mass * p.com;
-      tb.inertia_origin += p.inertia_origin;
-    }
-    if (tb.mass > 0) tb.com = first_moment / tb.mass;
+    const MassProperties p = body_mass_properties(m, static_cast<int>(b));
+    tb.mass = p.mass;
+    tb.com = p.com;
+    tb.inertia_origin = p.inertia_origin;
     t.bodies.push_back(tb);
   }
   t.theta_body = m.theta_joint;
