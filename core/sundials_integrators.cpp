@@ -126,16 +126,12 @@ Status Adaptive::finish(int flag, double t_reached, double t_target) {
   return failure(flag);
 }
 
-// ---- explicit Runge–Kutta (ARKODE ERKStep) -------------------------------------------------
-
-ExplicitRungeKutta::ExplicitRungeKutta(const Model& model, const AdaptiveOptions& options,
-                                       Actuation tau, int arkode_table)
-    : Adaptive(model, options, std::move(tau)), table_(arkode_table) {}
+// ---- Dormand–Prince (ARKODE ERKStep) ------------------------------------------------------
 
 DormandPrince::DormandPrince(const Model& model, const AdaptiveOptions& options, Actuation tau)
-    : ExplicitRungeKutta(model, options, std::move(tau), ARKODE_DORMAND_PRINCE_7_4_5) {}
+    : Adaptive(model, options, std::move(tau)) {}
 
-void ExplicitRungeKutta::start() {
+void DormandPrince::start() {
   run_ = std::make_unique<SundialsRun>();
   SundialsRun& r = *run_;
   open(r, y_);
@@ -143,7 +139,7 @@ void ExplicitRungeKutta::start() {
   if (!r.arkode) throw std::runtime_error("ERKStepCreate failed");
   ERKStepSetErrHandlerFn(r.arkode, error_handler, this);
   ERKStepSetUserData(r.arkode, this);
-  ERKStepSetTableNum(r.arkode, static_cast<ARKODE_ERKTableID>(table_));
+  ERKStepSetTableNum(r.arkode, ARKODE_DORMAND_PRINCE_7_4_5);
   ERKStepSStolerances(r.arkode, options_.rtol, options_.atol);
   ERKStepSetMaxNumSteps(r.arkode, options_.max_steps);
   if (options_.h_max > 0) ERKStepSetMaxStep(r.arkode, options_.h_max);
@@ -151,12 +147,12 @@ void ExplicitRungeKutta::start() {
   rhs_failure_ = {};
 }
 
-int ExplicitRungeKutta::evolve(double t_out, double& t_reached, bool one_step) {
+int DormandPrince::evolve(double t_out, double& t_reached, bool one_step) {
   if (options_.stop_at_outputs && !one_step) ERKStepSetStopTime(run_->arkode, t_out);
   return ERKStepEvolve(run_->arkode, t_out, run_->y, &t_reached, one_step ? ARK_ONE_STEP : ARK_NORMAL);
 }
 
-void ExplicitRungeKutta::read_stats() {
+void DormandPrince::read_stats() {
   long v = 0;
   ERKStepGetNumSteps(run_->arkode, &v);
   stats_.steps = v;
@@ -164,7 +160,7 @@ void ExplicitRungeKutta::read_stats() {
   stats_.rejected = v;
 }
 
-double ExplicitRungeKutta::current_step() const {
+double DormandPrince::current_step() const {
   double h = 0;
   ERKStepGetCurrentStep(run_->arkode, &h);
   return h;

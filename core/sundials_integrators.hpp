@@ -46,24 +46,16 @@ class Adaptive : public Integrator {
   std::string sundials_message_;  // the last message SUNDIALS sent to its error handler
 };
 
-// An explicit Runge–Kutta method of ARKODE's ERKStep, by its Butcher table.
-class ExplicitRungeKutta : public Adaptive {
- protected:
-  ExplicitRungeKutta(const Model& model, const AdaptiveOptions& options, Actuation tau,
-                     int arkode_table);
+class DormandPrince final : public Adaptive {
+ public:
+  DormandPrince(const Model& model, const AdaptiveOptions& options, Actuation tau = {});
+  IntegratorKind kind() const override { return IntegratorKind::Dopri; }
 
  private:
-  int table_;  // ARKODE_ERKTableID
   void start() override;
   int evolve(double t_out, double& t_reached, bool one_step) override;
   void read_stats() override;
   double current_step() const override;
-};
-
-class DormandPrince final : public ExplicitRungeKutta {
- public:
-  DormandPrince(const Model& model, const AdaptiveOptions& options, Actuation tau = {});
-  IntegratorKind kind() const override { return IntegratorKind::Dopri; }
 };
 
 class Bdf final : public Adaptive {
