@@ -137,7 +137,7 @@ Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const 
     if (!std::isfinite(ws.qdd[a]))
       return {false, "q̈ of '" + model.coordinate_names[a] +
                          "' is NaN or Inf (the forces or the state overflow double precision)",
-              static_cast<int>(a)};
+              static_cast<int>(a), true};
   return st;
 }
 

@@ -34,7 +34,7 @@ Status FixedStep::advance(double t_out) {
     stats_.rhs_evals = motion_.evaluations();
     if (!st.ok) {
       // A NaN met inside the step came from the step itself: say so.
-      if (st.message.find("NaN") != std::string::npos) st = unstable(std::move(st), dt);
+      if (st.non_finite) st = unstable(std::move(st), dt);
       return st;
     }
     if (Status bad = motion_.check_state(t_ + h, y_next_.data()); !bad.ok)

@@ -147,7 +147,7 @@ MassSolver& MassSolver::operator=(MassSolver&&) noexcept = default;
 
 Status MassSolver::factorize(const MatX& Ms) {
   const Eigen::Index n = Ms.rows();
-  if (!Ms.allFinite()) return {false, "the mass matrix M^s has NaN or Inf entries"};
+  if (!Ms.allFinite()) return {false, "the mass matrix M^s has NaN or Inf entries", -1, true};
   const double scale = n > 0 ? Ms.diagonal().cwiseAbs().maxCoeff() : 0.0;
   // A coordinate that moves no inertia has a zero row and column in M^s.
   for (Eigen::Index a = 0; a < n; ++a)

@@ -35,7 +35,8 @@ Status Motion::check_state(double t, const double* y) const {
     const std::string what = i < n       ? "q_" + model_.coordinate_names[i]
                              : i < 2 * n ? "qd_" + model_.coordinate_names[i - n]
                                          : std::string("W (work of the non-conservative forces)");
-    return {false, at_time(t) + "NaN or Inf in the state (" + what + ")", i < 2 * n ? i % n : -1};
+    return {false, at_time(t) + "NaN or Inf in the state (" + what + ")", i < 2 * n ? i % n : -1,
+            true};
   }
   return {};
 }
@@ -50,7 +51,7 @@ Status Motion::rhs(double t, const double* y, double* ydot) {
   else
     u_.setZero();
   if (Status st = check_state(t, y); !st.ok) return st;
-  if (!u_.allFinite()) return {false, at_time(t) + "the actuation tau(t) is NaN or Inf"};
+  if (!u_.allFinite()) return {false, at_time(t) + "the actuation tau(t) is NaN or Inf", -1, true};
   Status st = forward_dynamics(model_, ws_, q_, qd_, u_);
   if (!st.ok) {
     st.message = at_time(t) + st.message;

@@ -70,7 +70,7 @@ int Adaptive::rhs(double t, const double* y, double* ydot) {
 Status Adaptive::failure(int flag) {
   if (!rhs_failure_.ok) {  // f itself failed (directly, or in the Jacobian's differences)
     Status st = rhs_failure_;
-    if (st.message.find("NaN") != std::string::npos)
+    if (st.non_finite)
       st.message += "; likely cause: the state overflowed (forces or speeds beyond double range)";
     else
       st.message += "; likely cause: M^s lost positive definiteness along the motion";
