@@ -116,12 +116,12 @@ std::string csv_text(const StudyReport& rep) {
 }
 
 // gnuplot script with the data inline: one line per engine and integrator, femdyn solid,
-// Simbody dashed. `png` is the file it writes.
-std::string gnuplot_text(const StudyReport& rep, const std::string& png) {
+// Simbody dashed. It writes study.png, or the file named by `gnuplot -e "out='…'"`.
+std::string gnuplot_text(const StudyReport& rep) {
   std::ostringstream s, plots;
   s << std::setprecision(10) << "# femdyn study: " << rep.model << " (generated; gnuplot "
-    << "study.gp)\nset terminal pngcairo size 1000,650 font 'sans,11'\nset output '" << png
-    << "'\nset logscale xy\nset format x '10^{%L}'\nset format y '10^{%L}'\n"
+    << "study.gp)\nset terminal pngcairo size 1000,650 font 'sans,11'\n"
+    << "if (!exists('out')) out = 'study.png'\nset output out\nset logscale xy\nset format x '10^{%L}'\nset format y '10^{%L}'\n"
     << "set xlabel 'wall time (s)'\nset ylabel 'max state error ‖(θ, θ̇) − reference‖∞'\n"
     << "set title 'Work-precision: " << rep.model << ", t = 0…" << rep.t_end << " s'\n"
     << "set grid\nset key outside right top\n";
@@ -199,12 +199,13 @@ std::string markdown_text(const StudyReport& rep, const std::string& command) {
   return s.str();
 }
 
-// gnuplot study.gp in `dir`; false (with a warning) if gnuplot is missing or fails.
-bool run_gnuplot(const fs::path& dir) {
+// gnuplot study.gp in `dir`, rendering into `png`; false if gnuplot is missing or fails.
+bool run_gnuplot(const fs::path& dir, const std::string& png) {
+  const std::string out = "out='" + png + "'";
   const pid_t pid = fork();
   if (pid == 0) {
     if (chdir(dir.c_str()) != 0) _exit(127);
-    execlp("gnuplot", "gnuplot", ".study.gp.tmp", static_cast<char*>(nullptr));
+    execlp("gnuplot", "gnuplot", "-e", out.c_str(), "study.gp", static_cast<char*>(nullptr));
     _exit(127);
   }
   int status = 0;
@@ -264,17 +265,11 @@ int cmd_study(int argc, char** argv) {
     f.commit();
   };
   write("study.csv", csv_text(rep));
-  {
-    // gnuplot renders into a temporary name, renamed when it succeeded.
-    AtomicFile gp((dir / ".study.gp.tmp").string(), true);
-    gp.stream() << gnuplot_text(rep, ".study.png.tmp");
-    gp.commit();
-  }
-  const bool plotted = run_gnuplot(dir);
+  write("study.gp", gnuplot_text(rep));
+  // gnuplot renders into a temporary name, renamed when it succeeded.
+  const bool plotted = run_gnuplot(dir, ".study.png.tmp");
   if (plotted) fs::rename(dir / ".study.png.tmp", dir / "study.png", ec);
   fs::remove(dir / ".study.png.tmp", ec);
-  fs::remove(dir / ".study.gp.tmp", ec);
-  write("study.gp", gnuplot_text(rep, "study.png"));
   const std::string md = markdown_text(rep, command);
   write("study.md", md);
   if (!plotted)
