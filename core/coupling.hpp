@@ -24,7 +24,16 @@ inline void coupling_apply_transpose(const Model& m, const VecX& f, VecX& y) {
     y.noalias() = m.C_sparse.transpose() * f;
 }
 
-// y += v · (row j of C)ᵀ, for a vector y of n entries or a block of n columns (v a column).
+// y += v · (row j of C)ᵀ for a vector y of n entries: a generalized force from joint j.
+inline void coupling_add_row(const Model& m, int j, double v, VecX& y) {
+  if (m.identity_coupling) {
+    y[j] += v;
+    return;
+  }
+  for (SpRowMat::InnerIterator it(m.C_sparse, j); it; ++it) y[it.col()] += it.value() * v;
+}
+
+// Y += v (row j of C) for a block Y of n columns (v a column): a Jacobian's joint-j term.
 template <class Y, class V>
 inline void coupling_add_row(const Model& m, int j, const V& v, Y&& y) {
   if (m.identity_coupling) {

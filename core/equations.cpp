@@ -65,7 +65,7 @@ void add_joint_forces(const Model& model, const Workspace& ws, bool with_rates, 
     double f = 0;
     if (J.stiffness != 0) f -= J.stiffness * (ws.theta[j] - J.rest);
     if (with_rates && J.damping != 0) f -= J.damping * ws.theta_dot[j];
-    if (f != 0) coupling_add_row(model, j, Eigen::Matrix<double, 1, 1>(sign * f), y.transpose());
+    if (f != 0) coupling_add_row(model, j, sign * f, y);
   }
 }
 
