@@ -51,9 +51,8 @@ int cmd_check(int argc, char** argv) {
     return 0;
   }
   const Model m = load(a);
-  const int K = static_cast<int>(integer_option(a, "states", 10, 1));
-  if (K > 10000) throw CliError("--states expects at most 10000");
-  std::mt19937 rng(static_cast<unsigned>(integer_option(a, "seed", 1, 0)));
+  const int K = static_cast<int>(integer_option(a, "states", 10, 1, 10000));
+  std::mt19937 rng(static_cast<unsigned>(integer_option(a, "seed", 1, 0, 4294967295.0)));
   const int n = m.n();
   Workspace ws(m);
   const VecX tau = VecX::Zero(n);

@@ -71,10 +71,13 @@ double number_option(const Args& a, const std::string& opt, double fallback) {
   return v[0];
 }
 
-double integer_option(const Args& a, const std::string& opt, double fallback, double min) {
+double integer_option(const Args& a, const std::string& opt, double fallback, double min,
+                      double max) {
   const double v = number_option(a, opt, fallback);
-  if (v != std::floor(v) || v < min || v > 1e15)
-    throw CliError("--" + opt + " expects an integer >= " + std::to_string(static_cast<long>(min)));
+  if (v != std::floor(v) || v < min)
+    throw CliError("--" + opt + " expects one integer >= " + std::to_string(static_cast<long>(min)));
+  if (v > max)
+    throw CliError("--" + opt + " expects one integer <= " + format_number(max, "%.0f"));
   return v;
 }
 

@@ -29,7 +29,8 @@ std::vector<double> parse_numbers(const std::string& opt, const std::string& tex
 VecX state_vector(const Args& a, const std::string& opt, const Model& m);  // zero if absent
 LoadOptions load_options(const Args& a);                                   // --gravity
 double number_option(const Args& a, const std::string& opt, double fallback);  // one number
-double integer_option(const Args& a, const std::string& opt, double fallback, double min);
+double integer_option(const Args& a, const std::string& opt, double fallback, double min,
+                      double max = 1e15);
 Model load(const Args& a, std::size_t count = 1);  // the first positional; expects `count`
 
 int cmd_info(int argc, char** argv);

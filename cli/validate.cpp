@@ -1,4 +1,5 @@
 // femdyn validate MODEL…: the model against its Simbody twin (validation/validate.hpp).
+#include <climits>
 #include <deque>
 #include <iomanip>
 #include <iostream>
@@ -108,18 +109,13 @@ void print_markdown_row(const std::string& path, const validation::ValidationRep
 }
 
 int positive_int(const Args& a, const std::string& opt, int fallback, int min) {
-  if (!a.has(opt)) return fallback;
-  const auto v = parse_numbers(opt, a.options.at(opt));
-  if (v.size() != 1 || v[0] != static_cast<int>(v[0]) || v[0] < min)
-    throw CliError("--" + opt + " expects one integer >= " + std::to_string(min));
-  return static_cast<int>(v[0]);
+  return static_cast<int>(integer_option(a, opt, fallback, min, INT_MAX));
 }
 
 double nonnegative(const Args& a, const std::string& opt, double fallback) {
-  if (!a.has(opt)) return fallback;
-  const auto v = parse_numbers(opt, a.options.at(opt));
-  if (v.size() != 1 || v[0] < 0) throw CliError("--" + opt + " expects one number >= 0");
-  return v[0];
+  const double v = number_option(a, opt, fallback);
+  if (v < 0) throw CliError("--" + opt + " expects one number >= 0");
+  return v;
 }
 
 }  // namespace
