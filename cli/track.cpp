@@ -33,19 +33,9 @@ int cmd_track(int argc, char** argv) {
   const Model m = load(a);
   if (!a.has("to")) throw CliError("--to is required (try --help)");
   const VecX q1 = state_vector(a, "to", m), q0 = state_vector(a, "from", m);
-  double T = 1.0;
-  int N = 1000;
-  if (a.has("duration")) {
-    const auto v = parse_numbers("duration", a.options.at("duration"));
-    if (v.size() != 1 || !(v[0] > 0)) throw CliError("--duration expects one positive number");
-    T = v[0];
-  }
-  if (a.has("steps")) {
-    const auto v = parse_numbers("steps", a.options.at("steps"));
-    if (v.size() != 1 || v[0] < 1 || v[0] > 1e7 || v[0] != std::floor(v[0]))
-      throw CliError("--steps expects a positive integer");
-    N = static_cast<int>(v[0]);
-  }
+  const double T = number_option(a, "duration", 1.0);
+  if (!(T > 0)) throw CliError("--duration expects one positive number");
+  const int N = static_cast<int>(integer_option(a, "steps", 1000, 1, 1e7));
   const int n = m.n();
   Workspace wref(m);
   VecX qr(n), qdr(n), qddr(n);
