@@ -178,7 +178,7 @@ std::string markdown_text(const StudyReport& rep, const std::string& command) {
       << (b ? seconds(b->wall_time) : "—") << " | "
       << (f && b ? std::to_string(b->wall_time / f->wall_time).substr(0, 5) : "—") << " |\n";
   }
-  if (rep.resolution > 1e-9 / 100 * 100)
+  if (rep.resolution > 1e-9)  // the smallest target cannot be resolved
     s << "\nA target below " << sci(rep.resolution) << " cannot be told apart from the "
       << "reference's own error here.\n";
   s << "\n![error against wall time](study.png)\n\n";
