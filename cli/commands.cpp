@@ -158,6 +158,7 @@ int cmd_equations(int argc, char** argv) {
              tau = state_vector(a, "tau", m);
   Workspace ws(m);
   const Status st = forward_dynamics(m, ws, q, qd, tau);
+  evaluate(m, ws, q, qd, tau);
   // A result that overflowed is a fault, never printed as an answer.
   struct Result {
     const char* what;

@@ -75,6 +75,8 @@ int cmd_compare(int argc, char** argv) {
       qd = random_uniform(A.n(), vscale, rng);
     }
     const Status sa = forward_dynamics(A, wa, q, qd, tau), sb = forward_dynamics(B, wb, q, qd, tau);
+    evaluate(A, wa, q, qd, tau);
+    evaluate(B, wb, q, qd, tau);
     if (!sa.ok || !sb.ok) throw CliError("M^s singular at a sampled state: " + (sa.ok ? sb : sa).message);
     eM.push_back(rel(wa.Ms, wb.Ms));
     eh.push_back(qd.isZero(0) ? 0.0 : rel(wa.h, wb.h));

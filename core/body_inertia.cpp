@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "core/joint.hpp"
+
 namespace femdyn {
 namespace {
 
@@ -17,12 +19,36 @@ MatX twist_map(const Element& e, const Mat3& R) {
   return X;
 }
 
+// The Element contract for velocity forces: under a rigid motion (ω, v) of its body, the
+// element's g_e(u̇_e, u̇_e) = g_e(X ξ, X ξ) does the work of a rigid body's gyroscopic term,
+//   Xᵀ g_e(X ξ, X ξ) = (ω × J ω, 0),   J = Σ of m_e's rotation-rotation blocks,
+// so that the articulated recursion's V ×* Λ V is the same force. Checked at two twists.
+bool gyroscopic_is_rigid(const Element& e, const MatX& me) {
+  const MatX X = twist_map(e, Mat3::Identity());
+  Mat3 J = Mat3::Zero();
+  const int k = static_cast<int>(e.nodes().size());
+  for (int i = 0; i < k; ++i)
+    for (int l = 0; l < k; ++l) J += me.block<3, 3>(6 * i + 3, 6 * l + 3);
+  for (const Vec6& xi : {Vec6(0.3, -1.1, 0.7, 0.2, 0.5, -0.4), Vec6(-0.9, 0.4, 1.3, -0.6, 0.1, 0.8)}) {
+    const VecX x = X * xi;
+    VecX g = VecX::Zero(x.size());
+    e.add_velocity_force(x, x, g);
+    Vec6 expected = Vec6::Zero();
+    expected.head<3>() = xi.head<3>().cross(J * xi.head<3>());
+    const Vec6 got = X.transpose() * g;
+    const double scale = std::max(J.cwiseAbs().maxCoeff() * xi.head<3>().squaredNorm(), 1e-300);
+    if ((got - expected).cwiseAbs().maxCoeff() > 1e-12 * scale) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 void condense_body_inertia(Model& m) {
   const int nb = static_cast<int>(m.bodies.size());
-  m.body_inertia.assign(nb, Mat6::Zero());
+  std::vector<Mat6> L(nb, Mat6::Zero());
   m.condensable = !m.explicit_table;
+  m.velocity_forces_rigid = true;
   // Λ_b at the rest orientation and at a tilted one: equal iff orientation-independent.
   const Mat3 tilt = rpy_to_rotation(Vec3(0.3, -0.7, 1.1));
   for (const ElementEntry& e : m.elements) {
@@ -31,29 +57,43 @@ void condense_body_inertia(Model& m) {
     const Mat6 L0 = X0.transpose() * me * X0, L1 = X1.transpose() * me * X1;
     if ((L0 - L1).cwiseAbs().maxCoeff() > 1e-12 * std::max(L0.cwiseAbs().maxCoeff(), 1e-300))
       m.condensable = false;
-    m.body_inertia[e.body] += L0;
+    L[e.body] += L0;
+    if (!gyroscopic_is_rigid(*e.element, me)) m.velocity_forces_rigid = false;
   }
-  // The coordinates that move each body: those of the joints on its path, through C.
-  m.body_coords.assign(nb, {});
+  // Each Λ_b in the rigid form [[I, [h]×], [[h]×ᵀ, m 1]], as every physical element gives.
+  m.body_inertia.assign(nb, RigidInertia{});
   for (int b = 0; b < nb; ++b) {
-    const Body& B = m.bodies[b];
-    std::vector<bool> moves(m.n(), false);
-    if (B.parent >= 0)
-      for (int a : m.body_coords[B.parent]) moves[a] = true;
-    if (B.joint.theta >= 0)
-      for (int a = 0; a < m.n(); ++a)
-        if (m.C(B.joint.theta, a) != 0) moves[a] = true;
-    for (int a = 0; a < m.n(); ++a)
-      if (moves[a]) m.body_coords[b].push_back(a);
+    RigidInertia& r = m.body_inertia[b];
+    r.m = L[b](3, 3);
+    r.h = Vec3(L[b](2, 4), L[b](0, 5), L[b](1, 3));
+    r.I = L[b].topLeftCorner<3, 3>();
+    if ((r.matrix() - L[b]).cwiseAbs().maxCoeff() >
+        1e-12 * std::max(L[b].cwiseAbs().maxCoeff(), 1e-300))
+      m.condensable = false;
   }
-  // Choose by operation count: the dense M T and Tᵀ (M T), against the composite recursion
+}
+
+void choose_routes(Model& m) {
+  // Joints with a coordinate on each body's path to the root (its depth in moving joints).
+  const int nb = static_cast<int>(m.bodies.size());
+  std::vector<double> depth(nb, 0);
+  for (int b = 0; b < nb; ++b)
+    depth[b] = (m.bodies[b].parent >= 0 ? depth[m.bodies[b].parent] : 0) +
+               (m.bodies[b].joint.theta >= 0 ? 1 : 0);
+  // M^s by operation count: the dense M T and Tᵀ (M T), against the composite recursion
   // (about 300 operations a body to move Λ_b, 12 per joint on its path) and, with a coupling,
   // the reduction Cᵀ M_θ C.
   const double n = m.n(), nt = m.n_theta();
   const double dense = (m.n_u() * n + static_cast<double>(m.M.nonZeros())) * n;
   double by_body = m.identity_coupling ? 0 : 2 * nt * nt * n;
-  for (const auto& c : m.body_coords) by_body += 300 + 12 * static_cast<double>(c.size());
-  m.condensed = m.condensable && by_body < dense;
+  for (double d : depth) by_body += 300 + 12 * d;
+  m.mass_route = m.condensable && by_body < dense ? MassRoute::Composite : MassRoute::Transform;
+  // q̈: the articulated recursion needs the body-level form, velocity forces that are the
+  // elements' gyroscopic terms, and one coordinate per joint;
+  // measured faster than any M^s + Cholesky from one coordinate up (docs/performance.md).
+  m.dynamics_route = m.condensable && m.velocity_forces_rigid && m.identity_coupling
+                         ? DynamicsRoute::Articulated
+                         : DynamicsRoute::Cholesky;
 }
 
 MassProperties body_mass_properties(const Model& m, int body) {
@@ -73,30 +113,10 @@ MassProperties body_mass_properties(const Model& m, int body) {
 void composite_mass(const Model& m, Workspace& ws) {
   const int nb = static_cast<int>(m.bodies.size());
   // Λ_b^O into the composites, leaves to root (children come after their parents).
-  for (int b = 0; b < nb; ++b) ws.composite[b].setZero();
+  for (int b = 0; b < nb; ++b) inertia_at_origin(m.body_inertia[b], ws.body[b].R, ws.body[b].p, ws.composite[b]);
   for (int b = nb - 1; b >= 0; --b) {
-    const Mat3& R = ws.body[b].R;
-    const Mat6& L = m.body_inertia[b];
-    const Mat3 A = R * L.topLeftCorner<3, 3>() * R.transpose();
-    const Mat3 B = R * L.topRightCorner<3, 3>() * R.transpose();
-    const Mat3 D = R * L.bottomRightCorner<3, 3>() * R.transpose();
-    const Mat3 P = skew(ws.body[b].p);
-    // Xᵀ [[A, B], [Bᵀ, D]] X with X = [[I, 0], [−P, I]] and Pᵀ = −P.
-    const Mat3 BP = B * P, DP = D * P;
-    Mat6& I = ws.composite[b];
-    I.topLeftCorner<3, 3>() += A - BP - BP.transpose() - P * DP;
-    I.topRightCorner<3, 3>() += B + P * D;
-    I.bottomLeftCorner<3, 3>() += B.transpose() - DP;
-    I.bottomRightCorner<3, 3>() += D;
-    if (m.bodies[b].parent >= 0) ws.composite[m.bodies[b].parent] += I;
-    // The joint's motion subspace (world axes, about the origin).
-    const Joint& j = m.bodies[b].joint;
-    Vec6& S = ws.subspace[b];
-    const Vec3 s = ws.body[b].R * j.axis;
-    if (j.type == JointType::Revolute)
-      S << s, ws.body[b].p.cross(s);
-    else
-      S << Vec3::Zero(), s;
+    if (m.bodies[b].parent >= 0) ws.composite[m.bodies[b].parent] += ws.composite[b];
+    ws.subspace[b] = motion_subspace(m.bodies[b].joint, ws.body[b].R, ws.body[b].p);
   }
   // M_θ(i, k) = S_kᵀ I^c_b S_i along the path of b.
   MatX& Mt = m.identity_coupling ? ws.Ms : ws.Mtheta;

@@ -12,8 +12,8 @@
 // Valid when T_e = X_e J_b holds for every element DOF, i.e. when the correlation table is the
 // automatic one (an explicit table may give a DOF another body's motion, or leave out one that
 // moves), and when Λ_b does not depend on the body's orientation (translation inertia isotropic,
-// as for every physical element). compile() checks both (Model::condensable) and uses the form
-// where it takes fewer operations than the dense product (Model::condensed).
+// as for every physical element). compile() checks both (Model::condensable) and chooses the
+// routes (choose_routes: Model::mass_route, Model::dynamics_route).
 //
 // At run time the same Λ_b give M^s by composite inertias (the composite-rigid-body recursion,
 // Featherstone ch. 6), O(bodies · depth) instead of O(Σ p_b²):
@@ -29,6 +29,9 @@
 namespace femdyn {
 
 void condense_body_inertia(Model& model);
+
+// Model::mass_route and Model::dynamics_route from the structure and an operation count.
+void choose_routes(Model& model);
 
 // The sum of the body's elements' mass properties (body frame).
 MassProperties body_mass_properties(const Model& model, int body);

@@ -182,6 +182,7 @@ Model compile(MechanismSpec spec) {
   compile_coupling(spec, m);
   build_node_level(spec, body_of_spec, m);
   condense_body_inertia(m);
+  choose_routes(m);
   check_mass_matrix(m);
   return m;
 }

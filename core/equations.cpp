@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/articulated.hpp"
 #include "core/body_inertia.hpp"
 #include "core/coupling.hpp"
 #include "core/kinematics.hpp"
@@ -39,7 +40,7 @@ void add_velocity_forces(const Model& model, Workspace& ws, const X& x, const Y&
 // (small models: one dense product is cheapest), otherwise by the backward sweep.
 void generalized_force(const Model& model, Workspace& ws, const VecX& f, VecX& y,
                        bool with_torques) {
-  if (model.condensed) {
+  if (model.mass_route == MassRoute::Composite) {
     apply_transpose(model, ws, f, y, with_torques ? 1.0 : 0.0);
     return;
   }
@@ -85,12 +86,12 @@ bool is_zero(const VecX& v) { return v.size() == 0 || v.cwiseAbs().maxCoeff() ==
 
 void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau) {
   const bool moving = !is_zero(qd);
-  // The condensed route needs only the body poses; the dense one the rows of T.
-  propagate(model, ws, q, qd,
-            {.jacobian = !model.condensed, .bias = moving, .rows = !model.condensed});
+  // The composite route needs only the body poses; the transform route the rows of T.
+  const bool composite = model.mass_route == MassRoute::Composite;
+  propagate(model, ws, q, qd, {.jacobian = !composite, .bias = moving, .rows = !composite});
   if (!moving) ws.theta_dot.setZero();
 
-  if (model.condensed) {
+  if (composite) {
     composite_mass(model, ws);  // M^s by composite inertias; T is not formed
   } else {
     // M^s = Tᵀ (M T)
@@ -127,11 +128,18 @@ void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX&
 
 Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                         const VecX& tau) {
-  evaluate(model, ws, q, qd, tau);
-  Status st = ws.solver.factorize(ws.Ms);
+  Status st;
+  if (model.dynamics_route == DynamicsRoute::Articulated) {
+    st = articulated_forward_dynamics(model, ws, q, qd, tau);
+  } else {
+    evaluate(model, ws, q, qd, tau);
+    st = ws.solver.factorize(ws.Ms);
+    if (st.ok) {
+      ws.qdd = ws.Q - ws.h;
+      ws.solver.solve_in_place(ws.qdd);
+    }
+  }
   if (!st.ok) return st;
-  ws.qdd = ws.Q - ws.h;
-  ws.solver.solve_in_place(ws.qdd);
   // A result that overflowed is a failure naming the coordinate, never a NaN handed on.
   for (Eigen::Index a = 0; a < ws.qdd.size(); ++a)
     if (!std::isfinite(ws.qdd[a]))

@@ -13,14 +13,13 @@
 #include <vector>
 
 #include "core/element.hpp"
+#include "core/spatial.hpp"
 #include "core/spec.hpp"
 
 namespace femdyn {
 
 using SpMat = Eigen::SparseMatrix<double>;
 using SpRowMat = Eigen::SparseMatrix<double, Eigen::RowMajor>;
-using Mat6 = Eigen::Matrix<double, 6, 6>;
-using Vec6 = Eigen::Matrix<double, 6, 1>;
 
 struct Joint {
   std::string name;
@@ -77,6 +76,17 @@ struct PointLoad {
   Vec3 force;  // world frame
 };
 
+// The routes, chosen once by compile() from the model's structure and an operation count
+// (docs/performance.md gives the measured crossovers); the algorithms only dispatch on them.
+enum class MassRoute {
+  Transform,  // M^s = Tᵀ (M T) with T formed row by row: cheapest for a few bodies
+  Composite   // M^s by composite body inertias (core/body_inertia.hpp): O(bodies · depth)
+};
+enum class DynamicsRoute {
+  Cholesky,    // q̈ = (M^s)⁻¹ (Q − h): evaluate, then dense or CHOLMOD Cholesky
+  Articulated  // articulated-body recursion over the element-assembled Λ_b (core/articulated.hpp)
+};
+
 struct Model {
   Model() = default;
   // Movable into containers. Eigen 3.4's SparseMatrix has no move constructor, so moving M
@@ -111,13 +121,14 @@ struct Model {
   VecX F_constant;   // nodal forces that do not depend on the state (gravity, point loads)
   std::vector<BodyTorque> torques;
   std::vector<PointLoad> point_loads;
-  // Body level (core/body_inertia.hpp): M^s = Σ_b J_bᵀ Λ_b J_b when `condensed`.
-  std::vector<Mat6> body_inertia;             // Λ_b: Σ X_eᵀ m_e X_e, twist (ω, v) in body axes
-  std::vector<std::vector<int>> body_coords;  // coordinates that move body b, ascending
+  // Body level (core/body_inertia.hpp): M^s = Σ_b J_bᵀ Λ_b J_b where `condensable`.
+  std::vector<RigidInertia> body_inertia;  // Λ_b = Σ X_eᵀ m_e X_e, body axes (core/spatial.hpp)
   bool identity_coupling = false;  // C = I and θ0 = 0: the coupling level is nothing
   SpRowMat C_sparse;               // C for the hot path (core/coupling.hpp)
   bool condensable = false;  // the body-level form is exact for this model
-  bool condensed = false;    // ... and cheaper than the dense Tᵀ M T: evaluate() uses it
+  bool velocity_forces_rigid = false;  // every g_e is its element's gyroscopic term (checked)
+  MassRoute mass_route = MassRoute::Transform;         // how evaluate() forms M^s
+  DynamicsRoute dynamics_route = DynamicsRoute::Cholesky;  // how forward_dynamics() finds q̈
 
   bool has_nodal_forces = false;     // gravity or loads present
   bool has_velocity_forces = false;  // some element has a gyroscopic term

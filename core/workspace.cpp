@@ -21,6 +21,7 @@ Workspace::Workspace(const Model& model) : solver(model) {
   u_acc = VecX::Zero(N);
   composite.assign(nb, Mat6::Zero());
   subspace.assign(nb, Vec6::Zero());
+  if (model.dynamics_route == DynamicsRoute::Articulated) articulated.assign(nb, ArticulatedBody{});
   if (!model.identity_coupling) Mtheta = MatX::Zero(nt, nt);
   force.assign(nb, Vec3::Zero());
   moment.assign(nb, Vec3::Zero());

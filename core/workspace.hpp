@@ -19,6 +19,20 @@ struct BodyState {
   Vec3 a = Vec3::Zero();      // bias acceleration of the body origin (q̈ = 0)
 };
 
+// Per body, the articulated-body recursion's quantities (core/articulated.hpp), spatial vectors
+// in world axes about the world origin (core/spatial.hpp).
+struct ArticulatedBody {
+  Mat6 IA = Mat6::Zero();  // articulated inertia I^A
+  Vec6 S = Vec6::Zero();   // joint motion subspace
+  Vec6 V = Vec6::Zero();   // spatial velocity
+  Vec6 c = Vec6::Zero();   // velocity-product acceleration V × S θ̇
+  Vec6 pA = Vec6::Zero();  // articulated bias force p^A
+  Vec6 U = Vec6::Zero();   // I^A S
+  Vec6 a = Vec6::Zero();   // spatial acceleration
+  double d = 0, u = 0;     // Sᵀ I^A S, and τ − Sᵀ p^A
+  double trace = 0;        // tr(I^c), the composite inertia's trace (a bound for the pivots)
+};
+
 struct Workspace {
   explicit Workspace(const Model& model);
 
@@ -34,6 +48,7 @@ struct Workspace {
   VecX u_acc;                      // T q̈ + T'[q̇,q̇] (inverse dynamics)
   std::vector<Mat6> composite;     // per body: composite inertia I^c_b (core/body_inertia.hpp)
   std::vector<Vec6> subspace;      // per body: its joint's motion subspace S (world, origin)
+  std::vector<ArticulatedBody> articulated;  // per body, for the articulated route only
   MatX Mtheta;                     // M_θ (nθ x nθ), with a coupling only
   std::vector<Vec3> force, moment; // per body: wrench of Tᵀ f (world; moment about the origin)
   VecX tau_theta;                  // Tᵀ f on the joint coordinates θ

@@ -13,7 +13,8 @@ int main(int argc, char** argv) {
 
   VecX q = VecX::Constant(model.n(), 0.3), qd = VecX::Constant(model.n(), 1.0);
   VecX tau = VecX::Zero(model.n());
-  const Status st = forward_dynamics(model, ws, q, qd, tau);  // fills ws.Ms, ws.h, ws.Q, ws.qdd
+  evaluate(model, ws, q, qd, tau);                            // ws.Ms, ws.h, ws.Q
+  const Status st = forward_dynamics(model, ws, q, qd, tau);  // ws.qdd
   if (!st.ok) {
     std::cerr << path << ": " << st.message << "\n";
     return 1;

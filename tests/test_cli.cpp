@@ -34,6 +34,7 @@ TEST_CASE("femdyn equations --json equals the library on the spatial double pend
   qd << 1.5, -0.7;
   tau << 0.2, 0.1;
   REQUIRE(forward_dynamics(m, ws, q, qd, tau).ok);
+  evaluate(m, ws, q, qd, tau);
   CHECK(j["coordinates"] == nlohmann::json({"hinge1", "hinge2"}));
   CHECK(rel_error(vec(j["h"]), ws.h) < 1e-15);
   CHECK(rel_error(vec(j["Q"]), ws.Q) < 1e-15);

@@ -21,6 +21,7 @@ TEST_CASE("single pendulum: M = m l², Q = −m g l sin θ, h = 0", "[closed-for
     qd << 1.7;
     tau << 0.4;
     REQUIRE(forward_dynamics(m, ws, q, qd, tau).ok);
+    evaluate(m, ws, q, qd, tau);
     CHECK_THAT(ws.Ms(0, 0), WithinRel(1.0, 1e-14));
     CHECK_THAT(ws.h[0], WithinAbs(0.0, 1e-14));
     CHECK_THAT(ws.Q[0], WithinAbs(-9.81 * std::sin(th) + 0.4, 1e-13));
@@ -49,6 +50,7 @@ TEST_CASE("planar double pendulum of space bars matches the Lagrange closed form
   for (int k = 0; k < 10; ++k) {
     const VecX q = random_vector(rng, 2, 3.0), qd = random_vector(rng, 2, 4.0);
     REQUIRE(forward_dynamics(m, ws, q, qd, VecX::Zero(2)).ok);
+    evaluate(m, ws, q, qd, VecX::Zero(2));
     const double s2 = std::sin(q[1]), cs2 = std::cos(q[1]);
     MatX M(2, 2);
     M(0, 0) = Ic[0] + mass[0] * c1 * c1 + Ic[1] + mass[1] * (l1 * l1 + c2 * c2 + 2 * l1 * c2 * cs2);

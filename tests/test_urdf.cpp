@@ -171,6 +171,8 @@ TEST_CASE("every URDF: import writes JSON that loads back to the same equations"
                  tau = random_vector(rng, direct.n(), 1.0);
       REQUIRE(forward_dynamics(direct, wa, q, qd, tau).ok);
       REQUIRE(forward_dynamics(back, wb, q, qd, tau).ok);
+      evaluate(direct, wa, q, qd, tau);
+      evaluate(back, wb, q, qd, tau);
       CHECK(rel_error(wb.Ms, wa.Ms) < 1e-12);
       CHECK(rel_error(wb.h, wa.h) < 1e-12);
       CHECK(rel_error(wb.Q, wa.Q) < 1e-12);

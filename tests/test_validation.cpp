@@ -1,6 +1,8 @@
 // femdyn against Simbody (validation/): every bundled model, seeded random trees, one body in
 // every element description, loads/couplings, and a deliberately wrong element that must fail.
 #include <catch2/catch.hpp>
+
+#include "core/body_inertia.hpp"
 #include <algorithm>
 #include <fstream>
 #include <iterator>
@@ -184,6 +186,13 @@ TEST_CASE("a rotary node without its gyroscopic term fails validation", "[valida
       ++replaced;
     }
   REQUIRE(replaced > 0);
+  // The compile passes see that its velocity force is not the gyroscopic term of its inertia
+  // (the Element contract), and keep the model off the articulated route, which assumes it.
+  REQUIRE(m.dynamics_route == DynamicsRoute::Articulated);
+  condense_body_inertia(m);
+  choose_routes(m);
+  CHECK_FALSE(m.velocity_forces_rigid);
+  CHECK(m.dynamics_route == DynamicsRoute::Cholesky);
   const ValidationReport r = validation::validate(m, quick(8, 0.2));
   CHECK_FALSE(r.pass());
   for (const auto& q : r.quantities) {
@@ -246,7 +255,8 @@ TEST_CASE("extreme scales (mass ratio 1e6, length ratio 1e3, a stiff spring) mat
 TEST_CASE("a 100-DOF tree (sparse solver, body-level M^s) matches Simbody", "[validation]") {
   const Model m = load_text(random_tree_json(6, 100, 0.6, true));
   REQUIRE(Workspace(m).solver.kind() == SolverKind::Sparse);
-  REQUIRE(m.condensed);
+  REQUIRE(m.mass_route == MassRoute::Composite);
+  REQUIRE(m.dynamics_route == DynamicsRoute::Articulated);
   require_pass(validation::validate(m, quick(4, 0.02)), "100 bodies");
 }
 

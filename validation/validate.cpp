@@ -203,6 +203,7 @@ ValidationReport validate(const Model& m, const ValidationOptions& o) {
 
     const TwinEquations s = twin.equations(q, qd, tau);
     const Status st = forward_dynamics(m, ws, q, qd, tau);
+    evaluate(m, ws, q, qd, tau);
     accumulate(eM, ws.Ms, s.M);
     accumulate(eh, ws.h, s.h);
     accumulate(eQ, ws.Q, s.Q);

@@ -1,0 +1,133 @@
+#include "core/articulated.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/joint.hpp"
+#include "core/kinematics.hpp"
+
+namespace femdyn {
+namespace {
+
+// τ_b on joint j: the actuation and the joint's spring and damper (C = I: θ = q).
+double joint_force(const Joint& J, const Workspace& ws, const VecX& tau) {
+  const int j = J.theta;
+  double f = tau.size() > j ? tau[j] : 0.0;
+  if (J.stiffness != 0) f -= J.stiffness * (ws.theta[j] - J.rest);
+  if (J.damping != 0) f -= J.damping * ws.theta_dot[j];
+  return f;
+}
+
+Status singular(const Model& model, int j, bool independently) {
+  return {false,
+          "the mass matrix M^s is singular: coordinate '" + model.coordinate_names[j] +
+              (independently ? "' moves no inertia independently of the joints beyond it"
+                             : "' moves no inertia (a massless chain end, or all its mass on "
+                               "the joint axis?)"),
+          j};
+}
+
+// The Cholesky route's regularity test, exactly: M^s(b, b) = S_bᵀ I^c_b S_b against the largest
+// diagonal, and the pivot d_b against M^s(b, b). Only run when the cheap bound was inconclusive.
+Status check_regularity(const Model& model, Workspace& ws) {
+  const int nb = static_cast<int>(model.bodies.size());
+  for (int b = 0; b < nb; ++b)
+    inertia_at_origin(model.body_inertia[b], ws.body[b].R, ws.body[b].p, ws.composite[b]);
+  for (int b = nb - 1; b >= 0; --b)
+    if (model.bodies[b].parent >= 0) ws.composite[model.bodies[b].parent] += ws.composite[b];
+  double scale = 0;
+  for (int b = 0; b < nb; ++b)
+    if (moves(model.bodies[b].joint)) {
+      const Vec6& S = ws.articulated[b].S;
+      scale = std::max(scale, S.dot(ws.composite[b] * S));
+    }
+  for (int b = 0; b < nb; ++b) {
+    const int j = model.bodies[b].joint.theta;
+    if (j < 0) continue;
+    const Vec6& S = ws.articulated[b].S;
+    const double Mbb = S.dot(ws.composite[b] * S), d = ws.articulated[b].d;
+    if (!std::isfinite(Mbb) || !std::isfinite(d))
+      return {false, "the mass matrix M^s has NaN or Inf entries", -1, true};
+    if (!(Mbb > 1e-13 * scale)) return singular(model, j, false);
+    if (!(d >= 1e-13 * Mbb)) return singular(model, j, true);
+  }
+  return {};
+}
+
+}  // namespace
+
+Status articulated_forward_dynamics(const Model& model, Workspace& ws, const VecX& q,
+                                    const VecX& qd, const VecX& tau) {
+  const int nb = static_cast<int>(model.bodies.size());
+  propagate(model, ws, q, qd, {.jacobian = false, .bias = false, .rows = false});  // poses, θ
+  ws.theta_dot = qd;  // C = I
+  if (model.has_nodal_forces) gather_body_wrenches(model, ws, model.F_constant, 1.0);
+
+  // 1. Velocities, velocity-product accelerations and bias forces, root to leaves.
+  for (int b = 0; b < nb; ++b) {
+    const Body& body = model.bodies[b];
+    ArticulatedBody& A = ws.articulated[b];
+    BodyState& B = ws.body[b];
+    A.V = body.parent >= 0 ? ws.articulated[body.parent].V : Vec6::Zero();
+    A.c.setZero();
+    if (moves(body.joint)) {
+      A.S = motion_subspace(body.joint, B.R, B.p);
+      const Vec6 vj = A.S * ws.theta_dot[body.joint.theta];
+      A.V += vj;
+      A.c = cross_motion(A.V, vj);
+    }
+    B.w = A.V.head<3>();
+    inertia_at_origin(model.body_inertia[b], B.R, B.p, A.IA);
+    A.trace = A.IA.trace();
+    A.pA = cross_force(A.V, A.IA * A.V);
+    if (model.has_nodal_forces) {  // − the external wrench, moved to the world origin
+      A.pA.head<3>() -= ws.moment[b] + B.p.cross(ws.force[b]);
+      A.pA.tail<3>() -= ws.force[b];
+    }
+  }
+
+  // 2. Articulated inertias and bias forces, leaves to root.
+  for (int b = nb - 1; b >= 0; --b) {
+    const Body& body = model.bodies[b];
+    ArticulatedBody& A = ws.articulated[b];
+    const int p = body.parent;
+    if (moves(body.joint)) {
+      A.U = A.IA * A.S;
+      A.d = A.S.dot(A.U);
+      A.u = joint_force(body.joint, ws, tau) - A.S.dot(A.pA);
+      if (p < 0) continue;
+      A.IA.noalias() -= (A.U / A.d) * A.U.transpose();  // I^a = I^A − U Uᵀ / d
+      A.pA.noalias() += A.IA * A.c + A.U * (A.u / A.d);
+    } else if (p < 0) {
+      continue;
+    }
+    ws.articulated[p].IA += A.IA;
+    ws.articulated[p].pA += A.pA;
+    ws.articulated[p].trace += A.trace;
+  }
+
+  // Regularity. M^s(b, b) = S_bᵀ I^c_b S_b ≤ tr(I^c_b) |S_b|², so a pivot above 1e-13 of that
+  // bound passes the Cholesky route's test; otherwise that test is run exactly.
+  for (int b = 0; b < nb; ++b) {
+    const ArticulatedBody& A = ws.articulated[b];
+    if (!moves(model.bodies[b].joint)) continue;
+    if (!(A.d > 1e-13 * A.trace * A.S.squaredNorm() && std::isfinite(A.u))) {
+      if (Status st = check_regularity(model, ws); !st.ok) return st;
+      break;
+    }
+  }
+
+  // 3. Accelerations, root to leaves.
+  for (int b = 0; b < nb; ++b) {
+    const Body& body = model.bodies[b];
+    ArticulatedBody& A = ws.articulated[b];
+    A.a = (body.parent >= 0 ? ws.articulated[body.parent].a : Vec6::Zero()) + A.c;
+    if (!moves(body.joint)) continue;
+    const double qdd = (A.u - A.U.dot(A.a)) / A.d;
+    ws.qdd[body.joint.theta] = qdd;
+    A.a += A.S * qdd;
+  }
+  return {};
+}
+
+}  // namespace femdyn

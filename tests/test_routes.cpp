@@ -1,0 +1,159 @@
+// The routes compile() chooses (Model::mass_route, Model::dynamics_route, the mass solver) give
+// the same equations: each new route is checked against the one it replaces, on random trees of
+// every element type, with fixed joints, springs, dampers, loads and couplings, and at the sizes
+// where the choice switches.
+#include <catch2/catch.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include "core/mass_solver.hpp"
+#include "tests/helpers.hpp"
+
+using namespace femdyn;
+using namespace femdyn::test;
+using Json = nlohmann::json;
+
+namespace {
+
+// A random tree with every element type, fixed joints, springs, dampers, point loads and
+// torques, and (with `couplings`) joints that follow others linearly.
+std::string mixed_tree_json(unsigned seed, int bodies, double branching, bool couplings) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), pos(0.2, 1.0);
+  const auto v3 = [&](double s) { return Json::array({s * u(rng), s * u(rng), s * u(rng)}); };
+  Json list = Json::array(), loads = Json::array(), coupled = Json::array();
+  std::vector<int> movable;
+  for (int b = 0; b < bodies; ++b) {
+    int parent = b - 1;
+    if (b > 1 && pos(rng) < 0.2 + 0.8 * branching) parent = static_cast<int>(rng() % b);
+    const int kind = static_cast<int>(rng() % 8);
+    Json joint = {{"name", "j" + std::to_string(b)},
+                  {"origin", {{"xyz", v3(0.4)}, {"rpy", v3(2.0)}}}};
+    if (kind == 0 && b > 0) {
+      joint["type"] = "fixed";
+    } else {
+      joint["type"] = kind == 1 ? "prismatic" : "revolute";
+      joint["axis"] = v3(1.0);
+      if (kind == 2) joint["spring"] = {{"stiffness", 3 * pos(rng)}, {"rest", u(rng)}};
+      if (kind == 3) joint["damping"] = pos(rng);
+      movable.push_back(b);
+    }
+    Json elements = Json::array();
+    const double mass = pos(rng);
+    elements.push_back({{"type", "lumped_point"}, {"node", v3(0.3)}, {"mass", mass}});
+    if (rng() % 2)
+      elements.push_back({{"type", "rotary_node"},
+                          {"node", v3(0.3)},
+                          {"inertia", {{"ixx", 0.02}, {"iyy", 0.03}, {"izz", 0.04}, {"ixy", 0.004}}}});
+    if (rng() % 2)
+      elements.push_back({{"type", "space_bar"}, {"nodes", {v3(0.2), v3(0.5)}}, {"density", 2700},
+                          {"area", 2e-4}, {"Iy", 2e-9}, {"Iz", 3e-9}});
+    else
+      elements.push_back({{"type", "rigid_body"}, {"mass", mass}, {"com", v3(0.2)},
+                          {"inertia", {{"ixx", 0.05}, {"iyy", 0.06}, {"izz", 0.07}, {"iyz", -0.01}}}});
+    list.push_back({{"name", "b" + std::to_string(b)},
+                    {"parent", parent < 0 ? std::string("world") : "b" + std::to_string(parent)},
+                    {"joint", joint},
+                    {"elements", elements}});
+    if (rng() % 4 == 0)
+      loads.push_back({{"body", "b" + std::to_string(b)}, {"point", v3(0.3)}, {"force", v3(2.0)},
+                       {"torque", v3(0.5)}});
+  }
+  // Couplings: about one movable joint in five follows an earlier one (or two).
+  if (couplings)
+    for (std::size_t k = 2; k < movable.size(); k += 5) {
+      const std::string a = "j" + std::to_string(movable[k - 1]), c = "j" + std::to_string(movable[k - 2]);
+      coupled.push_back({{"joint", "j" + std::to_string(movable[k])},
+                         {"follows", {{{"joint", a}, {"ratio", u(rng)}}, {{"joint", c}, {"ratio", u(rng)}}}},
+                         {"offset", 0.1 * u(rng)}});
+    }
+  return Json{{"name", "mixed tree " + std::to_string(seed)},
+              {"gravity", {0.3, -0.2, -9.81}},
+              {"bodies", list},
+              {"loads", loads},
+              {"couplings", coupled}}
+      .dump();
+}
+
+// q̈, M^s, h, Q and τ of `a` and `b` (the same mechanism on different routes) at random states.
+void check_same_equations(const Model& a, const Model& b, unsigned seed, double tol) {
+  Workspace wa(a), wb(b);
+  std::mt19937 rng(seed);
+  for (int k = 0; k < 3; ++k) {
+    const VecX q = random_vector(rng, a.n(), 2), qd = random_vector(rng, a.n(), 2),
+               tau = random_vector(rng, a.n(), 3), qdd = random_vector(rng, a.n(), 3);
+    REQUIRE(forward_dynamics(a, wa, q, qd, tau).ok);
+    REQUIRE(forward_dynamics(b, wb, q, qd, tau).ok);
+    CHECK(rel_error(wa.qdd, wb.qdd) < tol);
+    evaluate(a, wa, q, qd, tau);
+    evaluate(b, wb, q, qd, tau);
+    CHECK(rel_error(wa.Ms, wb.Ms) < tol);
+    CHECK(rel_error(wa.h, wb.h) < tol);
+    CHECK(rel_error(wa.Q, wb.Q) < tol);
+    // q̈ solves the assembled equations.
+    CHECK(rel_error(wb.Ms * wa.qdd + wb.h, wb.Q) < tol);
+    inverse_dynamics(a, wa, q, qd, qdd);
+    inverse_dynamics(b, wb, q, qd, qdd);
+    CHECK(rel_error(wa.tau, wb.tau) < tol);
+    CHECK(rel_error(wa.tau, wb.Ms * qdd + wb.h - (wb.Q - tau)) < tol);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("articulated route equals M^s + Cholesky on mixed random trees", "[routes]") {
+  for (unsigned seed = 1; seed <= 6; ++seed)
+    for (const int bodies : {1, 2, 5, 12, 30}) {
+      INFO("seed " << seed << ", " << bodies << " bodies");
+      const std::string text = mixed_tree_json(seed, bodies, seed % 2 ? 0.6 : 0.0, false);
+      const Model art = load_text(text);
+      Model chol = load_text(text);
+      REQUIRE(art.dynamics_route == DynamicsRoute::Articulated);
+      chol.dynamics_route = DynamicsRoute::Cholesky;
+      check_same_equations(art, chol, seed, 1e-11);
+    }
+}
+
+TEST_CASE("coupled models take the Cholesky route, and both M^s routes agree", "[routes]") {
+  for (unsigned seed = 11; seed <= 16; ++seed) {
+    INFO("seed " << seed);
+    const std::string text = mixed_tree_json(seed, 24, 0.5, true);
+    Model composite = load_text(text), transform = load_text(text);
+    REQUIRE(!composite.identity_coupling);
+    CHECK(composite.dynamics_route == DynamicsRoute::Cholesky);
+    composite.mass_route = MassRoute::Composite;
+    transform.mass_route = MassRoute::Transform;
+    check_same_equations(composite, transform, seed, 1e-11);
+  }
+}
+
+TEST_CASE("articulated route equals dense and CHOLMOD Cholesky where the solver switches",
+          "[routes]") {
+  // choose_solver switches to CHOLMOD at n = 64 on a sparse M^s: check either side of it.
+  for (const int bodies : {63, 64, 65, 128}) {
+    INFO(bodies << " bodies");
+    const std::string text = random_tree_json(bodies, bodies, 1.0, true);
+    const Model art = load_text(text);
+    Model chol = load_text(text);
+    chol.dynamics_route = DynamicsRoute::Cholesky;
+    CHECK(Workspace(chol).solver.kind() ==
+          (bodies >= 64 ? SolverKind::Sparse : SolverKind::Dense));
+    check_same_equations(art, chol, bodies, 1e-10);
+  }
+}
+
+TEST_CASE("every bundled and test model: the chosen routes equal the reference routes",
+          "[routes]") {
+  std::vector<std::string> texts;
+  for (const std::string& name : bundled_models()) texts.push_back(model_path(name));
+  for (const char* name : {"urdf/arm7.urdf", "urdf/hand16.urdf", "urdf/gantry.urdf"})
+    texts.push_back(model_path(name));
+  for (const std::string& path : texts) {
+    INFO(path);
+    const Model chosen = load_model(path);
+    Model reference = load_model(path);
+    reference.dynamics_route = DynamicsRoute::Cholesky;
+    reference.mass_route = MassRoute::Transform;
+    check_same_equations(chosen, reference, 5, 1e-11);
+  }
+}
