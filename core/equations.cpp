@@ -8,6 +8,7 @@
 #include "core/coupling.hpp"
 #include "core/kinematics.hpp"
 #include "core/mass_solver.hpp"
+#include "core/newton_euler.hpp"
 
 namespace femdyn {
 namespace {
@@ -86,9 +87,15 @@ bool is_zero(const VecX& v) { return v.size() == 0 || v.cwiseAbs().maxCoeff() ==
 
 void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau) {
   const bool moving = !is_zero(qd);
-  // The composite route needs only the body poses; the transform route the rows of T.
+  // The composite route needs only the body poses; the transform route the rows of T. The
+  // body-level force route computes h by Newton–Euler, which leaves the poses.
   const bool composite = model.mass_route == MassRoute::Composite;
-  propagate(model, ws, q, qd, {.jacobian = !composite, .bias = moving, .rows = !composite});
+  const bool by_bodies = model.force_route == ForceRoute::Bodies;
+  if (by_bodies && moving)
+    newton_euler(model, ws, q, qd, nullptr, false, ws.h);
+  if (!(by_bodies && moving && composite))
+    propagate(model, ws, q, qd,
+              {.jacobian = !composite, .bias = moving && !by_bodies, .rows = !composite});
   if (!moving) ws.theta_dot.setZero();
 
   if (composite) {
@@ -105,12 +112,12 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
     for (Eigen::Index i = j + 1; i < ws.Ms.rows(); ++i) ws.Ms(i, j) = ws.Ms(j, i);
 
   // h = Tᵀ (M T'[q̇,q̇] + g(u̇,u̇)); zero at rest.
-  if (moving) {
+  if (!moving) {
+    ws.h.setZero();
+  } else if (!by_bodies) {
     ws.nodal.noalias() = model.M * ws.bias;
     if (model.has_velocity_forces) add_velocity_forces(model, ws, ws.u_dot, ws.u_dot, ws.nodal);
     generalized_force(model, ws, ws.nodal, ws.h, false);
-  } else {
-    ws.h.setZero();
   }
   assemble_forces(model, ws, tau, moving);
 }
@@ -118,6 +125,10 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
 void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
   if (is_zero(qd)) {
     ws.h.setZero();
+    return;
+  }
+  if (model.force_route == ForceRoute::Bodies) {
+    newton_euler(model, ws, q, qd, nullptr, false, ws.h);
     return;
   }
   propagate(model, ws, q, qd, {.jacobian = false, .bias = true});
@@ -152,7 +163,13 @@ Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const 
 void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                       const VecX& qdd) {
   // τ = M^s q̈ + h − Q(τ = 0) = Tᵀ (M (T q̈ + T'[q̇,q̇]) + g(u̇,u̇) − F) − Cᵀ(spring + damper),
-  // by two kinematic sweeps and one sweep of Tᵀ: O(N_u + bodies), neither T nor M^s formed.
+  // by body-level Newton–Euler, or by two kinematic sweeps and one sweep of Tᵀ:
+  // O(N_u + bodies), neither T nor M^s formed.
+  if (model.force_route == ForceRoute::Bodies) {
+    newton_euler(model, ws, q, qd, &qdd, true, ws.tau);
+    add_joint_forces(model, ws, true, -1.0, ws.tau);
+    return;
+  }
   propagate(model, ws, q, qdd, {.jacobian = false, .bias = true});
   ws.u_acc = ws.u_dot;  // T q̈
   propagate(model, ws, q, qd, {.jacobian = false, .bias = true});

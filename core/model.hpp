@@ -82,6 +82,10 @@ enum class MassRoute {
   Transform,  // M^s = Tᵀ (M T) with T formed row by row: cheapest for a few bodies
   Composite   // M^s by composite body inertias (core/body_inertia.hpp): O(bodies · depth)
 };
+enum class ForceRoute {
+  Nodes,  // h, τ by node-level sweeps: Tᵀ (M T'[q̇,q̇] + g) by apply_transpose (core/kinematics)
+  Bodies  // h, τ by recursive Newton–Euler over the body inertias Λ_b (core/newton_euler.hpp)
+};
 enum class DynamicsRoute {
   Cholesky,    // q̈ = (M^s)⁻¹ (Q − h): evaluate, then dense or CHOLMOD Cholesky
   Articulated  // articulated-body recursion over the element-assembled Λ_b (core/articulated.hpp)
@@ -128,6 +132,7 @@ struct Model {
   bool condensable = false;  // the body-level form is exact for this model
   bool velocity_forces_rigid = false;  // every g_e is its element's gyroscopic term (checked)
   MassRoute mass_route = MassRoute::Transform;         // how evaluate() forms M^s
+  ForceRoute force_route = ForceRoute::Nodes;              // how h and τ are computed
   DynamicsRoute dynamics_route = DynamicsRoute::Cholesky;  // how forward_dynamics() finds q̈
 
   bool has_nodal_forces = false;     // gravity or loads present

@@ -21,7 +21,8 @@ Workspace::Workspace(const Model& model) : solver(model) {
   u_acc = VecX::Zero(N);
   composite.assign(nb, Mat6::Zero());
   subspace.assign(nb, Vec6::Zero());
-  if (model.dynamics_route == DynamicsRoute::Articulated) articulated.assign(nb, ArticulatedBody{});
+  if (model.dynamics_route == DynamicsRoute::Articulated || model.force_route == ForceRoute::Bodies)
+    articulated.assign(nb, ArticulatedBody{});
   if (!model.identity_coupling) Mtheta = MatX::Zero(nt, nt);
   force.assign(nb, Vec3::Zero());
   moment.assign(nb, Vec3::Zero());

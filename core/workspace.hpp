@@ -19,8 +19,9 @@ struct BodyState {
   Vec3 a = Vec3::Zero();      // bias acceleration of the body origin (q̈ = 0)
 };
 
-// Per body, the articulated-body recursion's quantities (core/articulated.hpp), spatial vectors
-// in world axes about the world origin (core/spatial.hpp).
+// Per body, the body-level recursions' quantities (core/articulated.hpp, core/newton_euler.hpp),
+// spatial vectors in world axes about the world origin (core/spatial.hpp). Newton–Euler keeps
+// its body forces in pA.
 struct ArticulatedBody {
   Mat6 IA = Mat6::Zero();  // articulated inertia I^A
   Vec6 S = Vec6::Zero();   // joint motion subspace
@@ -48,7 +49,7 @@ struct Workspace {
   VecX u_acc;                      // T q̈ + T'[q̇,q̇] (inverse dynamics)
   std::vector<Mat6> composite;     // per body: composite inertia I^c_b (core/body_inertia.hpp)
   std::vector<Vec6> subspace;      // per body: its joint's motion subspace S (world, origin)
-  std::vector<ArticulatedBody> articulated;  // per body, for the articulated route only
+  std::vector<ArticulatedBody> articulated;  // per body, for the body-level routes only
   MatX Mtheta;                     // M_θ (nθ x nθ), with a coupling only
   std::vector<Vec3> force, moment; // per body: wrench of Tᵀ f (world; moment about the origin)
   VecX tau_theta;                  // Tᵀ f on the joint coordinates θ

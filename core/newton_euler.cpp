@@ -1,0 +1,86 @@
+#include "core/newton_euler.hpp"
+
+#include "core/coupling.hpp"
+#include "core/joint.hpp"
+#include "core/kinematics.hpp"
+
+namespace femdyn {
+namespace {
+
+// f = Λ^O a + V ×* Λ^O V, evaluated in the body frame about the body origin, where Λ is three
+// numbers (RigidInertia), instead of forming the 6 × 6 Λ^O: the motions move in by
+// (ω_b, v_b) = (Rᵀ ω, Rᵀ (v_O + ω × p)) and the force moves out by f = R f_b, n_O = R n_b + p × f.
+// (The spatial cross product is the same in any frame.)
+Vec6 body_force(const RigidInertia& L, const Mat3& R, const Vec3& p, const Vec6& V,
+                const Vec6& a) {
+  const auto to_body = [&](const Vec6& m) {
+    Vec6 mb;
+    mb.head<3>().noalias() = R.transpose() * m.head<3>();
+    mb.tail<3>().noalias() = R.transpose() * (m.tail<3>() + m.head<3>().cross(p));
+    return mb;
+  };
+  const auto inertia_times = [&](const Vec6& m) {  // Λ m = (I ω + h × v, m v − h × ω)
+    Vec6 f;
+    f.head<3>().noalias() = L.I * m.head<3>();
+    f.head<3>() += L.h.cross(m.tail<3>());
+    f.tail<3>() = L.m * m.tail<3>() - L.h.cross(m.head<3>());
+    return f;
+  };
+  const Vec6 Vb = to_body(V), ab = to_body(a);
+  const Vec6 fb = inertia_times(ab) + cross_force(Vb, inertia_times(Vb));
+  Vec6 f;
+  f.tail<3>().noalias() = R * fb.tail<3>();
+  f.head<3>().noalias() = R * fb.head<3>();
+  f.head<3>() += p.cross(f.tail<3>());
+  return f;
+}
+
+}  // namespace
+
+void newton_euler(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+                  const VecX* qdd, bool with_external, VecX& y) {
+  const int nb = static_cast<int>(model.bodies.size());
+  propagate(model, ws, q, qd, {.jacobian = false, .bias = false, .rows = false});  // poses, θ
+  coupling_apply(model, qd, ws.theta_dot, false);
+  if (qdd) coupling_apply(model, *qdd, ws.theta_dot_y, false);  // θ̈ = C q̈ (buffer reused)
+  const bool external = with_external && model.has_nodal_forces;
+  if (external) gather_body_wrenches(model, ws, model.F_constant, 1.0);
+
+  // Root to leaves: V_b, a_b, and the force f_b (kept in pA) the body needs.
+  for (int b = 0; b < nb; ++b) {
+    const Body& body = model.bodies[b];
+    ArticulatedBody& A = ws.articulated[b];
+    BodyState& B = ws.body[b];
+    if (body.parent >= 0) {
+      A.V = ws.articulated[body.parent].V;
+      A.a = ws.articulated[body.parent].a;
+    } else {
+      A.V.setZero();
+      A.a.setZero();
+    }
+    if (moves(body.joint)) {
+      const int j = body.joint.theta;
+      A.S = motion_subspace(body.joint, B.R, B.p);
+      const Vec6 vj = A.S * ws.theta_dot[j];
+      A.V += vj;
+      A.a += cross_motion(A.V, vj);
+      if (qdd) A.a += A.S * ws.theta_dot_y[j];
+    }
+    B.w = A.V.head<3>();
+    A.pA = body_force(model.body_inertia[b], B.R, B.p, A.V, A.a);
+    if (external) {
+      A.pA.head<3>() -= ws.moment[b] + B.p.cross(ws.force[b]);
+      A.pA.tail<3>() -= ws.force[b];
+    }
+  }
+  // Leaves to root: project on each joint, pass the rest to the parent.
+  for (int b = nb - 1; b >= 0; --b) {
+    const Body& body = model.bodies[b];
+    const ArticulatedBody& A = ws.articulated[b];
+    if (moves(body.joint)) ws.tau_theta[body.joint.theta] = A.S.dot(A.pA);
+    if (body.parent >= 0) ws.articulated[body.parent].pA += A.pA;
+  }
+  coupling_apply_transpose(model, ws.tau_theta, y);
+}
+
+}  // namespace femdyn
