@@ -37,11 +37,12 @@ int cmd_info(int argc, char** argv);
 int cmd_equations(int argc, char** argv);
 int cmd_compare(int argc, char** argv);
 int cmd_track(int argc, char** argv);
-int cmd_validate(int argc, char** argv);
+int cmd_validate(int argc, char** argv);  // only with FEMDYN_WITH_SIMBODY
 int cmd_import(int argc, char** argv);
 int cmd_simulate(int argc, char** argv);
 int cmd_check(int argc, char** argv);
-int cmd_study(int argc, char** argv);
-int cmd_stress(int argc, char** argv);    // only with FEMDYN_WITH_SIMBODY     // only with FEMDYN_WITH_SIMBODY  // only with FEMDYN_WITH_SIMBODY
+int cmd_study(int argc, char** argv);     // only with FEMDYN_WITH_SIMBODY
+int cmd_stress(int argc, char** argv);    // only with FEMDYN_WITH_SIMBODY
+int cmd_bench(int argc, char** argv);     // only with FEMDYN_WITH_SIMBODY
 
 }  // namespace femdyn::cli

@@ -18,6 +18,7 @@ commands:
   check       numerical diagnosis: conditioning, stiffest mode, stable steps, suspicious bodies
   stress      the stability suite on generated stiff and extreme cases (docs/stability.md)
   study       error against run time of every femdyn and Simbody integrator (work-precision)
+  bench       ns per call of M^s, h, g, Q, q̈, τ and D against the model's Simbody twin
   track       computed-torque feed-forward along a smooth motion, replayed in simulation
   validate    the model against its Simbody twin, pointwise and along a trajectory
   import      a URDF robot (or a plugin model) as femdyn JSON
@@ -49,7 +50,9 @@ int main(int argc, char** argv) {
     if (cmd == "validate") return cmd_validate(argc, argv);
     if (cmd == "study") return cmd_study(argc, argv);
     if (cmd == "stress") return cmd_stress(argc, argv);
+    if (cmd == "bench") return cmd_bench(argc, argv);
 #else
+    if (cmd == "bench") throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
     if (cmd == "stress") throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
     if (cmd == "study") throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
     if (cmd == "validate") throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");

@@ -74,23 +74,9 @@ void condense_body_inertia(Model& m) {
 }
 
 void choose_routes(Model& m) {
-  // Joints with a coordinate on each body's path to the root (its depth in moving joints).
-  const int nb = static_cast<int>(m.bodies.size());
-  std::vector<double> depth(nb, 0);
-  for (int b = 0; b < nb; ++b)
-    depth[b] = (m.bodies[b].parent >= 0 ? depth[m.bodies[b].parent] : 0) +
-               (m.bodies[b].joint.theta >= 0 ? 1 : 0);
-  // M^s by operation count: the dense M T and Tᵀ (M T), against the composite recursion
-  // (about 300 operations a body to move Λ_b, 12 per joint on its path) and, with a coupling,
-  // the reduction Cᵀ M_θ C.
-  const double n = m.n(), nt = m.n_theta();
-  const double dense = (m.n_u() * n + static_cast<double>(m.M.nonZeros())) * n;
-  double by_body = m.identity_coupling ? 0 : 2 * nt * nt * n;
-  for (double d : depth) by_body += 300 + 12 * d;
-  m.mass_route = m.condensable && by_body < dense ? MassRoute::Composite : MassRoute::Transform;
-  // q̈: the articulated recursion needs the body-level form, velocity forces that are the
-  // elements' gyroscopic terms, and one coordinate per joint;
-  // measured faster than any M^s + Cholesky from one coordinate up (docs/performance.md).
+  // M^s by composite inertias wherever the body-level form is exact: measured faster than
+  // Tᵀ (M T) on every model, from the 1-DOF pendulum up (docs/performance.md).
+  m.mass_route = m.condensable ? MassRoute::Composite : MassRoute::Transform;
   // h and τ: the body-level recursion is exact under the same conditions (couplings are
   // linear), and it is O(bodies) instead of O(N_u) (measured faster on every model).
   m.force_route = m.condensable && m.velocity_forces_rigid ? ForceRoute::Bodies : ForceRoute::Nodes;
@@ -134,7 +120,10 @@ void composite_mass(const Model& m, Workspace& ws) {
       Mt(k, i) = Mt(i, k) = ws.subspace[a].dot(F);
     }
   }
-  if (!m.identity_coupling) ws.Ms.noalias() = m.C.transpose() * (ws.Mtheta * m.C);
+  if (!m.identity_coupling) {  // M^s = Cᵀ (M_θ C), through a buffer: no temporary
+    ws.MthetaC.noalias() = ws.Mtheta * m.C;
+    ws.Ms.noalias() = m.C.transpose() * ws.MthetaC;
+  }
 }
 
 }  // namespace femdyn

@@ -83,7 +83,30 @@ void assemble_forces(const Model& model, Workspace& ws, const VecX& tau, bool wi
 
 bool is_zero(const VecX& v) { return v.size() == 0 || v.cwiseAbs().maxCoeff() == 0.0; }
 
+
+// ws.Ms from the body poses (composite route) or from T (transform route), both already
+// propagated; mirrored so that it is symmetric in floating point too.
+void form_mass_matrix(const Model& model, Workspace& ws) {
+  if (model.mass_route == MassRoute::Composite) {
+    composite_mass(model, ws);  // M^s by composite inertias; T is not formed
+  } else {
+    // M^s = Tᵀ (M T)
+    if (ws.MT.rows() != ws.T.rows() || ws.MT.cols() != ws.T.cols())
+      ws.MT.resize(ws.T.rows(), ws.T.cols());  // first use only
+    ws.MT.noalias() = model.M * ws.T;
+    ws.Ms.noalias() = ws.T.transpose() * ws.MT;
+  }
+  for (Eigen::Index j = 0; j < ws.Ms.cols(); ++j)
+    for (Eigen::Index i = j + 1; i < ws.Ms.rows(); ++i) ws.Ms(i, j) = ws.Ms(j, i);
+}
+
 }  // namespace
+
+void mass_matrix(const Model& model, Workspace& ws, const VecX& q) {
+  const bool composite = model.mass_route == MassRoute::Composite;
+  propagate(model, ws, q, q, {.jacobian = !composite, .bias = false, .rows = !composite});
+  form_mass_matrix(model, ws);
+}
 
 void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau) {
   const bool moving = !is_zero(qd);
@@ -98,18 +121,7 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
               {.jacobian = !composite, .bias = moving && !by_bodies, .rows = !composite});
   if (!moving) ws.theta_dot.setZero();
 
-  if (composite) {
-    composite_mass(model, ws);  // M^s by composite inertias; T is not formed
-  } else {
-    // M^s = Tᵀ (M T)
-    if (ws.MT.rows() != ws.T.rows() || ws.MT.cols() != ws.T.cols())
-      ws.MT.resize(ws.T.rows(), ws.T.cols());  // first use only
-    ws.MT.noalias() = model.M * ws.T;
-    ws.Ms.noalias() = ws.T.transpose() * ws.MT;
-  }
-  // Symmetric in exact arithmetic; mirror the upper triangle so it is in floating point too.
-  for (Eigen::Index j = 0; j < ws.Ms.cols(); ++j)
-    for (Eigen::Index i = j + 1; i < ws.Ms.rows(); ++i) ws.Ms(i, j) = ws.Ms(j, i);
+  form_mass_matrix(model, ws);
 
   // h = Tᵀ (M T'[q̇,q̇] + g(u̇,u̇)); zero at rest.
   if (!moving) {

@@ -17,6 +17,9 @@ namespace femdyn {
 // Fills ws.Ms, ws.h, ws.Q for the state (q, q̇, τ). Sizes are checked by the caller (io/cli).
 void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau);
 
+// M^s alone into ws.Ms (the body poses, or T, and nothing of h or Q).
+void mass_matrix(const Model& model, Workspace& ws, const VecX& q);
+
 // Velocity terms alone, h(q, q̇) (one kinematic sweep, T not formed).
 void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX& qd);
 

@@ -2,9 +2,12 @@
 // with one line naming file and path.
 #include <catch2/catch.hpp>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <set>
 #include <nlohmann/json.hpp>
 
 #include "tests/helpers.hpp"
@@ -80,7 +83,7 @@ TEST_CASE("bad command lines and bad models: one line, non-zero exit", "[cli]") 
 }
 
 TEST_CASE("every command has --help, info lists the correlation table", "[cli]") {
-  for (const char* cmd : {"info", "equations", "compare", "track", "validate", "import", "simulate", "check", "study", "stress"}) {
+  for (const char* cmd : {"info", "equations", "compare", "track", "validate", "import", "simulate", "check", "study", "stress", "bench"}) {
     const Run r = run(std::string(cmd) + " --help");
     CHECK(r.code == 0);
     CHECK_THAT(r.out, Catch::StartsWith("usage: femdyn " + std::string(cmd)));
@@ -175,6 +178,68 @@ TEST_CASE("validate: table and exit 0 on a good model, JSON, exit 1 when it cann
   const Run wrong_tol = run("validate " + model_path("pendulum.json") + " --states 0");
   CHECK(wrong_tol.code == 2);
   CHECK_THAT(wrong_tol.out, Catch::Contains("--states expects one integer >= 1"));
+}
+
+TEST_CASE("bench: every quantity timed on both engines, D skipped as documented, bad input",
+          "[cli][bench]") {
+#ifndef NDEBUG  // a Debug build (as this test's): bench refuses to time it
+  const Run refused = run("bench " + model_path("finger.json") + " --quick");
+  CHECK(refused.code == 2);
+  CHECK_THAT(refused.out, Catch::StartsWith("femdyn bench: refusing to time a Debug build ("));
+  return;
+#endif
+  // --quick --json on the finger: stdout is the JSON, stderr says D was not timed.
+  const auto tmp = std::filesystem::temp_directory_path();
+  const std::string err = (tmp / "femdyn_cli_bench.err").string();
+  const Run js = run_shell("{ " + std::string(FEMDYN_BINARY) + " bench " +
+                           model_path("finger.json") + " --quick --json 2>" + err + "; }");
+  REQUIRE(js.code == 0);
+  const auto j = nlohmann::json::parse(js.out);
+  CHECK(j.at("model") == model_path("finger.json"));
+  CHECK(j.at("n") == 4);
+  CHECK(j.at("build") != "Debug");
+  std::set<std::string> timed;
+  for (const auto& r : j.at("results")) {
+    const std::string what =
+        r.at("engine").get<std::string>() + " " + r.at("quantity").get<std::string>();
+    INFO(what);
+    const double median = r.at("median_ns"), lo = r.at("min_ns"), hi = r.at("max_ns");
+    CHECK(std::isfinite(lo));
+    CHECK(std::isfinite(hi));
+    CHECK(0 < lo);
+    CHECK(lo <= median);
+    CHECK(median <= hi);
+    CHECK(timed.insert(what).second);  // once each
+  }
+  for (const char* engine : {"femdyn", "simbody"})
+    for (const char* quantity : {"M", "h", "g", "Q", "qdd", "tau"})
+      CHECK(timed.count(std::string(engine) + " " + quantity) == 1);
+  CHECK(timed.size() == 12);  // and no D: --quick skips it
+  std::ifstream note(err);
+  const std::string stderr_text((std::istreambuf_iterator<char>(note)), {});
+  CHECK(stderr_text == "femdyn bench: D not timed (--quick)\n");
+  std::remove(err.c_str());
+
+  // Above 40 coordinates D is skipped too; the table says why.
+  const std::string big = (tmp / "femdyn_cli_bench41.json").string();
+  std::ofstream(big) << R"({"model": "random_tree", "params": {"seed": 3, "bodies": 41}})";
+  const Run table = run("bench " + big + " --quick --states 2");
+  CHECK(table.code == 0);
+  CHECK_THAT(table.out, Catch::Contains("(41 coordinates)"));
+  CHECK_THAT(table.out, Catch::Contains("\nqdd "));
+  CHECK_THAT(table.out, Catch::EndsWith("\nD        skipped (n = 41 > 40 and --quick)\n"));
+  std::remove(big.c_str());
+
+  // Bad command lines and models: one line, non-zero exit.
+  Run bad = run("bench " + model_path("finger.json") + " --bogus");
+  CHECK(bad.code == 2);
+  CHECK(bad.out == "femdyn bench: unknown option --bogus (try --help)\n");
+  bad = run("bench " + model_path("finger.json") + " --states 0");
+  CHECK(bad.code == 2);
+  CHECK(bad.out == "femdyn bench: --states expects one integer >= 1\n");
+  bad = run("bench /nonexistent.json --quick");
+  CHECK(bad.code == 1);
+  CHECK(bad.out == "femdyn bench: /nonexistent.json: cannot open file\n");
 }
 #endif
 

@@ -91,6 +91,9 @@ void check_same_equations(const Model& a, const Model& b, unsigned seed, double 
     // h vanishes for one joint: relative to the size of its terms, ‖M^s‖ ‖q̇‖², not to itself.
     CHECK(rel_error(wa.h, wb.h, wb.Ms.cwiseAbs().maxCoeff() * qd.squaredNorm()) < tol);
     CHECK(rel_error(wa.Q, wb.Q) < tol);
+    const MatX Ms = wb.Ms;
+    mass_matrix(a, wa, q);  // M^s alone
+    CHECK(rel_error(wa.Ms, Ms) < tol);
     // q̈ solves the assembled equations.
     CHECK(rel_error(wb.Ms * wa.qdd + wb.h, wb.Q) < tol);
     inverse_dynamics(a, wa, q, qd, qdd);

@@ -66,7 +66,7 @@ struct Scratch {
 
 }  // namespace
 
-TEST_CASE("simulate: CSV columns name the coordinates; energy balance holds row by row",
+TEST_CASE("simulate: CSV columns name the coordinates, energy balance holds row by row",
           "[simulate]") {
   Scratch s("sim_balance");
   // A driven, damped tree: τ from a table, linear between rows.
@@ -104,7 +104,7 @@ TEST_CASE("simulate: CSV columns name the coordinates; energy balance holds row 
   CHECK(std::abs(j["energy_balance_error"].get<double>() - balance) <= 1e-12 * scale);
 }
 
-TEST_CASE("simulate: a 1e4 rad/s spring breaks RK4 at 1e-3 s cleanly; BDF runs it", "[simulate]") {
+TEST_CASE("simulate: a 1e4 rad/s spring breaks RK4 at 1e-3 s cleanly, BDF runs it", "[simulate]") {
   Scratch s("sim_stiff");
   std::ofstream(s / "spring.json") << R"({"name": "stiff spring", "gravity": [0, 0, 0],
     "bodies": [{"name": "arm", "parent": "world", "joint": {"name": "theta", "type": "revolute",
@@ -130,7 +130,7 @@ TEST_CASE("simulate: a 1e4 rad/s spring breaks RK4 at 1e-3 s cleanly; BDF runs i
   CHECK(err < 1e-5);
 }
 
-TEST_CASE("simulate: existing files kept without --force; SIGINT leaves the old file whole",
+TEST_CASE("simulate: existing files kept without --force, SIGINT leaves the old file whole",
           "[simulate]") {
   Scratch s("sim_files");
   const std::string out = s / "traj.csv";

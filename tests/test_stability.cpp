@@ -130,7 +130,7 @@ nlohmann::json stress_class(const std::string& klass) {
 
 }  // namespace
 
-TEST_CASE("stress springs: 1e1 to 1e5 rad/s; RK4 unstable and BDF stable at 1e5", "[stress]") {
+TEST_CASE("stress springs: 1e1 to 1e5 rad/s, RK4 unstable and BDF stable at 1e5", "[stress]") {
   for (const auto& c : stress_class("springs")) {
     if (c["case"] != "spring w=100000 zeta=0") continue;
     CHECK(c["verdict"].get<std::string>().rfind("stable only with bdf", 0) == 0);

@@ -90,6 +90,7 @@ void add_case(std::string name, Model model) {
 
   const fv::TwinEquations s = c->twin->equations(c->q, c->qd, c->tau);
   const bool ok = forward_dynamics(m, *c->ws, c->q, c->qd, c->tau).ok;
+  evaluate(m, *c->ws, c->q, c->qd, c->tau);  // M^s, h, Q (the articulated route forms none)
   const double e = std::max({rel_diff(c->ws->Ms, s.M), rel_diff(c->ws->h, s.h),
                              rel_diff(c->ws->Q, s.Q), ok ? rel_diff(c->ws->qdd, s.qdd) : INFINITY});
   if (!(e < 1e-8))
@@ -125,6 +126,8 @@ void register_case(Case* c) {
         ->Unit(benchmark::kMicrosecond);
   };
   // femdyn and Simbody alternate, so drifts of a noisy machine hit both alike.
+  reg("femdyn", "mass", [](Case& c) { mass_matrix(c.model, *c.ws, c.q); });
+  reg("simbody", "mass", [](Case& c) { c.twin->time_mass(c.q); });
   reg("femdyn", "evaluate", [](Case& c) { evaluate(c.model, *c.ws, c.q, c.qd, c.tau); });
   reg("simbody", "evaluate", [](Case& c) { c.twin->time_mass_and_bias(c.q, c.qd); });
   reg("femdyn", "bias", [](Case& c) { evaluate_bias(c.model, *c.ws, c.q, c.qd); });
@@ -137,18 +140,40 @@ void register_case(Case* c) {
   reg("simbody", "inverse", [](Case& c) { c.twin->time_inverse(c.q, c.qd, c.qdd); });
 }
 
+Model random_model(int seed, int bodies, double branching) {
+  const std::string text = R"({"model": "random_tree", "params": {"seed": )" +
+                           std::to_string(seed) + R"(, "bodies": )" + std::to_string(bodies) +
+                           R"(, "branching": )" + std::to_string(branching) +
+                           R"(}, "gravity": [0.1, -0.2, -9.81]})";
+  return compile(parse_spec(text, "random"));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::string dir = std::string(FEMDYN_SOURCE_DIR) + "/models/";
+  const std::string root = std::string(FEMDYN_SOURCE_DIR) + "/";
+  // --sizes=a,b,...: the random chains and trees (default 8 to 1024); --sizes= for none.
+  std::vector<int> sizes = {8, 16, 32, 64, 128, 256, 512, 1024};
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]).rfind("--sizes=", 0) == 0) {
+      sizes.clear();
+      std::stringstream list(argv[i] + 8);
+      for (std::string item; std::getline(list, item, ',');) sizes.push_back(std::stoi(item));
+      for (int k = i; k + 1 < argc; ++k) argv[k] = argv[k + 1];
+      --argc;
+      break;
+    }
   try {
     for (const char* name : {"pendulum", "spatial_double_pendulum", "branched_tree", "finger",
                              "finger_coupled", "hand"})
-      add_case(name, load_model(dir + name + ".json"));
-    add_case("random_chain20",
-             compile(parse_spec(R"({"model": "random_tree", "params": {"seed": 20, "bodies": 20},
-                                    "gravity": [0.1, -0.2, -9.81]})",
-                                "random_chain20")));
+      add_case(name, load_model(root + "models/" + name + ".json"));
+    add_case("hand16", load_model(root + "models/urdf/hand16.urdf"));
+    for (const char* name : {"iiwa", "hyq", "atlas"})
+      add_case(name, load_model(root + "tests/robots/" + name + ".urdf"));
+    add_case("random_chain20", random_model(20, 20, 0));
+    // Growth with n: serial chains and branching trees (docs/performance.md).
+    for (int n : sizes) add_case("chain" + std::to_string(n), random_model(3, n, 0));
+    for (int n : sizes) add_case("tree" + std::to_string(n), random_model(3, n, 0.5));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "femdyn_bench: %s\n", e.what());
     return 1;

@@ -219,6 +219,21 @@ struct SimbodyTwin::Impl {
   // Buffers of the timing entry points (time_*).
   SimTK::Vector bench_applied, bench_udot, bench_theta_ddot, bench_out;
   SimTK::Vector_<SimTK::SpatialVec> bench_A_GB;
+  VecX bench_rest;                        // q̇ = 0
+  SimTK::Matrix bench_h1, bench_D;        // h(e_b) by columns; D_sym(·, b, c) in column b n + c
+
+  const VecX& rest() {  // q̇ = 0, sized by the first call
+    if (bench_rest.size() != model.n()) bench_rest = VecX::Zero(model.n());
+    return bench_rest;
+  }
+
+  // θ̇ = C (e_b + e_c) (c < 0: C e_b) written into the state; invalidates Velocity and above
+  // only, so the realized Position stage stays.
+  void set_unit_rates(int b, int c) {
+    SimTK::Vector& su = state.updU();
+    for (int j = 0; j < model.n_theta(); ++j)
+      su[theta_u[j]] = model.C(j, b) + (c >= 0 ? model.C(j, c) : 0.0);
+  }
 
   // Sets θ = C q + θ0, θ̇ = C q̇ (without temporaries: the timing entry points use it too) and
   // realizes `stage`.
@@ -362,6 +377,51 @@ void SimbodyTwin::time_inverse(const VecX& q, const VecX& qd, const VecX& qdd) {
       s.state, s.system.getMobilityForces(s.state, SimTK::Stage::Dynamics),
       s.system.getRigidBodyForces(s.state, SimTK::Stage::Dynamics), s.bench_theta_ddot,
       s.bench_out);
+}
+
+void SimbodyTwin::time_mass(const VecX& q) {
+  Impl& s = *impl_;
+  s.set_state(q, s.rest(), SimTK::Stage::Position);
+  s.matter.calcM(s.state, s.M_theta);
+}
+
+void SimbodyTwin::time_gravity(const VecX& q) {
+  Impl& s = *impl_;
+  s.set_state(q, s.rest(), SimTK::Stage::Dynamics);
+  s.matter.calcResidualForceIgnoringConstraints(
+      s.state, s.system.getMobilityForces(s.state, SimTK::Stage::Dynamics),
+      s.system.getRigidBodyForces(s.state, SimTK::Stage::Dynamics), s.zero_mobility, s.bench_out);
+}
+
+void SimbodyTwin::time_tensor(const VecX& q) {
+  Impl& s = *impl_;
+  const int n = s.model.n(), nu = s.state.getNU();
+  s.set_state(q, s.rest(), SimTK::Stage::Position);
+  if (s.bench_h1.nrow() != nu || s.bench_h1.ncol() != n) {  // first call only
+    s.bench_h1.resize(nu, n);
+    s.bench_D.resize(nu, n * n);
+  }
+  // h(e_b), b = 1…n: velocity-stage residuals with no force and θ̈ = 0.
+  for (int b = 0; b < n; ++b) {
+    s.set_unit_rates(b, -1);
+    s.system.realize(s.state, SimTK::Stage::Velocity);
+    s.matter.calcResidualForceIgnoringConstraints(s.state, s.zero_mobility, s.zero_body,
+                                                  s.zero_mobility, s.bench_out);
+    for (int i = 0; i < nu; ++i) s.bench_h1(i, b) = s.bench_out[i];
+  }
+  // D_sym(·, b, c) = (h(e_b + e_c) − h(e_b) − h(e_c)) / 2, b ≤ c, mirrored.
+  for (int b = 0; b < n; ++b)
+    for (int c = b; c < n; ++c) {
+      s.set_unit_rates(b, c);
+      s.system.realize(s.state, SimTK::Stage::Velocity);
+      s.matter.calcResidualForceIgnoringConstraints(s.state, s.zero_mobility, s.zero_body,
+                                                    s.zero_mobility, s.bench_out);
+      for (int i = 0; i < nu; ++i) {
+        const double d = 0.5 * (s.bench_out[i] - s.bench_h1(i, b) - s.bench_h1(i, c));
+        s.bench_D(i, b * n + c) = d;
+        s.bench_D(i, c * n + b) = d;
+      }
+    }
 }
 
 bool SimbodyTwin::can_simulate(std::string* why_not) const {

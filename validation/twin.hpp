@@ -131,10 +131,10 @@ class SimbodyTwin {
   TwinRun simulate(const VecX& q0, const VecX& qd0, const std::vector<double>& times,
                    double accuracy, SimbodyIntegrator which);
 
-  // Timing entry points (validation/benchmark.cpp): Simbody's own work only, on buffers
-  // allocated by the first call. Each sets θ = C q + θ0, θ̇ = C q̇ (a plain loop) and realizes
-  // the stage it needs; nothing is reduced to q or converted to Eigen, and the results stay
-  // inside the twin. With a coupling (n < nθ) Simbody's M, h and τ are those of the tree of
+  // Timing entry points (validation/benchmark.cpp, femdyn bench): Simbody's own work only,
+  // on buffers allocated by the first call. Each sets θ = C q + θ0, θ̇ = C q̇ (a plain loop)
+  // and realizes the stage it needs; nothing is reduced to q or converted to Eigen, and the
+  // results stay inside the twin. With a coupling (n < nθ) Simbody's M, h and τ are those of the tree of
   // nθ joints (the reduction by C is not timed).
   //   mass_and_bias: realize Dynamics (forces), calcM, and the residual with the applied forces
   //                  and θ̈ = 0 (that is h − Q), the counterpart of femdyn's evaluate();
@@ -143,11 +143,22 @@ class SimbodyTwin {
   //                  (independent_theta), then calcAccelerationIgnoringConstraints (O(n)
   //                  articulated body), or calcAcceleration when the coupling is posed as
   //                  coordinate couplers (the coupled motion, as femdyn's);
-  //   inverse:       realize Dynamics, the residual with the applied forces and θ̈ = C q̈.
+  //   inverse:       realize Dynamics, the residual with the applied forces and θ̈ = C q̈;
+  //   mass:          θ̇ = 0, realize Position, calcM (M_θ alone);
+  //   gravity:       θ̇ = 0, realize Dynamics, the residual with the applied forces and θ̈ = 0
+  //                  (that is −Q at rest: gravity, loads, springs);
+  //   tensor:        realize Position once, then n + n(n+1)/2 velocity-stage residuals with no
+  //                  force and θ̈ = 0 at θ̇ = C e_b and θ̇ = C (e_b + e_c), b ≤ c, combined by
+  //                  polarization into D_sym(·, b, c) = (h(e_b + e_c) − h(e_b) − h(e_c)) / 2,
+  //                  the part of D symmetric in (b, c) (Simbody forms no such tensor).
+  // (femdyn bench, cli/bench.cpp, times all seven.)
   void time_mass_and_bias(const VecX& q, const VecX& qd);
   void time_bias(const VecX& q, const VecX& qd);
   void time_forward(const VecX& q, const VecX& qd, const VecX& tau);
   void time_inverse(const VecX& q, const VecX& qd, const VecX& qdd);
+  void time_mass(const VecX& q);
+  void time_gravity(const VecX& q);
+  void time_tensor(const VecX& q);
 
  private:
   struct Impl;

@@ -1,0 +1,314 @@
+// femdyn bench MODEL: femdyn's equations of motion timed against the model's Simbody twin
+// (validation/twin.hpp, the twin femdyn validate checks against) in the same run: the median
+// ns per call of M^s, h, the forces at rest, the whole equations, q̈, τ and D, femdyn and
+// Simbody batch by batch in turn (docs/benchmarks.md).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli/commands.hpp"
+#include "core/equations.hpp"
+#include "core/math.hpp"
+#include "core/sampling.hpp"
+#include "validation/twin.hpp"
+#include "validation/validate.hpp"
+
+#ifndef FEMDYN_BUILD_TYPE
+#define FEMDYN_BUILD_TYPE "unknown"
+#endif
+
+namespace femdyn::cli {
+namespace {
+
+namespace fv = femdyn::validation;
+using Clock = std::chrono::steady_clock;
+
+constexpr const char* kHelp = R"(usage: femdyn bench MODEL [--json] [--quick] [--states N] [--gravity gx,gy,gz]
+
+Times femdyn's equations of motion against the model's Simbody twin (the one femdyn validate
+compares with) in the same run, and prints for each quantity the median ns per call of both
+engines and the ratio Simbody / femdyn (above 1: femdyn is faster):
+  M    femdyn: mass_matrix(), M^s alone;
+       Simbody: realize Position, calcM
+  h    the velocity terms alone, without gravity: femdyn evaluate_bias(); Simbody: realize
+       Velocity, the residual with no force and q̈ = 0
+  g    gravity and the other state-independent forces (loads, springs) at q̇ = 0: femdyn
+       inverse_dynamics(q, 0, 0), which is τ = −Q at rest; Simbody: realize Dynamics at rest,
+       the residual with the applied forces and q̈ = 0
+  Q    femdyn: evaluate(), M^s, h and Q together (its entry point that assembles Q); Simbody:
+       realize Dynamics, calcM and the residual with the applied forces (h − Q)
+  qdd  femdyn forward_dynamics(), by the model's route (core/equations.hpp); Simbody: realize
+       Dynamics, calcAccelerationIgnoringConstraints (calcAcceleration on a coupled model)
+  tau  femdyn inverse_dynamics(); Simbody: the residual with the applied forces and q̈
+  D    femdyn third_order_tensor(); Simbody forms no such tensor: n + n(n+1)/2 bias
+       evaluations combined by polarization, D_sym(b,c) = (h(e_b+e_c) − h(e_b) − h(e_c))/2,
+       the part symmetric in (b, c) (Christoffel symbols). Skipped, for both engines, when
+       n > 40 and with --quick (the table says so; with --json, stderr does).
+Method: N seeded random states (default 16: q within the joint limits, q̇ in ±2, τ in ±1,
+q̈ in ±5), cycled; per engine and quantity a warm-up, then 15 batches of about 20 ms
+(--quick: 3 batches of about 2 ms), femdyn and Simbody batches alternating; a batch gives ns
+per call, the report is the median, min and max over the batches. Both engines are first
+checked to agree on M^s, h and q̈ at the first state (relative 1e-8; a warning if not).
+A Debug build refuses to time anything.
+--json: {"model", "n", "build", "results": [{"engine": "femdyn" | "simbody", "quantity",
+"median_ns", "min_ns", "max_ns"}]}.
+)";
+
+constexpr int kTensorMaxN = 40;  // D above this many coordinates takes too long to time
+
+// Timing a Debug build would mislead: refuse (NDEBUG unset, or CMake's build type Debug).
+void refuse_debug_build() {
+#ifndef NDEBUG
+  throw CliError("refusing to time a Debug build (NDEBUG is not defined; build type "
+                 FEMDYN_BUILD_TYPE "): rebuild with -DCMAKE_BUILD_TYPE=Release");
+#endif
+  if (std::string_view(FEMDYN_BUILD_TYPE) == "Debug")
+    throw CliError("refusing to time a Debug build (build type Debug): rebuild with "
+                   "-DCMAKE_BUILD_TYPE=Release");
+}
+
+// The seeded states the calls cycle through.
+struct States {
+  std::vector<VecX> q, qd, tau, qdd;
+  VecX rest, none;  // q̇ = q̈ = 0; no τ
+};
+
+States random_states(const Model& m, int K) {
+  States s;
+  std::mt19937 rng(1);
+  for (int k = 0; k < K; ++k) {
+    s.q.push_back(random_posture(m, rng));
+    s.qd.push_back(random_uniform(m.n(), 2, rng));
+    s.tau.push_back(random_uniform(m.n(), 1, rng));
+    s.qdd.push_back(random_uniform(m.n(), 5, rng));
+  }
+  s.rest = VecX::Zero(m.n());
+  return s;
+}
+
+// max |a − b| / max(max |b|, 1e-6), as femdyn_bench.
+double rel_diff(const MatX& a, const MatX& b) {
+  return (a - b).cwiseAbs().maxCoeff() / std::max(b.cwiseAbs().maxCoeff(), 1e-6);
+}
+
+// Once, before timing: both engines compute the same M^s, h (evaluate()) and q̈
+// (forward_dynamics()) at the first state.
+void check_agreement(const std::string& path, const Model& m, Workspace& ws,
+                     fv::SimbodyTwin& twin, const States& s) {
+  const fv::TwinEquations e = twin.equations(s.q[0], s.qd[0], s.tau[0]);
+  const Status st = forward_dynamics(m, ws, s.q[0], s.qd[0], s.tau[0]);
+  const double dqdd = st.ok ? rel_diff(ws.qdd, e.qdd) : INFINITY;
+  evaluate(m, ws, s.q[0], s.qd[0], s.tau[0]);
+  const double dM = rel_diff(ws.Ms, e.M), dh = rel_diff(ws.h, e.h);
+  if (dM < 1e-8 && dh < 1e-8 && dqdd < 1e-8) return;
+  std::cerr << "femdyn bench: warning: " << path
+            << ": femdyn and Simbody differ at the first state (relative M^s "
+            << format_short(dM) << ", h " << format_short(dh) << ", q̈ "
+            << (st.ok ? format_short(dqdd) : "not computed: " + st.message)
+            << "); the timings compare different computations\n";
+}
+
+// Keeps the compiler from dropping work whose result it could prove unused.
+inline void keep(const void* p) { asm volatile("" : : "g"(p) : "memory"); }
+
+// ns per call of `calls` calls of fn over the cycled states.
+template <class Fn>
+double batch_ns(Fn& fn, long calls, int K) {
+  int k = 0;
+  const Clock::time_point start = Clock::now();
+  for (long i = 0; i < calls; ++i) {
+    fn(k);
+    if (++k == K) k = 0;
+  }
+  return std::chrono::duration<double, std::nano>(Clock::now() - start).count() /
+         static_cast<double>(calls);
+}
+
+// Warm-up and calibration: every state once (buffers are sized by the first call), runs
+// doubling in length until one lasts a tenth of a batch, which fixes the calls a batch makes,
+// then one whole batch whose time is thrown away. Returns the calls a batch makes.
+template <class Fn>
+long calls_per_batch(Fn& fn, int K, double batch_time_ns) {
+  for (int k = 0; k < K; ++k) fn(k);
+  for (long calls = 1;; calls *= 2) {
+    const double per_call = batch_ns(fn, calls, K);
+    if (per_call * static_cast<double>(calls) >= batch_time_ns / 10 || calls >= (1L << 30)) {
+      const long batch = std::max(1L, std::lround(batch_time_ns / std::max(per_call, 1e-3)));
+      batch_ns(fn, batch, K);
+      return batch;
+    }
+  }
+}
+
+struct Timing {
+  double median = 0, min = 0, max = 0;  // ns per call, over the batches
+};
+
+Timing summarize(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t h = v.size() / 2;
+  return {v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]), v.front(), v.back()};
+}
+
+struct Method {
+  int batches = 15;
+  double batch_time_ns = 20e6;
+};
+
+struct Row {
+  std::string quantity;
+  Timing femdyn, simbody;
+};
+
+// One quantity on both engines: each calibrated, then `batches` rounds of a femdyn batch and
+// a Simbody batch, so slow drifts of the machine hit both alike.
+template <class F, class S>
+Row time_both(const std::string& quantity, F&& femdyn_call, S&& simbody_call, int K,
+              const Method& method) {
+  const long nf = calls_per_batch(femdyn_call, K, method.batch_time_ns);
+  const long ns = calls_per_batch(simbody_call, K, method.batch_time_ns);
+  std::vector<double> f, s;
+  for (int b = 0; b < method.batches; ++b) {
+    f.push_back(batch_ns(femdyn_call, nf, K));
+    s.push_back(batch_ns(simbody_call, ns, K));
+  }
+  return {quantity, summarize(f), summarize(s)};
+}
+
+// Why D is not timed, or empty.
+std::string tensor_skipped(int n, bool quick) {
+  std::string why;
+  if (n > kTensorMaxN) why = "n = " + std::to_string(n) + " > " + std::to_string(kTensorMaxN);
+  if (quick) why += (why.empty() ? "" : " and ") + std::string("--quick");
+  return why;
+}
+
+std::string ns_text(double x) { return format_number(x, "%.0f"); }
+
+void print_table(const std::string& path, int n, int K, const Method& method,
+                 const std::vector<Row>& rows, const std::string& skipped) {
+  std::cout << path << " (" << n << " coordinates) against Simbody: median ns per call over "
+            << method.batches << " batches of ~" << method.batch_time_ns / 1e6 << " ms, " << K
+            << " states, build " FEMDYN_BUILD_TYPE "\n";
+  char line[200];
+  std::snprintf(line, sizeof line, "%-8s %10s %10s %15s   %-21s %s\n", "quantity", "femdyn",
+                "Simbody", "Simbody/femdyn", "femdyn min-max", "Simbody min-max");
+  std::cout << line;
+  for (const Row& r : rows) {
+    const std::string fr = ns_text(r.femdyn.min) + "-" + ns_text(r.femdyn.max);
+    const std::string sr = ns_text(r.simbody.min) + "-" + ns_text(r.simbody.max);
+    std::snprintf(line, sizeof line, "%-8s %10s %10s %15s   %-21s %s\n", r.quantity.c_str(),
+                  ns_text(r.femdyn.median).c_str(), ns_text(r.simbody.median).c_str(),
+                  format_number(r.simbody.median / r.femdyn.median, "%.2f").c_str(), fr.c_str(),
+                  sr.c_str());
+    std::cout << line;
+  }
+  if (!skipped.empty()) std::cout << "D        skipped (" << skipped << ")\n";
+}
+
+nlohmann::ordered_json report_json(const std::string& path, int n, const std::vector<Row>& rows) {
+  nlohmann::ordered_json results = nlohmann::ordered_json::array();
+  auto add = [&](const char* engine, const std::string& quantity, const Timing& t) {
+    results.push_back({{"engine", engine}, {"quantity", quantity}, {"median_ns", t.median},
+                       {"min_ns", t.min}, {"max_ns", t.max}});
+  };
+  for (const Row& r : rows) {
+    add("femdyn", r.quantity, r.femdyn);
+    add("simbody", r.quantity, r.simbody);
+  }
+  return {{"model", path}, {"n", n}, {"build", FEMDYN_BUILD_TYPE}, {"results", results}};
+}
+
+}  // namespace
+
+int cmd_bench(int argc, char** argv) {
+  const Args a = parse_args(argc, argv, 2, {"help", "json", "quick"}, {"states", "gravity"});
+  if (a.has("help")) {
+    std::cout << kHelp;
+    return 0;
+  }
+  refuse_debug_build();
+  const int K = static_cast<int>(integer_option(a, "states", 16, 1, 10000));
+  const Model m = load(a);
+  const std::string& path = a.positional[0];
+  const int n = m.n();
+  if (n == 0) throw ModelError(path, "the model has no coordinates: nothing to time");
+  const bool quick = a.has("quick");
+  const Method method = quick ? Method{3, 2e6} : Method{};
+
+  std::unique_ptr<fv::SimbodyTwin> twin;
+  try {
+    twin = std::make_unique<fv::SimbodyTwin>(fv::twin_model(m));
+  } catch (const std::exception& e) {  // Simbody's messages span lines: one line here
+    std::istringstream words(e.what());
+    std::string why, word;
+    while (words >> word) why += (why.empty() ? "" : " ") + word;
+    throw ModelError(path, "Simbody refused the twin: " + why);
+  }
+  Workspace ws(m);
+  const States s = random_states(m, K);
+  check_agreement(path, m, ws, *twin, s);
+
+  std::vector<Row> rows;
+  // M^s: femdyn's mass_matrix (M^s alone) / Simbody's calcM at Position.
+  rows.push_back(time_both(
+      "M", [&](int k) { mass_matrix(m, ws, s.q[k]); keep(ws.Ms.data()); },
+      [&](int k) { twin->time_mass(s.q[k]); }, K, method));
+  // h without gravity: velocity terms alone.
+  rows.push_back(time_both(
+      "h", [&](int k) { evaluate_bias(m, ws, s.q[k], s.qd[k]); keep(ws.h.data()); },
+      [&](int k) { twin->time_bias(s.q[k], s.qd[k]); }, K, method));
+  // Gravity and the other state-independent forces at rest: τ = −Q(q̇ = 0).
+  rows.push_back(time_both(
+      "g", [&](int k) { inverse_dynamics(m, ws, s.q[k], s.rest, s.rest); keep(ws.tau.data()); },
+      [&](int k) { twin->time_gravity(s.q[k]); }, K, method));
+  // Q: femdyn assembles it in evaluate() with M^s and h; Simbody calcM + residual (h − Q).
+  rows.push_back(time_both(
+      "Q", [&](int k) { evaluate(m, ws, s.q[k], s.qd[k], s.tau[k]); keep(ws.Q.data()); },
+      [&](int k) { twin->time_mass_and_bias(s.q[k], s.qd[k]); }, K, method));
+  // q̈: forward dynamics.
+  rows.push_back(time_both(
+      "qdd",
+      [&](int k) {
+        forward_dynamics(m, ws, s.q[k], s.qd[k], s.tau[k]);
+        keep(ws.qdd.data());
+      },
+      [&](int k) { twin->time_forward(s.q[k], s.qd[k], s.tau[k]); }, K, method));
+  // τ: inverse dynamics.
+  rows.push_back(time_both(
+      "tau",
+      [&](int k) {
+        inverse_dynamics(m, ws, s.q[k], s.qd[k], s.qdd[k]);
+        keep(ws.tau.data());
+      },
+      [&](int k) { twin->time_inverse(s.q[k], s.qd[k], s.qdd[k]); }, K, method));
+  // D: femdyn's tensor / Simbody's symmetric part by polarization of h.
+  const std::string skipped = tensor_skipped(n, quick);
+  if (skipped.empty())
+    rows.push_back(time_both(
+        "D",
+        [&](int k) {
+          const std::vector<MatX> D = third_order_tensor(m, ws, s.q[k]);
+          keep(D.data());
+        },
+        [&](int k) { twin->time_tensor(s.q[k]); }, K, method));
+
+  if (a.has("json")) {
+    if (!skipped.empty()) std::cerr << "femdyn bench: D not timed (" << skipped << ")\n";
+    std::cout << report_json(path, n, rows).dump(2) << "\n";
+  } else {
+    print_table(path, n, K, method, rows, skipped);
+  }
+  return 0;
+}
+
+}  // namespace femdyn::cli
