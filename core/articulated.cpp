@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/body_loads.hpp"
 #include "core/joint.hpp"
 #include "core/kinematics.hpp"
 
@@ -61,7 +62,6 @@ Status articulated_forward_dynamics(const Model& model, Workspace& ws, const Vec
   const int nb = static_cast<int>(model.bodies.size());
   propagate(model, ws, q, qd, {.jacobian = false, .bias = false, .rows = false});  // poses, θ
   ws.theta_dot = qd;  // C = I
-  if (model.has_nodal_forces) gather_body_wrenches(model, ws, model.F_constant, 1.0);
 
   // 1. Velocities, velocity-product accelerations and bias forces, root to leaves.
   for (int b = 0; b < nb; ++b) {
@@ -80,11 +80,8 @@ Status articulated_forward_dynamics(const Model& model, Workspace& ws, const Vec
     inertia_at_origin(model.body_inertia[b], B.R, B.p, A.IA);
     A.trace = A.IA.trace();
     A.pA = cross_force(A.V, A.IA * A.V);
-    if (model.has_nodal_forces) {  // − the external wrench, moved to the world origin
-      A.pA.head<3>() -= ws.moment[b] + B.p.cross(ws.force[b]);
-      A.pA.tail<3>() -= ws.force[b];
-    }
   }
+  subtract_body_loads(model, ws);
 
   // 2. Articulated inertias and bias forces, leaves to root.
   for (int b = nb - 1; b >= 0; --b) {
@@ -117,11 +114,12 @@ Status articulated_forward_dynamics(const Model& model, Workspace& ws, const Vec
     }
   }
 
-  // 3. Accelerations, root to leaves.
+  // 3. Accelerations, root to leaves, from the base acceleration −g that stands for gravity.
+  const Vec6 a_base = gravity_base_acceleration(model);
   for (int b = 0; b < nb; ++b) {
     const Body& body = model.bodies[b];
     ArticulatedBody& A = ws.articulated[b];
-    A.a = (body.parent >= 0 ? ws.articulated[body.parent].a : Vec6::Zero()) + A.c;
+    A.a = (body.parent >= 0 ? ws.articulated[body.parent].a : a_base) + A.c;
     if (!moves(body.joint)) continue;
     const double qdd = (A.u - A.U.dot(A.a)) / A.d;
     ws.qdd[body.joint.theta] = qdd;

@@ -9,13 +9,14 @@
 // (core/spatial.hpp), S_b the joint's motion subspace, θ̇_b its rate and τ_b its force
 // (τ + spring + damper), over the bodies in tree order:
 //   1. root to leaves:  V_b = V_p + S_b θ̇_b,   c_b = V_b × S_b θ̇_b,
-//                       p_b = V_b ×* I_b V_b − f_b     (f_b: nodal forces F and body torques,
-//                                                      gathered as in apply_transpose)
+//                       p_b = V_b ×* I_b V_b − f_b     (f_b: point loads and body torques;
+//                                                      gravity is the base acceleration −g,
+//                                                      core/body_loads.hpp)
 //   2. leaves to root:  U_b = I^A_b S_b,  d_b = S_bᵀ U_b,  u_b = τ_b − S_bᵀ p^A_b,
 //                       I^A_p += I^A_b − U_b U_bᵀ / d_b,
 //                       p^A_p += p^A_b + (I^A_b − U_b U_bᵀ / d_b) c_b + U_b u_b / d_b
 //      (a fixed joint passes I^A_b and p^A_b on whole)
-//   3. root to leaves:  a'_b = a_p + c_b,  θ̈_b = (u_b − U_bᵀ a'_b) / d_b,  a_b = a'_b + S_b θ̈_b
+//   3. root to leaves:  a'_b = a_p + c_b (a_0 = (0, −g)),  θ̈_b = (u_b − U_bᵀ a'_b) / d_b,  a_b = a'_b + S_b θ̈_b
 // O(bodies + N_u), no matrix of size n. Used when Model::dynamics_route is Articulated: the
 // body-level form is exact and there is no coupling (C = I, θ0 = 0). A coupled model has
 // coordinates that drive several joints, which the recursion cannot eliminate one joint at a

@@ -107,21 +107,21 @@ void composite_mass(const Model& m, Workspace& ws) {
     if (m.bodies[b].parent >= 0) ws.composite[m.bodies[b].parent] += ws.composite[b];
     ws.subspace[b] = motion_subspace(m.bodies[b].joint, ws.body[b].R, ws.body[b].p);
   }
-  // M_θ(i, k) = S_kᵀ I^c_b S_i along the path of b.
+  // M_θ(k, i) = S_kᵀ I^c_b S_i for the joints k on the path of b (k < i: the upper triangle,
+  // column i written contiguously). The entries off every path are structural zeros, written
+  // as zeros when the Workspace is made and never touched: no n² clearing per call.
   MatX& Mt = m.identity_coupling ? ws.Ms : ws.Mtheta;
-  Mt.setZero();
   for (int b = 0; b < nb; ++b) {
     const int i = m.bodies[b].joint.theta;
     if (i < 0) continue;
     const Vec6 F = ws.composite[b] * ws.subspace[b];
     for (int a = b; a >= 0; a = m.bodies[a].parent) {
       const int k = m.bodies[a].joint.theta;
-      if (k < 0) continue;
-      Mt(k, i) = Mt(i, k) = ws.subspace[a].dot(F);
+      if (k >= 0) Mt(k, i) = ws.subspace[a].dot(F);
     }
   }
   if (!m.identity_coupling) {  // M^s = Cᵀ (M_θ C), through a buffer: no temporary
-    ws.MthetaC.noalias() = ws.Mtheta * m.C;
+    ws.MthetaC.noalias() = ws.Mtheta.selfadjointView<Eigen::Upper>() * m.C;
     ws.Ms.noalias() = m.C.transpose() * ws.MthetaC;
   }
 }

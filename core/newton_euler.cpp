@@ -1,5 +1,6 @@
 #include "core/newton_euler.hpp"
 
+#include "core/body_loads.hpp"
 #include "core/coupling.hpp"
 #include "core/joint.hpp"
 #include "core/kinematics.hpp"
@@ -43,8 +44,7 @@ void newton_euler(const Model& model, Workspace& ws, const VecX& q, const VecX& 
   propagate(model, ws, q, qd, {.jacobian = false, .bias = false, .rows = false});  // poses, θ
   coupling_apply(model, qd, ws.theta_dot, false);
   if (qdd) coupling_apply(model, *qdd, ws.theta_dot_y, false);  // θ̈ = C q̈ (buffer reused)
-  const bool external = with_external && model.has_nodal_forces;
-  if (external) gather_body_wrenches(model, ws, model.F_constant, 1.0);
+  const Vec6 a_base = with_external ? gravity_base_acceleration(model) : Vec6::Zero();
 
   // Root to leaves: V_b, a_b, and the force f_b (kept in pA) the body needs.
   for (int b = 0; b < nb; ++b) {
@@ -56,7 +56,7 @@ void newton_euler(const Model& model, Workspace& ws, const VecX& q, const VecX& 
       A.a = ws.articulated[body.parent].a;
     } else {
       A.V.setZero();
-      A.a.setZero();
+      A.a = a_base;
     }
     if (moves(body.joint)) {
       const int j = body.joint.theta;
@@ -68,11 +68,8 @@ void newton_euler(const Model& model, Workspace& ws, const VecX& q, const VecX& 
     }
     B.w = A.V.head<3>();
     A.pA = body_force(model.body_inertia[b], B.R, B.p, A.V, A.a);
-    if (external) {
-      A.pA.head<3>() -= ws.moment[b] + B.p.cross(ws.force[b]);
-      A.pA.tail<3>() -= ws.force[b];
-    }
   }
+  if (with_external) subtract_body_loads(model, ws);
   // Leaves to root: project on each joint, pass the rest to the parent.
   for (int b = nb - 1; b >= 0; --b) {
     const Body& body = model.bodies[b];

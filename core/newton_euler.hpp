@@ -9,7 +9,8 @@
 //   root to leaves:  V_b = V_p + S_b θ̇_b,   a_b = a_p + S_b θ̈_b + V_b × S_b θ̇_b,
 //                    f_b = I_b a_b + V_b ×* I_b V_b − f^ext_b
 //   leaves to root:  τ_θ(b) = S_bᵀ f_b,   f_p += f_b
-// O(bodies + the loaded DOFs), with f^ext the nodal forces F and body torques gathered per body.
+// O(bodies), with gravity as a base acceleration a_0 = −g and f^ext the point loads and body
+// torques (core/body_loads.hpp).
 #pragma once
 #include "core/workspace.hpp"
 

@@ -28,6 +28,13 @@ inline Vec6 cross_force(const Vec6& a, const Vec6& f) {
   return r;
 }
 
+// The wrench (n_O, f) about the world origin of a force f at the world point x.
+inline Vec6 wrench_at_origin(const Vec3& x, const Vec3& f) {
+  Vec6 w;
+  w << x.cross(f), f;
+  return w;
+}
+
 // A rigid body's spatial inertia in the body frame about the body origin, twist (ω, v):
 //   Λ = [[I, [h]×], [[h]×ᵀ, m 1]],   m the mass, h = m c the first moment, I the inertia tensor
 // about the origin. Three numbers instead of 36: moving it costs a rotation of I and a few

@@ -1,12 +1,18 @@
-// femdyn_bench: femdyn's equations against Simbody's on the same mechanisms (docs/benchmarks.md).
+// femdyn_bench: femdyn's equations against Simbody's on the same mechanisms (docs/benchmarks.md,
+// docs/performance.md, generated from it by tools/update-performance-docs.sh).
 //
-// For each bundled model (and a seeded random 20-DOF chain), at one seeded random state:
+// For each bundled model, hand16, the KUKA iiwa, HyQ and Atlas, a seeded random 20-DOF chain
+// and random chains and trees of --sizes= bodies (default 8 to 1024), at one seeded state:
+//   femdyn/mass/M       mass_matrix(): M^s alone     simbody/mass/M      calcM
 //   femdyn/evaluate/M   evaluate(): M^s, h, Q          simbody/evaluate/M  calcM + residual (h − Q)
 //   femdyn/bias/M       evaluate_bias(): h             simbody/bias/M      residual, no forces (h)
 //   femdyn/forward/M    forward_dynamics(): q̈          simbody/forward/M   calcAccelerationIgnoringConstraints
 //   femdyn/inverse/M    inverse_dynamics(): τ          simbody/inverse/M   residual with θ̈
+//   reference/{mass,bias,forward,inverse}/M: femdyn on the reference routes (Tᵀ M T, node-level
+//   sweeps, Cholesky) where n ≤ 128, for the crossovers.
 // Simbody's side is SimbodyTwin::time_* (validation/twin.hpp): its own work only. This file
 // does not include Simbody, so it is compiled like the rest of femdyn (C++20, NDEBUG).
+// Exits 1 if an engine disagrees with Simbody or femdyn allocates in a timed call.
 //
 // Heap allocations are counted by interposing malloc (glibc) and reported per iteration as the
 // counter `allocs`; femdyn's hot path is documented allocation-free and must show 0.
@@ -18,6 +24,7 @@
 #include <cstdlib>
 #include <memory>
 #include <random>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -62,7 +69,18 @@ struct Case {
   std::unique_ptr<Workspace> ws;
   std::unique_ptr<fv::SimbodyTwin> twin;
   VecX q, qd, tau, qdd;
+  // The same mechanism on the reference routes (Tᵀ M T, node-level sweeps, Cholesky), for the
+  // crossovers in docs/performance.md; up to 128 coordinates (Tᵀ M T is O(N_u n²)).
+  std::unique_ptr<Model> reference;
+  std::unique_ptr<Workspace> ws_ref;
 };
+
+// What makes the run fail (exit 1): engines that disagree, femdyn allocating in its hot path.
+// (The reference routes are not held to that: Eigen's large dense products allocate.)
+std::set<std::string>& failures() {
+  static std::set<std::string> all;
+  return all;
+}
 
 std::vector<std::unique_ptr<Case>>& cases() {
   static std::vector<std::unique_ptr<Case>> all;
@@ -75,11 +93,19 @@ double rel_diff(const MatX& a, const MatX& b) {
 
 // The state of femdyn validate's first sample: seed 1, q within the joint limits,
 // q̇ in ±2, τ in ±1, q̈ in ±5. Checks once, outside the timing, that both sides agree.
-void add_case(std::string name, Model model) {
+template <class Load>
+void add_case(std::string name, Load load) {
   auto c = std::make_unique<Case>();
   c->name = std::move(name);
-  c->model = std::move(model);
+  c->model = load();
   const Model& m = c->model;
+  if (m.n() <= 128) {
+    c->reference = std::make_unique<Model>(load());
+    c->reference->mass_route = MassRoute::Transform;
+    c->reference->force_route = ForceRoute::Nodes;
+    c->reference->dynamics_route = DynamicsRoute::Cholesky;
+    c->ws_ref = std::make_unique<Workspace>(*c->reference);
+  }
   c->ws = std::make_unique<Workspace>(m);
   c->twin = std::make_unique<fv::SimbodyTwin>(fv::twin_model(m));
   std::mt19937 rng(1);
@@ -93,16 +119,19 @@ void add_case(std::string name, Model model) {
   evaluate(m, *c->ws, c->q, c->qd, c->tau);  // M^s, h, Q (the articulated route forms none)
   const double e = std::max({rel_diff(c->ws->Ms, s.M), rel_diff(c->ws->h, s.h),
                              rel_diff(c->ws->Q, s.Q), ok ? rel_diff(c->ws->qdd, s.qdd) : INFINITY});
-  if (!(e < 1e-8))
-    std::fprintf(stderr, "warning: %s: femdyn and Simbody differ (relative %.3g)\n",
+  if (!(e < 1e-8)) {  // timing two engines that disagree would mean nothing
+    std::fprintf(stderr, "femdyn_bench: %s: femdyn and Simbody differ (relative %.3g)\n",
                  c->name.c_str(), e);
+    failures().insert(c->name + ": femdyn and Simbody differ");
+  }
   cases().push_back(std::move(c));
 }
 
 // Runs `body` in the timing loop with allocation counting on; `allocs` = heap allocations per
 // iteration (a warm-up call first, so buffers sized on first use are not counted).
 template <class Body>
-void timed(benchmark::State& state, const Case& c, Body&& body) {
+void timed(benchmark::State& state, const Case& c, const std::string& name, bool femdyn,
+           Body&& body) {
   body();
   long allocs = 0;
   for (auto _ : state) {
@@ -116,13 +145,17 @@ void timed(benchmark::State& state, const Case& c, Body&& body) {
   state.counters["n"] = c.model.n();
   state.counters["allocs"] =
       state.iterations() ? static_cast<double>(allocs) / static_cast<double>(state.iterations()) : 0;
+  if (femdyn && allocs > 0) failures().insert(name + ": femdyn allocated");
 }
 
 void register_case(Case* c) {
   const std::string& name = c->name;
   auto reg = [&](const std::string& lib, const std::string& op, auto fn) {
-    benchmark::RegisterBenchmark((lib + "/" + op + "/" + name).c_str(),
-                                 [c, fn](benchmark::State& st) { timed(st, *c, [&] { fn(*c); }); })
+    const std::string full = lib + "/" + op + "/" + name;
+    benchmark::RegisterBenchmark(full.c_str(),
+                                 [c, fn, full, lib](benchmark::State& st) {
+                                   timed(st, *c, full, lib == "femdyn", [&] { fn(*c); });
+                                 })
         ->Unit(benchmark::kMicrosecond);
   };
   // femdyn and Simbody alternate, so drifts of a noisy machine hit both alike.
@@ -138,6 +171,14 @@ void register_case(Case* c) {
   reg("simbody", "forward", [](Case& c) { c.twin->time_forward(c.q, c.qd, c.tau); });
   reg("femdyn", "inverse", [](Case& c) { inverse_dynamics(c.model, *c.ws, c.q, c.qd, c.qdd); });
   reg("simbody", "inverse", [](Case& c) { c.twin->time_inverse(c.q, c.qd, c.qdd); });
+  if (!c->reference) return;
+  reg("reference", "mass", [](Case& c) { mass_matrix(*c.reference, *c.ws_ref, c.q); });
+  reg("reference", "bias", [](Case& c) { evaluate_bias(*c.reference, *c.ws_ref, c.q, c.qd); });
+  reg("reference", "forward", [](Case& c) {
+    benchmark::DoNotOptimize(forward_dynamics(*c.reference, *c.ws_ref, c.q, c.qd, c.tau).ok);
+  });
+  reg("reference", "inverse",
+      [](Case& c) { inverse_dynamics(*c.reference, *c.ws_ref, c.q, c.qd, c.qdd); });
 }
 
 Model random_model(int seed, int bodies, double branching) {
@@ -164,16 +205,20 @@ int main(int argc, char** argv) {
       break;
     }
   try {
+    const auto file = [&](std::string path) { return [path] { return load_model(path); }; };
+    const auto random = [](int seed, int n, double branching) {
+      return [=] { return random_model(seed, n, branching); };
+    };
     for (const char* name : {"pendulum", "spatial_double_pendulum", "branched_tree", "finger",
                              "finger_coupled", "hand"})
-      add_case(name, load_model(root + "models/" + name + ".json"));
-    add_case("hand16", load_model(root + "models/urdf/hand16.urdf"));
+      add_case(name, file(root + "models/" + name + ".json"));
+    add_case("hand16", file(root + "models/urdf/hand16.urdf"));
     for (const char* name : {"iiwa", "hyq", "atlas"})
-      add_case(name, load_model(root + "tests/robots/" + name + ".urdf"));
-    add_case("random_chain20", random_model(20, 20, 0));
+      add_case(name, file(root + "tests/robots/" + name + ".urdf"));
+    add_case("random_chain20", random(20, 20, 0));
     // Growth with n: serial chains and branching trees (docs/performance.md).
-    for (int n : sizes) add_case("chain" + std::to_string(n), random_model(3, n, 0));
-    for (int n : sizes) add_case("tree" + std::to_string(n), random_model(3, n, 0.5));
+    for (int n : sizes) add_case("chain" + std::to_string(n), random(3, n, 0));
+    for (int n : sizes) add_case("tree" + std::to_string(n), random(3, n, 0.5));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "femdyn_bench: %s\n", e.what());
     return 1;
@@ -183,5 +228,6 @@ int main(int argc, char** argv) {
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
-  return 0;
+  for (const std::string& f : failures()) std::fprintf(stderr, "femdyn_bench: %s\n", f.c_str());
+  return failures().empty() ? 0 : 1;
 }
