@@ -33,7 +33,7 @@ Status singular(const Model& model, int j, bool independently) {
 Status check_regularity(const Model& model, Workspace& ws) {
   const int nb = static_cast<int>(model.bodies.size());
   for (int b = 0; b < nb; ++b)
-    inertia_at_origin(model.body_inertia[b], ws.body[b].R, ws.body[b].p, ws.composite[b]);
+    ws.composite[b] = inertia_at_origin(model.body_inertia[b], ws.body[b].R, ws.body[b].p);
   for (int b = nb - 1; b >= 0; --b)
     if (model.bodies[b].parent >= 0) ws.composite[model.bodies[b].parent] += ws.composite[b];
   double scale = 0;
@@ -46,11 +46,16 @@ Status check_regularity(const Model& model, Workspace& ws) {
     const int j = model.bodies[b].joint.theta;
     if (j < 0) continue;
     const Vec6& S = ws.articulated[b].S;
-    const double Mbb = S.dot(ws.composite[b] * S), d = ws.articulated[b].d;
-    if (!std::isfinite(Mbb) || !std::isfinite(d))
-      return {false, "the mass matrix M^s has NaN or Inf entries", -1, true};
+    const double Mbb = S.dot(ws.composite[b] * S);
+    if (!std::isfinite(Mbb)) return {false, "the mass matrix M^s has NaN or Inf entries", -1, true};
     if (!(Mbb > 1e-13 * scale)) return singular(model, j, false);
-    if (!(d >= 1e-13 * Mbb)) return singular(model, j, true);
+  }
+  // Pivots in elimination order, leaves first: a lost pivot makes its ancestors' NaN.
+  for (int b = nb - 1; b >= 0; --b) {
+    const int j = model.bodies[b].joint.theta;
+    if (j < 0) continue;
+    const Vec6& S = ws.articulated[b].S;
+    if (!(ws.articulated[b].d >= 1e-13 * S.dot(ws.composite[b] * S))) return singular(model, j, true);
   }
   return {};
 }
@@ -77,9 +82,10 @@ Status articulated_forward_dynamics(const Model& model, Workspace& ws, const Vec
       A.c = cross_motion(A.V, vj);
     }
     B.w = A.V.head<3>();
-    inertia_at_origin(model.body_inertia[b], B.R, B.p, A.IA);
-    A.trace = A.IA.trace();
-    A.pA = cross_force(A.V, A.IA * A.V);
+    const RigidInertia I = inertia_at_origin(model.body_inertia[b], B.R, B.p);
+    A.IA = I.matrix();
+    A.trace = I.I.trace() + 3 * I.m;
+    A.pA = cross_force(A.V, I * A.V);
   }
   subtract_body_loads(model, ws);
 

@@ -102,7 +102,8 @@ MassProperties body_mass_properties(const Model& m, int body) {
 void composite_mass(const Model& m, Workspace& ws) {
   const int nb = static_cast<int>(m.bodies.size());
   // Λ_b^O into the composites, leaves to root (children come after their parents).
-  for (int b = 0; b < nb; ++b) inertia_at_origin(m.body_inertia[b], ws.body[b].R, ws.body[b].p, ws.composite[b]);
+  for (int b = 0; b < nb; ++b)
+    ws.composite[b] = inertia_at_origin(m.body_inertia[b], ws.body[b].R, ws.body[b].p);
   for (int b = nb - 1; b >= 0; --b) {
     if (m.bodies[b].parent >= 0) ws.composite[m.bodies[b].parent] += ws.composite[b];
     ws.subspace[b] = motion_subspace(m.bodies[b].joint, ws.body[b].R, ws.body[b].p);

@@ -71,6 +71,10 @@ Joint compile_joint(const JointSpec& js, const std::string& body_name) {
     if (!(norm > 1e-12)) throw ModelError(js.where + "/axis", "axis is zero");
     j.axis = js.axis / norm;
   }
+  const Mat3 K = skew(j.axis);
+  j.R_pj_K = j.R_pj * K;
+  j.R_pj_K2 = j.R_pj_K * K;
+  j.axis_parent = j.R_pj * j.axis;
   for (auto [x, what] : {std::pair{js.stiffness, "stiffness"}, {js.rest, "rest"},
                          {js.damping, "damping"}})
     check_finite(x, js.where, what);

@@ -311,9 +311,17 @@ void check_mass_matrix(const Model& m) {
   Workspace ws(m);
   std::vector<VecX> states = sample_states(m, 2);
   states.insert(states.begin(), VecX::Zero(m.n()));
+  const VecX rest = VecX::Zero(m.n());
   for (const VecX& q : states) {
-    evaluate(m, ws, q, VecX::Zero(m.n()), VecX());
-    const Status st = ws.solver.factorize(ws.Ms);
+    // The model's own route: the articulated recursion checks its pivots in O(bodies); the
+    // Cholesky route factorises M^s.
+    Status st;
+    if (m.dynamics_route == DynamicsRoute::Articulated) {
+      st = forward_dynamics(m, ws, q, rest, rest);
+    } else {
+      evaluate(m, ws, q, rest, VecX());
+      st = ws.solver.factorize(ws.Ms);
+    }
     if (st.ok) continue;
     std::string where = m.where;
     if (st.coordinate >= 0)

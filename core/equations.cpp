@@ -99,6 +99,7 @@ void mirror_upper(MatX& A) {
 // ws.Ms from the body poses (composite route) or from T (transform route), both already
 // propagated; mirrored so that it is symmetric in floating point too.
 void form_mass_matrix(const Model& model, Workspace& ws) {
+  if (ws.Ms.rows() != model.n()) ws.Ms.setZero(model.n(), model.n());  // first use only
   if (model.mass_route == MassRoute::Composite) {
     composite_mass(model, ws);  // M^s by composite inertias; T is not formed
   } else {

@@ -7,12 +7,22 @@
 // p_b the body origin (= the joint origin after motion):
 //   revolute S = (s, p_b × s),   prismatic S = (0, s).
 #pragma once
+#include <cmath>
+
 #include "core/model.hpp"
 #include "core/spatial.hpp"
 
 namespace femdyn {
 
 inline bool moves(const Joint& j) { return j.theta >= 0; }
+
+// The joint frame after motion, in the parent body frame: R_pj Rot(a, θ) for a revolute joint,
+// by Rodrigues with the products precomputed, R_pj (I + sin θ [a]× + (1 − cos θ) [a]×²).
+inline Mat3 joint_rotation(const Joint& j, double theta) {
+  if (j.type != JointType::Revolute) return j.R_pj;
+  const double s = std::sin(theta), c = std::cos(theta);
+  return j.R_pj + s * j.R_pj_K + (1 - c) * j.R_pj_K2;
+}
 
 inline Vec6 motion_subspace(const Joint& j, const Mat3& R_b, const Vec3& p_b) {
   const Vec3 s = R_b * j.axis;

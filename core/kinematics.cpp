@@ -1,6 +1,7 @@
 #include "core/kinematics.hpp"
 
 #include "core/coupling.hpp"
+#include "core/joint.hpp"
 
 namespace femdyn {
 namespace {
@@ -19,16 +20,15 @@ void propagate_tree(const Model& model, Workspace& ws, KinematicsRequest req) {
     const BodyState& P = parent < 0 ? root : ws.body[parent];
     BodyState& B = ws.body[b];
 
-    const Mat3 R_j = P.R * j.R_pj;
     const Vec3 origin = P.p + P.R * j.p_pj;
-    const Vec3 s = R_j * j.axis;
+    const Vec3 s = P.R * j.axis_parent;  // the joint axis in world (unchanged by its own turn)
     const double th = j.theta >= 0 ? ws.theta[j.theta] : 0.0;
     const double thd = j.theta >= 0 ? ws.theta_dot[j.theta] : 0.0;
     const double thd_y = j.theta >= 0 ? ws.theta_dot_y[j.theta] : 0.0;
     const bool rev = j.type == JointType::Revolute;
     const bool pri = j.type == JointType::Prismatic;
 
-    B.R = rev ? Mat3(R_j * axis_rotation(j.axis, th)) : R_j;
+    B.R.noalias() = P.R * joint_rotation(j, th);
     B.p = pri ? Vec3(origin + s * th) : origin;
     const Vec3 r = B.p - P.p;
 

@@ -2,30 +2,48 @@
 
 #include <cholmod.h>
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 
 namespace femdyn {
 namespace {
 
 // Structural pattern of M^s = Tᵀ M T: coordinates a and b couple iff some carrier (node or
 // body) moves with both. A carrier on body k moves with every coordinate of a joint on the
-// path from k to the root (through the coupling matrix C).
-std::vector<std::vector<bool>> coordinate_pattern(const Model& model) {
+// path from k to the root (through the coupling matrix C). As bit rows, built in
+// O((bodies + nnz(C)) · n / 64): moves[k] (the path's coordinates), sub[k] = ∪ moves over the
+// subtree of k, and row a = ∪ sub[k] over the bodies k whose joint a drives.
+struct Pattern {
+  int n = 0;
+  std::size_t words = 0;
+  std::vector<std::uint64_t> bits;  // row a: words [a·words, (a+1)·words)
+  bool test(int a, int c) const { return (bits[a * words + c / 64] >> (c % 64)) & 1U; }
+};
+
+Pattern coordinate_pattern(const Model& model) {
   const int n = model.n(), nb = static_cast<int>(model.bodies.size());
-  std::vector<std::vector<bool>> moves(nb, std::vector<bool>(n, false));  // body -> coordinates
+  const std::size_t w = (static_cast<std::size_t>(n) + 63) / 64;
+  std::vector<std::uint64_t> moves(nb * w, 0), sub;
+  const auto row = [w](std::vector<std::uint64_t>& v, int k) { return v.data() + k * w; };
   for (int b = 0; b < nb; ++b) {
     const Body& B = model.bodies[b];
-    if (B.parent >= 0) moves[b] = moves[B.parent];
+    if (B.parent >= 0) std::copy_n(row(moves, B.parent), w, row(moves, b));
     if (B.joint.theta >= 0)
-      for (int a = 0; a < n; ++a)
-        if (model.C(B.joint.theta, a) != 0) moves[b][a] = true;
+      for (SpRowMat::InnerIterator it(model.C_sparse, B.joint.theta); it; ++it)
+        row(moves, b)[it.col() / 64] |= std::uint64_t{1} << (it.col() % 64);
   }
-  std::vector<std::vector<bool>> pattern(n, std::vector<bool>(n, false));
-  for (int b = 0; b < nb; ++b)
-    for (int a = 0; a < n; ++a)
-      if (moves[b][a])
-        for (int c = 0; c < n; ++c)
-          if (moves[b][c]) pattern[a][c] = true;
-  return pattern;
+  sub = moves;
+  for (int b = nb - 1; b >= 0; --b)
+    if (model.bodies[b].parent >= 0)
+      for (std::size_t k = 0; k < w; ++k) row(sub, model.bodies[b].parent)[k] |= row(sub, b)[k];
+  Pattern p{n, w, std::vector<std::uint64_t>(static_cast<std::size_t>(n) * w, 0)};
+  for (int b = 0; b < nb; ++b) {
+    const int t = model.bodies[b].joint.theta;
+    if (t < 0) continue;
+    for (SpRowMat::InnerIterator it(model.C_sparse, t); it; ++it)
+      for (std::size_t k = 0; k < w; ++k) p.bits[it.col() * w + k] |= row(sub, b)[k];
+  }
+  return p;
 }
 
 }  // namespace
@@ -33,9 +51,9 @@ std::vector<std::vector<bool>> coordinate_pattern(const Model& model) {
 double mass_matrix_fill(const Model& model) {
   const int n = model.n();
   if (n == 0) return 1.0;
-  const auto p = coordinate_pattern(model);
+  const Pattern p = coordinate_pattern(model);
   double nnz = 0;
-  for (const auto& row : p) nnz += static_cast<double>(std::count(row.begin(), row.end(), true));
+  for (const std::uint64_t word : p.bits) nnz += std::popcount(word);
   return nnz / (static_cast<double>(n) * n);
 }
 
@@ -94,7 +112,7 @@ MassSolver::MassSolver(const Model& model, SolverKind kind)
       std::vector<std::pair<int, int>> e;  // (row, col) in the ordered matrix, upper triangle
       for (int c = 0; c < n; ++c)
         for (int r = 0; r < n; ++r)
-          if ((pattern[r][c] || r == c) && where[r] <= where[c]) e.emplace_back(where[r], where[c]);
+          if ((pattern.test(r, c) || r == c) && where[r] <= where[c]) e.emplace_back(where[r], where[c]);
       std::sort(e.begin(), e.end(), [](auto a, auto b) { return std::pair(a.second, a.first) < std::pair(b.second, b.first); });
       return e;
     };

@@ -31,6 +31,9 @@ struct Joint {
   double lower = 0, upper = 0;
   double stiffness = 0, rest = 0, damping = 0;
   std::string where;
+  // Derived by compile() for the tree sweep (core/joint.hpp): R_pj [a]×, R_pj [a]×², R_pj a.
+  Mat3 R_pj_K = Mat3::Zero(), R_pj_K2 = Mat3::Zero();
+  Vec3 axis_parent = Vec3::UnitZ();
 };
 
 struct Body {

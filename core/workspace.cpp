@@ -19,7 +19,7 @@ Workspace::Workspace(const Model& model) : solver(model) {
   u_dot = VecX::Zero(N);
   nodal = VecX::Zero(N);
   u_acc = VecX::Zero(N);
-  composite.assign(nb, Mat6::Zero());
+  composite.assign(nb, RigidInertia{});
   subspace.assign(nb, Vec6::Zero());
   if (model.dynamics_route == DynamicsRoute::Articulated || model.force_route == ForceRoute::Bodies)
     articulated.assign(nb, ArticulatedBody{});
@@ -36,7 +36,8 @@ Workspace::Workspace(const Model& model) : solver(model) {
     local_y.emplace_back(VecX::Zero(k));
     local_g.emplace_back(VecX::Zero(k));
   }
-  Ms = MatX::Zero(n, n);
+  // M^s (n x n) is sized on first use: the articulated route never forms it, and a chain of
+  // 10,000 bodies would need 800 MB for it.
   h = Q = qdd = tau = VecX::Zero(n);
 }
 

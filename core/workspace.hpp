@@ -47,7 +47,7 @@ struct Workspace {
   VecX nodal;                      // M T'[q̇,q̇] + g, then nodal forces F (N_u)
   MatX MT;                         // M T (N_u x n), sized when first formed
   VecX u_acc;                      // T q̈ + T'[q̇,q̇] (inverse dynamics)
-  std::vector<Mat6> composite;     // per body: composite inertia I^c_b (core/body_inertia.hpp)
+  std::vector<RigidInertia> composite;  // per body: composite inertia I^c_b (world, origin)
   std::vector<Vec6> subspace;      // per body: its joint's motion subspace S (world, origin)
   std::vector<ArticulatedBody> articulated;  // per body, for the body-level routes only
   MatX Mtheta, MthetaC;            // M_θ (nθ x nθ) and M_θ C (nθ x n), with a coupling only
@@ -56,7 +56,7 @@ struct Workspace {
   std::vector<VecX> local_x, local_y, local_g;  // per element local DOF buffers (6k)
 
   // System equations M^s q̈ + h = Q at the last evaluated state.
-  MatX Ms;
+  MatX Ms;  // sized on first use (evaluate, mass_matrix)
   VecX h, Q, qdd, tau;
   MassSolver solver;  // factorisation of M^s (dense or CHOLMOD, chosen for the model)
 };
