@@ -122,7 +122,8 @@ void composite_mass(const Model& m, Workspace& ws) {
     }
   }
   if (!m.identity_coupling) {  // M^s = Cᵀ (M_θ C), through a buffer: no temporary
-    ws.MthetaC.noalias() = ws.Mtheta.selfadjointView<Eigen::Upper>() * m.C;
+    ws.Mtheta.triangularView<Eigen::StrictlyLower>() = ws.Mtheta.transpose();
+    ws.MthetaC.noalias() = ws.Mtheta * m.C;
     ws.Ms.noalias() = m.C.transpose() * ws.MthetaC;
   }
 }

@@ -122,7 +122,7 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
   const int n = static_cast<int>(m.coordinate_names.size());
   if (nt == 0) throw ModelError(m.where, "has no movable joint: there is no motion to compute");
   // (n = 0 with nθ > 0 would need every joint coupled, i.e. a cycle: reported below.)
-  m.C = MatX::Zero(nt, n);
+  std::vector<std::map<int, double>> rows(nt);  // C row by row: O(non-zeros), not nθ × n
   m.theta0 = VecX::Zero(nt);
   std::vector<int> state(nt, 0);  // 0 new, 1 in progress, 2 done
   std::function<void(int)> resolve = [&](int t) {
@@ -132,14 +132,14 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
                                                  m.bodies[m.theta_joint[t]].joint.name + "'");
     state[t] = 1;
     if (q_of[t] >= 0) {
-      m.C(t, q_of[t]) = 1.0;
+      rows[t][q_of[t]] = 1.0;
     } else {
       const CouplingSpec& c = *coupled.at(t);
       m.theta0[t] = c.offset;
       for (const auto& [name, ratio] : c.terms) {
         const int f = theta_of.at(name);
         resolve(f);
-        m.C.row(t) += ratio * m.C.row(f);
+        for (const auto& [a, c] : rows[f]) rows[t][a] += ratio * c;
         m.theta0[t] += ratio * m.theta0[f];
       }
     }
@@ -147,8 +147,18 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
   };
   for (int t = 0; t < nt; ++t) resolve(t);
   // The hot path's form of C (core/coupling.hpp).
-  m.identity_coupling = nt == n && m.C.isIdentity(0) && m.theta0.isZero(0);
-  m.C_sparse = m.C.sparseView();
+  std::vector<Eigen::Triplet<double>> entries;
+  bool identity = nt == n && m.theta0.isZero(0);
+  for (int t = 0; t < nt; ++t)
+    for (const auto& [a, c] : rows[t])
+      if (c != 0) {
+        entries.emplace_back(t, a, c);
+        identity = identity && a == t && c == 1.0;
+      }
+  m.C.resize(nt, n);
+  m.C.setFromTriplets(entries.begin(), entries.end());
+  m.identity_coupling = identity && static_cast<int>(entries.size()) == n;
+  m.C_sparse = m.C;
 }
 
 }  // namespace

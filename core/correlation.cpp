@@ -72,30 +72,75 @@ void set_dofs(Model& m, const std::vector<SystemDof>& dofs) {
 
 // Rows of T at seeded random states: a row that is zero at all of them is a DOF that never
 // moves (T is analytic in q, so a non-zero row vanishes only on a set of measure zero).
-// `row_max` is the largest |T_ia| of each row over the samples; the samples themselves are kept
+// `row_max` is the largest |T_ia| of each row over the samples (or, by paths, a value above the
+// tolerance as soon as one is found); the samples themselves are kept
 // only when an explicit table must be checked motion by motion (they are N_u x n each).
-struct TSamples {
-  VecX row_max;
-  std::vector<MatX> T;
-};
-
-TSamples sample_T(const Model& m, bool keep) {
-  TSamples out;
-  out.row_max = VecX::Zero(m.n_u());
-  Workspace ws(m);
-  for (const VecX& q : sample_states(m, 3)) {
-    propagate(m, ws, q, VecX::Zero(m.n()), {.jacobian = true, .bias = false});
-    if (m.n() > 0) out.row_max = out.row_max.cwiseMax(ws.T.cwiseAbs().rowwise().maxCoeff());
-    if (keep) out.T.push_back(ws.T);
-  }
-  return out;
-}
-
 double length_scale(const Model& m) {
   double L = 1.0;
   for (const Body& b : m.bodies) L = std::max(L, b.joint.p_pj.norm());
   for (const SystemNode& n : m.nodes) L = std::max(L, n.r.norm());
   return L;
+}
+
+struct TSamples {
+  VecX row_max;
+  std::vector<MatX> T;
+};
+
+// Without a coupling (C = I) and without keeping the samples, the rows are not formed: each
+// DOF's largest |T_ia| is taken over the joints a on its carrier's path, with the body poses
+// of one sweep,
+//   translation k of a node at x:  revolute (s_a × (x − o_a))_k,  prismatic (s_a)_k
+//   rotation k of body b:           revolute (R_b e_k)·s_a,        prismatic 0,
+// The scan of a path stops at the first entry above `enough` (only whether a row exceeds the
+// tolerance is used): O(N_u) time for the DOFs that move, O(depth) each for those that never
+// do, and O(N_u) memory instead of the dense N_u × n T.
+void row_max_by_paths(const Model& m, Workspace& ws, VecX& row_max, double enough) {
+  const auto over_path = [&](int body, auto&& entry) {
+    double big = 0;
+    for (int a = body; a >= 0 && big <= enough; a = m.bodies[a].parent) {
+      const Joint& j = m.bodies[a].joint;
+      if (j.theta < 0) continue;
+      const Vec3 s = ws.body[a].R * j.axis;
+      big = std::max(big, std::abs(entry(j, s, ws.body[a].p)));
+    }
+    return big;
+  };
+  for (int i = 0; i < m.n_u(); ++i) {
+    const SystemDof& d = m.dofs[i];
+    double big;
+    if (d.kind == DofKind::Translation) {
+      const SystemNode& node = m.nodes[d.carrier];
+      const Vec3 x = ws.body[node.body].p + ws.body[node.body].R * node.r;
+      big = over_path(node.body, [&](const Joint& j, const Vec3& s, const Vec3& o) {
+        return j.type == JointType::Revolute ? s.cross(x - o)[d.axis] : s[d.axis];
+      });
+    } else {
+      const Vec3 e = ws.body[d.carrier].R.col(d.axis);
+      big = over_path(d.carrier, [&](const Joint& j, const Vec3& s, const Vec3&) {
+        return j.type == JointType::Revolute ? e.dot(s) : 0.0;
+      });
+    }
+    row_max[i] = std::max(row_max[i], big);
+  }
+}
+
+TSamples sample_T(const Model& m, bool keep, double tol) {
+  TSamples out;
+  out.row_max = VecX::Zero(m.n_u());
+  Workspace ws(m);
+  const bool by_paths = !keep && m.identity_coupling;
+  for (const VecX& q : sample_states(m, 3)) {
+    if (by_paths) {
+      propagate(m, ws, q, q, {.jacobian = false, .bias = false, .rows = false});
+      row_max_by_paths(m, ws, out.row_max, tol);
+      continue;
+    }
+    propagate(m, ws, q, VecX::Zero(m.n()), {.jacobian = true, .bias = false});
+    if (m.n() > 0) out.row_max = out.row_max.cwiseMax(ws.T.cwiseAbs().rowwise().maxCoeff());
+    if (keep) out.T.push_back(ws.T);
+  }
+  return out;
 }
 
 bool moves(const TSamples& Ts, int i, double tol) { return Ts.row_max[i] > tol; }
@@ -193,8 +238,8 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
 
   // Which candidates move at all.
   set_dofs(m, cand.list);
-  const TSamples Ts = sample_T(m, spec.correlation.has_value());
   const double tol = 1e-10 * length_scale(m);
+  const TSamples Ts = sample_T(m, spec.correlation.has_value(), tol);
   const int nc = static_cast<int>(cand.list.size());
 
   std::vector<int> number(nc, 0);  // candidate -> 1-based system DOF, 0 left out

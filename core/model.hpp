@@ -107,8 +107,8 @@ struct Model {
   std::vector<Body> bodies;  // parents before children
   std::vector<int> theta_joint;  // θ index -> body index of its joint
 
-  // Coupling level θ = C q + θ0.
-  MatX C;
+  // Coupling level θ = C q + θ0 (nθ x n, sparse: the identity is n entries, not n²).
+  SpMat C;
   VecX theta0;
   std::vector<std::string> coordinate_names;  // n: the independent joints
 

@@ -130,7 +130,7 @@ std::string info_text(const Model& model) {
       out << "   theta =";
       bool first = true;
       for (int a = 0; a < model.n(); ++a) {
-        const double c = model.C(j.theta, a);
+        const double c = model.C.coeff(j.theta, a);
         if (c == 0) continue;
         out << (first ? " " : " + ") << (c == 1 ? "" : num(c) + "*") << model.coordinate_names[a];
         first = false;

@@ -168,3 +168,29 @@ TEST_CASE("every bundled and test model: the chosen routes equal the reference r
     check_same_equations(chosen, reference, 5, 1e-11);
   }
 }
+
+TEST_CASE("chains and trees of 10000 bodies compile and run on the O(n) routes", "[routes]") {
+  // Model memory is linear in n (C sparse, no dense T sampled, M^s never formed): the
+  // chain's compile and forward dynamics take about a second (docs/performance.md).
+  for (const double branching : {0.0, 0.5}) {
+    const Model m = load_text(random_tree_json(3, 10000, branching, true));
+    REQUIRE(m.n() == 10000);
+    CHECK(m.C.nonZeros() == m.n());
+    CHECK(m.dynamics_route == DynamicsRoute::Articulated);
+    Workspace ws(m);
+    CHECK(ws.Ms.size() == 0);
+    std::mt19937 rng(5);
+    const VecX q = random_vector(rng, m.n(), 1), qd = random_vector(rng, m.n(), 1),
+               tau = random_vector(rng, m.n(), 1);
+    REQUIRE(forward_dynamics(m, ws, q, qd, tau).ok);
+    CHECK(ws.qdd.allFinite());
+    // Inverse dynamics of that q̈ gives back τ, to round-off of the forces that balance in it
+    // (‖M^s q̈‖ is far larger than ‖τ‖ along 10,000 links: a backward error, not a relative one).
+    const VecX qdd = ws.qdd;
+    inverse_dynamics(m, ws, q, VecX::Zero(m.n()), qdd);
+    const double scale = ws.tau.cwiseAbs().maxCoeff();
+    inverse_dynamics(m, ws, q, qd, qdd);
+    INFO("scale " << scale);
+    CHECK((ws.tau - tau).cwiseAbs().maxCoeff() < 1e-11 * scale);
+  }
+}

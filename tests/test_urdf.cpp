@@ -144,7 +144,7 @@ TEST_CASE("URDF mimic becomes θ = C q + θ0, coordinates in depth-first file or
     const std::string& joint = m.bodies[m.theta_joint[t]].joint.name;
     INFO(joint);
     if (joint == "j_d") {
-      CHECK(m.C.row(t).isApprox(Eigen::RowVector3d(0, 0, -0.5)));
+      CHECK(MatX(m.C).row(t).isApprox(Eigen::RowVector3d(0, 0, -0.5)));
       CHECK(m.theta0[t] == 0.1);
     } else {
       CHECK(m.theta0[t] == 0.0);

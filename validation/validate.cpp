@@ -40,7 +40,7 @@ TwinModel twin_model(const Model& m) {
     t.bodies.push_back(tb);
   }
   t.theta_body = m.theta_joint;
-  t.C = m.C;
+  t.C = MatX(m.C);
   t.theta0 = m.theta0;
   t.gravity = m.gravity;
   for (const PointLoad& l : m.point_loads) t.loads.push_back({l.body, l.point, l.force, Vec3::Zero()});
