@@ -1,6 +1,7 @@
 // The coupling level θ = C q + θ0 applied in the hot path: through the sparse copy of C
 // (Model::C_sparse, O(non-zeros)), or, for the identity (no couplings), as nothing at all.
-// The dense Model::C remains the description (twins, reports, M^s = Cᵀ M_θ C).
+// Model::C (column-major, for M^s = Cᵀ M_θ C and reports) and C_sparse (row-major) hold
+// the same entries.
 #pragma once
 #include "core/model.hpp"
 
