@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/body_inertia.hpp"
 #include "core/body_loads.hpp"
 #include "core/joint.hpp"
 #include "core/kinematics.hpp"
@@ -13,10 +14,7 @@ namespace {
 // τ_b on joint j: the actuation and the joint's spring and damper (C = I: θ = q).
 double joint_force(const Joint& J, const Workspace& ws, const VecX& tau) {
   const int j = J.theta;
-  double f = tau.size() > j ? tau[j] : 0.0;
-  if (J.stiffness != 0) f -= J.stiffness * (ws.theta[j] - J.rest);
-  if (J.damping != 0) f -= J.damping * ws.theta_dot[j];
-  return f;
+  return (tau.size() > j ? tau[j] : 0.0) + spring_damper_force(J, ws.theta[j], ws.theta_dot[j]);
 }
 
 Status singular(const Model& model, int j, bool independently) {
@@ -32,10 +30,7 @@ Status singular(const Model& model, int j, bool independently) {
 // diagonal, and the pivot d_b against M^s(b, b). Only run when the cheap bound was inconclusive.
 Status check_regularity(const Model& model, Workspace& ws) {
   const int nb = static_cast<int>(model.bodies.size());
-  for (int b = 0; b < nb; ++b)
-    ws.composite[b] = inertia_at_origin(model.body_inertia[b], ws.body[b].R, ws.body[b].p);
-  for (int b = nb - 1; b >= 0; --b)
-    if (model.bodies[b].parent >= 0) ws.composite[model.bodies[b].parent] += ws.composite[b];
+  composite_inertias(model, ws);
   double scale = 0;
   for (int b = 0; b < nb; ++b)
     if (moves(model.bodies[b].joint)) {

@@ -99,15 +99,19 @@ MassProperties body_mass_properties(const Model& m, int body) {
   return sum;
 }
 
-void composite_mass(const Model& m, Workspace& ws) {
+void composite_inertias(const Model& m, Workspace& ws) {
   const int nb = static_cast<int>(m.bodies.size());
-  // Λ_b^O into the composites, leaves to root (children come after their parents).
   for (int b = 0; b < nb; ++b)
     ws.composite[b] = inertia_at_origin(m.body_inertia[b], ws.body[b].R, ws.body[b].p);
-  for (int b = nb - 1; b >= 0; --b) {
+  for (int b = nb - 1; b >= 0; --b)  // children come after their parents
     if (m.bodies[b].parent >= 0) ws.composite[m.bodies[b].parent] += ws.composite[b];
+}
+
+void composite_mass(const Model& m, Workspace& ws) {
+  const int nb = static_cast<int>(m.bodies.size());
+  composite_inertias(m, ws);
+  for (int b = 0; b < nb; ++b)
     ws.subspace[b] = motion_subspace(m.bodies[b].joint, ws.body[b].R, ws.body[b].p);
-  }
   // M_θ(k, i) = S_kᵀ I^c_b S_i for the joints k on the path of b (k < i: the upper triangle,
   // column i written contiguously). The entries off every path are structural zeros, written
   // as zeros when the Workspace is made and never touched: no n² clearing per call.
@@ -122,7 +126,7 @@ void composite_mass(const Model& m, Workspace& ws) {
     }
   }
   if (!m.identity_coupling) {  // M^s = Cᵀ (M_θ C), through a buffer: no temporary
-    ws.Mtheta.triangularView<Eigen::StrictlyLower>() = ws.Mtheta.transpose();
+    mirror_upper(ws.Mtheta);
     ws.MthetaC.noalias() = ws.Mtheta * m.C;
     ws.Ms.noalias() = m.C.transpose() * ws.MthetaC;
   }

@@ -36,6 +36,9 @@ void choose_routes(Model& model);
 // The sum of the body's elements' mass properties (body frame).
 MassProperties body_mass_properties(const Model& model, int body);
 
+// ws.composite: the composite inertias I^c_b (world axes, about the origin) from the body poses.
+void composite_inertias(const Model& model, Workspace& ws);
+
 // ws.Ms from the body poses of the last propagate (no Jacobians needed).
 void composite_mass(const Model& model, Workspace& ws);
 

@@ -7,6 +7,7 @@
 #include "core/articulated.hpp"
 #include "core/body_inertia.hpp"
 #include "core/coupling.hpp"
+#include "core/joint.hpp"
 #include "core/kinematics.hpp"
 #include "core/mass_solver.hpp"
 #include "core/newton_euler.hpp"
@@ -65,9 +66,7 @@ void add_joint_forces(const Model& model, const Workspace& ws, bool with_rates, 
                       VecX& y) {
   for (int j = 0; j < model.n_theta(); ++j) {
     const Joint& J = model.bodies[model.theta_joint[j]].joint;
-    double f = 0;
-    if (J.stiffness != 0) f -= J.stiffness * (ws.theta[j] - J.rest);
-    if (with_rates && J.damping != 0) f -= J.damping * ws.theta_dot[j];
+    const double f = spring_damper_force(J, ws.theta[j], with_rates ? ws.theta_dot[j] : 0.0);
     if (f != 0) coupling_add_row(model, j, sign * f, y);
   }
 }
@@ -84,17 +83,6 @@ void assemble_forces(const Model& model, Workspace& ws, const VecX& tau, bool wi
 
 bool is_zero(const VecX& v) { return v.size() == 0 || v.cwiseAbs().maxCoeff() == 0.0; }
 
-
-// A(i, j) = A(j, i) below the diagonal, in 32 × 32 tiles so that the strided reads stay in cache.
-void mirror_upper(MatX& A) {
-  constexpr Eigen::Index kTile = 32;
-  const Eigen::Index n = A.rows();
-  for (Eigen::Index j0 = 0; j0 < n; j0 += kTile)
-    for (Eigen::Index i0 = j0; i0 < n; i0 += kTile)
-      for (Eigen::Index j = j0; j < std::min(j0 + kTile, n); ++j)
-        for (Eigen::Index i = std::max(i0, j + 1); i < std::min(i0 + kTile, n); ++i)
-          A(i, j) = A(j, i);
-}
 
 // ws.Ms from the body poses (composite route) or from T (transform route), both already
 // propagated; mirrored so that it is symmetric in floating point too.

@@ -24,6 +24,14 @@ inline Mat3 joint_rotation(const Joint& j, double theta) {
   return j.R_pj + s * j.R_pj_K + (1 - c) * j.R_pj_K2;
 }
 
+// The joint's own force on θ: spring and damper, −k (θ − θ_rest) − c θ̇ (θ̇ counted when given).
+inline double spring_damper_force(const Joint& j, double theta, double theta_dot) {
+  double f = 0;
+  if (j.stiffness != 0) f -= j.stiffness * (theta - j.rest);
+  if (j.damping != 0) f -= j.damping * theta_dot;
+  return f;
+}
+
 inline Vec6 motion_subspace(const Joint& j, const Mat3& R_b, const Vec3& p_b) {
   const Vec3 s = R_b * j.axis;
   Vec6 S;

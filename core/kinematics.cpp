@@ -132,8 +132,8 @@ void propagate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
   propagate_bilinear(model, ws, q, qd, qd, request);
 }
 
-void gather_body_wrenches(const Model& model, Workspace& ws, const VecX& f,
-                          double torque_scale) {
+void apply_transpose(const Model& model, Workspace& ws, const VecX& f, VecX& y,
+                     double torque_scale) {
   const int nb = static_cast<int>(model.bodies.size());
   for (int b = 0; b < nb; ++b) ws.force[b].setZero(), ws.moment[b].setZero();
   for (int i = 0; i < model.n_u(); ++i) {
@@ -151,12 +151,7 @@ void gather_body_wrenches(const Model& model, Workspace& ws, const VecX& f,
   }
   if (torque_scale != 0)
     for (const BodyTorque& t : model.torques) ws.moment[t.body] += torque_scale * t.torque;
-}
-
-void apply_transpose(const Model& model, Workspace& ws, const VecX& f, VecX& y,
-                     double torque_scale) {
-  gather_body_wrenches(model, ws, f, torque_scale);
-  for (int b = static_cast<int>(model.bodies.size()) - 1; b >= 0; --b) {  // children after parents in the list: leaves first
+  for (int b = nb - 1; b >= 0; --b) {  // children after parents in the list: leaves first
     const Body& body = model.bodies[b];
     const Joint& j = body.joint;
     if (j.theta >= 0) {

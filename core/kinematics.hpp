@@ -47,11 +47,6 @@ void propagate_bilinear(const Model& model, Workspace& ws, const VecX& q, const 
 //     F_p += F_b,   N_p += N_b + (p_b − p_p) × F_b,
 // and projected on each joint's world axis s: τ_θ = sᵀ N_b (revolute), sᵀ F_b (prismatic);
 // then y = Cᵀ τ_θ. O(N_u + bodies). Uses the body poses of the last propagate.
-// The first half of apply_transpose: nodal forces f (and body torques × torque_scale) gathered
-// into each carrier body's wrench ws.force[b], ws.moment[b] (world axes, moment about the body
-// origin).
-void gather_body_wrenches(const Model& model, Workspace& ws, const VecX& f, double torque_scale);
-
 void apply_transpose(const Model& model, Workspace& ws, const VecX& f, VecX& y,
                      double torque_scale = 0);
 

@@ -1,6 +1,7 @@
 // URDF import: closed forms for the conventions (inertial rpy, joint rpy, mimic, order),
 // round trip through `femdyn import`, real robots and bundled URDFs, every bad-URDF class.
 #include <catch2/catch.hpp>
+#include <unistd.h>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -22,7 +23,9 @@ using Catch::Matchers::Equals;
 namespace {
 
 std::string write_temp(const std::string& name, const std::string& text) {
-  const auto dir = std::filesystem::temp_directory_path() / "femdyn_urdf_tests";
+  // One folder per process: ctest runs the test cases in parallel processes.
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("femdyn_urdf_tests." + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
   const std::string path = (dir / name).string();
   std::ofstream(path) << text;
