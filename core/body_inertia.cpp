@@ -112,23 +112,46 @@ void composite_mass(const Model& m, Workspace& ws) {
   composite_inertias(m, ws);
   for (int b = 0; b < nb; ++b)
     ws.subspace[b] = motion_subspace(m.bodies[b].joint, ws.body[b].R, ws.body[b].p);
-  // M_θ(k, i) = S_kᵀ I^c_b S_i for the joints k on the path of b (k < i: the upper triangle,
-  // column i written contiguously). The entries off every path are structural zeros, written
-  // as zeros when the Workspace is made and never touched: no n² clearing per call.
-  MatX& Mt = m.identity_coupling ? ws.Ms : ws.Mtheta;
+  mass_from_composites(m, ws);
+}
+
+void mass_from_composites(const Model& m, Workspace& ws) {
+  const int nb = static_cast<int>(m.bodies.size());
+  if (m.identity_coupling) {
+    // M^s(k, i) = S_kᵀ I^c_b S_i for the joints k on the path of b (k < i: the upper
+    // triangle, column i written contiguously). The entries off every path are structural
+    // zeros, written as zeros when the Workspace is made and never touched: no n² clearing.
+    for (int b = 0; b < nb; ++b) {
+      const int i = m.bodies[b].joint.theta;
+      if (i < 0) continue;
+      const Vec6 F = ws.composite[b] * ws.subspace[b];
+      for (int a = b; a >= 0; a = m.bodies[a].parent) {
+        const int k = m.bodies[a].joint.theta;
+        if (k >= 0) ws.Ms(k, i) = ws.subspace[a].dot(F);
+      }
+    }
+    return;
+  }
+  // With couplings, M^s = Cᵀ M_θ C = Σ_{k,i} C_kᵀ M_θ(k, i) C_i over the rows C_k of C: each
+  // path entry M_θ(k, i) (k an ancestor joint of i, or i itself) is scattered through the
+  // non-zeros of rows k and i, once for (k, i) and once for (i, k). O(Σ depth · nnz²) and
+  // symmetric as built; no M_θ is formed.
+  ws.Ms.setZero();
   for (int b = 0; b < nb; ++b) {
     const int i = m.bodies[b].joint.theta;
     if (i < 0) continue;
     const Vec6 F = ws.composite[b] * ws.subspace[b];
     for (int a = b; a >= 0; a = m.bodies[a].parent) {
       const int k = m.bodies[a].joint.theta;
-      if (k >= 0) Mt(k, i) = ws.subspace[a].dot(F);
+      if (k < 0) continue;
+      const double v = ws.subspace[a].dot(F);
+      for (SpRowMat::InnerIterator ck(m.C_sparse, k); ck; ++ck)
+        for (SpRowMat::InnerIterator ci(m.C_sparse, i); ci; ++ci) {
+          const double w = ck.value() * v * ci.value();
+          ws.Ms(ck.col(), ci.col()) += w;
+          if (k != i) ws.Ms(ci.col(), ck.col()) += w;
+        }
     }
-  }
-  if (!m.identity_coupling) {  // M^s = Cᵀ (M_θ C), through a buffer: no temporary
-    mirror_upper(ws.Mtheta);
-    ws.MthetaC.noalias() = ws.Mtheta * m.C;
-    ws.Ms.noalias() = m.C.transpose() * ws.MthetaC;
   }
 }
 

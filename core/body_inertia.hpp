@@ -39,7 +39,12 @@ MassProperties body_mass_properties(const Model& model, int body);
 // ws.composite: the composite inertias I^c_b (world axes, about the origin) from the body poses.
 void composite_inertias(const Model& model, Workspace& ws);
 
-// ws.Ms from the body poses of the last propagate (no Jacobians needed).
+// ws.Ms from the body poses of the last propagate (no Jacobians needed): composite inertias,
+// motion subspaces, then mass_from_composites.
 void composite_mass(const Model& model, Workspace& ws);
+
+// ws.Ms from ws.composite and ws.subspace: the upper triangle without couplings (mirror it),
+// the whole of Cᵀ M_θ C with them.
+void mass_from_composites(const Model& model, Workspace& ws);
 
 }  // namespace femdyn

@@ -6,6 +6,7 @@
 
 #include "core/articulated.hpp"
 #include "core/body_inertia.hpp"
+#include "core/coupled_dynamics.hpp"
 #include "core/coupling.hpp"
 #include "core/joint.hpp"
 #include "core/kinematics.hpp"
@@ -156,15 +157,7 @@ Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const 
     st = articulated_forward_dynamics(model, ws, q, qd, tau);
   } else if (model.force_route == ForceRoute::Bodies &&
              model.mass_route == MassRoute::Composite) {
-    // Q − h by one Newton–Euler pass (gravity and loads in it: τ = h − Tᵀ F at q̈ = 0), plus
-    // τ and the joints' springs and dampers; M^s by composite inertias on the same poses.
-    newton_euler(model, ws, q, qd, nullptr, true, ws.qdd);
-    ws.qdd = -ws.qdd;
-    if (tau.size() == ws.qdd.size()) ws.qdd += tau;
-    add_joint_forces(model, ws, true, 1.0, ws.qdd);
-    form_mass_matrix(model, ws);
-    st = ws.solver.factorize(ws.Ms);
-    if (st.ok) ws.solver.solve_in_place(ws.qdd);
+    st = coupled_forward_dynamics(model, ws, q, qd, tau);
   } else {
     evaluate(model, ws, q, qd, tau);
     st = ws.solver.factorize(ws.Ms);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstdint>
+#include <stdexcept>
 
 namespace femdyn {
 namespace {
@@ -57,7 +58,26 @@ double mass_matrix_fill(const Model& model) {
   return nnz / (static_cast<double>(n) * n);
 }
 
+std::vector<int> coordinate_tree(const Model& model) {
+  const int n = model.n();
+  if (model.explicit_table || n == 0) return {};
+  const Pattern p = coordinate_pattern(model);
+  std::vector<int> lambda(n, -1);
+  for (int a = 0; a < n; ++a) {
+    int below = 0;  // coordinates b < a coupled with a
+    for (int b = 0; b < a; ++b)
+      if (p.test(a, b)) ++below, lambda[a] = b;
+    // A tree iff those are exactly the chain λ(a), λ(λ(a)), … (each coupled with a).
+    int chain = 0;
+    for (int b = lambda[a]; b >= 0; b = lambda[b], ++chain)
+      if (!p.test(a, b)) return {};
+    if (chain != below) return {};
+  }
+  return lambda;
+}
+
 SolverKind choose_solver(const Model& model) {
+  if (!coordinate_tree(model).empty()) return SolverKind::Tree;  // no fill, at any size
   // Dense Cholesky is faster below a few dozen coordinates whatever the fill.
   return model.n() >= 64 && mass_matrix_fill(model) < 0.3 ? SolverKind::Sparse
                                                            : SolverKind::Dense;
@@ -94,6 +114,12 @@ MassSolver::MassSolver(const Model& model) : MassSolver(model, choose_solver(mod
 
 MassSolver::MassSolver(const Model& model, SolverKind kind)
     : kind_(kind), names_(model.coordinate_names), impl_(std::make_unique<Impl>()) {
+  if (kind_ == SolverKind::Tree) {
+    lambda_ = coordinate_tree(model);
+    if (lambda_.empty() && model.n() > 0)
+      throw std::logic_error("MassSolver: the pattern of M^s is not a tree");
+    LD_ = MatX::Zero(model.n(), model.n());
+  }
   if (kind_ == SolverKind::Sparse) {
     const auto pattern = coordinate_pattern(model);
     const int n = model.n();
@@ -174,6 +200,7 @@ Status MassSolver::factorize(const MatX& Ms) {
                          "' moves no inertia (a massless chain end, or all its mass on the "
                          "joint axis?)",
               static_cast<int>(a)};
+  if (kind_ == SolverKind::Tree) return factorize_tree(Ms);
   if (kind_ == SolverKind::Dense) {
     impl_->dense.compute(Ms);
     if (impl_->dense.info() != Eigen::Success)
@@ -197,7 +224,40 @@ Status MassSolver::factorize(const MatX& Ms) {
   return {};
 }
 
+// M^s = Lᵀ D L over the coordinate tree, leaves first (Featherstone's LTDL): for a = n−1 … 0,
+//   for each ancestor i of a:  L(a, i) = H(a, i) / D(a),
+//                              H(i, j) −= L(a, i) H(a, j) for j = i and its ancestors,
+// with D(a) = H(a, a) once every coordinate beyond a is eliminated. Only the chain entries
+// are read or written: the pattern has no fill.
+Status MassSolver::factorize_tree(const MatX& Ms) {
+  const auto n = static_cast<int>(lambda_.size());
+  for (int a = 0; a < n; ++a)  // column a holds the chain of a (upper triangle of M^s)
+    for (int b = a; b >= 0; b = lambda_[b]) LD_(b, a) = Ms(b, a);
+  for (int a = n - 1; a >= 0; --a) {
+    const double d = LD_(a, a);
+    if (!(d > 1e-13 * Ms(a, a)))
+      return {false, "the mass matrix M^s is singular: coordinate '" + names_.at(a) +
+                         "' moves no inertia independently of the coordinates beyond it",
+              a};
+    for (int i = lambda_[a]; i >= 0; i = lambda_[i]) {
+      const double l = LD_(i, a) / d;
+      for (int j = i; j >= 0; j = lambda_[j]) LD_(j, i) -= l * LD_(j, a);
+      LD_(i, a) = l;
+    }
+  }
+  return {};
+}
+
 void MassSolver::solve_in_place(VecX& x) const {
+  if (kind_ == SolverKind::Tree) {  // Lᵀ D L x = y: Lᵀ z = y, D w = z, L x = w
+    const auto n = static_cast<int>(lambda_.size());
+    for (int a = n - 1; a >= 0; --a)
+      for (int i = lambda_[a]; i >= 0; i = lambda_[i]) x[i] -= LD_(i, a) * x[a];
+    for (int a = 0; a < n; ++a) x[a] /= LD_(a, a);
+    for (int a = 0; a < n; ++a)
+      for (int i = lambda_[a]; i >= 0; i = lambda_[i]) x[a] -= LD_(i, a) * x[i];
+    return;
+  }
   if (kind_ == SolverKind::Dense) {
     impl_->dense.solveInPlace(x);
     return;

@@ -1,7 +1,14 @@
-// Solves M^s x = y by Cholesky. Dense LLT for small systems; for large trees with a sparse
-// M^s (branches decouple) a CHOLMOD supernodal factorisation whose symbolic analysis is done
-// once. Chosen automatically from n and the structural fill of M^s; numerical failure (a
-// singular or indefinite M^s) is a Status naming the first coordinate that lost its pivot.
+// Solves M^s x = y by a Cholesky-type factorisation, chosen from the structural pattern of M^s:
+//   Tree    the pattern is a tree over the coordinates (coordinate a couples with b < a only
+//           along a chain b = λ(a), λ(λ(a)), …, the coordinate tree): Featherstone's sparse
+//           LTDL factorisation M^s = Lᵀ D L in that order, which has no fill ("Rigid Body
+//           Dynamics Algorithms" §6.5). O(Σ depth²) to factorise, O(Σ depth) to solve.
+//           Trees, chains and couplings that stay within one branch.
+//   Dense   LLT, any other pattern below 64 coordinates.
+//   Sparse  CHOLMOD with the symbolic analysis done once, for larger patterns with fill < 0.3
+//           (couplings across branches).
+// Numerical failure (a singular or indefinite M^s) is a Status naming the coordinate that lost
+// its pivot.
 #pragma once
 #include <memory>
 #include <string>
@@ -12,7 +19,7 @@
 
 namespace femdyn {
 
-enum class SolverKind { Dense, Sparse };
+enum class SolverKind { Dense, Sparse, Tree };
 
 class MassSolver {
  public:
@@ -31,13 +38,21 @@ class MassSolver {
 
  private:
   struct Impl;
+  Status factorize_tree(const MatX& Ms);
   SolverKind kind_;
   std::vector<std::string> names_;  // coordinate names, for messages
+  std::vector<int> lambda_;         // Tree: the parent coordinate λ(a) (-1 at a root)
+  MatX LD_;                         // Tree: L(a, b) at (b, a) for b = λ(a), λ(λ(a)), …; D(a) at (a, a)
   std::unique_ptr<Impl> impl_;
 };
 
-// Structural fill ratio of M^s (non-zeros / n²) and whether the sparse solver is chosen.
+// Structural fill ratio of M^s (non-zeros / n²), and the solver chosen for the model.
 double mass_matrix_fill(const Model& model);
 SolverKind choose_solver(const Model& model);
+
+// The coordinate tree λ of M^s's pattern (λ(a) < a, -1 at a root), or nothing when the
+// pattern is not a tree in coordinate order (or the model has an explicit table, whose DOF
+// aliases can couple branches).
+std::vector<int> coordinate_tree(const Model& model);
 
 }  // namespace femdyn

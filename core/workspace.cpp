@@ -23,10 +23,6 @@ Workspace::Workspace(const Model& model) : solver(model) {
   subspace.assign(nb, Vec6::Zero());
   if (model.dynamics_route == DynamicsRoute::Articulated || model.force_route == ForceRoute::Bodies)
     articulated.assign(nb, ArticulatedBody{});
-  if (!model.identity_coupling) {
-    Mtheta = MatX::Zero(nt, nt);
-    MthetaC = MatX::Zero(nt, n);
-  }
   force.assign(nb, Vec3::Zero());
   moment.assign(nb, Vec3::Zero());
   tau_theta = VecX::Zero(nt);

@@ -50,7 +50,6 @@ struct Workspace {
   std::vector<RigidInertia> composite;  // per body: composite inertia I^c_b (world, origin)
   std::vector<Vec6> subspace;      // per body: its joint's motion subspace S (world, origin)
   std::vector<ArticulatedBody> articulated;  // per body, for the body-level routes only
-  MatX Mtheta, MthetaC;            // M_θ (nθ x nθ) and M_θ C (nθ x n), with a coupling only
   std::vector<Vec3> force, moment; // per body: wrench of Tᵀ f (world; moment about the origin)
   VecX tau_theta;                  // Tᵀ f on the joint coordinates θ
   std::vector<VecX> local_x, local_y, local_g;  // per element local DOF buffers (6k)

@@ -23,12 +23,12 @@ TEST_CASE("inverse dynamics inverts forward dynamics", "[solver]") {
   }
 }
 
-TEST_CASE("CHOLMOD and dense Cholesky agree on a 90-DOF bushy tree", "[solver]") {
+TEST_CASE("tree LTDL and CHOLMOD and dense Cholesky agree on a 90-DOF bushy tree", "[solver]") {
   const Model m = load_text(random_tree_json(41, 90, 1.0, true));
   REQUIRE(m.n() == 90);
   INFO("fill " << mass_matrix_fill(m));
-  CHECK(choose_solver(m) == SolverKind::Sparse);
-  MassSolver dense(m, SolverKind::Dense), sparse(m, SolverKind::Sparse);
+  CHECK(choose_solver(m) == SolverKind::Tree);
+  MassSolver dense(m, SolverKind::Dense), sparse(m, SolverKind::Sparse), tree(m, SolverKind::Tree);
   Workspace ws(m);
   std::mt19937 rng(41);
   for (int k = 0; k < 3; ++k) {
@@ -36,14 +36,41 @@ TEST_CASE("CHOLMOD and dense Cholesky agree on a 90-DOF bushy tree", "[solver]")
     evaluate(m, ws, q, VecX::Zero(m.n()), VecX());
     REQUIRE(dense.factorize(ws.Ms).ok);
     REQUIRE(sparse.factorize(ws.Ms).ok);
-    VecX xd, xs;
+    REQUIRE(tree.factorize(ws.Ms).ok);
+    VecX xd, xs, xt;
     dense.solve(y, xd);
     sparse.solve(y, xs);
+    tree.solve(y, xt);
     CHECK(rel_error(ws.Ms * xs, y) < 1e-10);
+    CHECK(rel_error(ws.Ms * xt, y) < 1e-10);
     CHECK(rel_error(xs, xd) < 1e-8);
+    CHECK(rel_error(xt, xd) < 1e-8);
   }
-  // A small chain stays dense: no sparse machinery for a few DOFs.
-  CHECK(choose_solver(load_text(random_tree_json(42, 4, 0.0, false))) == SolverKind::Dense);
+  // A chain's coordinate tree is the chain itself: λ(a) = a − 1.
+  const std::vector<int> chain = coordinate_tree(load_text(random_tree_json(42, 4, 0.0, false)));
+  CHECK(chain == std::vector<int>{-1, 0, 1, 2});
+}
+
+TEST_CASE("the tree LTDL names the coordinate whose pivot is lost", "[solver]") {
+  // M^s of a 3-coordinate chain made singular by hand: coordinate 2 (the leaf) copies
+  // coordinate 1, so eliminating the leaf first leaves no pivot for coordinate 1.
+  const Model m = load_text(random_tree_json(42, 3, 0.0, false));
+  MassSolver tree(m, SolverKind::Tree);
+  MatX Ms(3, 3);
+  Ms << 4, 1, 1,  //
+      1, 2, 2,    //
+      1, 2, 2;
+  const Status st = tree.factorize(Ms);
+  CHECK(!st.ok);
+  CHECK(st.coordinate == 1);
+  CHECK_THAT(st.message, Catch::Contains("coordinate '" + m.coordinate_names[1] +
+                                         "' moves no inertia independently"));
+  // A positive definite matrix is solved exactly.
+  Ms(2, 2) = 3;
+  REQUIRE(tree.factorize(Ms).ok);
+  VecX x;
+  tree.solve(VecX::Ones(3), x);
+  CHECK(rel_error(Ms * x, VecX::Ones(3)) < 1e-14);
 }
 
 TEST_CASE("the structural pattern of M^s holds: different branches decouple exactly", "[solver]") {

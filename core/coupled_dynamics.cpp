@@ -1,0 +1,65 @@
+#include "core/coupled_dynamics.hpp"
+
+#include "core/body_inertia.hpp"
+#include "core/body_loads.hpp"
+#include "core/coupling.hpp"
+#include "core/joint.hpp"
+#include "core/kinematics.hpp"
+
+namespace femdyn {
+
+Status coupled_forward_dynamics(const Model& model, Workspace& ws, const VecX& q,
+                                const VecX& qd, const VecX& tau) {
+  const int nb = static_cast<int>(model.bodies.size());
+  propagate(model, ws, q, qd, {.jacobian = false, .bias = false, .rows = false});  // poses, θ
+  coupling_apply(model, qd, ws.theta_dot, false);
+
+  // Root to leaves: V_b, a_b (q̈ = 0), I_b and the force f_b (kept in pA) the body needs.
+  for (int b = 0; b < nb; ++b) {
+    const Body& body = model.bodies[b];
+    ArticulatedBody& A = ws.articulated[b];
+    const BodyState& B = ws.body[b];
+    if (body.parent >= 0) {
+      A.V = ws.articulated[body.parent].V;
+      A.a = ws.articulated[body.parent].a;
+    } else {
+      A.V.setZero();
+      A.a = gravity_base_acceleration(model);
+    }
+    ws.subspace[b] = motion_subspace(body.joint, B.R, B.p);
+    if (moves(body.joint)) {
+      const Vec6 vj = ws.subspace[b] * ws.theta_dot[body.joint.theta];
+      A.V += vj;
+      A.a += cross_motion(A.V, vj);
+    }
+    const RigidInertia I = inertia_at_origin(model.body_inertia[b], B.R, B.p);
+    A.pA = I * A.a + cross_force(A.V, I * A.V);
+    ws.composite[b] = I;
+  }
+  subtract_body_loads(model, ws);
+  // Leaves to root: project on each joint, pass the force and the inertia to the parent.
+  for (int b = nb - 1; b >= 0; --b) {
+    const Body& body = model.bodies[b];
+    const ArticulatedBody& A = ws.articulated[b];
+    if (moves(body.joint)) ws.tau_theta[body.joint.theta] = -ws.subspace[b].dot(A.pA);
+    if (body.parent >= 0) {
+      ws.articulated[body.parent].pA += A.pA;
+      ws.composite[body.parent] += ws.composite[b];
+    }
+  }
+  // Q − h = τ + Cᵀ(spring + damper − τ_θ).
+  for (int j = 0; j < model.n_theta(); ++j) {
+    const Joint& J = model.bodies[model.theta_joint[j]].joint;
+    ws.tau_theta[j] += spring_damper_force(J, ws.theta[j], ws.theta_dot[j]);
+  }
+  coupling_apply_transpose(model, ws.tau_theta, ws.qdd);
+  if (tau.size() == ws.qdd.size()) ws.qdd += tau;
+
+  if (ws.Ms.rows() != model.n()) ws.Ms.setZero(model.n(), model.n());  // first use only
+  mass_from_composites(model, ws);
+  const Status st = ws.solver.factorize(ws.Ms);
+  if (st.ok) ws.solver.solve_in_place(ws.qdd);
+  return st;
+}
+
+}  // namespace femdyn
