@@ -6,6 +6,7 @@
 #include <set>
 
 #include "core/body_inertia.hpp"
+#include "core/mass_solver.hpp"
 #include "core/correlation.hpp"
 #include "core/errors.hpp"
 #include "core/model.hpp"
@@ -197,6 +198,7 @@ Model compile(MechanismSpec spec) {
   build_node_level(spec, body_of_spec, m);
   condense_body_inertia(m);
   choose_routes(m);
+  analyse_mass_pattern(m);
   check_mass_matrix(m);
   return m;
 }

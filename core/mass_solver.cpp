@@ -47,6 +47,74 @@ Pattern coordinate_pattern(const Model& model) {
   return p;
 }
 
+// The upper triangle of M^s's pattern in the coordinate order `order`: (row, col) in the
+// ordered matrix, sorted by column then row.
+std::vector<std::pair<int, int>> ordered_upper_pattern(const Pattern& p, const std::vector<int>& order) {
+  const int n = p.n;
+  std::vector<int> where(n);  // coordinate -> position in `order`
+  for (int k = 0; k < n; ++k) where[order[k]] = k;
+  std::vector<std::pair<int, int>> e;
+  for (int c = 0; c < n; ++c)
+    for (int r = 0; r < n; ++r)
+      if ((p.test(r, c) || r == c) && where[r] <= where[c]) e.emplace_back(where[r], where[c]);
+  std::sort(e.begin(), e.end(), [](auto x, auto y) { return std::pair(x.second, x.first) < std::pair(y.second, y.first); });
+  return e;
+}
+
+// A CHOLMOD matrix (upper triangle stored) with the given pattern: 1 on the diagonal, 0 off it.
+cholmod_sparse* pattern_matrix(int n, const std::vector<std::pair<int, int>>& e, cholmod_common* c) {
+  cholmod_sparse* A = cholmod_allocate_sparse(n, n, e.size(), 1, 1, /*stype: upper*/ 1,
+                                              CHOLMOD_REAL, c);
+  if (!A) throw std::bad_alloc();
+  auto* Ap = static_cast<int*>(A->p);
+  auto* Ai = static_cast<int*>(A->i);
+  auto* Ax = static_cast<double*>(A->x);
+  for (std::size_t k = 0; k < e.size(); ++k) {
+    Ai[k] = e[k].first;
+    Ax[k] = e[k].first == e[k].second ? 1.0 : 0.0;
+  }
+  for (int col = 0, k = 0; col <= n; ++col) {
+    while (k < static_cast<int>(e.size()) && e[k].second < col) ++k;
+    Ap[col] = k;
+  }
+  return A;
+}
+
+// CHOLMOD's fill-reducing ordering of the pattern (its default choice among AMD and METIS).
+std::vector<int> fill_reducing_order(const Pattern& p) {
+  cholmod_common c;
+  cholmod_start(&c);
+  c.print = 0;
+  std::vector<int> identity(p.n);
+  for (int k = 0; k < p.n; ++k) identity[k] = k;
+  cholmod_sparse* A = pattern_matrix(p.n, ordered_upper_pattern(p, identity), &c);
+  cholmod_factor* L = cholmod_analyze(A, &c);
+  std::vector<int> order;
+  if (L) order.assign(static_cast<int*>(L->Perm), static_cast<int*>(L->Perm) + p.n);
+  cholmod_free_factor(&L, &c);
+  cholmod_free_sparse(&A, &c);
+  cholmod_finish(&c);
+  if (order.empty()) throw std::bad_alloc();
+  return order;
+}
+
+// λ for a tree without couplings, straight from the bodies: the coordinate of the nearest
+// moving ancestor joint. Coordinates are numbered in tree order, so λ(a) < a. O(bodies).
+std::vector<int> tree_without_coupling(const Model& model) {
+  const int nb = static_cast<int>(model.bodies.size());
+  std::vector<int> nearest(nb, -1), lambda(model.n(), -1);  // nearest moving joint at or above b
+  for (int b = 0; b < nb; ++b) {
+    const Body& B = model.bodies[b];
+    const int above = B.parent >= 0 ? nearest[B.parent] : -1;
+    nearest[b] = B.joint.theta >= 0 ? B.joint.theta : above;
+    if (B.joint.theta >= 0) {
+      if (above >= B.joint.theta) return {};
+      lambda[B.joint.theta] = above;
+    }
+  }
+  return lambda;
+}
+
 }  // namespace
 
 double mass_matrix_fill(const Model& model) {
@@ -61,6 +129,7 @@ double mass_matrix_fill(const Model& model) {
 std::vector<int> coordinate_tree(const Model& model) {
   const int n = model.n();
   if (model.explicit_table || n == 0) return {};
+  if (model.identity_coupling) return tree_without_coupling(model);
   const Pattern p = coordinate_pattern(model);
   std::vector<int> lambda(n, -1);
   for (int a = 0; a < n; ++a) {
@@ -76,22 +145,30 @@ std::vector<int> coordinate_tree(const Model& model) {
   return lambda;
 }
 
-SolverKind choose_solver(const Model& model) {
-  if (!coordinate_tree(model).empty()) return SolverKind::Tree;  // no fill, at any size
+void analyse_mass_pattern(Model& model) {
+  MassPattern& mp = model.mass_pattern;
+  mp = MassPattern{};
+  mp.coordinate_parent = coordinate_tree(model);
+  if (!mp.coordinate_parent.empty()) {
+    mp.solver = SolverKind::Tree;  // no fill, at any size
+    return;
+  }
   // Dense Cholesky is faster below a few dozen coordinates whatever the fill.
-  return model.n() >= 64 && mass_matrix_fill(model) < 0.3 ? SolverKind::Sparse
-                                                           : SolverKind::Dense;
+  if (model.n() < 64 || mass_matrix_fill(model) >= 0.3) return;
+  mp.solver = SolverKind::Sparse;
+  mp.sparse_order = fill_reducing_order(coordinate_pattern(model));
 }
 
 // CHOLMOD is driven directly (not through Eigen's wrapper) so that, after the first call, a
 // factorisation and a solve reuse every buffer: the sparse M^s (pattern fixed, values
-// overwritten), the factor L (symbolic analysis once), and the solve's X, Y, E workspaces
-// (cholmod_solve2).
+// overwritten), the factor L, and the solve's X, Y, E workspaces (cholmod_solve2). The
+// fill-reducing order comes from the Model (found once at compile); each solver stores
+// A = P M^s Pᵀ in that order and lets CHOLMOD lay out its own L for it (natural ordering).
 struct MassSolver::Impl {
   Eigen::LLT<MatX> dense;
   std::vector<std::pair<int, int>> entries;  // M^s (row, col) of each stored value of A
   cholmod_common common;
-  cholmod_sparse* A = nullptr;  // lower triangle of M^s (stype -1)
+  cholmod_sparse* A = nullptr;  // upper triangle of P M^s Pᵀ (stype 1)
   cholmod_factor* L = nullptr;
   cholmod_dense *X = nullptr, *Y = nullptr, *E = nullptr;
   cholmod_dense B;  // header over b
@@ -110,70 +187,38 @@ struct MassSolver::Impl {
   }
 };
 
-MassSolver::MassSolver(const Model& model) : MassSolver(model, choose_solver(model)) {}
+MassSolver::MassSolver(const Model& model) : MassSolver(model, model.mass_pattern.solver) {}
 
 MassSolver::MassSolver(const Model& model, SolverKind kind)
     : kind_(kind), names_(model.coordinate_names), impl_(std::make_unique<Impl>()) {
+  const int n = model.n();
   if (kind_ == SolverKind::Tree) {
-    lambda_ = coordinate_tree(model);
-    if (lambda_.empty() && model.n() > 0)
+    lambda_ = model.mass_pattern.coordinate_parent;
+    if (static_cast<int>(lambda_.size()) != n)
       throw std::logic_error("MassSolver: the pattern of M^s is not a tree");
-    LD_ = MatX::Zero(model.n(), model.n());
   }
   if (kind_ == SolverKind::Sparse) {
-    const auto pattern = coordinate_pattern(model);
-    const int n = model.n();
     Impl& s = *impl_;
+    const Pattern pattern = coordinate_pattern(model);
+    s.perm = model.mass_pattern.sparse_order;
+    if (static_cast<int>(s.perm.size()) != n) s.perm = fill_reducing_order(pattern);  // forced
     cholmod_start(&s.common);
+    s.started = true;
     s.common.print = 0;  // failures are reported as a Status, not printed
     s.common.supernodal = CHOLMOD_SIMPLICIAL;
     s.common.final_asis = 1;  // keep L as factorised: no per-call repacking
     s.common.final_pack = 0;
     s.common.final_monotonic = 0;
-    s.started = true;
-    // 1. A fill-reducing ordering P of the pattern (CHOLMOD's choice, on a pattern-only copy).
-    const auto lower_pattern = [&](const std::vector<int>& order) {
-      std::vector<int> where(n);  // original index -> position in `order`
-      for (int k = 0; k < n; ++k) where[order[k]] = k;
-      std::vector<std::pair<int, int>> e;  // (row, col) in the ordered matrix, upper triangle
-      for (int c = 0; c < n; ++c)
-        for (int r = 0; r < n; ++r)
-          if ((pattern.test(r, c) || r == c) && where[r] <= where[c]) e.emplace_back(where[r], where[c]);
-      std::sort(e.begin(), e.end(), [](auto a, auto b) { return std::pair(a.second, a.first) < std::pair(b.second, b.first); });
-      return e;
-    };
-    const auto build = [&](const std::vector<std::pair<int, int>>& e) {
-      cholmod_sparse* A = cholmod_allocate_sparse(n, n, e.size(), 1, 1, /*stype: upper*/ 1,
-                                                  CHOLMOD_REAL, &s.common);
-      auto* Ap = static_cast<int*>(A->p);
-      auto* Ai = static_cast<int*>(A->i);
-      auto* Ax = static_cast<double*>(A->x);
-      for (std::size_t k = 0; k < e.size(); ++k) {
-        Ai[k] = e[k].first;
-        Ax[k] = e[k].first == e[k].second ? 1.0 : 0.0;
-      }
-      for (int c = 0, k = 0; c <= n; ++c) {
-        while (k < static_cast<int>(e.size()) && e[k].second < c) ++k;
-        Ap[c] = k;
-      }
-      return A;
-    };
-    std::vector<int> identity(n);
-    for (int k = 0; k < n; ++k) identity[k] = k;
-    cholmod_sparse* A0 = build(lower_pattern(identity));
-    cholmod_factor* L0 = cholmod_analyze(A0, &s.common);
-    s.perm.assign(static_cast<int*>(L0->Perm), static_cast<int*>(L0->Perm) + n);
-    cholmod_free_factor(&L0, &s.common);
-    cholmod_free_sparse(&A0, &s.common);
-    // 2. A = P M^s Pᵀ stored once in that order, analysed with the natural ordering, so that
-    //    factorize and solve need no permuted copies (which CHOLMOD would allocate per call).
-    const auto e = lower_pattern(s.perm);
-    s.A = build(e);
+    // A = P M^s Pᵀ stored once in that order, analysed with the natural ordering, so that
+    // factorize and solve need no permuted copies (which CHOLMOD would allocate per call).
+    const auto e = ordered_upper_pattern(pattern, s.perm);
+    s.A = pattern_matrix(n, e, &s.common);
     for (const auto& [r, c] : e) s.entries.emplace_back(s.perm[r], s.perm[c]);
     s.common.nmethods = 1;
     s.common.method[0].ordering = CHOLMOD_NATURAL;
     s.common.postorder = false;
     s.L = cholmod_analyze(s.A, &s.common);
+    if (!s.L) throw std::bad_alloc();
     s.B = cholmod_dense{};
     s.B.nrow = s.B.d = static_cast<std::size_t>(n);
     s.B.ncol = 1;
@@ -228,21 +273,37 @@ Status MassSolver::factorize(const MatX& Ms) {
 //   for each ancestor i of a:  L(a, i) = H(a, i) / D(a),
 //                              H(i, j) −= L(a, i) H(a, j) for j = i and its ancestors,
 // with D(a) = H(a, a) once every coordinate beyond a is eliminated. Only the chain entries
-// are read or written: the pattern has no fill.
+// are read or written: the pattern has no fill. Column a of the upper triangle is stored as
+// its chain, LD[chain_start[a] + t] for the t-th of a, λ(a), λ(λ(a)), …; the chain of an
+// ancestor i at position t is the tail of a's chain from t, so the update is contiguous.
 Status MassSolver::factorize_tree(const MatX& Ms) {
   const auto n = static_cast<int>(lambda_.size());
-  for (int a = 0; a < n; ++a)  // column a holds the chain of a (upper triangle of M^s)
-    for (int b = a; b >= 0; b = lambda_[b]) LD_(b, a) = Ms(b, a);
+  if (chain_start_.empty()) {  // first use only: Σ (depth + 1) entries
+    chain_start_.assign(n + 1, 0);
+    for (int a = 0; a < n; ++a) {
+      int length = 0;
+      for (int b = a; b >= 0; b = lambda_[b]) ++length;
+      chain_start_[a + 1] = chain_start_[a] + length;
+    }
+    LD_ = VecX::Zero(chain_start_[n]);
+  }
+  for (int a = 0; a < n; ++a) {
+    double* H = LD_.data() + chain_start_[a];
+    for (int b = a, t = 0; b >= 0; b = lambda_[b], ++t) H[t] = Ms(b, a);
+  }
   for (int a = n - 1; a >= 0; --a) {
-    const double d = LD_(a, a);
+    double* Ha = LD_.data() + chain_start_[a];
+    const double d = Ha[0];
     if (!(d > 1e-13 * Ms(a, a)))
       return {false, "the mass matrix M^s is singular: coordinate '" + names_.at(a) +
                          "' moves no inertia independently of the coordinates beyond it",
               a};
-    for (int i = lambda_[a]; i >= 0; i = lambda_[i]) {
-      const double l = LD_(i, a) / d;
-      for (int j = i; j >= 0; j = lambda_[j]) LD_(j, i) -= l * LD_(j, a);
-      LD_(i, a) = l;
+    for (int i = lambda_[a], t = 1; i >= 0; i = lambda_[i], ++t) {
+      const double l = Ha[t] / d;
+      double* Hi = LD_.data() + chain_start_[i];
+      const int length = chain_start_[i + 1] - chain_start_[i];
+      for (int u = 0; u < length; ++u) Hi[u] -= l * Ha[t + u];
+      Ha[t] = l;
     }
   }
   return {};
@@ -251,11 +312,15 @@ Status MassSolver::factorize_tree(const MatX& Ms) {
 void MassSolver::solve_in_place(VecX& x) const {
   if (kind_ == SolverKind::Tree) {  // Lᵀ D L x = y: Lᵀ z = y, D w = z, L x = w
     const auto n = static_cast<int>(lambda_.size());
-    for (int a = n - 1; a >= 0; --a)
-      for (int i = lambda_[a]; i >= 0; i = lambda_[i]) x[i] -= LD_(i, a) * x[a];
-    for (int a = 0; a < n; ++a) x[a] /= LD_(a, a);
-    for (int a = 0; a < n; ++a)
-      for (int i = lambda_[a]; i >= 0; i = lambda_[i]) x[a] -= LD_(i, a) * x[i];
+    for (int a = n - 1; a >= 0; --a) {
+      const double* L = LD_.data() + chain_start_[a];
+      for (int i = lambda_[a], t = 1; i >= 0; i = lambda_[i], ++t) x[i] -= L[t] * x[a];
+    }
+    for (int a = 0; a < n; ++a) x[a] /= LD_[chain_start_[a]];
+    for (int a = 0; a < n; ++a) {
+      const double* L = LD_.data() + chain_start_[a];
+      for (int i = lambda_[a], t = 1; i >= 0; i = lambda_[i], ++t) x[a] -= L[t] * x[i];
+    }
     return;
   }
   if (kind_ == SolverKind::Dense) {

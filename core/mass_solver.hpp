@@ -19,14 +19,13 @@
 
 namespace femdyn {
 
-enum class SolverKind { Dense, Sparse, Tree };
 
 class MassSolver {
  public:
   // The structural pattern of M^s: (a, b) may be non-zero iff coordinates a and b move a
   // common transition coordinate.
-  MassSolver(const Model& model, SolverKind kind);
-  explicit MassSolver(const Model& model);  // automatic choice
+  explicit MassSolver(const Model& model);  // Model::mass_pattern's choice
+  MassSolver(const Model& model, SolverKind kind);  // another kind (Tree needs a tree)
   ~MassSolver();
   MassSolver(MassSolver&&) noexcept;
   MassSolver& operator=(MassSolver&&) noexcept;
@@ -42,13 +41,17 @@ class MassSolver {
   SolverKind kind_;
   std::vector<std::string> names_;  // coordinate names, for messages
   std::vector<int> lambda_;         // Tree: the parent coordinate λ(a) (-1 at a root)
-  MatX LD_;                         // Tree: L(a, b) at (b, a) for b = λ(a), λ(λ(a)), …; D(a) at (a, a)
+  std::vector<int> chain_start_;    // Tree: where column a's chain starts in LD_ (sized on first use)
+  VecX LD_;                         // Tree: D(a), then L(a, b) for b = λ(a), λ(λ(a)), …
   std::unique_ptr<Impl> impl_;
 };
 
-// Structural fill ratio of M^s (non-zeros / n²), and the solver chosen for the model.
+// The compile pass that fills Model::mass_pattern: the solver kind and what it needs (the
+// coordinate tree, or CHOLMOD's fill-reducing order), so that no Workspace redoes it.
+void analyse_mass_pattern(Model& model);
+
+// Structural fill ratio of M^s (non-zeros / n²).
 double mass_matrix_fill(const Model& model);
-SolverKind choose_solver(const Model& model);
 
 // The coordinate tree λ of M^s's pattern (λ(a) < a, -1 at a root), or nothing when the
 // pattern is not a tree in coordinate order (or the model has an explicit table, whose DOF

@@ -93,6 +93,21 @@ enum class DynamicsRoute {
   Cholesky,    // q̈ = (M^s)⁻¹ (Q − h): evaluate, then dense or CHOLMOD Cholesky
   Articulated  // articulated-body recursion over the element-assembled Λ_b (core/articulated.hpp)
 };
+// How the Cholesky route factorises M^s (core/mass_solver.hpp).
+enum class SolverKind {
+  Dense,   // LLT
+  Sparse,  // CHOLMOD, fill-reducing order found once at compile
+  Tree     // Featherstone's fill-free LTDL over the coordinate tree
+};
+
+// The structure of M^s, analysed once by compile() (analyse_mass_pattern, core/mass_solver.hpp)
+// and shared by every Workspace.
+struct MassPattern {
+  SolverKind solver = SolverKind::Dense;
+  std::vector<int> coordinate_parent;  // Tree: λ(a) < a, -1 at a root
+  std::vector<int> sparse_order;       // Sparse: position k of the factorised matrix holds
+                                       // coordinate sparse_order[k]
+};
 
 struct Model {
   Model() = default;
@@ -137,6 +152,7 @@ struct Model {
   MassRoute mass_route = MassRoute::Transform;         // how evaluate() forms M^s
   ForceRoute force_route = ForceRoute::Nodes;              // how h and τ are computed
   DynamicsRoute dynamics_route = DynamicsRoute::Cholesky;  // how forward_dynamics() finds q̈
+  MassPattern mass_pattern;                                // the Cholesky route's solver
 
   bool has_nodal_forces = false;     // gravity or loads present
   bool has_velocity_forces = false;  // some element has a gyroscopic term

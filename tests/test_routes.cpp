@@ -164,7 +164,7 @@ TEST_CASE("couplings within a branch keep the tree LTDL and across branches do n
   // hand16: each finger's distal joint follows its middle joint (one branch each).
   const Model hand = load_model(model_path("urdf/hand16.urdf"));
   REQUIRE(!hand.identity_coupling);
-  CHECK(choose_solver(hand) == SolverKind::Tree);
+  CHECK(hand.mass_pattern.solver == SolverKind::Tree);
   // A joint following joints of two branches couples those branches: no tree, no fill-free
   // order, so Dense (or CHOLMOD) is chosen; all three kinds that apply give the same q̈.
   int non_tree = 0;
@@ -173,7 +173,7 @@ TEST_CASE("couplings within a branch keep the tree LTDL and across branches do n
     const Model m = load_text(mixed_tree_json(seed, 70, 0.7, true));
     const bool tree = !coordinate_tree(m).empty();
     non_tree += !tree;
-    CHECK((choose_solver(m) == SolverKind::Tree) == tree);
+    CHECK((m.mass_pattern.solver == SolverKind::Tree) == tree);
     Workspace ws(m);
     std::mt19937 rng(seed);
     const VecX q = random_vector(rng, m.n(), 2), qd = random_vector(rng, m.n(), 2),

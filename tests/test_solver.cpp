@@ -27,7 +27,7 @@ TEST_CASE("tree LTDL and CHOLMOD and dense Cholesky agree on a 90-DOF bushy tree
   const Model m = load_text(random_tree_json(41, 90, 1.0, true));
   REQUIRE(m.n() == 90);
   INFO("fill " << mass_matrix_fill(m));
-  CHECK(choose_solver(m) == SolverKind::Tree);
+  CHECK(m.mass_pattern.solver == SolverKind::Tree);
   MassSolver dense(m, SolverKind::Dense), sparse(m, SolverKind::Sparse), tree(m, SolverKind::Tree);
   Workspace ws(m);
   std::mt19937 rng(41);
