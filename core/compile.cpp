@@ -1,7 +1,6 @@
 // compile(): MechanismSpec -> Model. Tree order and joints, the coupling level θ = C q + θ0,
 // then the node level and the correlation table (core/correlation.cpp).
 #include <cmath>
-#include <functional>
 #include <map>
 #include <set>
 
@@ -30,22 +29,30 @@ std::vector<int> tree_order(const MechanismSpec& spec) {
     if (!index.emplace(b.name, static_cast<int>(i)).second)
       throw ModelError(b.where, "duplicate body name '" + b.name + "'");
   }
-  std::map<std::string, std::vector<int>> children;
+  // children[k + 1]: the bodies hanging from body k (children[0]: from the world).
+  std::vector<std::vector<int>> children(spec.bodies.size() + 1);
   for (std::size_t i = 0; i < spec.bodies.size(); ++i) {
     const BodySpec& b = spec.bodies[i];
     if (b.parent != "world" && !index.count(b.parent))
       throw ModelError(b.where + "/parent", "unknown parent body '" + b.parent + "'");
     if (b.parent == b.name) throw ModelError(b.where + "/parent", "body is its own parent");
-    children[b.parent].push_back(static_cast<int>(i));
+    children[b.parent == "world" ? 0 : index.at(b.parent) + 1].push_back(static_cast<int>(i));
   }
+  // Depth-first, parents before children, siblings in file order; an explicit stack (not
+  // recursion), so that a chain of any length cannot overflow the call stack.
   std::vector<int> order;
-  std::function<void(const std::string&)> visit = [&](const std::string& name) {
-    for (int c : children[name]) {
-      order.push_back(c);
-      visit(spec.bodies[c].name);
+  order.reserve(spec.bodies.size());
+  std::vector<std::pair<int, std::size_t>> stack = {{0, 0}};  // (children slot, next child)
+  while (!stack.empty()) {
+    auto& [slot, next] = stack.back();
+    if (next == children[slot].size()) {
+      stack.pop_back();
+      continue;
     }
-  };
-  visit("world");
+    const int c = children[slot][next++];
+    order.push_back(c);
+    stack.emplace_back(c + 1, 0);
+  }
   if (order.size() != spec.bodies.size()) {
     std::set<int> reached(order.begin(), order.end());
     for (std::size_t i = 0; i < spec.bodies.size(); ++i)
@@ -126,27 +133,46 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
   std::vector<std::map<int, double>> rows(nt);  // C row by row: O(non-zeros), not nθ × n
   m.theta0 = VecX::Zero(nt);
   std::vector<int> state(nt, 0);  // 0 new, 1 in progress, 2 done
-  std::function<void(int)> resolve = [&](int t) {
-    if (state[t] == 2) return;
-    if (state[t] == 1)
-      throw ModelError(coupled.at(t)->where, "couplings form a cycle through joint '" +
-                                                 m.bodies[m.theta_joint[t]].joint.name + "'");
-    state[t] = 1;
-    if (q_of[t] >= 0) {
-      rows[t][q_of[t]] = 1.0;
-    } else {
-      const CouplingSpec& c = *coupled.at(t);
-      m.theta0[t] = c.offset;
-      for (const auto& [name, ratio] : c.terms) {
-        const int f = theta_of.at(name);
-        resolve(f);
-        for (const auto& [a, c] : rows[f]) rows[t][a] += ratio * c;
-        m.theta0[t] += ratio * m.theta0[f];
-      }
-    }
-    state[t] = 2;
+  // Resolve each joint's row of C after the rows of the joints it follows: depth-first with an
+  // explicit stack (a chain of couplings of any length cannot overflow the call stack).
+  const auto cycle = [&](int t) {
+    return ModelError(coupled.at(t)->where, "couplings form a cycle through joint '" +
+                                                m.bodies[m.theta_joint[t]].joint.name + "'");
   };
-  for (int t = 0; t < nt; ++t) resolve(t);
+  for (int t0 = 0; t0 < nt; ++t0) {
+    if (state[t0] == 2) continue;
+    std::vector<std::pair<int, std::size_t>> stack = {{t0, 0}};  // (joint, next term)
+    while (!stack.empty()) {
+      const int t = stack.back().first;
+      const std::size_t k = stack.back().second;
+      if (k == 0 && state[t] == 0) {
+        state[t] = 1;
+        if (q_of[t] >= 0) {  // a coordinate: its own row
+          rows[t][q_of[t]] = 1.0;
+          state[t] = 2;
+          stack.pop_back();
+          continue;
+        }
+        m.theta0[t] = coupled.at(t)->offset;
+      }
+      const auto& terms = coupled.at(t)->terms;
+      if (k == terms.size()) {
+        state[t] = 2;
+        stack.pop_back();
+        continue;
+      }
+      const auto& [name, ratio] = terms[k];
+      const int f = theta_of.at(name);
+      if (state[f] == 1) throw cycle(f);
+      if (state[f] == 0) {
+        stack.emplace_back(f, 0);
+        continue;
+      }
+      for (const auto& [a, c] : rows[f]) rows[t][a] += ratio * c;  // θ_t += ratio θ_f
+      m.theta0[t] += ratio * m.theta0[f];
+      ++stack.back().second;
+    }
+  }
   // The hot path's form of C (core/coupling.hpp).
   std::vector<Eigen::Triplet<double>> entries;
   bool identity = nt == n && m.theta0.isZero(0);

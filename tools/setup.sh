@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 
 packages=(cmake g++ make libeigen3-dev libsuitesparse-dev nlohmann-json3-dev catch2
           libsimbody-dev libtinyxml2-dev libbenchmark-dev libsundials-dev gnuplot-nox
-          fonts-dejavu-core)
+          fonts-dejavu-core clang libclang-rt-14-dev clang-format)
 
 missing=()
 for p in "${packages[@]}"; do
