@@ -192,6 +192,23 @@ P("On a model whose q̈ route is Cholesky (couplings: finger_coupled, hand16; th
   "recursion does, and the reduction is exact.")
 P("")
 
+# "Leave out what the scene does not need", measured: evaluate() against its parts.
+if any(t("femdyn", "rest", m) for m in named):
+    P("## Leaving out what the scene does not need")
+    P("")
+    P("`evaluate()` (M^s, h and Q at a moving state, with gravity) against the same call at rest "
+      "(q̇ = 0: h is not computed), on the model without gravity (Tᵀ F is not computed), and "
+      "`mass_matrix()` (M^s alone); femdyn only, same run.")
+    P("")
+    P("| model | n | evaluate | at rest | without gravity | M^s alone |")
+    P("|---|---:|---:|---:|---:|---:|")
+    for m in named:
+        P(f"| {m} | {n_of(m)} | " + " | ".join(
+            ns(t("femdyn", op, m)) for op in ("evaluate", "rest", "weightless", "mass")) + " |")
+    P("")
+    P("A model whose gravity is zero already (the finger) has no \"without gravity\" entry.")
+    P("")
+
 # Targets of issue 11 (this machine's fastest of Simbody, MuJoCo, Pinocchio).
 targets = [("finger", "forward", 800), ("finger", "mass", 250), ("hand16", "forward", 3100),
            ("atlas", "forward", 6000), ("chain512", "forward", 110e3), ("chain512", "bias", 56e3),

@@ -8,6 +8,8 @@
 //   femdyn/bias/M       evaluate_bias(): h             simbody/bias/M      residual, no forces (h)
 //   femdyn/forward/M    forward_dynamics(): q̈          simbody/forward/M   calcAccelerationIgnoringConstraints
 //   femdyn/inverse/M    inverse_dynamics(): τ          simbody/inverse/M   residual with θ̈
+//   femdyn/rest/M       evaluate() at q̇ = 0 (h not computed)
+//   femdyn/weightless/M evaluate() on the model without gravity (models with gravity only)
 //   reference/{mass,bias,forward,inverse}/M: femdyn on the reference routes (Tᵀ M T, node-level
 //   sweeps, Cholesky) where n ≤ 128, for the crossovers.
 // Simbody's side is SimbodyTwin::time_* (validation/twin.hpp): its own work only. This file
@@ -68,11 +70,15 @@ struct Case {
   Model model;
   std::unique_ptr<Workspace> ws;
   std::unique_ptr<fv::SimbodyTwin> twin;
-  VecX q, qd, tau, qdd;
+  VecX q, qd, tau, qdd, rest;  // rest: q̇ = 0
   // The same mechanism on the reference routes (Tᵀ M T, node-level sweeps, Cholesky), for the
   // crossovers in docs/performance.md; up to 128 coordinates (Tᵀ M T is O(N_u n²)).
   std::unique_ptr<Model> reference;
   std::unique_ptr<Workspace> ws_ref;
+  // The same mechanism without gravity (when it has some): "leave out what the scene does not
+  // need" measured, against evaluate() with gravity.
+  std::unique_ptr<Model> weightless;
+  std::unique_ptr<Workspace> ws_weightless;
 };
 
 // What makes the run fail (exit 1): engines that disagree, femdyn allocating in its hot path.
@@ -93,12 +99,19 @@ double rel_diff(const MatX& a, const MatX& b) {
 
 // The state of femdyn validate's first sample: seed 1, q within the joint limits,
 // q̇ in ±2, τ in ±1, q̈ in ±5. Checks once, outside the timing, that both sides agree.
-template <class Load>
-void add_case(std::string name, Load load) {
+template <class Spec>
+void add_case(std::string name, Spec spec) {
   auto c = std::make_unique<Case>();
   c->name = std::move(name);
+  const auto load = [&] { return compile(spec()); };
   c->model = load();
   const Model& m = c->model;
+  if (!m.gravity.isZero()) {
+    MechanismSpec s = spec();
+    s.gravity = Vec3::Zero();
+    c->weightless = std::make_unique<Model>(compile(std::move(s)));
+    c->ws_weightless = std::make_unique<Workspace>(*c->weightless);
+  }
   if (m.n() <= 128) {
     c->reference = std::make_unique<Model>(load());
     c->reference->mass_route = MassRoute::Transform;
@@ -113,6 +126,7 @@ void add_case(std::string name, Load load) {
   c->qd = random_uniform(m.n(), 2, rng);
   c->tau = random_uniform(m.n(), 1, rng);
   c->qdd = random_uniform(m.n(), 5, rng);
+  c->rest = VecX::Zero(m.n());
 
   const fv::TwinEquations s = c->twin->equations(c->q, c->qd, c->tau);
   const bool ok = forward_dynamics(m, *c->ws, c->q, c->qd, c->tau).ok;
@@ -163,6 +177,10 @@ void register_case(Case* c) {
   reg("simbody", "mass", [](Case& c) { c.twin->time_mass(c.q); });
   reg("femdyn", "evaluate", [](Case& c) { evaluate(c.model, *c.ws, c.q, c.qd, c.tau); });
   reg("simbody", "evaluate", [](Case& c) { c.twin->time_mass_and_bias(c.q, c.qd); });
+  reg("femdyn", "rest", [](Case& c) { evaluate(c.model, *c.ws, c.q, c.rest, c.tau); });
+  if (c->weightless)
+    reg("femdyn", "weightless",
+        [](Case& c) { evaluate(*c.weightless, *c.ws_weightless, c.q, c.qd, c.tau); });
   reg("femdyn", "bias", [](Case& c) { evaluate_bias(c.model, *c.ws, c.q, c.qd); });
   reg("simbody", "bias", [](Case& c) { c.twin->time_bias(c.q, c.qd); });
   reg("femdyn", "forward", [](Case& c) {
@@ -181,12 +199,12 @@ void register_case(Case* c) {
       [](Case& c) { inverse_dynamics(*c.reference, *c.ws_ref, c.q, c.qd, c.qdd); });
 }
 
-Model random_model(int seed, int bodies, double branching) {
+MechanismSpec random_spec(int seed, int bodies, double branching) {
   const std::string text = R"({"model": "random_tree", "params": {"seed": )" +
                            std::to_string(seed) + R"(, "bodies": )" + std::to_string(bodies) +
                            R"(, "branching": )" + std::to_string(branching) +
                            R"(}, "gravity": [0.1, -0.2, -9.81]})";
-  return compile(parse_spec(text, "random"));
+  return parse_spec(text, "random");
 }
 
 }  // namespace
@@ -205,9 +223,9 @@ int main(int argc, char** argv) {
       break;
     }
   try {
-    const auto file = [&](std::string path) { return [path] { return load_model(path); }; };
+    const auto file = [&](std::string path) { return [path] { return read_spec(path); }; };
     const auto random = [](int seed, int n, double branching) {
-      return [=] { return random_model(seed, n, branching); };
+      return [=] { return random_spec(seed, n, branching); };
     };
     for (const char* name : {"pendulum", "spatial_double_pendulum", "branched_tree", "finger",
                              "finger_coupled", "hand"})
