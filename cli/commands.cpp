@@ -2,11 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 
 #include "core/equations.hpp"
 #include "io/model_loader.hpp"
 #include "io/output.hpp"
+#include "core/limits.hpp"
+#include "core/names.hpp"
 
 namespace femdyn::cli {
 namespace {
@@ -38,14 +41,21 @@ std::vector<double> parse_numbers(const std::string& opt, const std::string& tex
     const std::string item = text.substr(start, end - start);
     std::size_t used = 0;
     double x = 0;
+    bool out_of_range = false;
     try {
       x = std::stod(item, &used);
+    } catch (const std::out_of_range&) {
+      out_of_range = true;
     } catch (const std::exception&) {
       used = 0;
     }
+    if (out_of_range || (std::isfinite(x) && std::abs(x) > kMaxMagnitude))
+      throw CliError("--" + opt + ": " + quoted_text(item) +
+                     " is out of range (|x| ≤ 1e100: beyond it the equations' products overflow "
+                     "double precision)");
     if (item.empty() || used != item.size())
-      throw CliError("--" + opt + ": '" + item + "' is not a number");
-    if (!std::isfinite(x)) throw CliError("--" + opt + ": '" + item + "' is NaN or Inf");
+      throw CliError("--" + opt + ": " + quoted_text(item) + " is not a number");
+    if (!std::isfinite(x)) throw CliError("--" + opt + ": " + quoted_text(item) + " is NaN or Inf");
     out.push_back(x);
     start = end + 1;
   }
@@ -178,6 +188,16 @@ int cmd_equations(int argc, char** argv) {
     }
   std::vector<MatX> D;
   if (a.has("tensor")) {
+    // D has n³ entries and its sweep holds T' (N_u n²): refused before allocating past the limit.
+    const double n = m.n(), entries = std::max(n * n * n, m.n_u() * n * n);
+    if (entries > kMaxTensorEntries) {
+      char buf[160];
+      std::snprintf(buf, sizeof buf,
+                    "--tensor: D needs %.3g numbers (%.3g GB) for n = %d; the limit is %.3g "
+                    "(about n = 150)",
+                    entries, entries * 8 / 1e9, m.n(), kMaxTensorEntries);
+      throw CliError(buf);
+    }
     D = third_order_tensor(m, ws, q);
     evaluate(m, ws, q, qd, tau);  // the tensor sweep reuses the workspace
   }

@@ -2,6 +2,7 @@
 // seeded random states and at given postures — e.g. the paper's discretisation against the
 // exact finger.
 #include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <random>
@@ -49,8 +50,9 @@ int cmd_compare(int argc, char** argv) {
   auto count = [&](const char* opt, int fallback) {
     if (!a.has(opt)) return fallback;
     const std::vector<double> v = parse_numbers(opt, a.options.at(opt));
-    if (v.size() != 1 || v[0] < 1 || v[0] != static_cast<int>(v[0]))
-      throw CliError(std::string("--") + opt + " expects a positive integer");
+    // Range first: a double beyond int's range does not convert (undefined behaviour).
+    if (v.size() != 1 || !(v[0] >= 1 && v[0] <= 2147483647.0) || v[0] != std::floor(v[0]))
+      throw CliError(std::string("--") + opt + " expects a positive integer (at most 2147483647)");
     return static_cast<int>(v[0]);
   };
   const int K = a.has("q") ? 1 : count("states", 100);

@@ -1,4 +1,5 @@
 // femdyn import ROBOT.urdf -o ROBOT.json: the femdyn JSON document of a model file.
+#include <filesystem>
 #include <iostream>
 
 #include "cli/commands.hpp"
@@ -7,7 +8,7 @@
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp = R"(usage: femdyn import MODEL -o OUT.json [--gravity gx,gy,gz]     (-o is --output)
+constexpr const char* kHelp = R"(usage: femdyn import MODEL -o OUT.json [--force] [--gravity gx,gy,gz]     (-o is --output)
 
 Writes the femdyn JSON document of MODEL: a URDF robot converted (each link with an <inertial>
 becomes a body with one rigid_body element, its inertia rotated out of the <inertial> frame; a
@@ -15,25 +16,36 @@ link with an inertia but zero mass gets a rotary_node; links without <inertial> 
 joints keep their names, origins, axes, limits and damping, fixed joints are kept as fixed
 joints; <mimic> becomes a coupling; the root link is welded to the world; gravity (0, 0, -9.81)
 m/s^2 unless --gravity), or a plugin model expanded. The file loads back to the same
-equations. It is written atomically: a failure leaves no partial file.
+equations. It is written atomically: a failure leaves no partial file. An existing OUT.json is
+replaced only with --force, and never when it is MODEL itself.
 )";
 
 }  // namespace
 
 int cmd_import(int argc, char** argv) {
-  const Args a = parse_args(argc, argv, 2, {"help"}, {"output", "gravity"});
+  const Args a = parse_args(argc, argv, 2, {"help", "force"}, {"output", "gravity"});
   if (a.has("help")) {
     std::cout << kHelp;
     return 0;
   }
   if (a.positional.size() != 1) throw CliError("expected one MODEL file (try --help)");
   if (!a.has("output")) throw CliError("-o OUT.json is required (try --help)");
+  const std::string& out = a.options.at("output");
+  std::error_code ec;
+  if (std::filesystem::equivalent(out, a.positional[0], ec))
+    throw CliError("-o " + out + " is the model file itself");
+  if (std::filesystem::exists(out, ec) && !a.has("force"))
+    throw CliError(out + ": exists (use --force to replace it)");
   const LoadOptions opt = load_options(a);
   Json doc = model_document(a.positional[0], opt);
   if (opt.gravity) doc["gravity"] = {opt.gravity->x(), opt.gravity->y(), opt.gravity->z()};
   (void)load_model(a.positional[0], opt);  // the model must compile before anything is written
-  write_file_atomic(a.options.at("output"), readable_json(doc));
-  std::cerr << "femdyn import: wrote " << a.options.at("output") << "\n";
+  try {
+    write_file_atomic(out, readable_json(doc), a.has("force"));
+  } catch (const std::runtime_error& e) {
+    throw CliError(e.what());
+  }
+  std::cerr << "femdyn import: wrote " << out << "\n";
   return 0;
 }
 

@@ -1,6 +1,7 @@
 // femdyn track: computed-torque feed-forward along a smooth point-to-point motion, replayed
 // open loop in forward simulation — the control use of the equations.
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <sstream>
 
@@ -12,23 +13,32 @@
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp = R"(usage: femdyn track MODEL --to a,b,… [--from …] [--duration T] [--steps N] [--csv FILE] [--json]
+constexpr const char* kHelp = R"(usage: femdyn track MODEL --to a,b,… [--from …] [--duration T] [--steps N] [--csv FILE [--force]] [--json]
                      [--gravity gx,gy,gz]
 
 Plans the quintic (minimum-jerk) motion q_ref(t) from --from (default 0) to --to in T seconds
 (default 1), computes the joint torques τ(t) = M^s q̈_ref + h − Q(τ = 0) by inverse dynamics,
 then simulates the model under τ(t) alone (RK4, N steps, default 1000) and reports how closely
-the simulated motion follows q_ref. --csv writes t, q_ref, τ and q_sim per step (atomically).
+the simulated motion follows q_ref. --csv writes t, q_ref, τ and q_sim per step (atomically; an
+existing FILE is replaced only with --force, and never when it is MODEL).
 )";
 
 }  // namespace
 
 int cmd_track(int argc, char** argv) {
-  const Args a = parse_args(argc, argv, 2, {"help", "json"},
+  const Args a = parse_args(argc, argv, 2, {"help", "json", "force"},
                             {"to", "from", "duration", "steps", "csv", "gravity"});
   if (a.has("help")) {
     std::cout << kHelp;
     return 0;
+  }
+  if (a.has("csv")) {  // refused before any work if it would clobber a file
+    const std::string& out = a.options.at("csv");
+    std::error_code ec;
+    if (std::filesystem::equivalent(out, a.positional.at(0), ec))
+      throw CliError("--csv " + out + " is the model file itself");
+    if (std::filesystem::exists(out, ec) && !a.has("force"))
+      throw CliError("--csv " + out + ": exists (use --force to replace it)");
   }
   const Model m = load(a);
   if (!a.has("to")) throw CliError("--to is required (try --help)");
@@ -71,7 +81,13 @@ int cmd_track(int argc, char** argv) {
     const Status st = rk4.advance_to((k + 1) * dt);
     if (!st.ok) throw CliError(st.message);
   }
-  if (a.has("csv")) write_file_atomic(a.options.at("csv"), csv.str());
+  if (a.has("csv")) {
+    try {
+      write_file_atomic(a.options.at("csv"), csv.str(), a.has("force"));
+    } catch (const std::runtime_error& e) {
+      throw CliError(std::string("--csv ") + e.what());
+    }
+  }
   if (a.has("json")) {
     std::cout << Json{{"model", m.name}, {"duration", T}, {"steps", N},
                       {"max_tracking_error", max_err}, {"max_abs_tau", max_tau}}

@@ -17,12 +17,10 @@ double joint_force(const Joint& J, const Workspace& ws, const VecX& tau) {
   return (tau.size() > j ? tau[j] : 0.0) + spring_damper_force(J, ws.theta[j], ws.theta_dot[j]);
 }
 
-Status singular(const Model& model, int j, bool independently) {
+Status dependent_pivot(const Model& model, int j) {
   return {false,
           "the mass matrix M^s is singular: coordinate '" + model.coordinate_names[j] +
-              (independently ? "' moves no inertia independently of the joints beyond it"
-                             : "' moves no inertia (a massless chain end, or all its mass on "
-                               "the joint axis?)"),
+              "' moves no inertia independently of the joints beyond it",
           j};
 }
 
@@ -43,14 +41,14 @@ Status check_regularity(const Model& model, Workspace& ws) {
     const Vec6& S = ws.articulated[b].S;
     const double Mbb = S.dot(ws.composite[b] * S);
     if (!std::isfinite(Mbb)) return {false, "the mass matrix M^s has NaN or Inf entries", -1, true};
-    if (!(Mbb > 1e-13 * scale)) return singular(model, j, false);
+    if (!(Mbb > 1e-13 * scale)) return negligible_inertia(model.coordinate_names[j], j, Mbb, scale);
   }
   // Pivots in elimination order, leaves first: a lost pivot makes its ancestors' NaN.
   for (int b = nb - 1; b >= 0; --b) {
     const int j = model.bodies[b].joint.theta;
     if (j < 0) continue;
     const Vec6& S = ws.articulated[b].S;
-    if (!(ws.articulated[b].d >= 1e-13 * S.dot(ws.composite[b] * S))) return singular(model, j, true);
+    if (!(ws.articulated[b].d >= 1e-13 * S.dot(ws.composite[b] * S))) return dependent_pivot(model, j);
   }
   return {};
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/joint.hpp"
+#include "core/limits.hpp"
 
 namespace femdyn {
 namespace {
@@ -53,6 +54,8 @@ void condense_body_inertia(Model& m) {
   const Mat3 tilt = rpy_to_rotation(Vec3(0.3, -0.7, 1.1));
   for (const ElementEntry& e : m.elements) {
     const MatX me = e.element->local_mass();
+    for (Eigen::Index k = 0; k < me.size(); ++k)
+      check_magnitude(me.data()[k], e.where, "element mass matrix entry");
     const MatX X0 = twist_map(*e.element, Mat3::Identity()), X1 = twist_map(*e.element, tilt);
     const Mat6 L0 = X0.transpose() * me * X0, L1 = X1.transpose() * me * X1;
     if ((L0 - L1).cwiseAbs().maxCoeff() > 1e-12 * std::max(L0.cwiseAbs().maxCoeff(), 1e-300))

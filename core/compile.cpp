@@ -8,16 +8,12 @@
 #include "core/mass_solver.hpp"
 #include "core/correlation.hpp"
 #include "core/errors.hpp"
+#include "core/limits.hpp"
+#include "core/names.hpp"
 #include "core/model.hpp"
 
 namespace femdyn {
 namespace {
-
-bool finite(const Vec3& v) { return v.allFinite(); }
-
-void check_finite(double x, const std::string& where, const std::string& what) {
-  if (!std::isfinite(x)) throw ModelError(where, what + " is NaN or Inf");
-}
 
 // Bodies in depth-first order from the world, children in file order. Returns spec indices.
 std::vector<int> tree_order(const MechanismSpec& spec) {
@@ -25,6 +21,8 @@ std::vector<int> tree_order(const MechanismSpec& spec) {
   for (std::size_t i = 0; i < spec.bodies.size(); ++i) {
     const BodySpec& b = spec.bodies[i];
     if (b.name.empty()) throw ModelError(b.where, "body has an empty name");
+    check_name(b.name, b.where + "/name", "body name");
+    check_name(b.joint.name, b.joint.where + "/name", "joint name");
     if (b.name == "world") throw ModelError(b.where, "'world' is reserved for the ground");
     if (!index.emplace(b.name, static_cast<int>(i)).second)
       throw ModelError(b.where, "duplicate body name '" + b.name + "'");
@@ -34,7 +32,7 @@ std::vector<int> tree_order(const MechanismSpec& spec) {
   for (std::size_t i = 0; i < spec.bodies.size(); ++i) {
     const BodySpec& b = spec.bodies[i];
     if (b.parent != "world" && !index.count(b.parent))
-      throw ModelError(b.where + "/parent", "unknown parent body '" + b.parent + "'");
+      throw ModelError(b.where + "/parent", "unknown parent body " + quoted_text(b.parent));
     if (b.parent == b.name) throw ModelError(b.where + "/parent", "body is its own parent");
     children[b.parent == "world" ? 0 : index.at(b.parent) + 1].push_back(static_cast<int>(i));
   }
@@ -69,12 +67,12 @@ Joint compile_joint(const JointSpec& js, const std::string& body_name) {
   j.name = js.name.empty() ? body_name : js.name;
   j.type = js.type;
   j.where = js.where;
-  if (!finite(js.xyz)) throw ModelError(js.where + "/origin/xyz", "origin xyz is NaN or Inf");
-  if (!finite(js.rpy)) throw ModelError(js.where + "/origin/rpy", "origin rpy is NaN or Inf");
+  check_magnitude(js.xyz, js.where + "/origin/xyz", "origin xyz");
+  check_magnitude(js.rpy, js.where + "/origin/rpy", "origin rpy");
   j.p_pj = js.xyz;
   j.R_pj = rpy_to_rotation(js.rpy);
   if (js.type != JointType::Fixed) {
-    if (!finite(js.axis)) throw ModelError(js.where + "/axis", "axis is NaN or Inf");
+    check_magnitude(js.axis, js.where + "/axis", "axis");
     const double norm = js.axis.norm();
     if (!(norm > 1e-12)) throw ModelError(js.where + "/axis", "axis is zero");
     j.axis = js.axis / norm;
@@ -85,7 +83,7 @@ Joint compile_joint(const JointSpec& js, const std::string& body_name) {
   j.axis_parent = j.R_pj * j.axis;
   for (auto [x, what] : {std::pair{js.stiffness, "stiffness"}, {js.rest, "rest"},
                          {js.damping, "damping"}})
-    check_finite(x, js.where, what);
+    check_magnitude(x, js.where, what);
   if (js.stiffness < 0) throw ModelError(js.where + "/spring", "negative stiffness");
   if (js.damping < 0) throw ModelError(js.where + "/damping", "negative damping");
   if (std::isnan(js.lower) || std::isnan(js.upper) || js.lower > js.upper)
@@ -108,16 +106,16 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
   for (const CouplingSpec& c : spec.couplings) {
     auto it = theta_of.find(c.joint);
     if (it == theta_of.end())
-      throw ModelError(c.where + "/joint", "unknown or fixed joint '" + c.joint + "'");
+      throw ModelError(c.where + "/joint", "unknown or fixed joint " + quoted_text(c.joint));
     if (!coupled.emplace(it->second, &c).second)
       throw ModelError(c.where + "/joint", "joint '" + c.joint + "' is coupled twice");
-    check_finite(c.offset, c.where + "/offset", "offset");
+    check_magnitude(c.offset, c.where + "/offset", "offset");
     if (c.terms.empty())
       throw ModelError(c.where + "/follows", "names no joint (to fix a joint, make it fixed)");
     for (const auto& [name, ratio] : c.terms) {
       if (!theta_of.count(name))
-        throw ModelError(c.where + "/follows", "unknown or fixed joint '" + name + "'");
-      check_finite(ratio, c.where + "/ratio", "ratio");
+        throw ModelError(c.where + "/follows", "unknown or fixed joint " + quoted_text(name));
+      check_magnitude(ratio, c.where + "/ratio", "ratio");
     }
   }
   const int nt = m.n_theta();
@@ -194,13 +192,19 @@ Model compile(MechanismSpec spec) {
   Model m;
   m.name = spec.name;
   m.where = spec.where.size() >= 2 ? spec.where.substr(0, spec.where.size() - 2) : spec.where;
-  if (!finite(spec.gravity)) throw ModelError(spec.where + "/gravity", "gravity is NaN or Inf");
+  check_magnitude(spec.gravity, spec.where + "/gravity", "gravity");
+  check_name(spec.name, spec.where + "/name", "model name");
+  if (static_cast<long long>(spec.bodies.size()) > kMaxBodies)
+    throw ModelError(spec.where + "/bodies", std::to_string(spec.bodies.size()) +
+                                                 " bodies: more than femdyn's limit of " +
+                                                 std::to_string(kMaxBodies));
   m.gravity = spec.gravity;
   if (spec.bodies.empty()) throw ModelError(spec.where + "/bodies", "the model has no bodies");
 
   const std::vector<int> order = tree_order(spec);
   std::vector<int> body_of_spec(spec.bodies.size());
   std::set<std::string> joint_names;
+  std::map<std::string, int> compiled;  // body name -> index in m.bodies
   for (std::size_t k = 0; k < order.size(); ++k) {
     const BodySpec& bs = spec.bodies[order[k]];
     body_of_spec[order[k]] = static_cast<int>(k);
@@ -210,10 +214,8 @@ Model compile(MechanismSpec spec) {
     b.joint = compile_joint(bs.joint, bs.name);
     if (!joint_names.insert(b.joint.name).second)
       throw ModelError(bs.joint.where + "/name", "duplicate joint name '" + b.joint.name + "'");
-    b.parent = -1;
-    if (bs.parent != "world")
-      for (std::size_t p = 0; p < k; ++p)
-        if (m.bodies[p].name == bs.parent) b.parent = static_cast<int>(p);
+    b.parent = bs.parent == "world" ? -1 : compiled.at(bs.parent);  // (placed before: tree order)
+    compiled.emplace(bs.name, static_cast<int>(k));
     if (b.joint.type != JointType::Fixed) {
       b.joint.theta = static_cast<int>(m.theta_joint.size());
       m.theta_joint.push_back(static_cast<int>(k));

@@ -1,12 +1,16 @@
 #include "core/correlation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <random>
 #include <tuple>
 
 #include "core/equations.hpp"
 #include "core/errors.hpp"
+#include "core/limits.hpp"
+#include "core/names.hpp"
+#include "core/joint.hpp"
 #include "core/kinematics.hpp"
 
 namespace femdyn {
@@ -29,12 +33,16 @@ std::pair<int, Vec3> canonical_point(const Model& m, int b, Vec3 r) {
   return {b, r};
 }
 
-int find_or_add_node(Model& m, int body, const Vec3& r_body, const std::string& label) {
+// nodes_of[b]: the system nodes on body b, so that a lookup scans one body's nodes only.
+using NodesOfBody = std::vector<std::vector<int>>;
+
+int find_or_add_node(Model& m, NodesOfBody& nodes_of, int body, const Vec3& r_body,
+                     const std::string& label) {
   const auto [b, r] = canonical_point(m, body, r_body);
-  for (std::size_t i = 0; i < m.nodes.size(); ++i)
-    if (m.nodes[i].body == b && (m.nodes[i].r - r).norm() <= 1e-12 * (1.0 + r.norm()))
-      return static_cast<int>(i);
+  for (const int i : nodes_of[b])
+    if ((m.nodes[i].r - r).norm() <= 1e-12 * (1.0 + r.norm())) return i;
   m.nodes.push_back({b, r, label});
+  nodes_of[b].push_back(static_cast<int>(m.nodes.size()) - 1);
   return static_cast<int>(m.nodes.size()) - 1;
 }
 
@@ -92,10 +100,40 @@ struct TSamples {
 // of one sweep,
 //   translation k of a node at x:  revolute (s_a × (x − o_a))_k,  prismatic (s_a)_k
 //   rotation k of body b:           revolute (R_b e_k)·s_a,        prismatic 0,
-// The scan of a path stops at the first entry above `enough` (only whether a row exceeds the
-// tolerance is used): O(N_u) time for the DOFs that move, O(depth) each for those that never
-// do, and O(N_u) memory instead of the dense N_u × n T.
-void row_max_by_paths(const Model& m, Workspace& ws, VecX& row_max, double enough) {
+// Each entry is a linear functional of the joint's motion subspace S_a = (s_a, o_a × s_a)
+// (core/joint.hpp): T_ia = S_a · w_i with w = (x × e_k, e_k) for a translation, (R_b e_k, 0) for
+// a rotation. So the whole row is bounded by |P_b w| · max_a |S_a|, P_b the projector on the
+// span of the S_a along the path, kept per body as an orthonormal basis of at most six vectors
+// (O(1) per body). A row under the tolerance by that bound (every left-out DOF, e.g. the z of a
+// planar chain) costs O(1); otherwise the path is scanned, stopping at the first entry above
+// `enough` (only whether a row exceeds the tolerance is used), which for a DOF that moves is
+// near its own body. O(N_u + bodies) time, O(N_u + bodies) memory instead of the dense N_u × n T.
+struct PathSpan {
+  std::array<Vec6, 6> basis;  // orthonormal
+  int size = 0;
+  double s_max = 0;           // max |S_a| on the path
+  double bound(const Vec6& w) const {  // |P w| · max |S_a|
+    Vec6 p = Vec6::Zero();
+    for (int k = 0; k < size; ++k) p += basis[k].dot(w) * basis[k];
+    return p.norm() * s_max;
+  }
+};
+
+void row_max_by_paths(const Model& m, Workspace& ws, std::vector<PathSpan>& span, VecX& row_max,
+                      double enough) {
+  const int nb = static_cast<int>(m.bodies.size());
+  for (int b = 0; b < nb; ++b) {  // parents first
+    const Body& B = m.bodies[b];
+    span[b] = B.parent >= 0 ? span[B.parent] : PathSpan{};
+    if (B.joint.theta < 0) continue;
+    const Vec6 S = motion_subspace(B.joint, ws.body[b].R, ws.body[b].p);
+    PathSpan& P = span[b];
+    P.s_max = std::max(P.s_max, S.norm());
+    Vec6 r = S;  // Gram–Schmidt, twice for orthogonality in floating point
+    for (int pass = 0; pass < 2; ++pass)
+      for (int k = 0; k < P.size; ++k) r -= P.basis[k].dot(r) * P.basis[k];
+    if (P.size < 6 && r.norm() > 1e-9 * S.norm()) P.basis[P.size++] = r.normalized();
+  }
   const auto over_path = [&](int body, auto&& entry) {
     double big = 0;
     for (int a = body; a >= 0 && big <= enough; a = m.bodies[a].parent) {
@@ -109,17 +147,25 @@ void row_max_by_paths(const Model& m, Workspace& ws, VecX& row_max, double enoug
   for (int i = 0; i < m.n_u(); ++i) {
     const SystemDof& d = m.dofs[i];
     double big;
+    Vec6 w;
     if (d.kind == DofKind::Translation) {
       const SystemNode& node = m.nodes[d.carrier];
       const Vec3 x = ws.body[node.body].p + ws.body[node.body].R * node.r;
-      big = over_path(node.body, [&](const Joint& j, const Vec3& s, const Vec3& o) {
-        return j.type == JointType::Revolute ? s.cross(x - o)[d.axis] : s[d.axis];
-      });
+      const Vec3 e = Vec3::Unit(d.axis);
+      w << x.cross(e), e;
+      big = span[node.body].bound(w);
+      if (big > enough)
+        big = over_path(node.body, [&](const Joint& j, const Vec3& s, const Vec3& o) {
+          return j.type == JointType::Revolute ? s.cross(x - o)[d.axis] : s[d.axis];
+        });
     } else {
       const Vec3 e = ws.body[d.carrier].R.col(d.axis);
-      big = over_path(d.carrier, [&](const Joint& j, const Vec3& s, const Vec3&) {
-        return j.type == JointType::Revolute ? e.dot(s) : 0.0;
-      });
+      w << e, Vec3::Zero();
+      big = span[d.carrier].bound(w);
+      if (big > enough)
+        big = over_path(d.carrier, [&](const Joint& j, const Vec3& s, const Vec3&) {
+          return j.type == JointType::Revolute ? e.dot(s) : 0.0;
+        });
     }
     row_max[i] = std::max(row_max[i], big);
   }
@@ -130,10 +176,11 @@ TSamples sample_T(const Model& m, bool keep, double tol) {
   out.row_max = VecX::Zero(m.n_u());
   Workspace ws(m);
   const bool by_paths = !keep && m.identity_coupling;
+  std::vector<PathSpan> span(by_paths ? m.bodies.size() : 0);
   for (const VecX& q : sample_states(m, 3)) {
     if (by_paths) {
       propagate(m, ws, q, q, {.jacobian = false, .bias = false, .rows = false});
-      row_max_by_paths(m, ws, out.row_max, tol);
+      row_max_by_paths(m, ws, span, out.row_max, tol);
       continue;
     }
     propagate(m, ws, q, VecX::Zero(m.n()), {.jacobian = true, .bias = false});
@@ -178,6 +225,7 @@ std::vector<VecX> sample_states(const Model& m, int count) {
 void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec, Model& m) {
   // Elements in file order; each local DOF gets its candidate transition coordinate.
   Candidates cand;
+  NodesOfBody nodes_of(m.bodies.size());
   std::vector<std::vector<int>> local_cand;  // per element: 6k, -1 where unused
   std::vector<std::vector<int>> all_cand;    // per element: 6k, also for unused local DOFs
   for (std::size_t s = 0; s < spec.bodies.size(); ++s) {
@@ -192,10 +240,10 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
       std::vector<int> used, all;
       for (std::size_t l = 0; l < nodes.size(); ++l) {
         std::string label = l < es.node_labels.size() ? es.node_labels[l] : "node";
+        check_name(label, es.where, "node label");
         if (label.find('/') == std::string::npos) label = m.bodies[b].name + "/" + label;
-        if (!nodes[l].position.allFinite())
-          throw ModelError(es.where, "element node position is NaN or Inf");
-        const int node = find_or_add_node(m, b, nodes[l].position, label);
+        check_magnitude(nodes[l].position, es.where, "element node position");
+        const int node = find_or_add_node(m, nodes_of, b, nodes[l].position, label);
         for (int k = 0; k < kNodeDofs; ++k) {
           const bool use = nodes[l].uses[k];
           const int c = k < 3 ? cand.add(DofKind::Translation, node, k, use)
@@ -220,14 +268,17 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
     std::string where;
   };
   std::vector<LoadAt> loads;
+  std::map<std::string, int> body_index;
+  if (!spec.loads.empty())
+    for (std::size_t k = 0; k < m.bodies.size(); ++k) body_index.emplace(m.bodies[k].name, static_cast<int>(k));
   for (const LoadSpec& ls : spec.loads) {
-    int b = -1;
-    for (std::size_t k = 0; k < m.bodies.size(); ++k)
-      if (m.bodies[k].name == ls.body) b = static_cast<int>(k);
-    if (b < 0) throw ModelError(ls.where + "/body", "unknown body '" + ls.body + "'");
-    if (!ls.point.allFinite() || !ls.force.allFinite() || !ls.torque.allFinite())
-      throw ModelError(ls.where, "load has NaN or Inf");
-    const int node = find_or_add_node(m, b, ls.point, ls.body + "/load");
+    const auto found = body_index.find(ls.body);
+    const int b = found == body_index.end() ? -1 : found->second;
+    if (b < 0) throw ModelError(ls.where + "/body", "unknown body " + quoted_text(ls.body));
+    check_magnitude(ls.point, ls.where + "/point", "load point");
+    check_magnitude(ls.force, ls.where + "/force", "load force");
+    check_magnitude(ls.torque, ls.where + "/torque", "load torque");
+    const int node = find_or_add_node(m, nodes_of, b, ls.point, ls.body + "/load");
     if (!ls.force.isZero(0))
       for (int k = 0; k < 3; ++k) cand.add(DofKind::Translation, node, k, true);
     if (!ls.torque.isZero(0))

@@ -1,5 +1,6 @@
-// User-input errors found while compiling a mechanism. `where` is an opaque location label
-// supplied by the front end (for JSON models: "file.json: /bodies/3/joint").
+// User-input errors found while compiling a mechanism. `where` is the location label supplied
+// by the front end (for JSON models "file.json: /bodies/3/joint"); compile appends JSON-pointer
+// segments to it ("/origin/xyz") to name a field.
 #pragma once
 #include <stdexcept>
 #include <string>

@@ -241,10 +241,7 @@ Status MassSolver::factorize(const MatX& Ms) {
   // A coordinate that moves no inertia has a zero row and column in M^s.
   for (Eigen::Index a = 0; a < n; ++a)
     if (!(Ms(a, a) > 1e-13 * scale))
-      return {false, "the mass matrix M^s is singular: coordinate '" + names_.at(a) +
-                         "' moves no inertia (a massless chain end, or all its mass on the "
-                         "joint axis?)",
-              static_cast<int>(a)};
+      return negligible_inertia(names_.at(a), static_cast<int>(a), Ms(a, a), scale);
   if (kind_ == SolverKind::Tree) return factorize_tree(Ms);
   if (kind_ == SolverKind::Dense) {
     impl_->dense.compute(Ms);

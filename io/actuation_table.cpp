@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "io/input_file.hpp"
 
 namespace femdyn {
 namespace {
@@ -25,8 +26,7 @@ std::vector<std::string> split(const std::string& line) {
 }  // namespace
 
 ActuationTable::ActuationTable(const std::string& path, const Model& m) : path_(path) {
-  std::ifstream in(path);
-  if (!in) throw ModelError(path, "cannot read the actuation file");
+  std::istringstream in(read_input_file(path));
   const int n = m.n();
   std::string line;
   int lineno = 1;

@@ -13,6 +13,10 @@ AtomicFile::AtomicFile(std::string path, bool replace) : path_(std::move(path)) 
   std::error_code ec;
   if (path_.empty()) throw std::runtime_error("the output path is empty");
   if (fs::is_directory(path_, ec)) throw std::runtime_error(path_ + ": is a directory");
+  // A device, FIFO or socket is never renamed over (as root, /dev/full would be replaced).
+  const fs::file_status st = fs::status(path_, ec);
+  if (fs::exists(st) && !fs::is_regular_file(st))
+    throw std::runtime_error(path_ + ": is not a regular file (femdyn writes regular files only)");
   if (!replace && fs::exists(fs::symlink_status(path_, ec)))
     throw std::runtime_error(path_ + ": exists (use --force to replace it)");
   const fs::path target(path_);

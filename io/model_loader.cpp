@@ -8,6 +8,8 @@
 #include "io/params.hpp"
 #include "io/urdf_loader.hpp"
 #include "models/plugins.hpp"
+#include "core/limits.hpp"
+#include "io/input_file.hpp"
 
 namespace femdyn {
 namespace {
@@ -244,7 +246,14 @@ MechanismSpec parse_document(const Json& root, const std::string& source) {
 MechanismSpec parse_spec(const std::string& text, const std::string& source) {
   Json root;
   try {
-    root = Json::parse(text);
+    // The nesting depth is bounded while parsing (core/limits.hpp), before a deep document
+    // can exhaust anything.
+    root = Json::parse(text, [&](int depth, Json::parse_event_t, Json&) {
+      if (depth > kMaxNesting)
+        throw ModelError(source, "JSON nested deeper than " + std::to_string(kMaxNesting) +
+                                     " levels (femdyn's limit)");
+      return true;
+    });
   } catch (const Json::parse_error& e) {
     std::string what = e.what();
     const auto colon = what.rfind(": ");
@@ -267,13 +276,7 @@ MechanismSpec parse_model_json(const Json& root, const std::string& source) {
 
 namespace {
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ModelError(path, "cannot open file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string read_text(const std::string& path) { return read_input_file(path); }
 
 // Errors found after conversion name the URDF's link and joint, not the generated JSON path:
 // "robot.urdf: /bodies/3/joint: …" becomes "robot.urdf: joint 'elbow' (link 'forearm'): …".

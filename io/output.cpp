@@ -129,10 +129,11 @@ std::string info_text(const Model& model) {
     if (j.theta >= 0) {
       out << "   theta =";
       bool first = true;
-      for (int a = 0; a < model.n(); ++a) {
-        const double c = model.C.coeff(j.theta, a);
+      for (SpRowMat::InnerIterator it(model.C_sparse, j.theta); it; ++it) {
+        const double c = it.value();
         if (c == 0) continue;
-        out << (first ? " " : " + ") << (c == 1 ? "" : num(c) + "*") << model.coordinate_names[a];
+        out << (first ? " " : " + ") << (c == 1 ? "" : num(c) + "*")
+            << model.coordinate_names[it.col()];
         first = false;
       }
       if (model.theta0[j.theta] != 0) out << " + " << model.theta0[j.theta];
@@ -140,12 +141,11 @@ std::string info_text(const Model& model) {
     out << "\n";
   }
   out << "bodies and elements (" << model.elements.size() << " elements):\n";
-  for (std::size_t b = 0; b < model.bodies.size(); ++b) {
-    out << "  " << model.bodies[b].name << ":";
-    for (const ElementEntry& e : model.elements)
-      if (e.body == static_cast<int>(b)) out << " " << e.element->type_name();
-    out << "\n";
-  }
+  std::vector<std::string> element_types(model.bodies.size());
+  for (const ElementEntry& e : model.elements)
+    element_types[e.body].append(" ").append(e.element->type_name());
+  for (std::size_t b = 0; b < model.bodies.size(); ++b)
+    out << "  " << model.bodies[b].name << ":" << element_types[b] << "\n";
   out << "transition coordinates u (N_u = " << model.n_u() << " kept):\n";
   for (int i = 0; i < model.n_u(); ++i)
     out << "  " << std::setw(3) << i + 1 << " " << model.dof_name(i) << "\n";
@@ -181,8 +181,8 @@ Json info_json(const Model& model) {
   return j;
 }
 
-void write_file_atomic(const std::string& path, const std::string& content) {
-  AtomicFile f(path, true);
+void write_file_atomic(const std::string& path, const std::string& content, bool replace) {
+  AtomicFile f(path, replace);
   f.stream() << content;
   f.commit();
 }

@@ -31,6 +31,6 @@ std::string readable_json(const Json& doc);
 
 // Writes content to path through an AtomicFile (io/atomic_file.hpp): readers never see a
 // half-written file. Replaces an existing file.
-void write_file_atomic(const std::string& path, const std::string& content);
+void write_file_atomic(const std::string& path, const std::string& content, bool replace);
 
 }  // namespace femdyn

@@ -87,7 +87,10 @@ Mat3 Params::inertia(const char* key) const {
   Params p(v, w);
   p.allow_only({"ixx", "iyy", "izz", "ixy", "ixz", "iyz"});
   const double ixy = p.number_or("ixy", 0), ixz = p.number_or("ixz", 0), iyz = p.number_or("iyz", 0);
-  I << p.number("ixx"), ixy, ixz, ixy, p.number("iyy"), iyz, ixz, iyz, p.number("izz");
+  // Read before the comma initializer: a ModelError thrown inside it would leave it unfinished
+  // (an Eigen assertion in builds with assertions).
+  const double ixx = p.number("ixx"), iyy = p.number("iyy"), izz = p.number("izz");
+  I << ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz;
   return I;
 }
 

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/inertia.hpp"
+#include "io/input_file.hpp"
 
 namespace femdyn {
 namespace {
@@ -236,12 +237,6 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
   return out;
 }
 
-UrdfResult read_urdf(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ModelError(path, "cannot open file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return urdf_to_model(ss.str(), path);
-}
+UrdfResult read_urdf(const std::string& path) { return urdf_to_model(read_input_file(path), path); }
 
 }  // namespace femdyn

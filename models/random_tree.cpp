@@ -1,5 +1,6 @@
 #include "models/random_tree.hpp"
 
+#include <cmath>
 #include <random>
 
 #include "core/math.hpp"
@@ -9,7 +10,9 @@ namespace femdyn {
 Json random_tree(const Params& p) {
   p.allow_only({"seed", "bodies", "branching", "prismatic"});
   const double seed = p.has("seed") ? p.number("seed") : 1.0;
-  if (seed < 0 || seed != static_cast<unsigned>(seed)) p.fail("seed", "expected an integer >= 0");
+  if (seed < 0 || seed != std::floor(seed)) p.fail("seed", "expected an integer >= 0");
+  // Checked before any cast: a double beyond unsigned's range does not convert (undefined).
+  if (seed > 4294967295.0) p.fail("seed", "expected an integer <= 4294967295");
   const double count = p.has("bodies") ? p.number("bodies") : 10.0;
   if (count < 1 || count > 10000 || count != static_cast<int>(count))
     p.fail("bodies", "expected an integer from 1 to 10000");

@@ -72,7 +72,7 @@ TEST_CASE("bad command lines and bad models: one line, non-zero exit", "[cli]") 
   CHECK(r.code == 2);
   r = run("equations /nonexistent.json");
   CHECK(r.code == 1);
-  CHECK(r.out == "femdyn equations: /nonexistent.json: cannot open file\n");
+  CHECK(r.out == "femdyn equations: /nonexistent.json: cannot open file: No such file or directory\n");
   const std::string bad = "femdyn_test_bad.json";
   std::ofstream(bad) << R"({"bodies": [{"name": "a", "parent": "world", "joint": {"type": "revolute", "axis": [0, 0, 1]}, "elements": [{"type": "rigid_body", "mass": 1, "inertia": {"ixx": NaN}}]}]})";
   r = run("info " + bad);
@@ -239,7 +239,7 @@ TEST_CASE("bench: every quantity timed on both engines, D skipped as documented,
   CHECK(bad.out == "femdyn bench: --states expects one integer >= 1\n");
   bad = run("bench /nonexistent.json --quick");
   CHECK(bad.code == 1);
-  CHECK(bad.out == "femdyn bench: /nonexistent.json: cannot open file\n");
+  CHECK(bad.out == "femdyn bench: /nonexistent.json: cannot open file: No such file or directory\n");
 }
 #endif
 

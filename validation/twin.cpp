@@ -1,6 +1,7 @@
 // The Simbody twin (twin.hpp). Compiled without NDEBUG: Debian's Simbody 3.7 is built without
 // it and some of its header classes change layout with it (see CMakeLists.txt).
 #include "validation/twin.hpp"
+#include "core/names.hpp"
 
 #include <Simbody.h>
 #include <dlfcn.h>
@@ -131,6 +132,19 @@ struct SimbodyTwin::Impl {
     mobod.reserve(nb);
     for (int b = 0; b < nb; ++b) {
       const TwinBody& j = m.bodies[b];
+      try {
+        add_body(j);
+      } catch (const std::exception& e) {
+        throw std::runtime_error("Simbody refuses body '" + escaped(j.name) + "': " + one_line(e.what()));
+      }
+    }
+    finish_system();
+  }
+
+  // One femdyn body as a mobilized body with its mobilizer, spring and damper.
+  void add_body(const TwinBody& j) {
+    using namespace SimTK;
+    {
       MobilizedBody& parent = j.parent < 0 ? static_cast<MobilizedBody&>(matter.updGround())
                                                  : mobod[j.parent];
       const SimTK::Body::Rigid rigid(mass_properties(j));
@@ -160,6 +174,12 @@ struct SimbodyTwin::Impl {
           Force::MobilityLinearDamper(forces, mobod.back(), MobilizerUIndex(0), j.damping);
       }
     }
+  }
+
+  // Gravity, loads and couplers, then the realized state.
+  void finish_system() {
+    using namespace SimTK;
+    const TwinModel& m = model;
     if (m.gravity.norm() > 0)
       Force::Gravity(forces, matter, UnitVec3(to_simtk(m.gravity)), m.gravity.norm());
     for (const TwinModel::Load& l : m.loads) {
@@ -280,6 +300,14 @@ SimbodyTwin::SimbodyTwin(TwinModel model) : impl_(std::make_unique<Impl>(std::mo
 SimbodyTwin::~SimbodyTwin() = default;
 
 TwinEquations SimbodyTwin::equations(const VecX& q, const VecX& qd, const VecX& tau) {
+  try {
+    return equations_unguarded(q, qd, tau);
+  } catch (const std::exception& e) {  // SimTK's multi-line text, as one line
+    throw std::runtime_error("Simbody failed at this state: " + one_line(e.what()));
+  }
+}
+
+TwinEquations SimbodyTwin::equations_unguarded(const VecX& q, const VecX& qd, const VecX& tau) {
   Impl& s = *impl_;
   const TwinModel& m = s.model;
   const int n = m.n(), nt = m.n_theta();
@@ -321,6 +349,14 @@ TwinEquations SimbodyTwin::equations(const VecX& q, const VecX& qd, const VecX& 
 }
 
 VecX SimbodyTwin::inverse_dynamics(const VecX& q, const VecX& qd, const VecX& qdd) {
+  try {
+    return inverse_dynamics_unguarded(q, qd, qdd);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("Simbody failed at this state: " + one_line(e.what()));
+  }
+}
+
+VecX SimbodyTwin::inverse_dynamics_unguarded(const VecX& q, const VecX& qd, const VecX& qdd) {
   Impl& s = *impl_;
   s.set_state(q, qd, SimTK::Stage::Dynamics);
   const SimTK::Vector& mob = s.system.getMobilityForces(s.state, SimTK::Stage::Dynamics);

@@ -31,6 +31,7 @@ using Vec3 = Eigen::Vector3d;
 
 // What the twin needs of a femdyn Model (built by twin_model() in validate.cpp).
 struct TwinBody {
+  std::string name;              // for messages ("Simbody refuses body 'x': …")
   int parent = -1;               // -1: the ground
   enum class Joint { Revolute, Prismatic, Fixed } joint = Joint::Fixed;
   Mat3 R_pj = Mat3::Identity();  // joint frame in the parent body frame
@@ -161,6 +162,9 @@ class SimbodyTwin {
   void time_tensor(const VecX& q);
 
  private:
+  // The same without the guard that turns SimTK's exceptions into one line.
+  TwinEquations equations_unguarded(const VecX& q, const VecX& qd, const VecX& tau);
+  VecX inverse_dynamics_unguarded(const VecX& q, const VecX& qd, const VecX& qdd);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

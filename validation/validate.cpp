@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 #include <random>
+#include <stdexcept>
 
 #include "core/equations.hpp"
 #include "core/model.hpp"
@@ -22,6 +23,7 @@ TwinModel twin_model(const Model& m) {
   for (std::size_t b = 0; b < m.bodies.size(); ++b) {
     const Joint& j = m.bodies[b].joint;
     TwinBody tb;
+    tb.name = m.bodies[b].name;
     tb.parent = m.bodies[b].parent;
     tb.joint = j.type == JointType::Revolute    ? TwinBody::Joint::Revolute
                : j.type == JointType::Prismatic ? TwinBody::Joint::Prismatic
@@ -61,12 +63,15 @@ void accumulate(QuantityError& e, const MatX& femdyn, const MatX& simbody) {
 
 // femdyn's passive motion by RK4 (core/fixed_step.hpp) at step dt, sampled at `times`
 // (multiples of dt). Returns false if the integration failed (M^s singular on the way).
+// An overflow along the trajectory (NaN or Inf) is an error, never a skipped comparison.
 bool integrate(const Model& m, const VecX& q0, const VecX& qd0, const std::vector<double>& times,
                double dt, std::vector<VecX>& state, std::vector<double>& energy) {
   Rk4 rk4(m, {.dt = dt});
   rk4.reset(0, q0, qd0);
   for (double target : times) {
-    if (!rk4.advance_to(target).ok) return false;
+    const Status st = rk4.advance_to(target);
+    if (st.non_finite) throw std::runtime_error("along the trajectory: " + st.message);
+    if (!st.ok) return false;
     VecX x(2 * m.n_theta());
     x << m.C * rk4.q() + m.theta0, m.C * rk4.qd();
     state.push_back(std::move(x));

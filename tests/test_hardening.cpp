@@ -1,0 +1,247 @@
+// Hostile input (issue 12): every case ends in a one-line error naming the place, or succeeds;
+// never a crash, a hang, a foreign exception text, or NaN printed as an answer.
+#include <catch2/catch.hpp>
+#include <pthread.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/errors.hpp"
+#include "core/sampling.hpp"
+#include "tests/helpers.hpp"
+#include "validation/twin.hpp"
+
+using namespace femdyn;
+using namespace femdyn::test;
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A fresh directory per process (ctest runs test cases in parallel processes).
+fs::path scratch() {
+  const fs::path dir = fs::temp_directory_path() / ("femdyn_hardening_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string load_error(const std::string& path) {
+  try {
+    load_model(path);
+  } catch (const ModelError& e) {
+    return e.what();
+  }
+  return "(loaded)";
+}
+
+std::string text_error(const std::string& text) {
+  try {
+    load_text(text);
+  } catch (const ModelError& e) {
+    return e.what();
+  }
+  return "(loaded)";
+}
+
+json pendulum() {
+  std::ifstream in(model_path("pendulum.json"));
+  return json::parse(in);
+}
+
+// A planar serial chain of `n` links of 0.1 m, a point mass at each link's end.
+std::string planar_chain(int n) {
+  json bodies = json::array();
+  for (int i = 0; i < n; ++i)
+    bodies.push_back({{"name", "b" + std::to_string(i)},
+                      {"parent", i == 0 ? std::string("world") : "b" + std::to_string(i - 1)},
+                      {"joint", {{"type", "revolute"}, {"axis", {0, 0, 1}}, {"origin", {{"xyz", {0.1, 0, 0}}}}}},
+                      {"elements", {{{"type", "lumped_point"}, {"node", {0.1, 0, 0}}, {"mass", 1}}}}});
+  return json{{"name", "chain"}, {"gravity", {0, -9.81, 0}}, {"bodies", bodies}}.dump();
+}
+
+}  // namespace
+
+TEST_CASE("a FIFO or a device or a directory is refused at once", "[hardening]") {
+  const fs::path fifo = scratch() / "model.json";
+  fs::remove(fifo);
+  REQUIRE(mkfifo(fifo.c_str(), 0600) == 0);
+  // Without a writer, reading a FIFO would block for ever: it is refused before any read.
+  CHECK(load_error(fifo) == fifo.string() + ": is not a regular file (a FIFO, device or socket): femdyn reads files only");
+  fs::remove(fifo);
+  CHECK(load_error("/dev/zero") == "/dev/zero: is not a regular file (a FIFO, device or socket): femdyn reads files only");
+  CHECK(load_error(scratch().string()) == scratch().string() + ": is a directory, not a file");
+  CHECK(load_error("/dev/zero.urdf").find("cannot open file") != std::string::npos);
+}
+
+TEST_CASE("a file over the size limit is refused before it is read", "[hardening]") {
+  const fs::path big = scratch() / "big.json";
+  { std::ofstream(big.string()); }
+  fs::resize_file(big, (256u << 20) + 1);  // sparse: no 256 MiB written
+  CHECK_THAT(load_error(big), Catch::Contains("bytes: more than the limit of 268435456 bytes"));
+  fs::remove(big);
+}
+
+TEST_CASE("JSON nested deeper than the limit is refused without recursion", "[hardening]") {
+  for (const int depth : {65, 100000}) {
+    INFO(depth);
+    const std::string text = "{\"name\": " + std::string(depth, '[') + std::string(depth, ']') + "}";
+    CHECK(text_error(text) == "test: JSON nested deeper than 64 levels (femdyn's limit)");
+  }
+}
+
+TEST_CASE("out-of-range numbers are refused naming the field", "[hardening]") {
+  json g = pendulum();
+  g["gravity"] = {0, 0, -1e308};
+  CHECK(text_error(g.dump()) == "test: /gravity: gravity -1e+308 is out of range (|x| ≤ 1e100: "
+                               "beyond it the equations' products overflow double precision)");
+  json k = pendulum();
+  k["bodies"][0]["joint"]["spring"] = {{"stiffness", 1e308}};
+  CHECK_THAT(text_error(k.dump()), Catch::StartsWith("test: /bodies/0/joint: stiffness 1e+308 is out of range"));
+  json m = pendulum();
+  m["bodies"][0]["elements"][0]["mass"] = 1e308;
+  CHECK_THAT(text_error(m.dump()), Catch::StartsWith("test: /bodies/0/elements/0: element mass matrix entry 1e+308 is out of range"));
+  // The same from the command line: one line, exit 1 or 2, no NaN printed.
+  const Run cli = run("equations " + model_path("finger.json") + " --gravity 0,0,1e308");
+  CHECK(cli.code != 0);
+  CHECK(cli.out.find('\n') == cli.out.size() - 1);
+  const Run qd = run("equations " + model_path("finger.json") + " --qd 1e200,0,0,0");
+  CHECK(qd.code == 2);
+  CHECK_THAT(qd.out, Catch::Contains("--qd: '1e200' is out of range"));
+}
+
+TEST_CASE("names with control characters are refused and user text is echoed escaped",
+          "[hardening]") {
+  json j = pendulum();
+  j["bodies"][0]["name"] = "arm\x1b[31m";
+  const std::string e = text_error(j.dump());
+  CHECK(e == "test: /bodies/0/name: body name 'arm\\x1b[31m' contains a control character "
+             "(names must be printable)");
+  json p = pendulum();
+  p["bodies"][0]["parent"] = "w\x1b]0;title\x07";
+  CHECK(text_error(p.dump()) == "test: /bodies/0/parent: unknown parent body 'w\\x1b]0;title\\x07'");
+  json c1 = pendulum();  // U+009B, the one-byte CSI of 8-bit terminals
+  c1["bodies"][0]["joint"]["name"] = "hinge\xc2\x9b" "2J";
+  CHECK_THAT(text_error(c1.dump()), Catch::Contains("'hinge\\xc2\\x9b2J' contains a control character"));
+  const Run cli = run("equations " + model_path("finger.json") + " --q \"$(printf '0,0,0,1\\033[2J')\"");
+  CHECK(cli.code == 2);
+  CHECK(cli.out.find('\x1b') == std::string::npos);
+}
+
+TEST_CASE("a 100000-body chain is compiled or refused with a message and never crashes",
+          "[hardening]") {
+  // The compile passes are linear in the bodies (no recursion, no search over all nodes or
+  // bodies). This chain is 10 km of 0.1 m links: the leaf's M^s(a, a) is ~1e-14 of the root's,
+  // which femdyn reports as singular to double precision.
+  const std::string e = text_error(planar_chain(100000));
+  CHECK_THAT(e, Catch::Contains("is singular to double precision: coordinate 'b9999"));
+  // 10,000 links compile.
+  CHECK(load_text(planar_chain(10000)).n() == 10000);
+}
+
+TEST_CASE("deep trees and long coupling chains compile on a small stack", "[hardening]") {
+  // Compile walks the tree and resolves couplings with explicit stacks. Proved on a thread with
+  // a 256 KiB stack: a recursion per body or per coupling (≥ 100 bytes a frame) would overflow it
+  // at 5,000. Joint names default to the body names; every joint follows the previous one.
+  json j = json::parse(planar_chain(5000));
+  json couplings = json::array();
+  for (int i = 1; i < 5000; ++i)
+    couplings.push_back({{"joint", "b" + std::to_string(i)}, {"follows", "b" + std::to_string(i - 1)}});
+  j["couplings"] = couplings;
+  struct Job {
+    std::string text;
+    int n = -1;
+    std::string error;
+  } job{j.dump()};
+  pthread_attr_t attr;
+  pthread_attr_init(&attr);
+  pthread_attr_setstacksize(&attr, 256 * 1024);
+  pthread_t thread;
+  const auto body = [](void* p) -> void* {
+    auto& job = *static_cast<Job*>(p);
+    try {
+      job.n = load_text(job.text).n();
+    } catch (const std::exception& e) {
+      job.error = e.what();
+    }
+    return nullptr;
+  };
+  REQUIRE(pthread_create(&thread, &attr, body, &job) == 0);
+  pthread_join(thread, nullptr);
+  pthread_attr_destroy(&attr);
+  INFO(job.error);
+  CHECK(job.n == 1);  // one coordinate drives all 5,000 joints
+}
+
+TEST_CASE("huge joint limits give finite sample postures", "[hardening]") {
+  json j = pendulum();
+  j["bodies"][0]["joint"]["limits"] = {-1e308, 1e308};
+  const Model m = load_text(j.dump());
+  std::mt19937 rng(1);
+  for (int k = 0; k < 100; ++k) {
+    const VecX q = random_posture(m, rng);
+    CHECK(std::abs(q[0]) <= 3.15);
+  }
+  j["bodies"][0]["joint"]["limits"] = {10, 1e308};  // disjoint from ±π: the first 2π of them
+  const Model n = load_text(j.dump());
+  const double q = random_posture(n, rng)[0];
+  CHECK((q >= 10 && q <= 10 + 6.3));
+}
+
+TEST_CASE("Simbody's refusals reach the user as one line naming the body", "[hardening]") {
+  validation::TwinModel t;
+  validation::TwinBody b;
+  b.name = "bad";
+  b.joint = validation::TwinBody::Joint::Revolute;
+  b.theta = 0;
+  b.mass = 1;
+  b.inertia_origin = Mat3::Identity();
+  b.inertia_origin(0, 1) = b.inertia_origin(1, 0) = std::nan("");  // Simbody asserts no NaN
+  t.bodies.push_back(b);
+  t.theta_body = {0};
+  t.C = MatX::Identity(1, 1);
+  t.theta0 = VecX::Zero(1);
+  try {
+    validation::SimbodyTwin twin(t);
+    FAIL("Simbody accepted a NaN inertia");
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    CHECK_THAT(what, Catch::StartsWith("Simbody refuses body 'bad': "));
+    CHECK(what.find('\n') == std::string::npos);
+  }
+}
+
+TEST_CASE("outputs never clobber an input or an existing file without --force", "[hardening]") {
+  const fs::path dir = scratch();
+  const fs::path urdf = dir / "robot.urdf", json_out = dir / "robot.json";
+  fs::copy_file(model_path("urdf/hand16.urdf"), urdf, fs::copy_options::overwrite_existing);
+  fs::remove(json_out);
+  const std::string before = [&] { std::ifstream in(urdf); return std::string(std::istreambuf_iterator<char>(in), {}); }();
+  const Run self = run("import " + urdf.string() + " -o " + urdf.string());
+  CHECK(self.code == 2);
+  CHECK(self.out == "femdyn import: -o " + urdf.string() + " is the model file itself\n");
+  const std::string after = [&] { std::ifstream in(urdf); return std::string(std::istreambuf_iterator<char>(in), {}); }();
+  CHECK(after == before);
+  CHECK(run("import " + urdf.string() + " -o " + json_out.string()).code == 0);
+  const Run again = run("import " + urdf.string() + " -o " + json_out.string());
+  CHECK(again.out == "femdyn import: " + json_out.string() + ": exists (use --force to replace it)\n");
+  CHECK(run("import " + urdf.string() + " -o " + json_out.string() + " --force").code == 0);
+  // A device is never renamed over, even with --force (as root, that would replace /dev/full).
+  const Run dev = run("import " + urdf.string() + " -o /dev/full --force");
+  CHECK(dev.out == "femdyn import: /dev/full: is not a regular file (femdyn writes regular files only)\n");
+  fs::remove(urdf);
+  fs::remove(json_out);
+}
+
+TEST_CASE("the D tensor is refused before allocating past the limit", "[hardening]") {
+  const fs::path big = scratch() / "tree300.json";
+  std::ofstream(big.string()) << R"({"model": "random_tree", "params": {"seed": 1, "bodies": 300}})";
+  const Run r = run("equations " + big.string() + " --tensor");
+  CHECK(r.code == 2);
+  CHECK_THAT(r.out, Catch::StartsWith("femdyn equations: --tensor: D needs "));
+  CHECK_THAT(r.out, Catch::Contains("the limit is 2e+07"));
+  fs::remove(big);
+}

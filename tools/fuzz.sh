@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# Fuzzing (docs/robustness.md#fuzzing): builds the libFuzzer targets of tests/fuzz/ in
+# ./build-fuzz (clang++, -DFEMDYN_FUZZ=ON, ASan + UBSan) and runs each for SECONDS (default 60)
+# on its seed corpus. Exits 1 if a target found a bug (a crash, sanitizer report, unexpected
+# exception, timeout, out-of-memory or NaN), naming the input kept in build-fuzz/artifacts/.
+#   tools/fuzz.sh [SECONDS]          e.g. CI: tools/fuzz.sh 60
+#   FEMDYN_FUZZ_NAN_CHECK=1 tools/fuzz.sh   NaN/Inf results on finite input count as bugs
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+seconds=${1:-60}
+if ! [[ $seconds =~ ^[0-9]+$ ]] || [ "$seconds" -lt 1 ]; then
+  echo "usage: tools/fuzz.sh [SECONDS]   (seconds per target, default 60)" >&2
+  exit 2
+fi
+build=build-fuzz
+mkdir -p "$build/artifacts"
+log=$build/build.log
+
+# Build: everything instrumented, asserts on (-O1 -g without NDEBUG), only what the targets need.
+t0=$(date +%s)
+if ! { cmake -S . -B "$build" -DCMAKE_CXX_COMPILER=clang++ -DFEMDYN_FUZZ=ON \
+         -DFEMDYN_BUILD_TESTS=OFF -DFEMDYN_WITH_SIMBODY=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+         "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g" &&
+       cmake --build "$build" -j"$(nproc)" --target fuzz_targets; } >"$log" 2>&1; then
+  cat "$log" >&2
+  echo "fuzz: build failed (log above, also in $log)" >&2
+  exit 1
+fi
+echo "fuzz: built $build in $(($(date +%s) - t0)) s (log: $log)"
+
+# target  max_len  dictionary  seed corpora (read only; new inputs go to build-fuzz/corpus/TARGET)
+targets=(
+  "json_model 8192 tests/fuzz/json_model.dict models"
+  "urdf 20480 tests/fuzz/urdf.dict models/urdf tests/robots"
+  "vector 256 - tests/fuzz/corpus/vector"
+)
+found=()
+for spec in "${targets[@]}"; do
+  read -r name max_len dict seeds <<<"$spec"
+  corpus=$build/corpus/$name
+  mkdir -p "$corpus"
+  before=$(ls "$build/artifacts")
+  args=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len="$max_len"
+        -artifact_prefix="$build/artifacts/$name-" -print_final_stats=1)
+  [ "$dict" != - ] && args+=(-dict="$dict")
+  t1=$(date +%s)
+  # shellcheck disable=SC2086  # seeds: a list of directories
+  if "$build/tests/fuzz/fuzz_$name" "${args[@]}" "$corpus" $seeds "tests/fuzz/regressions/$name" \
+       >"$build/fuzz-$name.log" 2>&1; then
+    status=ok
+  else
+    status=failed
+  fi
+  runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$build/fuzz-$name.log" | tail -1)
+  cov=$(grep -o 'cov: [0-9]*' "$build/fuzz-$name.log" | tail -1 || true)
+  new=$(comm -13 <(echo "$before") <(ls "$build/artifacts") | sed "s|^|$build/artifacts/|")
+  echo "fuzz: $name: $(($(date +%s) - t1)) s, ${runs:-?} inputs, ${cov:-cov: ?}, corpus $(ls "$corpus" | wc -l) files: $status"
+  if [ "$status" != ok ] || [ -n "$new" ]; then
+    grep -E 'BUG:|ERROR:|SUMMARY:|runtime error|Assertion|Test unit written' "$build/fuzz-$name.log" | head -20 >&2 || true
+    [ -n "$new" ] || new="(no artifact; see $build/fuzz-$name.log)"
+    for a in $new; do found+=("$name: $a"); done
+  fi
+done
+
+if [ ${#found[@]} -gt 0 ]; then
+  echo "fuzz: FAILED, bug inputs:" >&2
+  printf '  %s\n' "${found[@]}" >&2
+  echo "fuzz: reproduce with $build/tests/fuzz/fuzz_TARGET INPUT; once understood, copy the input" \
+       "to tests/fuzz/regressions/TARGET/ (replayed by ctest)" >&2
+  exit 1
+fi
+echo "fuzz: no bug found"
