@@ -315,6 +315,8 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
       throw ModelError(cs.where, "has " + std::to_string(cs.rows.size()) + " rows, expected " +
                                      std::to_string(m.elements.size()) + " (one per element)");
     int N = 0;
+    std::size_t entries = 0;
+    for (const auto& row : cs.rows) entries += row.size();
     for (std::size_t e = 0; e < cs.rows.size(); ++e) {
       const std::string where = cs.where + "/" + std::to_string(e);
       if (cs.rows[e].size() != all_cand[e].size())
@@ -323,6 +325,11 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
                                     " (6 per element node)");
       for (int d : cs.rows[e]) {
         if (d < 0) throw ModelError(where, "negative system DOF number");
+        // Numbered 1, 2, … without gaps: no number exceeds the entries (nor sizes a huge buffer).
+        if (static_cast<std::size_t>(d) > entries)
+          throw ModelError(where, "system DOF number " + std::to_string(d) + " exceeds the " +
+                                      std::to_string(entries) +
+                                      " entries of the table (DOFs are numbered 1, 2, … without gaps)");
         N = std::max(N, d);
       }
     }

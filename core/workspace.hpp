@@ -46,7 +46,8 @@ struct Workspace {
   VecX u_dot;                      // u̇ = T q̇
   VecX nodal;                      // M T'[q̇,q̇] + g, then nodal forces F (N_u)
   MatX MT;                         // M T (N_u x n), sized when first formed
-  VecX u_acc;                      // T q̈ + T'[q̇,q̇] (inverse dynamics)
+  VecX u_acc;                      // T q̈ + T'[q̇,q̇] (inverse dynamics); also the nodal forces
+                                   // plus the body torques in generalized_force (N_u)
   std::vector<RigidInertia> composite;  // per body: composite inertia I^c_b (world, origin)
   std::vector<Vec6> subspace;      // per body: its joint's motion subspace S (world, origin)
   std::vector<ArticulatedBody> articulated;  // per body, for the body-level routes only

@@ -11,7 +11,6 @@ class LumpedPoint final : public Element {
   std::string_view type_name() const override { return "lumped_point"; }
   std::span<const ElementNode> nodes() const override { return {&node_, 1}; }
   MatX local_mass() const override;
-  double mass() const { return mass_; }
 
   static void from_params(const Params& p, ElementSink& sink);
 

@@ -11,13 +11,10 @@ namespace femdyn {
 
 // The one place element types are registered.
 static const std::array kTypes = {
-    ElementType{"lumped_point", &LumpedPoint::from_params, "a mass at a node"},
-    ElementType{"space_bar", &SpaceBar::from_params,
-                "a rigid bar lumped to its two end nodes, with its rotary inertia"},
-    ElementType{"rotary_node", &RotaryNode::from_params,
-                "a rotary inertia at a node, with its gyroscopic term"},
-    ElementType{"rigid_body", &RigidBodyShorthand::from_params,
-                "mass, centre of mass, inertia: turned into equivalent elements"},
+    ElementType{"lumped_point", &LumpedPoint::from_params},  // a mass at a node
+    ElementType{"space_bar", &SpaceBar::from_params},  // a rigid bar lumped to its two end nodes
+    ElementType{"rotary_node", &RotaryNode::from_params},  // a rotary inertia at a node
+    ElementType{"rigid_body", &RigidBodyShorthand::from_params},  // mass, com, inertia
 };
 
 std::span<const ElementType> element_types() { return kTypes; }

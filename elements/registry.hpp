@@ -29,7 +29,6 @@ using ElementFactory = void (*)(const Params& params, ElementSink& sink);
 struct ElementType {
   std::string_view name;
   ElementFactory make;
-  std::string_view summary;
 };
 
 std::span<const ElementType> element_types();

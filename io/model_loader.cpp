@@ -1,6 +1,7 @@
 #include "io/model_loader.hpp"
 
 #include <cctype>
+#include <cstdint>
 #include <fstream>
 #include <sstream>
 
@@ -230,9 +231,16 @@ MechanismSpec parse_document(const Json& root, const std::string& source) {
       if (!t[r].is_array()) throw ModelError(w, "expected an array of integers");
       std::vector<int> row;
       for (std::size_t k = 0; k < t[r].size(); ++k) {
-        if (!t[r][k].is_number_integer())
-          throw ModelError(w + "/" + std::to_string(k), "expected an integer DOF number");
-        row.push_back(t[r][k].get<int>());
+        const Json& x = t[r][k];
+        const std::string wk = w + "/" + std::to_string(k);
+        if (!x.is_number_integer()) throw ModelError(wk, "expected an integer DOF number");
+        // Range-checked before narrowing: 2^31 must not wrap to a negative int, nor 2^63 to 0.
+        const bool fits = x.is_number_unsigned() ? x.get<std::uint64_t>() <= 2147483647u
+                                                 : x.get<std::int64_t>() >= 0 &&
+                                                       x.get<std::int64_t>() <= 2147483647;
+        if (!fits)
+          throw ModelError(wk, "DOF number " + x.dump() + " is out of range (0 to 2147483647)");
+        row.push_back(x.get<int>());
       }
       cs.rows.push_back(std::move(row));
     }

@@ -65,6 +65,5 @@ double translation_value(const Model& m, const Workspace& ws, int i) {
   return (B.p + B.R * n.r)[d.axis];
 }
 
-Mat3 body_rotation(const Workspace& ws, int body) { return ws.body[body].R; }
 
 }  // namespace femdyn::test

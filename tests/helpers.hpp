@@ -37,7 +37,4 @@ struct Run {
 Run run(const std::string& args);
 Run run_shell(const std::string& command);  // any shell command
 
-// Body rotation R_WB after propagate().
-Mat3 body_rotation(const Workspace& ws, int body);
-
 }  // namespace femdyn::test

@@ -245,3 +245,38 @@ TEST_CASE("the D tensor is refused before allocating past the limit", "[hardenin
   CHECK_THAT(r.out, Catch::Contains("the limit is 2e+07"));
   fs::remove(big);
 }
+
+TEST_CASE("correlation-table integers are range-checked before narrowing", "[hardening]") {
+  Json doc = model_document(model_path("finger_paper.json"));
+  REQUIRE(doc.contains("correlation_table"));
+  const auto with_entry = [&](const Json& value) {
+    Json d = doc;
+    d["correlation_table"]["rows"][0][5] = value;
+    return text_error(d.dump());
+  };
+  CHECK(with_entry(std::int64_t{1} << 31) ==
+        "test: /correlation_table/rows/0/5: DOF number 2147483648 is out of range (0 to 2147483647)");
+  CHECK(with_entry(std::uint64_t{1} << 63) ==
+        "test: /correlation_table/rows/0/5: DOF number 9223372036854775808 is out of range (0 to 2147483647)");
+  CHECK(with_entry(-1) == "test: /correlation_table/rows/0/5: DOF number -1 is out of range (0 to 2147483647)");
+  CHECK_THAT(with_entry(999999), Catch::Contains("system DOF number 999999 exceeds the 48 entries"));
+}
+
+TEST_CASE("an interrupted simulate leaves the old output file intact", "[hardening]") {
+  const fs::path dir = scratch() / "sigint";
+  fs::create_directories(dir);
+  const fs::path out = dir / "traj.csv";
+  std::ofstream(out.string()) << "old\n";
+  // A run of a simulated hour at a 1 µs step takes far longer than the 1 s before SIGINT.
+  const Run r = run_shell("sh -c '" + std::string(FEMDYN_BINARY) + " simulate " +
+                          model_path("finger.json") + " --t-end 3600 --integrator rk4 --dt 1e-6 --out " +
+                          out.string() + " --force & pid=$!; sleep 1; kill -INT $pid; wait $pid; echo exit=$?'");
+  INFO(r.out);
+  CHECK(r.out.find("exit=130") != std::string::npos);  // stopped by the signal, as documented
+  std::ifstream in(out.string());
+  CHECK(std::string(std::istreambuf_iterator<char>(in), {}) == "old\n");
+  int files = 0;
+  for ([[maybe_unused]] const auto& f : fs::directory_iterator(dir)) ++files;
+  CHECK(files == 1);  // no temporary file left beside it
+  fs::remove_all(dir);
+}

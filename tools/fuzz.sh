@@ -40,6 +40,18 @@ for spec in "${targets[@]}"; do
   read -r name max_len dict seeds <<<"$spec"
   corpus=$build/corpus/$name
   mkdir -p "$corpus"
+  # The scratch corpus keeps every input that was once new; loading 10,000 of them takes longer
+  # than a short run. Above 2,000 files it is minimised first (libFuzzer -merge=1).
+  if [ "$(ls "$corpus" | wc -l)" -gt 2000 ]; then
+    rm -rf "$corpus.min" && mkdir "$corpus.min"
+    if "$build/tests/fuzz/fuzz_$name" -merge=1 -timeout=10 -rss_limit_mb=2048 -max_len="$max_len" \
+         "$corpus.min" "$corpus" >"$build/merge-$name.log" 2>&1; then
+      echo "fuzz: $name: scratch corpus minimised from $(ls "$corpus" | wc -l) to $(ls "$corpus.min" | wc -l) files"
+      rm -rf "$corpus" && mv "$corpus.min" "$corpus"
+    else
+      rm -rf "$corpus.min"  # keep the corpus as it is (log: $build/merge-$name.log)
+    fi
+  fi
   before=$(ls "$build/artifacts")
   args=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len="$max_len"
         -artifact_prefix="$build/artifacts/$name-" -print_final_stats=1)

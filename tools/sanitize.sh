@@ -40,7 +40,8 @@ ctest --test-dir "$build" --output-on-failure -j"$jobs" >"$testlog" 2>&1 || stat
 t2=$(date +%s)
 if [ "$status" -ne 0 ]; then
   # Everything but the passing tests' lines: failing tests' output and sanitizer reports.
-  grep -v -E '^ *[0-9]+/[0-9]+ Test +#[0-9]+: .* (Passed|\*\*\*Skipped) ' "$testlog" >&2 || true
+  grep -v -E '^ *Start +[0-9]+: |^ *[0-9]+/[0-9]+ Test +#[0-9]+: .* (Passed|\*\*\*Skipped) ' \
+    "$testlog" >&2 || true
   echo "sanitize: FAILED after $((t2 - t1)) s of tests (whole log: $testlog)" >&2
   exit 1
 fi

@@ -28,7 +28,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     model.emplace(compile(std::move(spec)));
   });
   if (model)
-    fuzz::expected_errors_only("json_model evaluation",
-                               [&] { fuzz::evaluate_once(*model, fuzz::hash(data, size), finite); });
+    fuzz::expected_errors_only("json_model evaluation", [&] {
+      fuzz::evaluate_once(*model, fuzz::hash(data, size), finite);
+    });
   return 0;
 }

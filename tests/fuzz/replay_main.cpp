@@ -35,7 +35,8 @@ int main(int argc, char** argv) {
     for (const auto& e : fs::directory_iterator(arg)) {
       const std::string name = e.path().filename().string();
       if (!e.is_regular_file() || name.front() == '.') continue;
-      if (name.size() < suffix.size() || name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
+      if (name.size() < suffix.size() ||
+          name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0)
         continue;
       files.push_back(e.path());
     }

@@ -2,10 +2,12 @@
 // body limit look at that document); then, if it converted, the text goes the way a .urdf
 // MODEL file goes (load_model: conversion, parse_model_json, compile, and the renaming of
 // errors to the URDF's joints and links), and the model is evaluated once.
+#include <unistd.h>
+
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <optional>
-#include <unistd.h>
 
 #include "core/errors.hpp"
 #include "io/model_loader.hpp"
@@ -47,7 +49,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     model.emplace(load_model(scratch_path()));
   });
   if (model)
-    fuzz::expected_errors_only("urdf evaluation",
-                               [&] { fuzz::evaluate_once(*model, fuzz::hash(data, size), finite); });
+    fuzz::expected_errors_only(
+        "urdf evaluation", [&] { fuzz::evaluate_once(*model, fuzz::hash(data, size), finite); });
   return 0;
 }
