@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 
 #include "core/equations.hpp"
@@ -45,7 +46,12 @@ std::vector<double> parse_numbers(const std::string& opt, const std::string& tex
     try {
       x = std::stod(item, &used);
     } catch (const std::out_of_range&) {
-      out_of_range = true;
+      // Overflow is out of range; underflow (1e-400) is a number too small to matter: its
+      // nearest double (0 or a subnormal) is taken.
+      char* end = nullptr;
+      x = std::strtod(item.c_str(), &end);
+      used = static_cast<std::size_t>(end - item.c_str());
+      out_of_range = !(std::abs(x) < 1);
     } catch (const std::exception&) {
       used = 0;
     }

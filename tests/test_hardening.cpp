@@ -111,6 +111,8 @@ TEST_CASE("out-of-range numbers are refused naming the field", "[hardening]") {
   const Run qd = run("equations " + model_path("finger.json") + " --qd 1e200,0,0,0");
   CHECK(qd.code == 2);
   CHECK_THAT(qd.out, Catch::Contains("--qd: '1e200' is out of range"));
+  // Underflow is not out of range: 1e-400 is read as its nearest double (0).
+  CHECK(run("equations " + model_path("pendulum.json") + " --q 1e-400").code == 0);
 }
 
 TEST_CASE("names with control characters are refused and user text is echoed escaped",

@@ -13,7 +13,7 @@ if ! [[ $seconds =~ ^[0-9]+$ ]] || [ "$seconds" -lt 1 ]; then
   echo "usage: tools/fuzz.sh [SECONDS]   (seconds per target, default 60)" >&2
   exit 2
 fi
-build=build-fuzz
+build="build-fuzz"
 mkdir -p "$build/artifacts"
 log=$build/build.log
 
@@ -40,19 +40,23 @@ for spec in "${targets[@]}"; do
   read -r name max_len dict seeds <<<"$spec"
   corpus=$build/corpus/$name
   mkdir -p "$corpus"
+  before=$(ls "$build/artifacts")
   # The scratch corpus keeps every input that was once new; loading 10,000 of them takes longer
-  # than a short run. Above 2,000 files it is minimised first (libFuzzer -merge=1).
-  if [ "$(ls "$corpus" | wc -l)" -gt 2000 ]; then
+  # than a short run. Above 1,000 files, and twice its size after the last minimisation, it is
+  # minimised first (libFuzzer -merge=1).
+  last=$(cat "$corpus.minimised" 2>/dev/null || echo 500)
+  if [ "$(ls "$corpus" | wc -l)" -gt $((2 * last)) ]; then
     rm -rf "$corpus.min" && mkdir "$corpus.min"
     if "$build/tests/fuzz/fuzz_$name" -merge=1 -timeout=10 -rss_limit_mb=2048 -max_len="$max_len" \
-         "$corpus.min" "$corpus" >"$build/merge-$name.log" 2>&1; then
+         -artifact_prefix="$build/artifacts/$name-" "$corpus.min" "$corpus" \
+         >"$build/merge-$name.log" 2>&1; then
       echo "fuzz: $name: scratch corpus minimised from $(ls "$corpus" | wc -l) to $(ls "$corpus.min" | wc -l) files"
       rm -rf "$corpus" && mv "$corpus.min" "$corpus"
+      ls "$corpus" | wc -l >"$corpus.minimised"
     else
       rm -rf "$corpus.min"  # keep the corpus as it is (log: $build/merge-$name.log)
     fi
   fi
-  before=$(ls "$build/artifacts")
   args=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len="$max_len"
         -artifact_prefix="$build/artifacts/$name-" -print_final_stats=1)
   [ "$dict" != - ] && args+=(-dict="$dict")
@@ -66,12 +70,16 @@ for spec in "${targets[@]}"; do
   fi
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$build/fuzz-$name.log" | tail -1)
   cov=$(grep -o 'cov: [0-9]*' "$build/fuzz-$name.log" | tail -1 || true)
-  new=$(comm -13 <(echo "$before") <(ls "$build/artifacts") | sed "s|^|$build/artifacts/|")
+  new=$(LC_ALL=C comm -13 <(echo "$before" | LC_ALL=C sort) <(ls "$build/artifacts" | LC_ALL=C sort) |
+          sed "s|^|$build/artifacts/|")
   echo "fuzz: $name: $(($(date +%s) - t1)) s, ${runs:-?} inputs, ${cov:-cov: ?}, corpus $(ls "$corpus" | wc -l) files: $status"
   if [ "$status" != ok ] || [ -n "$new" ]; then
     grep -E 'BUG:|ERROR:|SUMMARY:|runtime error|Assertion|Test unit written' "$build/fuzz-$name.log" | head -20 >&2 || true
-    [ -n "$new" ] || new="(no artifact; see $build/fuzz-$name.log)"
-    for a in $new; do found+=("$name: $a"); done
+    if [ -z "$new" ]; then
+      found+=("$name: no artifact written, see $build/fuzz-$name.log")
+    else
+      for a in $new; do found+=("$name: $a"); done
+    fi
   fi
 done
 
