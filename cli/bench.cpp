@@ -8,12 +8,11 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
 #include <string_view>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
 #include "core/equations.hpp"
@@ -32,7 +31,8 @@ namespace {
 namespace fv = femdyn::validation;
 using Clock = std::chrono::steady_clock;
 
-constexpr const char* kHelp = R"(usage: femdyn bench MODEL [--json] [--quick] [--states N] [--gravity gx,gy,gz]
+constexpr const char* kHelp =
+    R"(usage: femdyn bench MODEL [--json] [--quick] [--states N] [--gravity gx,gy,gz]
 
 Times femdyn's equations of motion against the model's Simbody twin (the one femdyn validate
 compares with) in the same run, and prints for each quantity the median ns per call of both
@@ -68,12 +68,14 @@ constexpr int kTensorMaxN = 40;  // D above this many coordinates takes too long
 // Timing a Debug build would mislead: refuse (NDEBUG unset, or CMake's build type Debug).
 void refuse_debug_build() {
 #ifndef NDEBUG
-  throw CliError("refusing to time a Debug build (NDEBUG is not defined; build type "
-                 FEMDYN_BUILD_TYPE "): rebuild with -DCMAKE_BUILD_TYPE=Release");
+  throw CliError(
+      "refusing to time a Debug build (NDEBUG is not defined; build type " FEMDYN_BUILD_TYPE
+      "): rebuild with -DCMAKE_BUILD_TYPE=Release");
 #endif
   if (std::string_view(FEMDYN_BUILD_TYPE) == "Debug")
-    throw CliError("refusing to time a Debug build (build type Debug): rebuild with "
-                   "-DCMAKE_BUILD_TYPE=Release");
+    throw CliError(
+        "refusing to time a Debug build (build type Debug): rebuild with "
+        "-DCMAKE_BUILD_TYPE=Release");
 }
 
 // The seeded states the calls cycle through.
@@ -95,24 +97,19 @@ States random_states(const Model& m, int K) {
   return s;
 }
 
-// max |a − b| / max(max |b|, 1e-6), as femdyn_bench.
-double rel_diff(const MatX& a, const MatX& b) {
-  return (a - b).cwiseAbs().maxCoeff() / std::max(b.cwiseAbs().maxCoeff(), 1e-6);
-}
-
 // Once, before timing: both engines compute the same M^s, h (evaluate()) and q̈
 // (forward_dynamics()) at the first state.
-void check_agreement(const std::string& path, const Model& m, Workspace& ws,
-                     fv::SimbodyTwin& twin, const States& s) {
+void check_agreement(const std::string& path, const Model& m, Workspace& ws, fv::SimbodyTwin& twin,
+                     const States& s) {
   const fv::TwinEquations e = twin.equations(s.q[0], s.qd[0], s.tau[0]);
   const Status st = forward_dynamics(m, ws, s.q[0], s.qd[0], s.tau[0]);
-  const double dqdd = st.ok ? rel_diff(ws.qdd, e.qdd) : INFINITY;
+  const double dqdd = st.ok ? relative_error(ws.qdd, e.qdd, 1e-6) : INFINITY;
   evaluate(m, ws, s.q[0], s.qd[0], s.tau[0]);
-  const double dM = rel_diff(ws.Ms, e.M), dh = rel_diff(ws.h, e.h);
+  const double dM = relative_error(ws.Ms, e.M, 1e-6), dh = relative_error(ws.h, e.h, 1e-6);
   if (dM < 1e-8 && dh < 1e-8 && dqdd < 1e-8) return;
   std::cerr << "femdyn bench: warning: " << path
-            << ": femdyn and Simbody differ at the first state (relative M^s "
-            << format_short(dM) << ", h " << format_short(dh) << ", q̈ "
+            << ": femdyn and Simbody differ at the first state (relative M^s " << format_short(dM)
+            << ", h " << format_short(dh) << ", q̈ "
             << (st.ok ? format_short(dqdd) : "not computed: " + st.message)
             << "); the timings compare different computations\n";
 }
@@ -218,8 +215,11 @@ void print_table(const std::string& path, int n, int K, const Method& method,
 nlohmann::ordered_json report_json(const std::string& path, int n, const std::vector<Row>& rows) {
   nlohmann::ordered_json results = nlohmann::ordered_json::array();
   auto add = [&](const char* engine, const std::string& quantity, const Timing& t) {
-    results.push_back({{"engine", engine}, {"quantity", quantity}, {"median_ns", t.median},
-                       {"min_ns", t.min}, {"max_ns", t.max}});
+    results.push_back({{"engine", engine},
+                       {"quantity", quantity},
+                       {"median_ns", t.median},
+                       {"min_ns", t.min},
+                       {"max_ns", t.max}});
   };
   for (const Row& r : rows) {
     add("femdyn", r.quantity, r.femdyn);
@@ -261,19 +261,35 @@ int cmd_bench(int argc, char** argv) {
   std::vector<Row> rows;
   // M^s: femdyn's mass_matrix (M^s alone) / Simbody's calcM at Position.
   rows.push_back(time_both(
-      "M", [&](int k) { mass_matrix(m, ws, s.q[k]); keep(ws.Ms.data()); },
+      "M",
+      [&](int k) {
+        mass_matrix(m, ws, s.q[k]);
+        keep(ws.Ms.data());
+      },
       [&](int k) { twin->time_mass(s.q[k]); }, K, method));
   // h without gravity: velocity terms alone.
   rows.push_back(time_both(
-      "h", [&](int k) { evaluate_bias(m, ws, s.q[k], s.qd[k]); keep(ws.h.data()); },
+      "h",
+      [&](int k) {
+        evaluate_bias(m, ws, s.q[k], s.qd[k]);
+        keep(ws.h.data());
+      },
       [&](int k) { twin->time_bias(s.q[k], s.qd[k]); }, K, method));
   // Gravity and the other state-independent forces at rest: τ = −Q(q̇ = 0).
   rows.push_back(time_both(
-      "g", [&](int k) { inverse_dynamics(m, ws, s.q[k], s.rest, s.rest); keep(ws.tau.data()); },
+      "g",
+      [&](int k) {
+        inverse_dynamics(m, ws, s.q[k], s.rest, s.rest);
+        keep(ws.tau.data());
+      },
       [&](int k) { twin->time_gravity(s.q[k]); }, K, method));
   // Q: femdyn assembles it in evaluate() with M^s and h; Simbody calcM + residual (h − Q).
   rows.push_back(time_both(
-      "Q", [&](int k) { evaluate(m, ws, s.q[k], s.qd[k], s.tau[k]); keep(ws.Q.data()); },
+      "Q",
+      [&](int k) {
+        evaluate(m, ws, s.q[k], s.qd[k], s.tau[k]);
+        keep(ws.Q.data());
+      },
       [&](int k) { twin->time_mass_and_bias(s.q[k], s.qd[k]); }, K, method));
   // q̈: forward dynamics.
   rows.push_back(time_both(

@@ -16,7 +16,8 @@
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp = R"(usage: femdyn check MODEL [--states K] [--seed S] [--json] [--gravity gx,gy,gz]
+constexpr const char* kHelp =
+    R"(usage: femdyn check MODEL [--states K] [--seed S] [--json] [--gravity gx,gy,gz]
 
 Diagnoses the model at K seeded states (default 10: q = 0 at rest, then q within the joint
 limits and q̇ in ±1):
@@ -88,8 +89,10 @@ int cmd_check(int argc, char** argv) {
     }
     for (int i = 0; i < 3; ++i) {
       const auto hs = largest_stable_step(lin, explicit_kinds[i]);
-      if (!hs) h_known[i] = false;
-      else h_max[i] = std::min(h_max[i], *hs);
+      if (!hs)
+        h_known[i] = false;
+      else
+        h_max[i] = std::min(h_max[i], *hs);
     }
   }
   const std::vector<SuspiciousBody> bodies = suspicious_bodies(m);
@@ -101,7 +104,8 @@ int cmd_check(int argc, char** argv) {
                      " of the states; repair the model first";
   else if (h_max[0] < 1e-4)
     recommendation = "bdf (e.g. --rtol 1e-6): the stiffest mode limits rk4 to dt < " +
-                     format_short(h_max[0]) + " s and dopri to steps < " + format_short(h_max[2]) + " s";
+                     format_short(h_max[0]) + " s and dopri to steps < " + format_short(h_max[2]) +
+                     " s";
   else if (std::isfinite(h_max[0]))
     recommendation = "dopri (--rtol 1e-6) for accuracy; for a fixed-rate loop rk4 with dt <= " +
                      format_short(h_max[0] / 2) + " s (half its stability limit)";
@@ -109,11 +113,16 @@ int cmd_check(int argc, char** argv) {
     recommendation = "dopri (--rtol 1e-6); no stiff mode was found";
 
   if (a.has("json")) {
-    Json j = {{"model", m.name}, {"coordinates", n}, {"states", K},
+    Json j = {{"model", m.name},
+              {"coordinates", n},
+              {"states", K},
               {"condition", {{"min", cond_lo}, {"max", cond_hi}}},
-              {"digits_lost", std::log10(cond_hi)}, {"asymmetry", asym},
-              {"singular_states", singular_states}, {"stiffest_mode", stiffest},
-              {"stiffest_kind", mode_text(stiffest_lambda)}, {"recommendation", recommendation}};
+              {"digits_lost", std::log10(cond_hi)},
+              {"asymmetry", asym},
+              {"singular_states", singular_states},
+              {"stiffest_mode", stiffest},
+              {"stiffest_kind", mode_text(stiffest_lambda)},
+              {"recommendation", recommendation}};
     Json steps = Json::object();
     for (int i = 0; i < 3; ++i)
       steps[integrator_name(explicit_kinds[i])] =
@@ -131,19 +140,22 @@ int cmd_check(int argc, char** argv) {
       std::cout << "M^s: singular at " << singular_states << " of " << K
                 << " states: " << singular_message << "\n";
     if (singular_states < K)
-      std::cout << "M^s: cond from " << format_short(cond_lo) << " to " << format_short(cond_hi) << " (q̈ loses up to "
-                << format_short(std::log10(cond_hi)) << " digits of 16), symmetric to " << format_short(asym)
+      std::cout << "M^s: cond from " << format_short(cond_lo) << " to " << format_short(cond_hi)
+                << " (q̈ loses up to " << format_short(std::log10(cond_hi))
+                << " digits of 16), symmetric to " << format_short(asym)
                 << (singular_states ? "" : ", positive definite at every state") << "\n";
-    std::cout << "stiffest mode: |λ| = " << format_short(stiffest) << " rad/s (" << mode_text(stiffest_lambda)
-              << ")\nlargest stable step:";
+    std::cout << "stiffest mode: |λ| = " << format_short(stiffest) << " rad/s ("
+              << mode_text(stiffest_lambda) << ")\nlargest stable step:";
     for (int i = 0; i < 3; ++i)
       std::cout << " " << integrator_name(explicit_kinds[i]) << " "
-                << (!h_known[i] ? std::string("n/a (n > 200)")
-                    : std::isfinite(h_max[i]) ? format_short(h_max[i]) + " s" : std::string("unlimited"))
+                << (!h_known[i]               ? std::string("n/a (n > 200)")
+                    : std::isfinite(h_max[i]) ? format_short(h_max[i]) + " s"
+                                              : std::string("unlimited"))
                 << (i < 2 ? "," : "");
     std::cout << " (bdf: unlimited)\n";
     if (bodies.empty()) std::cout << "suspicious bodies: none\n";
-    for (const auto& b : bodies) std::cout << "suspicious body '" << b.name << "': " << b.why << "\n";
+    for (const auto& b : bodies)
+      std::cout << "suspicious body '" << b.name << "': " << b.why << "\n";
     std::cout << "recommended: " << recommendation << "\n";
   }
   return singular_states > 0 || !bodies.empty() ? 1 : 0;

@@ -7,10 +7,10 @@
 #include <iostream>
 
 #include "core/equations.hpp"
-#include "io/model_loader.hpp"
-#include "io/output.hpp"
 #include "core/limits.hpp"
 #include "core/names.hpp"
+#include "io/model_loader.hpp"
+#include "io/output.hpp"
 
 namespace femdyn::cli {
 namespace {
@@ -22,7 +22,8 @@ their elements, the transition coordinates u kept and those left out, and the co
 table N_m (one row per element; per node x y z rx ry rz; 0 = left out).
 )";
 
-constexpr const char* kEquationsHelp = R"(usage: femdyn equations MODEL [--q a,b,…] [--qd …] [--tau …] [--tensor] [--json]
+constexpr const char* kEquationsHelp =
+    R"(usage: femdyn equations MODEL [--q a,b,…] [--qd …] [--tau …] [--tensor] [--json]
                         [--gravity gx,gy,gz]
 
 Prints the system equations M^s(q) q̈ + h(q, q̇) = Q(q, q̇, τ) at the state, and
@@ -91,9 +92,9 @@ double integer_option(const Args& a, const std::string& opt, double fallback, do
                       double max) {
   const double v = number_option(a, opt, fallback);
   if (v != std::floor(v) || v < min)
-    throw CliError("--" + opt + " expects one integer >= " + std::to_string(static_cast<long>(min)));
-  if (v > max)
-    throw CliError("--" + opt + " expects one integer <= " + format_number(max, "%.0f"));
+    throw CliError("--" + opt +
+                   " expects one integer >= " + std::to_string(static_cast<long>(min)));
+  if (v > max) throw CliError("--" + opt + " expects one integer <= " + format_number(max, "%.0f"));
   return v;
 }
 
@@ -111,6 +112,7 @@ LoadOptions load_options(const Args& a) {
     const std::vector<double> g = parse_numbers("gravity", a.options.at("gravity"));
     if (g.size() != 3) throw CliError("--gravity expects 3 values gx,gy,gz");
     opt.gravity = Vec3(g[0], g[1], g[2]);
+    opt.gravity_source = "--gravity";
   }
   return opt;
 }

@@ -26,8 +26,8 @@ Args parse_args(int argc, char** argv, int first, const std::vector<std::string>
 
 // Shared by the commands.
 std::vector<double> parse_numbers(const std::string& opt, const std::string& text);
-VecX state_vector(const Args& a, const std::string& opt, const Model& m);  // zero if absent
-LoadOptions load_options(const Args& a);                                   // --gravity
+VecX state_vector(const Args& a, const std::string& opt, const Model& m);      // zero if absent
+LoadOptions load_options(const Args& a);                                       // --gravity
 double number_option(const Args& a, const std::string& opt, double fallback);  // one number
 double integer_option(const Args& a, const std::string& opt, double fallback, double min,
                       double max = 1e15);
@@ -41,8 +41,8 @@ int cmd_validate(int argc, char** argv);  // only with FEMDYN_WITH_SIMBODY
 int cmd_import(int argc, char** argv);
 int cmd_simulate(int argc, char** argv);
 int cmd_check(int argc, char** argv);
-int cmd_study(int argc, char** argv);     // only with FEMDYN_WITH_SIMBODY
-int cmd_stress(int argc, char** argv);    // only with FEMDYN_WITH_SIMBODY
-int cmd_bench(int argc, char** argv);     // only with FEMDYN_WITH_SIMBODY
+int cmd_study(int argc, char** argv);   // only with FEMDYN_WITH_SIMBODY
+int cmd_stress(int argc, char** argv);  // only with FEMDYN_WITH_SIMBODY
+int cmd_bench(int argc, char** argv);   // only with FEMDYN_WITH_SIMBODY
 
 }  // namespace femdyn::cli

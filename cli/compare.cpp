@@ -2,6 +2,7 @@
 // seeded random states and at given postures — e.g. the paper's discretisation against the
 // exact finger.
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -16,7 +17,8 @@
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp = R"(usage: femdyn compare MODEL_A MODEL_B [--states K] [--seed S] [--qd-scale V]
+constexpr const char* kHelp =
+    R"(usage: femdyn compare MODEL_A MODEL_B [--states K] [--seed S] [--qd-scale V]
                        [--q a,b,… [--qd …]] [--tau …] [--json] [--gravity gx,gy,gz]
 
 Relative error of A against B, ‖A − B‖ / ‖B‖ (max-norm), for M^s, h and q̈ (under the actuation
@@ -26,11 +28,7 @@ default V = 2), or at the one state given by --q/--qd. Both models must have the
 generalized coordinates. Prints max and median over the states.
 )";
 
-double rel(const MatX& a, const MatX& b) {
-  const double nb = b.cwiseAbs().maxCoeff();
-  const double d = (a - b).cwiseAbs().maxCoeff();
-  return nb > 0 ? d / nb : d;
-}
+double rel(const MatX& a, const MatX& b) { return relative_error(a, b, 0.0); }
 
 }  // namespace
 
@@ -47,22 +45,10 @@ int cmd_compare(int argc, char** argv) {
   if (A.n() != B.n())
     throw CliError("the models have " + std::to_string(A.n()) + " and " + std::to_string(B.n()) +
                    " coordinates; compare needs the same");
-  auto count = [&](const char* opt, int fallback) {
-    if (!a.has(opt)) return fallback;
-    const std::vector<double> v = parse_numbers(opt, a.options.at(opt));
-    // Range first: a double beyond int's range does not convert (undefined behaviour).
-    if (v.size() != 1 || !(v[0] >= 1 && v[0] <= 2147483647.0) || v[0] != std::floor(v[0]))
-      throw CliError(std::string("--") + opt + " expects a positive integer (at most 2147483647)");
-    return static_cast<int>(v[0]);
-  };
-  const int K = a.has("q") ? 1 : count("states", 100);
-  const unsigned seed = static_cast<unsigned>(count("seed", 1));
-  double vscale = 2.0;
-  if (a.has("qd-scale")) {
-    const auto v = parse_numbers("qd-scale", a.options.at("qd-scale"));
-    if (v.size() != 1 || v[0] < 0) throw CliError("--qd-scale expects one number >= 0");
-    vscale = v[0];
-  }
+  const int K = a.has("q") ? 1 : static_cast<int>(integer_option(a, "states", 100, 1, INT_MAX));
+  const auto seed = static_cast<unsigned>(integer_option(a, "seed", 1, 0, 4294967295.0));
+  const double vscale = number_option(a, "qd-scale", 2.0);
+  if (vscale < 0) throw CliError("--qd-scale expects one number >= 0");
   Workspace wa(A), wb(B);
   std::mt19937 rng(seed);
   std::vector<double> eM, eh, eqdd;
@@ -79,7 +65,8 @@ int cmd_compare(int argc, char** argv) {
     const Status sa = forward_dynamics(A, wa, q, qd, tau), sb = forward_dynamics(B, wb, q, qd, tau);
     evaluate(A, wa, q, qd, tau);
     evaluate(B, wb, q, qd, tau);
-    if (!sa.ok || !sb.ok) throw CliError("M^s singular at a sampled state: " + (sa.ok ? sb : sa).message);
+    if (!sa.ok || !sb.ok)
+      throw CliError("M^s singular at a sampled state: " + (sa.ok ? sb : sa).message);
     eM.push_back(rel(wa.Ms, wb.Ms));
     eh.push_back(qd.isZero(0) ? 0.0 : rel(wa.h, wb.h));
     eqdd.push_back(rel(wa.qdd, wb.qdd));
@@ -92,16 +79,22 @@ int cmd_compare(int argc, char** argv) {
   const auto [mh, dh] = stats(eh);
   const auto [mq, dq] = stats(eqdd);
   if (a.has("json")) {
-    Json j = {{"a", a.positional[0]}, {"b", a.positional[1]}, {"states", K}, {"seed", seed},
+    Json j = {{"a", a.positional[0]},
+              {"b", a.positional[1]},
+              {"states", K},
+              {"seed", seed},
               {"max_rel_error", {{"M", mM}, {"h", mh}, {"qdd", mq}}},
               {"median_rel_error", {{"M", dM}, {"h", dh}, {"qdd", dq}}}};
     std::cout << j.dump(2) << "\n";
     return 0;
   }
   std::cout << "A: " << a.positional[0] << "\nB: " << B.where << "\n"
-            << K << (a.has("q") ? " given state" : " seeded random states (seed " + std::to_string(seed) + ")")
+            << K
+            << (a.has("q") ? " given state"
+                           : " seeded random states (seed " + std::to_string(seed) + ")")
             << "; relative error ‖A − B‖ / ‖B‖\n"
-            << "quantity   max         median\n" << std::scientific << std::setprecision(3);
+            << "quantity   max         median\n"
+            << std::scientific << std::setprecision(3);
   for (auto [name, mx, md] : {std::tuple{"M^s", mM, dM}, {"h", mh, dh}, {"qdd", mq, dq}})
     std::cout << std::left << std::setw(10) << name << " " << mx << "   " << md << "\n";
   return 0;

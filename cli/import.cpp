@@ -8,7 +8,8 @@
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp = R"(usage: femdyn import MODEL -o OUT.json [--force] [--gravity gx,gy,gz]     (-o is --output)
+constexpr const char* kHelp =
+    R"(usage: femdyn import MODEL -o OUT.json [--force] [--gravity gx,gy,gz]     (-o is --output)
 
 Writes the femdyn JSON document of MODEL: a URDF robot converted (each link with an <inertial>
 becomes a body with one rigid_body element, its inertia rotated out of the <inertial> frame; a

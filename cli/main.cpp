@@ -6,7 +6,8 @@
 
 namespace {
 
-constexpr const char* kUsage = R"(femdyn — equations of motion of mechanisms by the equivalent-element method
+constexpr const char* kUsage =
+    R"(femdyn — equations of motion of mechanisms by the equivalent-element method
 
 usage: femdyn COMMAND MODEL [options]
 
@@ -52,10 +53,14 @@ int main(int argc, char** argv) {
     if (cmd == "stress") return cmd_stress(argc, argv);
     if (cmd == "bench") return cmd_bench(argc, argv);
 #else
-    if (cmd == "bench") throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
-    if (cmd == "stress") throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
-    if (cmd == "study") throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
-    if (cmd == "validate") throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
+    if (cmd == "bench")
+      throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
+    if (cmd == "stress")
+      throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
+    if (cmd == "study")
+      throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
+    if (cmd == "validate")
+      throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
 #endif
     throw CliError("unknown command '" + cmd + "' (try femdyn --help)");
   } catch (const CliError& e) {

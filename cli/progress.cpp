@@ -7,8 +7,11 @@
 namespace femdyn::cli {
 
 Progress::Progress(double total, std::string unit)
-    : total_(total), unit_(std::move(unit)), tty_(::isatty(STDERR_FILENO) == 1),
-      start_(Clock::now()), last_(start_) {}
+    : total_(total),
+      unit_(std::move(unit)),
+      tty_(::isatty(STDERR_FILENO) == 1),
+      start_(Clock::now()),
+      last_(start_) {}
 
 void Progress::update(double done) {
   if (!tty_) return;

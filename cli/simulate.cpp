@@ -17,7 +17,8 @@
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp = R"(usage: femdyn simulate MODEL --t-end T [--integrator rk4|euler|dopri|bdf]
+constexpr const char* kHelp =
+    R"(usage: femdyn simulate MODEL --t-end T [--integrator rk4|euler|dopri|bdf]
                         [--dt h | --rtol r --atol a] [--q0 …] [--qd0 …] [--tau … | --tau-csv FILE]
                         [--out traj.csv] [--every k] [--force] [--json] [--gravity gx,gy,gz]
 
@@ -64,7 +65,8 @@ class InterruptGuard {
   }
 
  private:
-  struct sigaction old_int_ {}, old_term_ {};
+  struct sigaction old_int_ {
+  }, old_term_{};
 };
 
 }  // namespace
@@ -118,9 +120,8 @@ int cmd_simulate(int argc, char** argv) {
   } else if (a.has("tau-csv")) {
     table.emplace(a.options.at("tau-csv"), m);
     if (table->t_first() > 0 || table->t_last() < t_end)
-      throw CliError("--tau-csv " + table->path() + " covers t in [" +
-                     num(table->t_first()) + ", " + num(table->t_last()) +
-                     "] s; it must cover [0, " + num(t_end) + "] s");
+      throw CliError("--tau-csv " + table->path() + " covers t in [" + num(table->t_first()) +
+                     ", " + num(table->t_last()) + "] s; it must cover [0, " + num(t_end) + "] s");
     tau = [&table](double t, VecX& out) { (*table)(t, out); };
     driven = true;
   }
@@ -172,7 +173,8 @@ int cmd_simulate(int argc, char** argv) {
     }
   }
   progress.finish();
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   if (out) out->commit();
 
   const IntegratorStats& s = integ->stats();
@@ -180,13 +182,23 @@ int cmd_simulate(int argc, char** argv) {
   const double rtf = s.wall_time > 0 ? simulated / s.wall_time : 0;
   const std::string balance_name = conservative ? "energy drift" : "energy-balance error";
   if (a.has("json")) {
-    Json j = {{"model", m.name}, {"coordinates", m.n()}, {"integrator", integ->name()},
-              {"t_end", t_end}, {"t_reached", simulated}, {"steps", s.steps},
-              {"rejected", s.rejected}, {"rhs_evals", s.rhs_evals}, {"jac_evals", s.jac_evals},
-              {"wall_time", wall}, {"integration_time", s.wall_time}, {"real_time_factor", rtf},
-              {"conservative", conservative}, {"energy_initial", E0.total()},
+    Json j = {{"model", m.name},
+              {"coordinates", m.n()},
+              {"integrator", integ->name()},
+              {"t_end", t_end},
+              {"t_reached", simulated},
+              {"steps", s.steps},
+              {"rejected", s.rejected},
+              {"rhs_evals", s.rhs_evals},
+              {"jac_evals", s.jac_evals},
+              {"wall_time", wall},
+              {"integration_time", s.wall_time},
+              {"real_time_factor", rtf},
+              {"conservative", conservative},
+              {"energy_initial", E0.total()},
               {"energy_balance_error", max_balance},
-              {"energy_balance_relative", scale > 0 ? max_balance / scale : 0.0}, {"rows", rows},
+              {"energy_balance_relative", scale > 0 ? max_balance / scale : 0.0},
+              {"rows", rows},
               {"ok", st.ok}};
     if (is_adaptive(o.kind))
       j["options"] = {{"rtol", o.adaptive.rtol}, {"atol", o.adaptive.atol}};
@@ -198,24 +210,23 @@ int cmd_simulate(int argc, char** argv) {
   } else {
     std::cout << "model: " << m.name << " (" << m.n() << " coordinates)\n"
               << "integrator: " << integ->name() << " ("
-              << (is_adaptive(o.kind) ? "rtol " + num(o.adaptive.rtol) + ", atol " +
-                                            num(o.adaptive.atol)
-                                      : "dt " + num(o.fixed.dt) + " s")
+              << (is_adaptive(o.kind)
+                      ? "rtol " + num(o.adaptive.rtol) + ", atol " + num(o.adaptive.atol)
+                      : "dt " + num(o.fixed.dt) + " s")
               << ")\n"
-              << "simulated " << num(simulated) << " of " << num(t_end)
-              << " s: " << s.steps << " steps (" << s.rejected << " rejected), " << s.rhs_evals
+              << "simulated " << num(simulated) << " of " << num(t_end) << " s: " << s.steps
+              << " steps (" << s.rejected << " rejected), " << s.rhs_evals
               << " evaluations of forward dynamics, " << s.jac_evals << " Jacobians\n"
-              << "wall time " << num(wall) << " s (integration "
-              << num(s.wall_time) << " s), real-time factor " << num(rtf) << "\n"
-              << balance_name << ": max |E(t) - E(0) - W(t)| = " << num(max_balance)
-              << " J (" << num(scale > 0 ? max_balance / scale : 0)
-              << " of the energy scale) over " << rows << " rows\n";
+              << "wall time " << num(wall) << " s (integration " << num(s.wall_time)
+              << " s), real-time factor " << num(rtf) << "\n"
+              << balance_name << ": max |E(t) - E(0) - W(t)| = " << num(max_balance) << " J ("
+              << num(scale > 0 ? max_balance / scale : 0) << " of the energy scale) over " << rows
+              << " rows\n";
     if (out) std::cout << "wrote " << out->path() << " (" << rows << " rows)\n";
   }
   if (!st.ok) {
     std::cerr << "femdyn simulate: " << a.positional[0] << ": " << st.message
-              << (out ? "; the rows up to t = " + num(simulated) + " s are in " +
-                            out->path()
+              << (out ? "; the rows up to t = " + num(simulated) + " s are in " + out->path()
                       : std::string())
               << "\n";
     return 1;

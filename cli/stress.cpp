@@ -1,26 +1,29 @@
 // femdyn stress: the stability suite on generated cases (cli/stress_cases.hpp,
 // validation/stress.hpp); writes stress.md and stress.csv (docs/stability.md is spliced from
 // stress.md by tools/update-stability-docs.sh).
+#include "validation/stress.hpp"
+
+#include <unistd.h>
+
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
-#include <unistd.h>
 
 #include "cli/commands.hpp"
 #include "cli/stress_cases.hpp"
 #include "core/errors.hpp"
 #include "io/atomic_file.hpp"
 #include "io/model_loader.hpp"
-#include "validation/stress.hpp"
 
 namespace femdyn::cli {
 namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* kHelp = R"(usage: femdyn stress [--out DIR] [--quick] [--class NAME] [--json] [--force]
+constexpr const char* kHelp =
+    R"(usage: femdyn stress [--out DIR] [--quick] [--class NAME] [--json] [--force]
 
 Runs the stability suite on generated cases (docs/stability.md): stiff joint springs
 (ω = 1e1…1e5 rad/s, damping ratio 0…100), mass ratios up to 1e6 and lengths 1e-4…10 m in one
@@ -50,14 +53,16 @@ int cmd_stress(int argc, char** argv) {
   std::vector<StressCase> cases = stress_cases(a.has("quick"));
   if (a.has("class")) {
     std::erase_if(cases, [&](const StressCase& c) { return c.klass != a.options.at("class"); });
-    if (cases.empty()) throw CliError("--class: no class '" + a.options.at("class") + "' (try --help)");
+    if (cases.empty())
+      throw CliError("--class: no class '" + a.options.at("class") + "' (try --help)");
   }
   const fs::path dir = a.has("out") ? fs::path(a.options.at("out")) : fs::path("stress");
   const bool write = !a.has("json") || a.has("out");
   if (write) {
     std::error_code ec;
     fs::create_directories(dir, ec);
-    if (!fs::is_directory(dir)) throw CliError("--out " + dir.string() + ": cannot create the directory");
+    if (!fs::is_directory(dir))
+      throw CliError("--out " + dir.string() + ": cannot create the directory");
     for (const char* f : {"stress.md", "stress.csv"})
       if (fs::exists(dir / f) && !a.has("force"))
         throw CliError((dir / f).string() + ": exists (use --force to replace it)");
@@ -68,7 +73,8 @@ int cmd_stress(int argc, char** argv) {
   std::ostringstream md, csv;
   md << "| class | case | n | cond(M^s) along the motion | SPD | stiffest mode (rad/s) | "
         "largest stable step rk4 / euler (s) | relative error: rk4 / euler at the fixed step, "
-        "dopri / bdf at rtol 1e-6 | energy balance | Simbody (relative) | verdict |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "dopri / bdf at rtol 1e-6 | energy balance | Simbody (relative) | verdict "
+        "|\n|---|---|---|---|---|---|---|---|---|---|---|\n";
   csv << "class,case,n,cond_min,cond_max,positive_definite,stiffest,rk4_stable_step,"
          "euler_stable_step,dt,rk4_error,euler_error,dopri_error,bdf_error,energy_error,"
          "simbody_error,verdict\n";
@@ -102,19 +108,27 @@ int cmd_stress(int argc, char** argv) {
     const auto step = [&](std::size_t i) {
       return i < r.integrators.size() ? r.integrators[i].largest_stable_step : -1.0;
     };
-    Json j = {{"class", c.klass}, {"case", c.name}, {"description", c.description},
+    Json j = {{"class", c.klass},     {"case", c.name},       {"description", c.description},
               {"expected", c.expect}, {"verdict", r.verdict}, {"n", r.n},
               {"seconds", seconds}};
     if (r.refused.empty()) {
-      j.update({{"cond_min", r.cond_min}, {"cond_max", r.cond_max},
-                {"positive_definite", r.positive_definite}, {"asymmetry", r.asymmetry},
-                {"stiffest", r.stiffest}, {"reference", r.reference},
-                {"energy_error", r.energy_error}, {"simbody_error", r.simbody_error},
-                {"simbody_note", r.simbody_note}, {"dt", c.dt}});
+      j.update({{"cond_min", r.cond_min},
+                {"cond_max", r.cond_max},
+                {"positive_definite", r.positive_definite},
+                {"asymmetry", r.asymmetry},
+                {"stiffest", r.stiffest},
+                {"reference", r.reference},
+                {"energy_error", r.energy_error},
+                {"simbody_error", r.simbody_error},
+                {"simbody_note", r.simbody_note},
+                {"dt", c.dt}});
       Json its = Json::array();
       for (const auto& it : r.integrators)
-        its.push_back({{"integrator", it.name}, {"largest_stable_step", it.largest_stable_step},
-                       {"error", it.error}, {"steps", it.steps}, {"failure", it.failure}});
+        its.push_back({{"integrator", it.name},
+                       {"largest_stable_step", it.largest_stable_step},
+                       {"error", it.error},
+                       {"steps", it.steps},
+                       {"failure", it.failure}});
       j["integrators"] = its;
     }
     results.push_back(j);
@@ -123,9 +137,11 @@ int cmd_stress(int argc, char** argv) {
       md << g(r.cond_min) << " … " << g(r.cond_max) << " | " << (r.positive_definite ? "yes" : "no")
          << " | " << (r.stiffest > 0 ? g(r.stiffest) : "—") << " | " << g(step(0)) << " / "
          << g(step(1)) << " | at " << g(c.dt) << " s: " << (err(0) < 0 ? "unstable" : g(err(0)))
-         << " / " << (err(1) < 0 ? "unstable" : g(err(1))) << "; rtol 1e-6: " << g(err(2))
-         << " / " << g(err(3)) << " | " << g(r.energy_error) << " | "
-         << (r.simbody_error >= 0 ? g(r.simbody_error) : r.simbody_note.empty() ? "—" : "not run")
+         << " / " << (err(1) < 0 ? "unstable" : g(err(1))) << "; rtol 1e-6: " << g(err(2)) << " / "
+         << g(err(3)) << " | " << g(r.energy_error) << " | "
+         << (r.simbody_error >= 0     ? g(r.simbody_error)
+             : r.simbody_note.empty() ? "—"
+                                      : "not run")
          << " | " << r.verdict << " |\n";
     else
       md << "— | — | — | — | — | — | — | " << r.verdict << " |\n";

@@ -10,7 +10,9 @@ namespace {
 // r = L/20 (r = 0: a thin rod, no inertia about its axis).
 Json rod(double m, double L, double r) {
   const double ax = 0.5 * m * r * r, tr = m * (3 * r * r + L * L) / 12;
-  return {{"type", "rigid_body"}, {"mass", m}, {"com", {L / 2, 0, 0}},
+  return {{"type", "rigid_body"},
+          {"mass", m},
+          {"com", {L / 2, 0, 0}},
           {"inertia", {{"ixx", ax}, {"iyy", tr}, {"izz", tr}}}};
 }
 
@@ -48,25 +50,27 @@ Json spring(double w, double zeta) {
   Json j = joint("theta", "revolute", {0, 1, 0}, {0, 0, 0});
   j["spring"] = {{"stiffness", w * w}};
   j["damping"] = 2 * zeta * w;
-  return model("spring", {body("arm", "world", j,
-                               {{{"type", "lumped_point"}, {"node", {1, 0, 0}}, {"mass", 1.0}}})},
-               0);
+  return model(
+      "spring",
+      {body("arm", "world", j, {{{"type", "lumped_point"}, {"node", {1, 0, 0}}, {"mass", 1.0}}})},
+      0);
 }
 
 // A slender steel bar (1 m, 1 mm², section Iy = Iz = 1e-13 m⁴) by section: its lumped rotary
 // inertia J_rot is negative across the bar. Two joints: perpendicular, then along the bar.
 Json slender_bars() {
-  Json bar = {{"type", "space_bar"}, {"nodes", {{0, 0, 0}, {1, 0, 0}}}, {"density", 7800},
-              {"area", 1e-6}, {"Iy", 1e-13}, {"Iz", 1e-13}};
-  return model("slender bars",
-               {body("bar1", "world", joint("perpendicular", "revolute", {0, 1, 0}, {0, 0, 0}), {bar}),
-                body("bar2", "bar1", joint("along", "revolute", {1, 0, 0}, {1, 0, 0}),
-                     {bar, rod(1e-3, 0.01, 0.005)})});
+  Json bar = {{"type", "space_bar"}, {"nodes", {{0, 0, 0}, {1, 0, 0}}},
+              {"density", 7800},     {"area", 1e-6},
+              {"Iy", 1e-13},         {"Iz", 1e-13}};
+  return model(
+      "slender bars",
+      {body("bar1", "world", joint("perpendicular", "revolute", {0, 1, 0}, {0, 0, 0}), {bar}),
+       body("bar2", "bar1", joint("along", "revolute", {1, 0, 0}, {1, 0, 0}),
+            {bar, rod(1e-3, 0.01, 0.005)})});
 }
 
 Json finger(double gravity) {
-  return {{"model", "dexterous_finger"}, {"params", Json::object()},
-          {"gravity", {0, 0, -gravity}}};
+  return {{"model", "dexterous_finger"}, {"params", Json::object()}, {"gravity", {0, 0, -gravity}}};
 }
 
 }  // namespace
@@ -76,69 +80,162 @@ std::vector<StressCase> stress_cases(bool quick) {
   // Stiff joint springs: ω = 1e1 … 1e5 rad/s, ζ = 0 … 100.
   for (double w : quick ? std::vector<double>{1e1, 1e5} : std::vector<double>{1e1, 1e3, 1e5})
     for (double zeta : quick ? std::vector<double>{0, 100} : std::vector<double>{0, 1, 100}) {
-      StressCase s{"springs", "spring w=" + format_number(w, "%g") + " zeta=" + format_number(zeta, "%g"),
-                   "1 kg·m² arm on a joint spring of ω = " + format_number(w, "%g") + " rad/s, damping ratio " + format_number(zeta, "%g"),
-                   spring(w, zeta), {0.1}, {0}};
+      StressCase s{"springs",
+                   "spring w=" + format_number(w, "%g") + " zeta=" + format_number(zeta, "%g"),
+                   "1 kg·m² arm on a joint spring of ω = " + format_number(w, "%g") +
+                       " rad/s, damping ratio " + format_number(zeta, "%g"),
+                   spring(w, zeta),
+                   {0.1},
+                   {0}};
       s.t_end = w >= 1e4 ? 0.02 : w >= 1e3 ? 0.2 : 2;
       s.dt = 1e-4;
       s.expect = w >= 1e5 ? "stable only with bdf" : "stable";
       c.push_back(s);
     }
   // Mass and length ratios in one chain.
-  c.push_back({"ratios", "mass ratio 1e6", "4 links of 0.3 m, masses 1, 1e6, 1, 1e-6 kg (neighbour ratios up to 1e6)",
-               chain("mass ratios", {1, 1e6, 1, 1e-6}, {0.3, 0.3, 0.3, 0.3}), {0.3, -0.5, 0.7, 0.2}, {}, 0.5, 1e-3});
+  c.push_back({"ratios",
+               "mass ratio 1e6",
+               "4 links of 0.3 m, masses 1, 1e6, 1, 1e-6 kg (neighbour ratios up to 1e6)",
+               chain("mass ratios", {1, 1e6, 1, 1e-6}, {0.3, 0.3, 0.3, 0.3}),
+               {0.3, -0.5, 0.7, 0.2},
+               {},
+               0.5,
+               1e-3});
   c.back().expect = "ill-conditioned";
-  c.push_back({"ratios", "lengths 1e-4 to 10 m", "4 links of 1e-4, 1e-2, 1 and 10 m, 1 kg each",
-               chain("length ratios", {1, 1, 1, 1}, {1e-4, 1e-2, 1, 10}), {0.3, -0.5, 0.7, 0.2}, {}, 0.5, 1e-3});
+  c.push_back({"ratios",
+               "lengths 1e-4 to 10 m",
+               "4 links of 1e-4, 1e-2, 1 and 10 m, 1 kg each",
+               chain("length ratios", {1, 1, 1, 1}, {1e-4, 1e-2, 1, 10}),
+               {0.3, -0.5, 0.7, 0.2},
+               {},
+               0.5,
+               1e-3});
   // Fast joints and a fast gyroscopic rotor.
-  c.push_back({"speeds", "joints at 1e3 rad/s", "double pendulum of 0.5 m rods started at 1000 rad/s",
-               chain("fast double pendulum", {1, 0.5}, {0.5, 0.5}), {0.2, 0.4}, {1000, -1000}, 0.01, 1e-5});
+  c.push_back({"speeds",
+               "joints at 1e3 rad/s",
+               "double pendulum of 0.5 m rods started at 1000 rad/s",
+               chain("fast double pendulum", {1, 0.5}, {0.5, 0.5}),
+               {0.2, 0.4},
+               {1000, -1000},
+               0.01,
+               1e-5});
   {
-    Json rotor = {{"type", "rigid_body"}, {"mass", 1.0}, {"com", {0, 0, 0}},
+    Json rotor = {{"type", "rigid_body"},
+                  {"mass", 1.0},
+                  {"com", {0, 0, 0}},
                   {"inertia", {{"ixx", 0.02}, {"iyy", 0.01}, {"izz", 0.01}}}};
-    Json m = model("gyroscope", {body("gimbal", "world", joint("precession", "revolute", {0, 0, 1}, {0, 0, 0}),
-                                      {rod(0.2, 0.1, 0.005)}),
-                                 body("fork", "gimbal", joint("nutation", "revolute", {0, 1, 0}, {0.1, 0, 0}),
-                                      {rod(0.1, 0.05, 0.005)}),
-                                 body("rotor", "fork", joint("spin", "revolute", {1, 0, 0}, {0.05, 0, 0}), {rotor})});
-    c.push_back({"speeds", "gyroscopic rotor at 1e3 rad/s", "a disc spinning at 1000 rad/s in a two-axis gimbal: nutation at ~2000 rad/s",
-                 m, {0, 0.2, 0}, {1, 0, 1000}, 0.05, 1e-5});
+    Json m =
+        model("gyroscope",
+              {body("gimbal", "world", joint("precession", "revolute", {0, 0, 1}, {0, 0, 0}),
+                    {rod(0.2, 0.1, 0.005)}),
+               body("fork", "gimbal", joint("nutation", "revolute", {0, 1, 0}, {0.1, 0, 0}),
+                    {rod(0.1, 0.05, 0.005)}),
+               body("rotor", "fork", joint("spin", "revolute", {1, 0, 0}, {0.05, 0, 0}), {rotor})});
+    c.push_back({"speeds",
+                 "gyroscopic rotor at 1e3 rad/s",
+                 "a disc spinning at 1000 rad/s in a two-axis gimbal: nutation at ~2000 rad/s",
+                 m,
+                 {0, 0.2, 0},
+                 {1, 0, 1000},
+                 0.05,
+                 1e-5});
   }
   // Slender bars with negative lumped rotary inertia.
-  c.push_back({"slender bars", "slender bars, axes perpendicular and along", "two 1 m steel bars of 1 mm² by section (J_rot negative): the second turns about its own axis",
-               slender_bars(), {0.3, 0.2}, {0, 5}, 0.5, 1e-4});
+  c.push_back({"slender bars",
+               "slender bars, axes perpendicular and along",
+               "two 1 m steel bars of 1 mm² by section (J_rot negative): the second turns about "
+               "its own axis",
+               slender_bars(),
+               {0.3, 0.2},
+               {0, 5},
+               0.5,
+               1e-4});
   // Near-singular postures.
-  c.push_back({"postures", "finger stretched", "the paper's finger fully stretched (q = 0) under gravity",
-               finger(9.81), {0, 0, 0, 0}, {0, 0.5, 0.5, 0.5}, 0.2, 1e-3});
+  c.push_back({"postures",
+               "finger stretched",
+               "the paper's finger fully stretched (q = 0) under gravity",
+               finger(9.81),
+               {0, 0, 0, 0},
+               {0, 0.5, 0.5, 0.5},
+               0.2,
+               1e-3});
   {
-    Json m = model("aligned axes", {body("b1", "world", joint("yaw", "revolute", {0, 0, 1}, {0, 0, 0}), {rod(1, 0.5, 0.025)}),
-                                    body("b2", "b1", joint("pitch", "revolute", {0, 1, 0}, {0, 0, 0.5}), {rod(1, 0.5, 0.025)}),
-                                    body("b3", "b2", joint("roll", "revolute", {0, 0, 1}, {0, 0, 0}), {rod(0.5, 0.3, 0.015)})});
-    c.push_back({"postures", "two joint axes aligned", "yaw and roll axes collinear at pitch = 0 (a wrist singularity)",
-                 m, {0, 0, 0}, {0.5, 0.5, 0.5}, 0.5, 1e-3});
+    Json m = model(
+        "aligned axes",
+        {body("b1", "world", joint("yaw", "revolute", {0, 0, 1}, {0, 0, 0}), {rod(1, 0.5, 0.025)}),
+         body("b2", "b1", joint("pitch", "revolute", {0, 1, 0}, {0, 0, 0.5}), {rod(1, 0.5, 0.025)}),
+         body("b3", "b2", joint("roll", "revolute", {0, 0, 1}, {0, 0, 0}),
+              {rod(0.5, 0.3, 0.015)})});
+    c.push_back({"postures",
+                 "two joint axes aligned",
+                 "yaw and roll axes collinear at pitch = 0 (a wrist singularity)",
+                 m,
+                 {0, 0, 0},
+                 {0.5, 0.5, 0.5},
+                 0.5,
+                 1e-3});
   }
   {
-    Json slider = {{"type", "rigid_body"}, {"mass", 1.0}, {"com", {0, 0, 0}},
+    Json slider = {{"type", "rigid_body"},
+                   {"mass", 1.0},
+                   {"com", {0, 0, 0}},
                    {"inertia", {{"ixx", 1e-6}, {"iyy", 1e-6}, {"izz", 1e-6}}}};
-    Json m = model("slider at zero", {body("table", "world", joint("spin", "revolute", {0, 0, 1}, {0, 0, 0}), Json::array()),
-                                      body("slider", "table", joint("reach", "prismatic", {1, 0, 0}, {0, 0, 0}), {slider})});
-    c.push_back({"postures", "prismatic at zero extension", "a slider of 1 kg on a massless turntable at zero extension: the turntable moves only the slider's 1e-6 kg·m²",
-                 m, {0, 0}, {0.1, 0}, 0.2, 1e-3});
+    Json m = model(
+        "slider at zero",
+        {body("table", "world", joint("spin", "revolute", {0, 0, 1}, {0, 0, 0}), Json::array()),
+         body("slider", "table", joint("reach", "prismatic", {1, 0, 0}, {0, 0, 0}), {slider})});
+    c.push_back({"postures",
+                 "prismatic at zero extension",
+                 "a slider of 1 kg on a massless turntable at zero extension: the turntable moves "
+                 "only the slider's 1e-6 kg·m²",
+                 m,
+                 {0, 0},
+                 {0.1, 0},
+                 0.2,
+                 1e-3});
   }
   // Size and gravity.
   {
-    StressCase s{"size", "chain of 1000 links", "random_tree plugin, 1000 bodies in one chain",
-                 {{"model", "random_tree"}, {"params", {{"seed", 3}, {"bodies", quick ? 200 : 1000}, {"branching", 0}}}},
-                 {}, {}, 4e-3, 1e-3};
-    if (quick) s.name = "chain of 200 links", s.description = "random_tree plugin, 200 bodies in one chain (--quick)";
+    StressCase s{"size",
+                 "chain of 1000 links",
+                 "random_tree plugin, 1000 bodies in one chain",
+                 {{"model", "random_tree"},
+                  {"params", {{"seed", 3}, {"bodies", quick ? 200 : 1000}, {"branching", 0}}}},
+                 {},
+                 {},
+                 4e-3,
+                 1e-3};
+    if (quick)
+      s.name = "chain of 200 links",
+      s.description = "random_tree plugin, 200 bodies in one chain (--quick)";
     s.large = true;
     c.push_back(s);
   }
-  c.push_back({"gravity", "zero gravity", "the finger in space", finger(0), {0.1, 0.5, 0.6, 0.5}, {0.5, 1, 1, 1}, 0.5, 1e-3});
-  c.push_back({"gravity", "1000 g", "the finger at 9810 m/s²", finger(9810), {0.1, 0.5, 0.6, 0.5}, {0.5, 1, 1, 1}, 0.01, 1e-4});
+  c.push_back({"gravity",
+               "zero gravity",
+               "the finger in space",
+               finger(0),
+               {0.1, 0.5, 0.6, 0.5},
+               {0.5, 1, 1, 1},
+               0.5,
+               1e-3});
+  c.push_back({"gravity",
+               "1000 g",
+               "the finger at 9810 m/s²",
+               finger(9810),
+               {0.1, 0.5, 0.6, 0.5},
+               {0.5, 1, 1, 1},
+               0.01,
+               1e-4});
   // A massless chain end: M^s singular, refused.
-  c.push_back({"singular", "zero-mass chain end", "a 1 kg link with a massless link at its end",
-               chain("massless end", {1, 0}, {0.5, 0.5}), {}, {}, 0.5, 1e-3});
+  c.push_back({"singular",
+               "zero-mass chain end",
+               "a 1 kg link with a massless link at its end",
+               chain("massless end", {1, 0}, {0.5, 0.5}),
+               {},
+               {},
+               0.5,
+               1e-3});
   c.back().model["bodies"][1]["elements"] = Json::array();
   c.back().expect = "refused";
   for (auto& s : c)

@@ -1,6 +1,9 @@
 // femdyn study: error against run time for every femdyn and Simbody integrator on one model
 // (validation/study.hpp). Writes study.csv, study.gp + study.png (gnuplot) and study.md.
+#include "validation/study.hpp"
+
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -12,12 +15,10 @@
 #include <random>
 #include <sstream>
 #include <thread>
-#include <unistd.h>
 
 #include "cli/commands.hpp"
 #include "core/sampling.hpp"
 #include "io/atomic_file.hpp"
-#include "validation/study.hpp"
 
 #ifndef FEMDYN_BUILD_TYPE
 #define FEMDYN_BUILD_TYPE "unknown"
@@ -30,7 +31,8 @@ namespace fs = std::filesystem;
 using validation::StudyReport;
 using validation::StudyRun;
 
-constexpr const char* kHelp = R"(usage: femdyn study MODEL [--t-end T] [--out DIR] [--quick] [--q0 …] [--qd0 …] [--force]
+constexpr const char* kHelp =
+    R"(usage: femdyn study MODEL [--t-end T] [--out DIR] [--quick] [--q0 …] [--qd0 …] [--force]
                      [--gravity gx,gy,gz]
 
 Error against run time (work-precision) for every femdyn integrator (rk4, euler over steps;
@@ -87,7 +89,8 @@ std::string machine() {
     }
   std::ostringstream s;
   s << model << ", " << std::thread::hardware_concurrency() << " cores; build " FEMDYN_BUILD_TYPE
-    << " (" << "g++ " << __VERSION__ << ")";
+    << " ("
+    << "g++ " << __VERSION__ << ")";
   return s.str();
 }
 
@@ -109,8 +112,8 @@ std::string csv_text(const StudyReport& rep) {
     std::replace(failure.begin(), failure.end(), '"', '\'');
     s << r.engine << "," << r.integrator << "," << r.setting << "," << r.value << "," << r.error
       << "," << r.final_error << "," << r.energy_drift << "," << r.wall_time << ","
-      << r.times.size() << "," << r.rhs_evals << "," << r.steps << "," << r.ok << ","
-      << r.resolved << ",\"" << failure << "\"\n";
+      << r.times.size() << "," << r.rhs_evals << "," << r.steps << "," << r.ok << "," << r.resolved
+      << ",\"" << failure << "\"\n";
   }
   return s.str();
 }
@@ -121,14 +124,14 @@ std::string gnuplot_text(const StudyReport& rep) {
   std::ostringstream s, plots;
   s << std::setprecision(10) << "# femdyn study: " << rep.model << " (generated; gnuplot "
     << "study.gp)\nset terminal pngcairo size 1000,650 font 'sans,11'\n"
-    << "if (!exists('out')) out = 'study.png'\nset output out\nset logscale xy\nset format x '10^{%L}'\nset format y '10^{%L}'\n"
+    << "if (!exists('out')) out = 'study.png'\nset output out\nset logscale xy\nset format x "
+       "'10^{%L}'\nset format y '10^{%L}'\n"
     << "set xlabel 'wall time (s)'\nset ylabel 'max state error ‖(θ, θ̇) − reference‖∞'\n"
     << "set title 'Work-precision: " << rep.model << ", t = 0…" << rep.t_end << " s'\n"
     << "set grid\nset key outside right top\n";
   // Distinct colours: femdyn's in warm, Simbody's in cool tones.
   const char* femdyn_colour[] = {"#d62728", "#ff7f0e", "#8c564b", "#e377c2", "#bcbd22"};
-  const char* simbody_colour[] = {"#1f77b4", "#2ca02c", "#17becf", "#9467bd", "#7f7f7f",
-                                  "#393b79"};
+  const char* simbody_colour[] = {"#1f77b4", "#2ca02c", "#17becf", "#9467bd", "#7f7f7f", "#393b79"};
   int block = 0, nf = 0, ns = 0;
   std::vector<std::string> done;
   for (const StudyRun& first : rep.runs) {
@@ -145,10 +148,10 @@ std::string gnuplot_text(const StudyReport& rep) {
     if (points == 0) continue;
     s << "$d" << block << " << EOD\n" << data.str() << "EOD\n";
     plots << (block ? ", \\\n     " : "plot ") << "$d" << block << " using 1:2 with linespoints "
-          << (first.engine == "femdyn" ? "lw 2 pt 7 dt 1 lc rgb '" + std::string(femdyn_colour[nf++ % 5])
-                                       : "lw 1.5 pt 6 dt 2 lc rgb '" + std::string(simbody_colour[ns++ % 6]))
-          << "' title '"
-          << key << "'";
+          << (first.engine == "femdyn"
+                  ? "lw 2 pt 7 dt 1 lc rgb '" + std::string(femdyn_colour[nf++ % 5])
+                  : "lw 1.5 pt 6 dt 2 lc rgb '" + std::string(simbody_colour[ns++ % 6]))
+          << "' title '" << key << "'";
     ++block;
   }
   s << plots.str() << "\n";
@@ -163,8 +166,8 @@ std::string markdown_text(const StudyReport& rep, const std::string& command) {
     << rep.n << " coordinates, t = 0…" << rep.t_end << " s from q0 = " << vector_text(rep.q0)
     << ", q̇0 = " << vector_text(rep.qd0) << ". Error: the largest ‖(θ, θ̇) − reference‖∞ "
     << "over the sample times (rad and rad/s, or m and m/s). Reference: " << rep.reference_method
-    << "; its estimated error " << sci(rep.reference_error)
-    << ", so errors below " << sci(rep.resolution) << " are not resolved and left out. Wall time: "
+    << "; its estimated error " << sci(rep.reference_error) << ", so errors below "
+    << sci(rep.resolution) << " are not resolved and left out. Wall time: "
     << "the integration alone, median of up to 5 runs when a run is under 50 ms.\n\n"
     << "| target error | fastest femdyn | wall time | fastest Simbody | wall time | "
        "Simbody / femdyn |\n|---|---|---|---|---|---|\n";
@@ -183,10 +186,11 @@ std::string markdown_text(const StudyReport& rep, const std::string& command) {
       << "reference's own error here.\n";
   s << "\n![error against wall time](study.png)\n\n";
   for (const std::string& n : rep.notes) s << "Note: " << n << "\n\n";
-  s << "Every run (" << (rep.conservative ? "the model is conservative: energy drift is "
-                                            "max |E(t) − E(0)|"
-                                          : "the model is not conservative: the energy column "
-                                            "is max |E(t) − E(0)|, not a drift")
+  s << "Every run ("
+    << (rep.conservative ? "the model is conservative: energy drift is "
+                           "max |E(t) − E(0)|"
+                         : "the model is not conservative: the energy column "
+                           "is max |E(t) − E(0)|, not a drift")
     << "):\n\n| engine | integrator | setting | error | wall time | evaluations | steps | energy "
        "change (J) | note |\n|---|---|---|---|---|---|---|---|---|\n";
   for (const StudyRun& r : rep.runs)
@@ -194,7 +198,9 @@ std::string markdown_text(const StudyReport& rep, const std::string& command) {
       << std::setprecision(3) << r.value << " | " << (r.ok ? sci(r.error) : "—") << " | "
       << seconds(r.wall_time) << " | " << r.rhs_evals << " | " << r.steps << " | "
       << (r.ok ? sci(r.energy_drift) : "—") << " | "
-      << (!r.ok ? "failed: " + r.failure.substr(0, 90) : r.resolved ? "" : "below resolution")
+      << (!r.ok        ? "failed: " + r.failure.substr(0, 90)
+          : r.resolved ? ""
+                       : "below resolution")
       << " |\n";
   return s.str();
 }
@@ -239,7 +245,8 @@ int cmd_study(int argc, char** argv) {
   const fs::path dir = a.has("out") ? fs::path(a.options.at("out")) : fs::path("study");
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (!fs::is_directory(dir)) throw CliError("--out " + dir.string() + ": cannot create the directory");
+  if (!fs::is_directory(dir))
+    throw CliError("--out " + dir.string() + ": cannot create the directory");
   for (const char* f : {"study.csv", "study.gp", "study.png", "study.md"})
     if (fs::exists(dir / f) && !a.has("force"))
       throw CliError((dir / f).string() + ": exists (use --force to replace it)");

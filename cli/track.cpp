@@ -13,7 +13,8 @@
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp = R"(usage: femdyn track MODEL --to a,b,… [--from …] [--duration T] [--steps N] [--csv FILE [--force]] [--json]
+constexpr const char* kHelp =
+    R"(usage: femdyn track MODEL --to a,b,… [--from …] [--duration T] [--steps N] [--csv FILE [--force]] [--json]
                      [--gravity gx,gy,gz]
 
 Plans the quintic (minimum-jerk) motion q_ref(t) from --from (default 0) to --to in T seconds
@@ -89,8 +90,11 @@ int cmd_track(int argc, char** argv) {
     }
   }
   if (a.has("json")) {
-    std::cout << Json{{"model", m.name}, {"duration", T}, {"steps", N},
-                      {"max_tracking_error", max_err}, {"max_abs_tau", max_tau}}
+    std::cout << Json{{"model", m.name},
+                      {"duration", T},
+                      {"steps", N},
+                      {"max_tracking_error", max_err},
+                      {"max_abs_tau", max_tau}}
                      .dump(2)
               << "\n";
   } else {

@@ -1,4 +1,6 @@
 // femdyn validate MODEL…: the model against its Simbody twin (validation/validate.hpp).
+#include "validation/validate.hpp"
+
 #include <climits>
 #include <deque>
 #include <iomanip>
@@ -8,12 +10,12 @@
 #include "cli/commands.hpp"
 #include "io/output.hpp"
 #include "io/urdf_loader.hpp"
-#include "validation/validate.hpp"
 
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp = R"(usage: femdyn validate MODEL… [--states K] [--seed S] [--t-end T] [--tol X]
+constexpr const char* kHelp =
+    R"(usage: femdyn validate MODEL… [--states K] [--seed S] [--t-end T] [--tol X]
                         [--qd-scale V] [--json | --markdown] [--gravity gx,gy,gz]
 
 Builds each model's Simbody twin (same tree, each body's mass properties from its equivalent
@@ -39,19 +41,27 @@ Json report_json(const std::string& path, const validation::ValidationReport& r)
     abs[q.name] = q.max_abs;
   }
   const auto& t = r.trajectory;
-  Json traj = {{"run", t.run}, {"t_end", t.t_end}, {"max_state_error", t.max_state_error},
-               {"rk4_step", t.rk4_step}, {"rk4_error_estimate", t.rk4_error_estimate},
-               {"simbody_error_estimate", t.simbody_error_estimate}, {"resolved", t.resolved},
-               {"tolerance", t.tolerance},
-               {"energy_change", {{"femdyn", t.energy_change_femdyn}, {"simbody", t.energy_change_simbody}}},
-               {"pass", t.pass()},
-               {"t", t.t}, {"state_error", t.error},
-               {"energy", {{"femdyn", t.energy_femdyn}, {"simbody", t.energy_simbody}}}};
+  Json traj = {
+      {"run", t.run},
+      {"t_end", t.t_end},
+      {"max_state_error", t.max_state_error},
+      {"rk4_step", t.rk4_step},
+      {"rk4_error_estimate", t.rk4_error_estimate},
+      {"simbody_error_estimate", t.simbody_error_estimate},
+      {"resolved", t.resolved},
+      {"tolerance", t.tolerance},
+      {"energy_change", {{"femdyn", t.energy_change_femdyn}, {"simbody", t.energy_change_simbody}}},
+      {"pass", t.pass()},
+      {"t", t.t},
+      {"state_error", t.error},
+      {"energy", {{"femdyn", t.energy_femdyn}, {"simbody", t.energy_simbody}}}};
   if (!t.run) traj["skipped"] = t.skipped;
-  return {{"model", path}, {"states", r.states}, {"coordinates", r.n},
-          {"tolerance", r.quantities.empty() ? 0.0 : r.quantities[0].tolerance},
-          {"max_rel_error", rel}, {"max_abs_error", abs}, {"trajectory", traj},
-          {"notes", r.notes}, {"failure", r.failure}, {"pass", r.pass()}};
+  return {
+      {"model", path},        {"states", r.states},
+      {"coordinates", r.n},   {"tolerance", r.quantities.empty() ? 0.0 : r.quantities[0].tolerance},
+      {"max_rel_error", rel}, {"max_abs_error", abs},
+      {"trajectory", traj},   {"notes", r.notes},
+      {"failure", r.failure}, {"pass", r.pass()}};
 }
 
 void print_text(const std::string& path, const validation::ValidationReport& r) {
@@ -70,13 +80,14 @@ void print_text(const std::string& path, const validation::ValidationReport& r) 
               << std::setw(11) << sci(q.tolerance) << " " << (q.pass() ? "PASS" : "FAIL") << "\n";
   const auto& t = r.trajectory;
   if (t.run)
-    std::cout << std::setw(10) << "trajectory" << " " << std::setw(13) << sci(t.max_state_error)
-              << " " << std::setw(13) << "" << " " << std::setw(11) << sci(t.tolerance) << " "
-              << (t.pass() ? "PASS" : "FAIL") << "   (" << t.t_end
-              << " s; error estimates: femdyn RK4 (step " << sci(t.rk4_step) << " s) "
-              << sci(t.rk4_error_estimate) << ", Simbody " << sci(t.simbody_error_estimate)
-              << "; energy change femdyn " << sci(t.energy_change_femdyn) << " J, Simbody "
-              << sci(t.energy_change_simbody) << " J)\n";
+    std::cout << std::setw(10) << "trajectory"
+              << " " << std::setw(13) << sci(t.max_state_error) << " " << std::setw(13) << ""
+              << " " << std::setw(11) << sci(t.tolerance) << " " << (t.pass() ? "PASS" : "FAIL")
+              << "   (" << t.t_end << " s; error estimates: femdyn RK4 (step " << sci(t.rk4_step)
+              << " s) " << sci(t.rk4_error_estimate) << ", Simbody "
+              << sci(t.simbody_error_estimate) << "; energy change femdyn "
+              << sci(t.energy_change_femdyn) << " J, Simbody " << sci(t.energy_change_simbody)
+              << " J)\n";
   else
     std::cout << "trajectory not compared: " << t.skipped << "\n";
   if (t.run && !t.error.empty()) {  // the state error over time, at five of the samples
@@ -88,8 +99,9 @@ void print_text(const std::string& path, const validation::ValidationReport& r) 
     std::cout << "\n";
   }
   if (t.run && !t.resolved)
-    std::cout << "trajectory unresolved: the integrators' own error estimates exceed 1e-6 of the "
-                 "state; the motion is too fast or chaotic over this time (try a shorter --t-end)\n";
+    std::cout
+        << "trajectory unresolved: the integrators' own error estimates exceed 1e-6 of the "
+           "state; the motion is too fast or chaotic over this time (try a shorter --t-end)\n";
   for (const auto& n : r.notes) std::cout << "note: " << n << "\n";
   std::cout << (r.pass() ? "PASS" : "FAIL") << "\n";
 }
@@ -128,7 +140,8 @@ int cmd_validate(int argc, char** argv) {
     return 0;
   }
   if (a.positional.empty()) throw CliError("expected a MODEL file (try --help)");
-  if (a.has("json") && a.has("markdown")) throw CliError("--json and --markdown exclude each other");
+  if (a.has("json") && a.has("markdown"))
+    throw CliError("--json and --markdown exclude each other");
   validation::ValidationOptions o;
   o.states = positive_int(a, "states", o.states, 1);
   o.seed = static_cast<unsigned>(positive_int(a, "seed", static_cast<int>(o.seed), 0));
@@ -151,7 +164,8 @@ int cmd_validate(int argc, char** argv) {
     if (is_urdf_path(a.positional[i]) && r.failure.empty()) {
       // The import itself, against a Simbody model read straight from the XML.
       std::string failure;
-      r.quantities.push_back(validation::validate_urdf_import(models[i], a.positional[i], o, failure));
+      r.quantities.push_back(
+          validation::validate_urdf_import(models[i], a.positional[i], o, failure));
       if (!failure.empty()) r.failure = failure;
     }
     all_pass = all_pass && r.pass();

@@ -48,7 +48,8 @@ Status check_regularity(const Model& model, Workspace& ws) {
     const int j = model.bodies[b].joint.theta;
     if (j < 0) continue;
     const Vec6& S = ws.articulated[b].S;
-    if (!(ws.articulated[b].d >= 1e-13 * S.dot(ws.composite[b] * S))) return dependent_pivot(model, j);
+    if (!(ws.articulated[b].d >= 1e-13 * S.dot(ws.composite[b] * S)))
+      return dependent_pivot(model, j);
   }
   return {};
 }
@@ -59,7 +60,7 @@ Status articulated_forward_dynamics(const Model& model, Workspace& ws, const Vec
                                     const VecX& qd, const VecX& tau) {
   const int nb = static_cast<int>(model.bodies.size());
   propagate(model, ws, q, qd, {.jacobian = false, .bias = false, .rows = false});  // poses, θ
-  ws.theta_dot = qd;  // C = I
+  ws.theta_dot = qd;                                                               // C = I
 
   // 1. Velocities, velocity-product accelerations and bias forces, root to leaves.
   for (int b = 0; b < nb; ++b) {

@@ -16,7 +16,8 @@
 //                       I^A_p += I^A_b − U_b U_bᵀ / d_b,
 //                       p^A_p += p^A_b + (I^A_b − U_b U_bᵀ / d_b) c_b + U_b u_b / d_b
 //      (a fixed joint passes I^A_b and p^A_b on whole)
-//   3. root to leaves:  a'_b = a_p + c_b (a_0 = (0, −g)),  θ̈_b = (u_b − U_bᵀ a'_b) / d_b,  a_b = a'_b + S_b θ̈_b
+//   3. root to leaves:  a'_b = a_p + c_b (a_0 = (0, −g)),
+//                       θ̈_b = (u_b − U_bᵀ a'_b) / d_b,  a_b = a'_b + S_b θ̈_b
 // O(bodies + N_u), no matrix of size n. Used when Model::dynamics_route is Articulated: the
 // body-level form is exact and there is no coupling (C = I, θ0 = 0). A coupled model has
 // coordinates that drive several joints, which the recursion cannot eliminate one joint at a

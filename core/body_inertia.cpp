@@ -30,7 +30,8 @@ bool gyroscopic_is_rigid(const Element& e, const MatX& me) {
   const int k = static_cast<int>(e.nodes().size());
   for (int i = 0; i < k; ++i)
     for (int l = 0; l < k; ++l) J += me.block<3, 3>(6 * i + 3, 6 * l + 3);
-  for (const Vec6& xi : {Vec6(0.3, -1.1, 0.7, 0.2, 0.5, -0.4), Vec6(-0.9, 0.4, 1.3, -0.6, 0.1, 0.8)}) {
+  for (const Vec6& xi :
+       {Vec6(0.3, -1.1, 0.7, 0.2, 0.5, -0.4), Vec6(-0.9, 0.4, 1.3, -0.6, 0.1, 0.8)}) {
     const VecX x = X * xi;
     VecX g = VecX::Zero(x.size());
     e.add_velocity_force(x, x, g);

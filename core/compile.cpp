@@ -5,12 +5,12 @@
 #include <set>
 
 #include "core/body_inertia.hpp"
-#include "core/mass_solver.hpp"
 #include "core/correlation.hpp"
 #include "core/errors.hpp"
 #include "core/limits.hpp"
-#include "core/names.hpp"
+#include "core/mass_solver.hpp"
 #include "core/model.hpp"
+#include "core/names.hpp"
 
 namespace femdyn {
 namespace {
@@ -81,8 +81,8 @@ Joint compile_joint(const JointSpec& js, const std::string& body_name) {
   j.R_pj_K = j.R_pj * K;
   j.R_pj_K2 = j.R_pj_K * K;
   j.axis_parent = j.R_pj * j.axis;
-  for (auto [x, what] : {std::pair{js.stiffness, "stiffness"}, {js.rest, "rest"},
-                         {js.damping, "damping"}})
+  for (auto [x, what] :
+       {std::pair{js.stiffness, "stiffness"}, {js.rest, "rest"}, {js.damping, "damping"}})
     check_magnitude(x, js.where, what);
   if (js.stiffness < 0) throw ModelError(js.where + "/spring", "negative stiffness");
   if (js.damping < 0) throw ModelError(js.where + "/damping", "negative damping");
@@ -192,7 +192,9 @@ Model compile(MechanismSpec spec) {
   Model m;
   m.name = spec.name;
   m.where = spec.where.size() >= 2 ? spec.where.substr(0, spec.where.size() - 2) : spec.where;
-  check_magnitude(spec.gravity, spec.where + "/gravity", "gravity");
+  check_magnitude(spec.gravity,
+                  spec.gravity_where.empty() ? spec.where + "/gravity" : spec.gravity_where,
+                  "gravity");
   check_name(spec.name, spec.where + "/name", "model name");
   if (static_cast<long long>(spec.bodies.size()) > kMaxBodies)
     throw ModelError(spec.where + "/bodies", std::to_string(spec.bodies.size()) +

@@ -8,10 +8,10 @@
 
 #include "core/equations.hpp"
 #include "core/errors.hpp"
-#include "core/limits.hpp"
-#include "core/names.hpp"
 #include "core/joint.hpp"
 #include "core/kinematics.hpp"
+#include "core/limits.hpp"
+#include "core/names.hpp"
 
 namespace femdyn {
 namespace {
@@ -24,8 +24,8 @@ constexpr const char* kAxis[] = {"x", "y", "z"};
 std::pair<int, Vec3> canonical_point(const Model& m, int b, Vec3 r) {
   while (m.bodies[b].parent >= 0) {
     const Joint& j = m.bodies[b].joint;
-    const bool on_axis = j.type == JointType::Revolute &&
-                         r.cross(j.axis).norm() <= 1e-12 * (1.0 + r.norm());
+    const bool on_axis =
+        j.type == JointType::Revolute && r.cross(j.axis).norm() <= 1e-12 * (1.0 + r.norm());
     if (!(j.type == JointType::Fixed || on_axis)) break;
     r = j.R_pj * r + j.p_pj;
     b = m.bodies[b].parent;
@@ -111,7 +111,7 @@ struct TSamples {
 struct PathSpan {
   std::array<Vec6, 6> basis;  // orthonormal
   int size = 0;
-  double s_max = 0;           // max |S_a| on the path
+  double s_max = 0;                    // max |S_a| on the path
   double bound(const Vec6& w) const {  // |P w| · max |S_a|
     Vec6 p = Vec6::Zero();
     for (int k = 0; k < size; ++k) p += basis[k].dot(w) * basis[k];
@@ -253,8 +253,8 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
         }
       }
       const MatX me = e.element->local_mass();
-      if (me.rows() != e.element->local_dof_count() || me.cols() != me.rows() ||
-          !me.allFinite() || (me - me.transpose()).norm() > 1e-12 * (1.0 + me.norm()))
+      if (me.rows() != e.element->local_dof_count() || me.cols() != me.rows() || !me.allFinite() ||
+          (me - me.transpose()).norm() > 1e-12 * (1.0 + me.norm()))
         throw ModelError(es.where, "element local mass is not a finite symmetric matrix");
       local_cand.push_back(std::move(used));
       all_cand.push_back(std::move(all));
@@ -270,7 +270,8 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
   std::vector<LoadAt> loads;
   std::map<std::string, int> body_index;
   if (!spec.loads.empty())
-    for (std::size_t k = 0; k < m.bodies.size(); ++k) body_index.emplace(m.bodies[k].name, static_cast<int>(k));
+    for (std::size_t k = 0; k < m.bodies.size(); ++k)
+      body_index.emplace(m.bodies[k].name, static_cast<int>(k));
   for (const LoadSpec& ls : spec.loads) {
     const auto found = body_index.find(ls.body);
     const int b = found == body_index.end() ? -1 : found->second;
@@ -320,20 +321,20 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
     for (std::size_t e = 0; e < cs.rows.size(); ++e) {
       const std::string where = cs.where + "/" + std::to_string(e);
       if (cs.rows[e].size() != all_cand[e].size())
-        throw ModelError(where, "has " + std::to_string(cs.rows[e].size()) +
-                                    " entries, expected " + std::to_string(all_cand[e].size()) +
-                                    " (6 per element node)");
+        throw ModelError(where, "has " + std::to_string(cs.rows[e].size()) + " entries, expected " +
+                                    std::to_string(all_cand[e].size()) + " (6 per element node)");
       for (int d : cs.rows[e]) {
         if (d < 0) throw ModelError(where, "negative system DOF number");
         // Numbered 1, 2, … without gaps: no number exceeds the entries (nor sizes a huge buffer).
         if (static_cast<std::size_t>(d) > entries)
-          throw ModelError(where, "system DOF number " + std::to_string(d) + " exceeds the " +
-                                      std::to_string(entries) +
-                                      " entries of the table (DOFs are numbered 1, 2, … without gaps)");
+          throw ModelError(where,
+                           "system DOF number " + std::to_string(d) + " exceeds the " +
+                               std::to_string(entries) +
+                               " entries of the table (DOFs are numbered 1, 2, … without gaps)");
         N = std::max(N, d);
       }
     }
-    std::vector<int> def(N + 1, -1);  // system DOF -> defining candidate
+    std::vector<int> def(N + 1, -1);                  // system DOF -> defining candidate
     std::vector<std::pair<int, std::string>> joined;  // approximate joins (join_deepest)
     for (std::size_t e = 0; e < cs.rows.size(); ++e)
       for (std::size_t l = 0; l < cs.rows[e].size(); ++l) {
@@ -354,7 +355,8 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
                                     m.dof_name_of(cand.list[c]) + ", which move differently";
           if (!cs.join_deepest)
             throw ModelError(cs.where + "/" + std::to_string(e) + "/" + std::to_string(l), joins);
-          if (depth(m, carrier_body(m, cand.list[c])) > depth(m, carrier_body(m, cand.list[def[d]])))
+          if (depth(m, carrier_body(m, cand.list[c])) >
+              depth(m, carrier_body(m, cand.list[def[d]])))
             def[d] = c;
           joined.emplace_back(d, joins);
         }

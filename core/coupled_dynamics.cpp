@@ -8,8 +8,8 @@
 
 namespace femdyn {
 
-Status coupled_forward_dynamics(const Model& model, Workspace& ws, const VecX& q,
-                                const VecX& qd, const VecX& tau) {
+Status coupled_forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+                                const VecX& tau) {
   const int nb = static_cast<int>(model.bodies.size());
   propagate(model, ws, q, qd, {.jacobian = false, .bias = false, .rows = false});  // poses, θ
   coupling_apply(model, qd, ws.theta_dot, false);

@@ -18,7 +18,7 @@ namespace femdyn {
 // q̈ into ws.qdd, M^s into ws.Ms (factorised in ws.solver); θ, θ̇ and the body poses as
 // propagate leaves them. Requires the body-level routes (Model::force_route == Bodies,
 // Model::mass_route == Composite).
-Status coupled_forward_dynamics(const Model& model, Workspace& ws, const VecX& q,
-                                const VecX& qd, const VecX& tau);
+Status coupled_forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+                                const VecX& tau);
 
 }  // namespace femdyn

@@ -3,8 +3,8 @@
 namespace femdyn {
 
 Mat3 MassProperties::inertia_com() const {
-  // Parallel axis: I_o = I_c + m([c]xᵀ[c]x)  =>  I_c = I_o - m(|c|² 1 - c cᵀ)
-  return inertia_origin - mass * (com.squaredNorm() * Mat3::Identity() - com * com.transpose());
+  // Parallel axis: I_o = I_c + m [c]xᵀ[c]x.
+  return inertia_origin - point_inertia(mass, com);
 }
 
 MassProperties Element::mass_properties() const {

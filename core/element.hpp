@@ -19,7 +19,7 @@ namespace femdyn {
 constexpr int kNodeDofs = 6;  // x y z rx ry rz
 
 struct ElementNode {
-  Vec3 position;                  // in the body frame
+  Vec3 position;                     // in the body frame
   std::array<bool, kNodeDofs> uses;  // which local DOFs this element uses at the node
 };
 

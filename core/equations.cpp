@@ -18,8 +18,7 @@ namespace {
 
 // nodal += g(x, y): element velocity forces, gathered and scattered through N_m.
 template <class X, class Y>
-void add_velocity_forces(const Model& model, Workspace& ws, const X& x, const Y& y,
-                         VecX& nodal) {
+void add_velocity_forces(const Model& model, Workspace& ws, const X& x, const Y& y, VecX& nodal) {
   for (std::size_t e = 0; e < model.elements.size(); ++e) {
     const ElementEntry& E = model.elements[e];
     if (!E.element->has_velocity_force()) continue;
@@ -84,7 +83,6 @@ void assemble_forces(const Model& model, Workspace& ws, const VecX& tau, bool wi
 
 bool is_zero(const VecX& v) { return v.size() == 0 || v.cwiseAbs().maxCoeff() == 0.0; }
 
-
 // ws.Ms from the body poses (composite route) or from T (transform route), both already
 // propagated; mirrored so that it is symmetric in floating point too.
 void form_mass_matrix(const Model& model, Workspace& ws) {
@@ -115,8 +113,7 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
   // body-level force route computes h by Newton–Euler, which leaves the poses.
   const bool composite = model.mass_route == MassRoute::Composite;
   const bool by_bodies = model.force_route == ForceRoute::Bodies;
-  if (by_bodies && moving)
-    newton_euler(model, ws, q, qd, nullptr, false, ws.h);
+  if (by_bodies && moving) newton_euler(model, ws, q, qd, nullptr, false, ws.h);
   if (!(by_bodies && moving && composite))
     propagate(model, ws, q, qd,
               {.jacobian = !composite, .bias = moving && !by_bodies, .rows = !composite});
@@ -155,8 +152,7 @@ Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const 
   Status st;
   if (model.dynamics_route == DynamicsRoute::Articulated) {
     st = articulated_forward_dynamics(model, ws, q, qd, tau);
-  } else if (model.force_route == ForceRoute::Bodies &&
-             model.mass_route == MassRoute::Composite) {
+  } else if (model.force_route == ForceRoute::Bodies && model.mass_route == MassRoute::Composite) {
     st = coupled_forward_dynamics(model, ws, q, qd, tau);
   } else {
     evaluate(model, ws, q, qd, tau);
@@ -170,8 +166,9 @@ Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const 
   // A result that overflowed is a failure naming the coordinate, never a NaN handed on.
   for (Eigen::Index a = 0; a < ws.qdd.size(); ++a)
     if (!std::isfinite(ws.qdd[a]))
-      return {false, "q̈ of '" + model.coordinate_names[a] +
-                         "' is NaN or Inf (the forces or the state overflow double precision)",
+      return {false,
+              "q̈ of '" + model.coordinate_names[a] +
+                  "' is NaN or Inf (the forces or the state overflow double precision)",
               static_cast<int>(a), true};
   return st;
 }

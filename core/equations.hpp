@@ -26,8 +26,8 @@ void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX&
 // q̈ = (M^s)⁻¹ (Q − h) into ws.qdd, by the model's route (Model::dynamics_route): the
 // articulated-body recursion (core/articulated.hpp), which forms neither M^s nor h nor Q, or
 // a Cholesky factorisation of M^s (with Q − h from one Newton–Euler pass where the body level
-// is exact, else from evaluate()). Call evaluate() for M^s, h and Q. Fails on a singular or indefinite M^s and on a q̈ that is not finite (naming
-// the coordinate).
+// is exact, else from evaluate()). Call evaluate() for M^s, h and Q. Fails on a singular or
+// indefinite M^s and on a q̈ that is not finite (naming the coordinate).
 Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                         const VecX& tau);
 

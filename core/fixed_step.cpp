@@ -64,8 +64,7 @@ Status Rk4::take_step(double h) {
   return {};
 }
 
-SymplecticEuler::SymplecticEuler(const Model& model, const FixedStepOptions& options,
-                                 Actuation tau)
+SymplecticEuler::SymplecticEuler(const Model& model, const FixedStepOptions& options, Actuation tau)
     : FixedStep(model, options, std::move(tau)), f_(VecX::Zero(y_.size())) {}
 
 Status SymplecticEuler::take_step(double h) {

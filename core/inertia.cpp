@@ -11,8 +11,7 @@ std::optional<std::string> inertia_problem(const Mat3& I, double reference) {
   if ((I - I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) return "inertia is not symmetric";
   const Vec3 p = Eigen::SelfAdjointEigenSolver<Mat3>(I).eigenvalues();  // ascending
   const double tol = 1e-9 * std::max(scale, 1e-300);
-  if (p[0] < -tol)
-    return "inertia has a negative principal moment (" + format_number(p[0]) + ")";
+  if (p[0] < -tol) return "inertia has a negative principal moment (" + format_number(p[0]) + ")";
   if (p[0] + p[1] < p[2] - tol)
     return "inertia violates the triangle inequality (principal moments " + format_number(p[0]) +
            ", " + format_number(p[1]) + ", " + format_number(p[2]) + ")";

@@ -18,20 +18,28 @@ std::string bad(const char* field, const std::string& what, double value) {
 
 const char* integrator_name(IntegratorKind kind) {
   switch (kind) {
-    case IntegratorKind::Rk4: return "rk4";
-    case IntegratorKind::Euler: return "euler";
-    case IntegratorKind::Dopri: return "dopri";
-    case IntegratorKind::Bdf: return "bdf";
+    case IntegratorKind::Rk4:
+      return "rk4";
+    case IntegratorKind::Euler:
+      return "euler";
+    case IntegratorKind::Dopri:
+      return "dopri";
+    case IntegratorKind::Bdf:
+      return "bdf";
   }
   return "?";
 }
 
 const char* integrator_method(IntegratorKind kind) {
   switch (kind) {
-    case IntegratorKind::Rk4: return "classical Runge-Kutta 4, fixed step";
-    case IntegratorKind::Euler: return "semi-implicit (symplectic) Euler, fixed step";
-    case IntegratorKind::Dopri: return "Dormand-Prince 5(4), adaptive, SUNDIALS ARKODE";
-    case IntegratorKind::Bdf: return "BDF 1-5 with Newton, adaptive, SUNDIALS CVODE";
+    case IntegratorKind::Rk4:
+      return "classical Runge-Kutta 4, fixed step";
+    case IntegratorKind::Euler:
+      return "semi-implicit (symplectic) Euler, fixed step";
+    case IntegratorKind::Dopri:
+      return "Dormand-Prince 5(4), adaptive, SUNDIALS ARKODE";
+    case IntegratorKind::Bdf:
+      return "BDF 1-5 with Newton, adaptive, SUNDIALS CVODE";
   }
   return "?";
 }
@@ -60,7 +68,8 @@ std::string AdaptiveOptions::check() const {
   if (rtol < 1e-15) return bad("rtol", "below double round-off (1e-15)", rtol);
   if (!(atol > 0) || !std::isfinite(atol))
     return bad("atol", "the absolute tolerance must be a positive number", atol);
-  if (!(h_max >= 0) || !std::isfinite(h_max)) return bad("h_max", "must be >= 0 (0: no limit)", h_max);
+  if (!(h_max >= 0) || !std::isfinite(h_max))
+    return bad("h_max", "must be >= 0 (0: no limit)", h_max);
   if (max_steps < 1) return bad("max_steps", "must be at least 1", static_cast<double>(max_steps));
   return {};
 }
@@ -75,8 +84,7 @@ Integrator::Integrator(const Model& model, Actuation tau)
 void Integrator::reset(double t0, const VecX& q0, const VecX& qd0, double t_stop) {
   const int n = motion_.n();
   if (q0.size() != n || qd0.size() != n)
-    throw std::invalid_argument("Integrator::reset: expected q0, qd0 of size " +
-                                std::to_string(n));
+    throw std::invalid_argument("Integrator::reset: expected q0, qd0 of size " + std::to_string(n));
   y_ << q0, qd0, 0.0;
   t_ = t0;
   t_stop_ = t_stop;
@@ -87,7 +95,8 @@ void Integrator::reset(double t0, const VecX& q0, const VecX& qd0, double t_stop
 Status Integrator::advance_to(double t_out) {
   const auto begin = std::chrono::steady_clock::now();
   Status st = t_out > t_ ? advance(t_out) : Status{};
-  stats_.wall_time += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  stats_.wall_time +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   return st;
 }
 
@@ -95,7 +104,8 @@ Status Integrator::step() {
   if (t_ >= t_stop_) return {};
   const auto begin = std::chrono::steady_clock::now();
   Status st = one_step();
-  stats_.wall_time += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  stats_.wall_time +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   return st;
 }
 
@@ -103,12 +113,14 @@ std::unique_ptr<Integrator> make_integrator(const Model& model, const Integrator
                                             Actuation tau) {
   if (const std::string why = o.check(); !why.empty()) throw std::invalid_argument(why);
   switch (o.kind) {
-    case IntegratorKind::Rk4: return std::make_unique<Rk4>(model, o.fixed, std::move(tau));
+    case IntegratorKind::Rk4:
+      return std::make_unique<Rk4>(model, o.fixed, std::move(tau));
     case IntegratorKind::Euler:
       return std::make_unique<SymplecticEuler>(model, o.fixed, std::move(tau));
     case IntegratorKind::Dopri:
       return std::make_unique<DormandPrince>(model, o.adaptive, std::move(tau));
-    case IntegratorKind::Bdf: return std::make_unique<Bdf>(model, o.adaptive, std::move(tau));
+    case IntegratorKind::Bdf:
+      return std::make_unique<Bdf>(model, o.adaptive, std::move(tau));
   }
   return nullptr;
 }

@@ -24,7 +24,7 @@
 namespace femdyn {
 
 enum class IntegratorKind { Rk4, Euler, Dopri, Bdf };
-const char* integrator_name(IntegratorKind kind);  // "rk4", "euler", "dopri", "bdf"
+const char* integrator_name(IntegratorKind kind);    // "rk4", "euler", "dopri", "bdf"
 const char* integrator_method(IntegratorKind kind);  // e.g. "Dormand–Prince 5(4), SUNDIALS ARKODE"
 inline constexpr IntegratorKind kIntegrators[] = {IntegratorKind::Rk4, IntegratorKind::Euler,
                                                   IntegratorKind::Dopri, IntegratorKind::Bdf};
@@ -32,15 +32,15 @@ bool parse_integrator(std::string_view name, IntegratorKind& kind);
 bool is_adaptive(IntegratorKind kind);
 
 struct FixedStepOptions {
-  double dt = 1e-3;               // s
+  double dt = 1e-3;                // s
   long max_steps = 1'000'000'000;  // a run of more steps stops with a message
-  std::string check() const;      // "" if valid, else "dt: …" naming the field
+  std::string check() const;       // "" if valid, else "dt: …" naming the field
 };
 
 struct AdaptiveOptions {
-  double rtol = 1e-6;   // relative tolerance on each component of y
-  double atol = 1e-8;   // absolute tolerance (rad, m, rad/s, m/s, J)
-  double h_max = 0;     // largest step (s); 0: no limit
+  double rtol = 1e-6;           // relative tolerance on each component of y
+  double atol = 1e-8;           // absolute tolerance (rad, m, rad/s, m/s, J)
+  double h_max = 0;             // largest step (s); 0: no limit
   long max_steps = 10'000'000;  // per advance_to
   // advance_to(t_out) interpolates (dense output: ARKODE's Hermite interpolant of degree 4 for
   // the explicit methods, CVODE's Nordsieck history for BDF), which costs no step but adds an

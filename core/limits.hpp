@@ -20,8 +20,8 @@ inline constexpr double kMaxMagnitude = 1e100;
 inline constexpr int kMaxBodies = 200'000;
 inline constexpr int kMaxElements = 1'000'000;
 inline constexpr long long kMaxFileBytes = 256LL << 20;  // a model file: 256 MiB
-inline constexpr int kMaxNesting = 64;                    // JSON nesting depth
-inline constexpr double kMaxTensorEntries = 2e7;          // D and T' (equations --tensor): 160 MB
+inline constexpr int kMaxNesting = 64;                   // JSON nesting depth
+inline constexpr double kMaxTensorEntries = 2e7;         // D and T' (equations --tensor): 160 MB
 
 inline std::string magnitude_text(double x) {
   char buf[32];

@@ -1,6 +1,7 @@
 #include "core/mass_solver.hpp"
 
 #include <cholmod.h>
+
 #include <algorithm>
 #include <bit>
 #include <cstdint>
@@ -49,7 +50,8 @@ Pattern coordinate_pattern(const Model& model) {
 
 // The upper triangle of M^s's pattern in the coordinate order `order`: (row, col) in the
 // ordered matrix, sorted by column then row.
-std::vector<std::pair<int, int>> ordered_upper_pattern(const Pattern& p, const std::vector<int>& order) {
+std::vector<std::pair<int, int>> ordered_upper_pattern(const Pattern& p,
+                                                       const std::vector<int>& order) {
   const int n = p.n;
   std::vector<int> where(n);  // coordinate -> position in `order`
   for (int k = 0; k < n; ++k) where[order[k]] = k;
@@ -57,14 +59,17 @@ std::vector<std::pair<int, int>> ordered_upper_pattern(const Pattern& p, const s
   for (int c = 0; c < n; ++c)
     for (int r = 0; r < n; ++r)
       if ((p.test(r, c) || r == c) && where[r] <= where[c]) e.emplace_back(where[r], where[c]);
-  std::sort(e.begin(), e.end(), [](auto x, auto y) { return std::pair(x.second, x.first) < std::pair(y.second, y.first); });
+  std::sort(e.begin(), e.end(), [](auto x, auto y) {
+    return std::pair(x.second, x.first) < std::pair(y.second, y.first);
+  });
   return e;
 }
 
 // A CHOLMOD matrix (upper triangle stored) with the given pattern: 1 on the diagonal, 0 off it.
-cholmod_sparse* pattern_matrix(int n, const std::vector<std::pair<int, int>>& e, cholmod_common* c) {
-  cholmod_sparse* A = cholmod_allocate_sparse(n, n, e.size(), 1, 1, /*stype: upper*/ 1,
-                                              CHOLMOD_REAL, c);
+cholmod_sparse* pattern_matrix(int n, const std::vector<std::pair<int, int>>& e,
+                               cholmod_common* c) {
+  cholmod_sparse* A =
+      cholmod_allocate_sparse(n, n, e.size(), 1, 1, /*stype: upper*/ 1, CHOLMOD_REAL, c);
   if (!A) throw std::bad_alloc();
   auto* Ap = static_cast<int*>(A->p);
   auto* Ai = static_cast<int*>(A->i);
@@ -171,8 +176,8 @@ struct MassSolver::Impl {
   cholmod_sparse* A = nullptr;  // upper triangle of P M^s Pᵀ (stype 1)
   cholmod_factor* L = nullptr;
   cholmod_dense *X = nullptr, *Y = nullptr, *E = nullptr;
-  cholmod_dense B;  // header over b
-  VecX b;           // the right-hand side in CHOLMOD's order
+  cholmod_dense B;        // header over b
+  VecX b;                 // the right-hand side in CHOLMOD's order
   std::vector<int> perm;  // position k of the factorised matrix holds coordinate perm[k]
   bool started = false;
 
@@ -250,14 +255,16 @@ Status MassSolver::factorize(const MatX& Ms) {
     const auto& L = impl_->dense.matrixLLT();
     for (Eigen::Index a = 0; a < n; ++a)
       if (L(a, a) * L(a, a) < 1e-13 * Ms(a, a))
-        return {false, "the mass matrix M^s is singular: coordinate '" + names_.at(a) +
-                           "' moves no inertia independently of the coordinates before it",
+        return {false,
+                "the mass matrix M^s is singular: coordinate '" + names_.at(a) +
+                    "' moves no inertia independently of the coordinates before it",
                 static_cast<int>(a)};
     return {};
   }
   Impl& s = *impl_;
   auto* Ax = static_cast<double*>(s.A->x);
-  for (std::size_t k = 0; k < s.entries.size(); ++k) Ax[k] = Ms(s.entries[k].first, s.entries[k].second);
+  for (std::size_t k = 0; k < s.entries.size(); ++k)
+    Ax[k] = Ms(s.entries[k].first, s.entries[k].second);
   cholmod_factorize(s.A, s.L, &s.common);
   if (s.common.status == CHOLMOD_NOT_POSDEF || s.L->minor < s.L->n)
     return {false, "the mass matrix M^s is not positive definite (CHOLMOD, at coordinate '" +
@@ -292,8 +299,9 @@ Status MassSolver::factorize_tree(const MatX& Ms) {
     double* Ha = LD_.data() + chain_start_[a];
     const double d = Ha[0];
     if (!(d > 1e-13 * Ms(a, a)))
-      return {false, "the mass matrix M^s is singular: coordinate '" + names_.at(a) +
-                         "' moves no inertia independently of the coordinates beyond it",
+      return {false,
+              "the mass matrix M^s is singular: coordinate '" + names_.at(a) +
+                  "' moves no inertia independently of the coordinates beyond it",
               a};
     for (int i = lambda_[a], t = 1; i >= 0; i = lambda_[i], ++t) {
       const double l = Ha[t] / d;

@@ -19,12 +19,11 @@
 
 namespace femdyn {
 
-
 class MassSolver {
  public:
   // The structural pattern of M^s: (a, b) may be non-zero iff coordinates a and b move a
   // common transition coordinate.
-  explicit MassSolver(const Model& model);  // Model::mass_pattern's choice
+  explicit MassSolver(const Model& model);          // Model::mass_pattern's choice
   MassSolver(const Model& model, SolverKind kind);  // another kind (Tree needs a tree)
   ~MassSolver();
   MassSolver(MassSolver&&) noexcept;
@@ -41,8 +40,8 @@ class MassSolver {
   SolverKind kind_;
   std::vector<std::string> names_;  // coordinate names, for messages
   std::vector<int> lambda_;         // Tree: the parent coordinate λ(a) (-1 at a root)
-  std::vector<int> chain_start_;    // Tree: where column a's chain starts in LD_ (sized on first use)
-  VecX LD_;                         // Tree: D(a), then L(a, b) for b = λ(a), λ(λ(a)), …
+  std::vector<int> chain_start_;  // Tree: where column a's chain starts in LD_ (sized on first use)
+  VecX LD_;                       // Tree: D(a), then L(a, b) for b = λ(a), λ(λ(a)), …
   std::unique_ptr<Impl> impl_;
 };
 

@@ -43,6 +43,27 @@ inline void mirror_upper(MatX& A) {
           A(i, j) = A(j, i);
 }
 
+// m(|r|² 1 − r rᵀ) = m [r]xᵀ[r]x: the inertia of a point mass m at r about the origin, the term
+// of the parallel-axis theorem (I_o = I_c + m [c]xᵀ[c]x).
+inline Mat3 point_inertia(double m, const Vec3& r) {
+  return m * (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
+}
+
+// ‖x‖∞, the largest |x_ij| (0 for an empty x).
+template <class Derived>
+double max_abs(const Eigen::MatrixBase<Derived>& x) {
+  return x.size() ? x.cwiseAbs().maxCoeff() : 0.0;
+}
+
+// ‖a − b‖∞ / max(‖b‖∞, floor): the error of a relative to the reference b. `floor` keeps it
+// meaningful where b vanishes; with floor 0 and b = 0 it is the absolute error ‖a‖∞.
+template <class DerivedA, class DerivedB>
+double relative_error(const Eigen::MatrixBase<DerivedA>& a, const Eigen::MatrixBase<DerivedB>& b,
+                      double floor) {
+  const double scale = std::max(max_abs(b), floor), d = max_abs(a - b);
+  return scale > 0 ? d / scale : d;
+}
+
 // A number for messages: 6 significant digits (std::to_string would print 1e-9 as 0.000000),
 // or any one-number printf conversion.
 inline std::string format_number(double x, const char* spec = "%.6g") {

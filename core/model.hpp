@@ -45,7 +45,7 @@ struct Body {
 
 // A point that carries translation DOFs (x y z, world axes). Coincident element nodes share one.
 struct SystemNode {
-  int body = -1;  // carrier body (the shallowest body on which the point is fixed)
+  int body = -1;          // carrier body (the shallowest body on which the point is fixed)
   Vec3 r = Vec3::Zero();  // body frame
   std::string label;
 };
@@ -119,7 +119,7 @@ struct Model {
   std::string name;
   std::string where;  // the source, for messages
   Vec3 gravity = Vec3::Zero();
-  std::vector<Body> bodies;  // parents before children
+  std::vector<Body> bodies;      // parents before children
   std::vector<int> theta_joint;  // θ index -> body index of its joint
 
   // Coupling level θ = C q + θ0 (nθ x n, sparse: the identity is n entries, not n²).
@@ -129,27 +129,27 @@ struct Model {
 
   // Node level.
   std::vector<SystemNode> nodes;
-  std::vector<SystemDof> dofs;                  // u
-  std::vector<std::array<int, 3>> node_dof;     // node -> u index per axis, -1 if left out
+  std::vector<SystemDof> dofs;                   // u
+  std::vector<std::array<int, 3>> node_dof;      // node -> u index per axis, -1 if left out
   std::vector<std::array<int, 3>> body_rot_dof;  // body -> u index per axis, -1 if left out
-  std::vector<std::pair<int, int>> dof_alias;   // (copy, original): an explicit table may give
-                                                // one motion two numbers (the paper's u12, u16)
-  std::vector<std::string> left_out;            // descriptions of DOFs left out, and why
+  std::vector<std::pair<int, int>> dof_alias;    // (copy, original): an explicit table may give
+                                                 // one motion two numbers (the paper's u12, u16)
+  std::vector<std::string> left_out;             // descriptions of DOFs left out, and why
   bool explicit_table = false;
-  std::vector<std::string> approximations;      // joins made by an explicit table
+  std::vector<std::string> approximations;  // joins made by an explicit table
 
   std::vector<ElementEntry> elements;
-  SpMat M;           // system lumped mass, N_u x N_u
-  VecX F_constant;   // nodal forces that do not depend on the state (gravity, point loads)
+  SpMat M;          // system lumped mass, N_u x N_u
+  VecX F_constant;  // nodal forces that do not depend on the state (gravity, point loads)
   std::vector<BodyTorque> torques;
   std::vector<PointLoad> point_loads;
   // Body level (core/body_inertia.hpp): M^s = Σ_b J_bᵀ Λ_b J_b where `condensable`.
   std::vector<RigidInertia> body_inertia;  // Λ_b = Σ X_eᵀ m_e X_e, body axes (core/spatial.hpp)
-  bool identity_coupling = false;  // C = I and θ0 = 0: the coupling level is nothing
-  SpRowMat C_sparse;               // C for the hot path (core/coupling.hpp)
-  bool condensable = false;  // the body-level form is exact for this model
-  bool velocity_forces_rigid = false;  // every g_e is its element's gyroscopic term (checked)
-  MassRoute mass_route = MassRoute::Transform;         // how evaluate() forms M^s
+  bool identity_coupling = false;          // C = I and θ0 = 0: the coupling level is nothing
+  SpRowMat C_sparse;                       // C for the hot path (core/coupling.hpp)
+  bool condensable = false;                // the body-level form is exact for this model
+  bool velocity_forces_rigid = false;      // every g_e is its element's gyroscopic term (checked)
+  MassRoute mass_route = MassRoute::Transform;             // how evaluate() forms M^s
   ForceRoute force_route = ForceRoute::Nodes;              // how h and τ are computed
   DynamicsRoute dynamics_route = DynamicsRoute::Cholesky;  // how forward_dynamics() finds q̈
   MassPattern mass_pattern;                                // the Cholesky route's solver

@@ -12,8 +12,7 @@ namespace {
 // numbers (RigidInertia), instead of forming the 6 × 6 Λ^O: the motions move in by
 // (ω_b, v_b) = (Rᵀ ω, Rᵀ (v_O + ω × p)) and the force moves out by f = R f_b, n_O = R n_b + p × f.
 // (The spatial cross product is the same in any frame.)
-Vec6 body_force(const RigidInertia& L, const Mat3& R, const Vec3& p, const Vec6& V,
-                const Vec6& a) {
+Vec6 body_force(const RigidInertia& L, const Mat3& R, const Vec3& p, const Vec6& V, const Vec6& a) {
   const auto to_body = [&](const Vec6& m) {
     Vec6 mb;
     mb.head<3>().noalias() = R.transpose() * m.head<3>();
@@ -38,8 +37,8 @@ Vec6 body_force(const RigidInertia& L, const Mat3& R, const Vec3& p, const Vec6&
 
 }  // namespace
 
-void newton_euler(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
-                  const VecX* qdd, bool with_external, VecX& y) {
+void newton_euler(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX* qdd,
+                  bool with_external, VecX& y) {
   const int nb = static_cast<int>(model.bodies.size());
   propagate(model, ws, q, qd, {.jacobian = false, .bias = false, .rows = false});  // poses, θ
   coupling_apply(model, qd, ws.theta_dot, false);

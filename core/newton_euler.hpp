@@ -19,7 +19,7 @@ namespace femdyn {
 // y = Cᵀ τ_θ for the motion (q, q̇, q̈) (q̈ = nullptr: q̈ = 0), minus the external forces when
 // `with_external` (F and body torques, not springs or dampers). Leaves θ, θ̇, the body poses and
 // ω in ws. Requires Model::force_route == Bodies.
-void newton_euler(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
-                  const VecX* qdd, bool with_external, VecX& y);
+void newton_euler(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX* qdd,
+                  bool with_external, VecX& y);
 
 }  // namespace femdyn

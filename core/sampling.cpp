@@ -1,11 +1,10 @@
 #include "core/sampling.hpp"
 
 #include <algorithm>
-#include <map>
-#include <string>
-
 #include <cmath>
+#include <map>
 #include <numbers>
+#include <string>
 
 namespace femdyn {
 

@@ -18,8 +18,8 @@ enum class JointType { Revolute, Prismatic, Fixed };
 struct JointSpec {
   std::string name;
   JointType type = JointType::Fixed;
-  Vec3 xyz = Vec3::Zero();  // joint frame origin in the parent body frame
-  Vec3 rpy = Vec3::Zero();  // joint frame orientation, R = Rz(y) Ry(p) Rx(r)
+  Vec3 xyz = Vec3::Zero();    // joint frame origin in the parent body frame
+  Vec3 rpy = Vec3::Zero();    // joint frame orientation, R = Rz(y) Ry(p) Rx(r)
   Vec3 axis = Vec3::UnitZ();  // in the joint frame (normalised on compile)
   double lower = -std::numeric_limits<double>::infinity();
   double upper = std::numeric_limits<double>::infinity();
@@ -73,6 +73,7 @@ struct CorrelationSpec {
 struct MechanismSpec {
   std::string name;
   Vec3 gravity = Vec3::Zero();
+  std::string gravity_where;  // where gravity was given, for messages (empty: the file's /gravity)
   std::vector<BodySpec> bodies;
   std::vector<CouplingSpec> couplings;
   std::vector<LoadSpec> loads;

@@ -56,8 +56,8 @@ MassMatrixHealth mass_matrix_health(const MatX& Ms) {
   h.lambda_min = eig.eigenvalues().minCoeff();
   h.lambda_max = eig.eigenvalues().maxCoeff();
   h.positive_definite = h.lambda_min > 0;
-  h.condition = h.positive_definite ? h.lambda_max / h.lambda_min
-                                    : std::numeric_limits<double>::infinity();
+  h.condition =
+      h.positive_definite ? h.lambda_max / h.lambda_min : std::numeric_limits<double>::infinity();
   return h;
 }
 
@@ -128,9 +128,11 @@ std::vector<SuspiciousBody> suspicious_bodies(const Model& m) {
     }
     const double mass = p[b].mass;
     if (mass > 0 && heaviest > 0 && mass < 1e-6 * heaviest)
-      flag(b, "near-zero mass: " + format_short(mass) + " kg, " + format_short(mass / heaviest) + " of its neighbour '" +
-                  heaviest_name + "' (" + format_short(heaviest) + " kg); where nothing heavier hangs "
-                  "beyond it M^s loses about " + format_short(std::log10(heaviest / mass)) +
+      flag(b, "near-zero mass: " + format_short(mass) + " kg, " + format_short(mass / heaviest) +
+                  " of its neighbour '" + heaviest_name + "' (" + format_short(heaviest) +
+                  " kg); where nothing heavier hangs "
+                  "beyond it M^s loses about " +
+                  format_short(std::log10(heaviest / mass)) +
                   " digits: merge it into its neighbour or give it a realistic mass");
     if (mass <= 0) continue;
     const Mat3 Ic = p[b].inertia_com();
@@ -138,7 +140,8 @@ std::vector<SuspiciousBody> suspicious_bodies(const Model& m) {
     const Vec3 I = eig.eigenvalues();  // ascending
     if (I[2] <= 0) continue;           // a point mass: no rotational inertia by design
     if (I[0] < 1e-9 * I[2])
-      flag(b, "near-zero principal inertia: " + format_short(I[0]) + " kg·m² against " + format_short(I[2]) +
+      flag(b, "near-zero principal inertia: " + format_short(I[0]) + " kg·m² against " +
+                  format_short(I[2]) +
                   " (a thin rod or a point): rotations about that axis are ill-conditioned");
     else if (I[0] + I[1] - I[2] < 1e-6 * I[2])
       flag(b, "inertia nearly violates the triangle inequality (I1 + I2 − I3 = " +

@@ -26,20 +26,20 @@
 namespace femdyn {
 
 struct MassMatrixHealth {
-  double condition = 0;       // λ_max / λ_min, +inf if λ_min ≤ 0
+  double condition = 0;  // λ_max / λ_min, +inf if λ_min ≤ 0
   double lambda_min = 0, lambda_max = 0;
-  double asymmetry = 0;       // ‖M − Mᵀ‖_max / ‖M‖_max
+  double asymmetry = 0;  // ‖M − Mᵀ‖_max / ‖M‖_max
   bool positive_definite = false;
   double digits_lost() const;  // log10 cond
 };
 MassMatrixHealth mass_matrix_health(const MatX& Ms);
 
 struct Linearization {
-  MatX A;                              // 2n x 2n
-  Eigen::VectorXcd eigenvalues;        // of A
-  std::complex<double> stiffest;       // the eigenvalue of largest modulus
-  double max_growth = 0;               // max Re λ (≥ 0: physical instability, e.g. falling)
-  Status status;                       // a failed forward dynamics on the way
+  MatX A;                         // 2n x 2n
+  Eigen::VectorXcd eigenvalues;   // of A
+  std::complex<double> stiffest;  // the eigenvalue of largest modulus
+  double max_growth = 0;          // max Re λ (≥ 0: physical instability, e.g. falling)
+  Status status;                  // a failed forward dynamics on the way
 };
 Linearization linearize(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                         const VecX& tau);

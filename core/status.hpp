@@ -8,7 +8,7 @@ namespace femdyn {
 struct Status {
   bool ok = true;
   std::string message;
-  int coordinate = -1;  // the coordinate a failure is attributed to, if any
+  int coordinate = -1;      // the coordinate a failure is attributed to, if any
   bool non_finite = false;  // the failure is a NaN or Inf (an overflow), not a singular matrix
 };
 

@@ -43,8 +43,8 @@ void error_handler(int, const char* module, const char* function, char* msg, voi
 
 int jacobian_callback(double t, N_Vector y, N_Vector fy, SUNMatrix J, void* user_data, N_Vector,
                       N_Vector, N_Vector) {
-  return static_cast<Bdf*>(user_data)->jacobian(t, N_VGetArrayPointer(y),
-                                                N_VGetArrayPointer(fy), SUNDenseMatrix_Data(J));
+  return static_cast<Bdf*>(user_data)->jacobian(t, N_VGetArrayPointer(y), N_VGetArrayPointer(fy),
+                                                SUNDenseMatrix_Data(J));
 }
 
 // Creates the context and wraps y (both methods).
@@ -88,7 +88,8 @@ Status Adaptive::failure(int flag) {
     case CV_ERR_FAILURE:
     case CV_TOO_CLOSE:
       return {false, at + "step-size underflow: the error test failed repeatedly down to step " +
-                         h + "; likely cause: a singularity in the motion (M^s nearly "
+                         h +
+                         "; likely cause: a singularity in the motion (M^s nearly "
                          "singular, a discontinuous actuation) or tolerances below round-off"};
     case CV_CONV_FAILURE:
     case CV_LSETUP_FAIL:
@@ -149,7 +150,8 @@ void DormandPrince::start() {
 
 int DormandPrince::evolve(double t_out, double& t_reached, bool one_step) {
   if (options_.stop_at_outputs && !one_step) ERKStepSetStopTime(run_->arkode, t_out);
-  return ERKStepEvolve(run_->arkode, t_out, run_->y, &t_reached, one_step ? ARK_ONE_STEP : ARK_NORMAL);
+  return ERKStepEvolve(run_->arkode, t_out, run_->y, &t_reached,
+                       one_step ? ARK_ONE_STEP : ARK_NORMAL);
 }
 
 void DormandPrince::read_stats() {

@@ -35,14 +35,14 @@ class Adaptive : public Integrator {
   virtual void read_stats() = 0;
   virtual double current_step() const = 0;
 
- public:  // reached from the C callbacks
+ public:                                             // reached from the C callbacks
   int rhs(double t, const double* y, double* ydot);  // 0, or < 0 after recording rhs_failure_
   void record(const std::string& sundials_message) { sundials_message_ = sundials_message; }
 
  protected:
   AdaptiveOptions options_;
   std::unique_ptr<SundialsRun> run_;
-  Status rhs_failure_;           // the last failed evaluation of f
+  Status rhs_failure_;            // the last failed evaluation of f
   std::string sundials_message_;  // the last message SUNDIALS sent to its error handler
 };
 

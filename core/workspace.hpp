@@ -38,21 +38,21 @@ struct Workspace {
   explicit Workspace(const Model& model);
 
   VecX theta, theta_dot, theta_dot_y;  // θ, θ̇ (= C x), C y
-  std::vector<BodyState> body;     // per body
-  MatX Jw, Jv;                     // body Jacobians in q: rows 3b..3b+2 of body b (3nb x n),
-                                   // sized when first formed
-  MatX T;                          // T = ∂u/∂q (N_u x n), sized when first formed
-  VecX bias;                       // T'[q̇,q̇] (N_u)
-  VecX u_dot;                      // u̇ = T q̇
-  VecX nodal;                      // M T'[q̇,q̇] + g, then nodal forces F (N_u)
-  MatX MT;                         // M T (N_u x n), sized when first formed
-  VecX u_acc;                      // T q̈ + T'[q̇,q̇] (inverse dynamics); also the nodal forces
-                                   // plus the body torques in generalized_force (N_u)
+  std::vector<BodyState> body;         // per body
+  MatX Jw, Jv;                         // body Jacobians in q: rows 3b..3b+2 of body b (3nb x n),
+                                       // sized when first formed
+  MatX T;                              // T = ∂u/∂q (N_u x n), sized when first formed
+  VecX bias;                           // T'[q̇,q̇] (N_u)
+  VecX u_dot;                          // u̇ = T q̇
+  VecX nodal;                          // M T'[q̇,q̇] + g, then nodal forces F (N_u)
+  MatX MT;                             // M T (N_u x n), sized when first formed
+  VecX u_acc;  // T q̈ + T'[q̇,q̇] (inverse dynamics); also the nodal forces
+               // plus the body torques in generalized_force (N_u)
   std::vector<RigidInertia> composite;  // per body: composite inertia I^c_b (world, origin)
-  std::vector<Vec6> subspace;      // per body: its joint's motion subspace S (world, origin)
+  std::vector<Vec6> subspace;           // per body: its joint's motion subspace S (world, origin)
   std::vector<ArticulatedBody> articulated;  // per body, for the body-level routes only
-  std::vector<Vec3> force, moment; // per body: wrench of Tᵀ f (world; moment about the origin)
-  VecX tau_theta;                  // Tᵀ f on the joint coordinates θ
+  std::vector<Vec3> force, moment;  // per body: wrench of Tᵀ f (world; moment about the origin)
+  VecX tau_theta;                   // Tᵀ f on the joint coordinates θ
   std::vector<VecX> local_x, local_y, local_g;  // per element local DOF buffers (6k)
 
   // System equations M^s q̈ + h = Q at the last evaluated state.

@@ -13,16 +13,13 @@ namespace femdyn {
 static const std::array kTypes = {
     ElementType{"lumped_point", &LumpedPoint::from_params},  // a mass at a node
     ElementType{"space_bar", &SpaceBar::from_params},  // a rigid bar lumped to its two end nodes
-    ElementType{"rotary_node", &RotaryNode::from_params},  // a rotary inertia at a node
+    ElementType{"rotary_node", &RotaryNode::from_params},         // a rotary inertia at a node
     ElementType{"rigid_body", &RigidBodyShorthand::from_params},  // mass, com, inertia
 };
 
-std::span<const ElementType> element_types() { return kTypes; }
-
-const ElementType* find_element_type(std::string_view name) {
-  for (const ElementType& t : kTypes)
-    if (t.name == name) return &t;
-  return nullptr;
+const Registry<ElementType>& element_types() {
+  static const Registry<ElementType> registry{kTypes};
+  return registry;
 }
 
 }  // namespace femdyn

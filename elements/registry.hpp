@@ -8,13 +8,15 @@
 
 #include "core/spec.hpp"
 #include "io/params.hpp"
+#include "io/registry.hpp"
 
 namespace femdyn {
 
 // Where factories put the elements they make (a shorthand may make several).
 class ElementSink {
  public:
-  ElementSink(std::vector<ElementSpec>& out, std::string where) : out_(out), where_(std::move(where)) {}
+  ElementSink(std::vector<ElementSpec>& out, std::string where)
+      : out_(out), where_(std::move(where)) {}
   void add(std::unique_ptr<Element> element, std::vector<std::string> node_labels) {
     out_.push_back({std::move(element), std::move(node_labels), where_});
   }
@@ -31,7 +33,6 @@ struct ElementType {
   ElementFactory make;
 };
 
-std::span<const ElementType> element_types();
-const ElementType* find_element_type(std::string_view name);
+const Registry<ElementType>& element_types();
 
 }  // namespace femdyn

@@ -18,8 +18,10 @@ void RigidBodyShorthand::from_params(const Params& p, ElementSink& sink) {
     sink.add(std::make_unique<RotaryNode>(c, I), {"com"});
   } else if (how == "four_points") {
     const auto pts = equimomental_points(m, c, I);
-    if (!pts) p.fail("inertia", "four equimomental points need a strictly physical inertia "
-                                "(positive definite pseudo-inertia); use point_rotary");
+    if (!pts)
+      p.fail("inertia",
+             "four equimomental points need a strictly physical inertia "
+             "(positive definite pseudo-inertia); use point_rotary");
     static const char* const labels[4] = {"p1", "p2", "p3", "p4"};
     for (int i = 0; i < 4; ++i)
       sink.add(std::make_unique<LumpedPoint>((*pts)[i], m / 4), {labels[i]});

@@ -49,8 +49,8 @@ Mat3 SpaceBar::bar_frame(const Vec3& a, const Vec3& b, const Vec3* y_hint) {
 // {"type": "space_bar", "nodes": [a, b], "density": ρ, "area": A, "Iy": …, "Iz": …,
 //  "section_y": [..]}  or  {"type": "space_bar", "nodes": [a, b], "mass": m, "inertia": I_c}
 void SpaceBar::from_params(const Params& p, ElementSink& sink) {
-  p.allow_only({"type", "nodes", "density", "area", "Iy", "Iz", "section_y", "mass", "inertia",
-                "lumping"});
+  p.allow_only(
+      {"type", "nodes", "density", "area", "Iy", "Iz", "section_y", "mass", "inertia", "lumping"});
   const std::string lumping = p.has("lumping") ? p.string("lumping") : "exact";
   if (lumping != "exact" && lumping != "paper")
     p.fail("lumping", "expected \"exact\" or \"paper\", got \"" + lumping + "\"");
@@ -63,16 +63,18 @@ void SpaceBar::from_params(const Params& p, ElementSink& sink) {
   double m;
   Mat3 J;
   if (p.has("mass")) {
-    if (lumping != "exact") p.fail("lumping", "the paper's lumping is given by density and section");
+    if (lumping != "exact")
+      p.fail("lumping", "the paper's lumping is given by density and section");
     for (const char* key : {"density", "area", "Iy", "Iz", "section_y"})
       if (p.has(key)) p.fail(key, "give either mass and inertia or density, area, Iy, Iz");
     m = p.positive("mass");
     const Mat3 Ic = p.inertia("inertia");
     if (auto problem = inertia_problem(Ic)) p.fail("inertia", *problem);
-    J = Ic - 0.25 * m * l * l * (Mat3::Identity() - x * x.transpose());
+    J = Ic - point_inertia(m, 0.5 * l * x);  // ends m/2 at ±(l/2) x
     J = 0.5 * (J + J.transpose()).eval();
   } else {
-    if (p.has("inertia")) p.fail("inertia", "give either mass and inertia or density, area, Iy, Iz");
+    if (p.has("inertia"))
+      p.fail("inertia", "give either mass and inertia or density, area, Iy, Iz");
     const double rho = p.positive("density"), A = p.positive("area");
     const double Iy = p.positive("Iy"), Iz = p.positive("Iz");
     Vec3 hint;

@@ -30,7 +30,8 @@ ActuationTable::ActuationTable(const std::string& path, const Model& m) : path_(
   const int n = m.n();
   std::string line;
   int lineno = 1;
-  if (!std::getline(in, line)) throw ModelError(path, "empty file (expected a header t,<coordinates>)");
+  if (!std::getline(in, line))
+    throw ModelError(path, "empty file (expected a header t,<coordinates>)");
   const std::vector<std::string> head = split(line);
   if (head.empty() || head[0] != "t")
     throw ModelError(path + ":1", "the first column must be 't' (time in s)");
@@ -69,8 +70,8 @@ ActuationTable::ActuationTable(const std::string& path, const Model& m) : path_(
         used = 0;
       }
       if (cells[c].empty() || used != cells[c].size())
-        throw ModelError(where, "column " + std::to_string(c + 1) + ": '" + cells[c] +
-                                    "' is not a number");
+        throw ModelError(
+            where, "column " + std::to_string(c + 1) + ": '" + cells[c] + "' is not a number");
       if (!std::isfinite(v[c]))
         throw ModelError(where, "column " + std::to_string(c + 1) + " is NaN or Inf");
     }

@@ -20,8 +20,8 @@ AtomicFile::AtomicFile(std::string path, bool replace) : path_(std::move(path)) 
   if (!replace && fs::exists(fs::symlink_status(path_, ec)))
     throw std::runtime_error(path_ + ": exists (use --force to replace it)");
   const fs::path target(path_);
-  tmp_ = (target.parent_path() / ("." + target.filename().string() + ".tmp-" +
-                                  std::to_string(::getpid())))
+  tmp_ = (target.parent_path() /
+          ("." + target.filename().string() + ".tmp-" + std::to_string(::getpid())))
              .string();
   out_.open(tmp_, std::ios::binary | std::ios::trunc);
   if (!out_) throw std::runtime_error(path_ + ": cannot write (directory missing or not writable)");

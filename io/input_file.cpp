@@ -20,10 +20,12 @@ std::string read_input_file(const std::string& path) {
     ~Closer() { ::close(fd); }
   } closer{fd};
   struct stat st {};
-  if (::fstat(fd, &st) != 0) throw ModelError(path, std::string("cannot read file: ") + std::strerror(errno));
+  if (::fstat(fd, &st) != 0)
+    throw ModelError(path, std::string("cannot read file: ") + std::strerror(errno));
   if (S_ISDIR(st.st_mode)) throw ModelError(path, "is a directory, not a file");
   if (!S_ISREG(st.st_mode))
-    throw ModelError(path, "is not a regular file (a FIFO, device or socket): femdyn reads files only");
+    throw ModelError(path,
+                     "is not a regular file (a FIFO, device or socket): femdyn reads files only");
   if (st.st_size > kMaxFileBytes)
     throw ModelError(path, "is " + std::to_string(st.st_size) + " bytes: more than the limit of " +
                                std::to_string(kMaxFileBytes) + " bytes for an input file");

@@ -5,12 +5,12 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/limits.hpp"
 #include "elements/registry.hpp"
+#include "io/input_file.hpp"
 #include "io/params.hpp"
 #include "io/urdf_loader.hpp"
 #include "models/plugins.hpp"
-#include "core/limits.hpp"
-#include "io/input_file.hpp"
 
 namespace femdyn {
 namespace {
@@ -33,7 +33,8 @@ JointType joint_type(const Params& p) {
   if (t == "revolute" || t == "continuous") return JointType::Revolute;
   if (t == "prismatic") return JointType::Prismatic;
   if (t == "fixed") return JointType::Fixed;
-  p.fail("type", "unknown joint type '" + t + "' (expected revolute, continuous, prismatic or fixed)");
+  p.fail("type",
+         "unknown joint type '" + t + "' (expected revolute, continuous, prismatic or fixed)");
 }
 
 JointSpec read_joint(const Params& p) {
@@ -51,7 +52,8 @@ JointSpec read_joint(const Params& p) {
   if (j.type != JointType::Fixed) j.axis = p.vec3("axis");
   if (j.type == JointType::Fixed)
     for (const char* key : {"axis", "limits", "spring", "damping"})
-      if (p.has(key)) p.fail(key, "a fixed joint has no motion: no axis, limits, spring or damping");
+      if (p.has(key))
+        p.fail(key, "a fixed joint has no motion: no axis, limits, spring or damping");
   if (p.has("limits")) {
     const Json& l = p.json().at("limits");
     if (!l.is_array() || l.size() != 2) p.fail("limits", "expected [lower, upper]");
@@ -89,12 +91,10 @@ BodySpec read_body(const Json& jb, const std::string& where) {
     for (std::size_t e = 0; e < je.size(); ++e) {
       const Params ep(je[e], p.path("elements") + "/" + std::to_string(e), b.name, &nodes);
       const std::string type = ep.string("type");
-      const ElementType* t = find_element_type(type);
-      if (!t) {
-        std::string known;
-        for (const ElementType& k : element_types()) known += (known.empty() ? "" : ", ") + std::string(k.name);
-        ep.fail("type", "unknown element type '" + type + "' (known: " + known + ")");
-      }
+      const ElementType* t = element_types().find(type);
+      if (!t)
+        ep.fail("type",
+                "unknown element type '" + type + "' (known: " + element_types().names() + ")");
       ElementSink sink(b.elements, ep.where());
       t->make(ep, sink);
     }
@@ -157,12 +157,9 @@ Json expand_plugin(const Json& root, const std::string& source) {
   const Params p(root, source + ": ");
   p.allow_only({"model", "params", "name", "description", "gravity", "loads", "$schema"});
   const std::string name = p.string("model");
-  const ModelPlugin* plugin = find_model_plugin(name);
-  if (!plugin) {
-    std::string known;
-    for (const ModelPlugin& k : model_plugins()) known += (known.empty() ? "" : ", ") + std::string(k.name);
-    p.fail("model", "unknown model plugin '" + name + "' (known: " + known + ")");
-  }
+  const ModelPlugin* plugin = model_plugins().find(name);
+  if (!plugin)
+    p.fail("model", "unknown model plugin '" + name + "' (known: " + model_plugins().names() + ")");
   static const Json empty = Json::object();
   Json doc = plugin->expand(p.has("params") ? p.child("params") : Params(empty, p.path("params")));
   for (const char* key : {"name", "description", "gravity"})
@@ -180,8 +177,8 @@ MechanismSpec parse_document(const Json& root, const std::string& source) {
   spec.where = source + ": ";
   const auto path = [&](const std::string& s) { return source + ": /" + s; };
   for (auto it = root.begin(); it != root.end(); ++it) {
-    static const char* known[] = {"name", "description", "gravity", "bodies", "couplings",
-                                  "loads", "correlation_table", "$schema"};
+    static const char* known[] = {"name",      "description", "gravity",           "bodies",
+                                  "couplings", "loads",       "correlation_table", "$schema"};
     bool ok = false;
     for (const char* k : known) ok = ok || it.key() == k;
     if (!ok) throw ModelError(path(it.key()), "unknown key '" + it.key() + "'");
@@ -235,9 +232,9 @@ MechanismSpec parse_document(const Json& root, const std::string& source) {
         const std::string wk = w + "/" + std::to_string(k);
         if (!x.is_number_integer()) throw ModelError(wk, "expected an integer DOF number");
         // Range-checked before narrowing: 2^31 must not wrap to a negative int, nor 2^63 to 0.
-        const bool fits = x.is_number_unsigned() ? x.get<std::uint64_t>() <= 2147483647u
-                                                 : x.get<std::int64_t>() >= 0 &&
-                                                       x.get<std::int64_t>() <= 2147483647;
+        const bool fits = x.is_number_unsigned()
+                              ? x.get<std::uint64_t>() <= 2147483647u
+                              : x.get<std::int64_t>() >= 0 && x.get<std::int64_t>() <= 2147483647;
         if (!fits)
           throw ModelError(wk, "DOF number " + x.dump() + " is out of range (0 to 2147483647)");
         row.push_back(x.get<int>());
@@ -299,10 +296,10 @@ std::string read_text(const std::string& path) { return read_input_file(path); }
     const std::size_t rest = msg.find(": ", end);
     if (end == i || rest == std::string::npos) break;
     const Json& item = doc[section][std::stoul(msg.substr(i, end - i))];
-    const std::string who =
-        section == "bodies" ? "joint '" + item["joint"]["name"].get<std::string>() + "' (link '" +
-                                  item["name"].get<std::string>() + "')"
-                            : "joint '" + item["joint"].get<std::string>() + "' <mimic>";
+    const std::string who = section == "bodies"
+                                ? "joint '" + item["joint"]["name"].get<std::string>() +
+                                      "' (link '" + item["name"].get<std::string>() + "')"
+                                : "joint '" + item["joint"].get<std::string>() + "' <mimic>";
     msg = path + ": " + who + msg.substr(rest);
   }
   throw ModelError("", msg);
@@ -336,7 +333,10 @@ MechanismSpec read_spec(const std::string& path, const LoadOptions& options) {
 
 Model load_model(const std::string& path, const LoadOptions& options) {
   MechanismSpec spec = read_spec(path, options);
-  if (options.gravity) spec.gravity = *options.gravity;
+  if (options.gravity) {
+    spec.gravity = *options.gravity;
+    spec.gravity_where = spec.where + options.gravity_source;  // (where ends in ": ")
+  }
   if (!is_urdf_path(path)) return compile(std::move(spec));
   try {
     return compile(std::move(spec));

@@ -11,7 +11,8 @@
 namespace femdyn {
 
 struct LoadOptions {
-  std::optional<Vec3> gravity;  // overrides the model's gravity
+  std::optional<Vec3> gravity;                          // overrides the model's gravity
+  std::string gravity_source = "LoadOptions::gravity";  // names it in messages ("--gravity")
   std::function<void(const std::string&)> warn;  // non-fatal notes (e.g. URDF friction ignored)
 };
 

@@ -1,13 +1,13 @@
 #include "io/output.hpp"
 
-#include "io/atomic_file.hpp"
-
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
 #include <system_error>
-#include <filesystem>
+
+#include "io/atomic_file.hpp"
 
 namespace femdyn {
 namespace {
@@ -69,9 +69,8 @@ Json equations_json(const Model& model, const Workspace& ws, const VecX& q, cons
   return j;
 }
 
-std::string equations_text(const Model& model, const Workspace& ws, const VecX& q,
-                           const VecX& qd, const VecX& tau, bool have_qdd,
-                           const std::vector<MatX>& D) {
+std::string equations_text(const Model& model, const Workspace& ws, const VecX& q, const VecX& qd,
+                           const VecX& tau, bool have_qdd, const std::vector<MatX>& D) {
   std::ostringstream out;
   out << "model: " << model.name << "\n";
   out << "coordinates:";
@@ -124,8 +123,7 @@ std::string info_text(const Model& model) {
                        : j.type == JointType::Prismatic ? "prismatic"
                                                         : "fixed";
     out << "  " << j.name << " (" << type << ") "
-        << (b.parent < 0 ? std::string("world") : model.bodies[b.parent].name) << " -> "
-        << b.name;
+        << (b.parent < 0 ? std::string("world") : model.bodies[b.parent].name) << " -> " << b.name;
     if (j.theta >= 0) {
       out << "   theta =";
       bool first = true;
@@ -203,9 +201,9 @@ bool is_flat(const Json& a) {
 
 int key_rank(const std::string& k) {
   static const char* order[] = {"$schema", "name", "description", "model", "gravity", "params",
-                                "type", "parent", "joint", "origin", "xyz", "rpy", "axis",
-                                "limits", "spring", "damping", "nodes", "elements", "mass", "com",
-                                "inertia", "bodies", "couplings", "loads", "correlation_table",
+                                "type", "parent", "joint", "origin", "xyz", "rpy", "axis", "limits",
+                                "spring", "damping", "nodes", "elements", "mass", "com", "inertia",
+                                "bodies", "couplings", "loads", "correlation_table",
                                 // equations --json
                                 "coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd", "D"};
   for (std::size_t i = 0; i < std::size(order); ++i)
@@ -226,7 +224,8 @@ void write_json(std::ostringstream& o, const Json& j, int indent) {
     }
     // A small object of vectors and numbers on one line: {"xyz": [..], "rpy": [..]}.
     bool small = true;
-    for (const auto& k : keys) small = small && (j.at(k).is_primitive() || (j.at(k).is_array() && is_flat(j.at(k))));
+    for (const auto& k : keys)
+      small = small && (j.at(k).is_primitive() || (j.at(k).is_array() && is_flat(j.at(k))));
     if (small && j.dump().size() < 72) {
       o << "{";
       for (std::size_t i = 0; i < keys.size(); ++i) {

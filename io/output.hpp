@@ -14,9 +14,8 @@ namespace femdyn {
 Json equations_json(const Model& model, const Workspace& ws, const VecX& q, const VecX& qd,
                     const VecX& tau, bool have_qdd, const std::vector<MatX>& D);
 
-std::string equations_text(const Model& model, const Workspace& ws, const VecX& q,
-                           const VecX& qd, const VecX& tau, bool have_qdd,
-                           const std::vector<MatX>& D);
+std::string equations_text(const Model& model, const Workspace& ws, const VecX& q, const VecX& qd,
+                           const VecX& tau, bool have_qdd, const std::vector<MatX>& D);
 
 std::string info_text(const Model& model);
 Json info_json(const Model& model);

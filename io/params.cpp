@@ -5,7 +5,8 @@
 namespace femdyn {
 
 double json_number(const Json& v, const std::string& where) {
-  if (!v.is_number()) throw ModelError(where, "expected a number, got " + std::string(v.type_name()));
+  if (!v.is_number())
+    throw ModelError(where, "expected a number, got " + std::string(v.type_name()));
   const double x = v.get<double>();
   if (!std::isfinite(x)) throw ModelError(where, "is NaN or Inf");
   return x;
@@ -76,7 +77,8 @@ Mat3 Params::inertia(const char* key) const {
   const std::string w = path(key);
   Mat3 I;
   if (v.is_array()) {
-    if (v.size() != 3) throw ModelError(w, "expected a 3x3 array or {ixx, iyy, izz, ixy, ixz, iyz}");
+    if (v.size() != 3)
+      throw ModelError(w, "expected a 3x3 array or {ixx, iyy, izz, ixy, ixz, iyz}");
     for (int r = 0; r < 3; ++r) {
       const Vec3 row = json_vec3(v[r], w + "/" + std::to_string(r));
       I.row(r) = row.transpose();
@@ -86,7 +88,8 @@ Mat3 Params::inertia(const char* key) const {
   if (!v.is_object()) throw ModelError(w, "expected a 3x3 array or {ixx, iyy, izz, ixy, ixz, iyz}");
   Params p(v, w);
   p.allow_only({"ixx", "iyy", "izz", "ixy", "ixz", "iyz"});
-  const double ixy = p.number_or("ixy", 0), ixz = p.number_or("ixz", 0), iyz = p.number_or("iyz", 0);
+  const double ixy = p.number_or("ixy", 0), ixz = p.number_or("ixz", 0),
+               iyz = p.number_or("iyz", 0);
   // Read before the comma initializer: a ModelError thrown inside it would leave it unfinished
   // (an Eigen assertion in builds with assertions).
   const double ixx = p.number("ixx"), iyy = p.number("iyy"), izz = p.number("izz");

@@ -61,5 +61,7 @@ class Params {
 // Helpers shared by the loaders.
 double json_number(const Json& v, const std::string& where);
 Vec3 json_vec3(const Json& v, const std::string& where);
+// [x, y, z], the model format's vector, for plugins and importers that write models.
+inline Json vec3_json(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
 
 }  // namespace femdyn

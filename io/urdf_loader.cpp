@@ -56,8 +56,6 @@ Vec3 vec_attr(const Ctx& c, const XMLElement* e, const char* attr, const Vec3& f
   return v;
 }
 
-Json vec(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
-
 struct Origin {
   Vec3 xyz = Vec3::Zero(), rpy = Vec3::Zero();
 };
@@ -89,11 +87,11 @@ Json inertial_element(const Ctx& c, const XMLElement* link, const std::string& w
   const Mat3 R = rpy_to_rotation(o.rpy);
   const Mat3 I_link = R * I * R.transpose();
   Json rows = Json::array();
-  for (int r = 0; r < 3; ++r) rows.push_back(vec(I_link.row(r).transpose()));
+  for (int r = 0; r < 3; ++r) rows.push_back(vec3_json(I_link.row(r).transpose()));
   // Zero mass with an inertia (some exporters' placeholder links, or a pure rotor): a rotary
   // inertia alone.
-  if (m == 0) return {{"type", "rotary_node"}, {"node", vec(o.xyz)}, {"inertia", rows}};
-  return {{"type", "rigid_body"}, {"mass", m}, {"com", vec(o.xyz)}, {"inertia", rows}};
+  if (m == 0) return {{"type", "rotary_node"}, {"node", vec3_json(o.xyz)}, {"inertia", rows}};
+  return {{"type", "rigid_body"}, {"mass", m}, {"com", vec3_json(o.xyz)}, {"inertia", rows}};
 }
 
 }  // namespace
@@ -105,8 +103,9 @@ bool is_urdf_path(const std::string& path) {
 UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
   const Ctx c{source};
   if (text.find("xmlns:xacro") != std::string::npos || text.find("<xacro:") != std::string::npos)
-    throw ModelError(source, "xacro is not supported: expand it first (xacro robot.urdf.xacro > "
-                             "robot.urdf)");
+    throw ModelError(source,
+                     "xacro is not supported: expand it first (xacro robot.urdf.xacro > "
+                     "robot.urdf)");
   tinyxml2::XMLDocument doc;
   if (doc.Parse(text.c_str(), text.size()) != tinyxml2::XML_SUCCESS)
     throw ModelError(source, std::string("malformed XML at line ") +
@@ -118,10 +117,12 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
   // Links.
   std::map<std::string, const XMLElement*> links;
   std::vector<std::string> link_order;
-  for (const XMLElement* l = robot->FirstChildElement("link"); l; l = l->NextSiblingElement("link")) {
+  for (const XMLElement* l = robot->FirstChildElement("link"); l;
+       l = l->NextSiblingElement("link")) {
     const char* name = l->Attribute("name");
     if (!name || !*name) c.fail("a <link>", "has no name");
-    if (!links.emplace(name, l).second) c.fail(std::string("link '") + name + "'", "is defined twice");
+    if (!links.emplace(name, l).second)
+      c.fail(std::string("link '") + name + "'", "is defined twice");
     link_order.push_back(name);
   }
   if (links.empty()) throw ModelError(source, "no <link> elements");
@@ -134,7 +135,8 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
   std::vector<JointInfo> joints;
   std::map<std::string, std::string> parent_joint;  // child link -> joint name
   std::set<std::string> joint_names;
-  for (const XMLElement* j = robot->FirstChildElement("joint"); j; j = j->NextSiblingElement("joint")) {
+  for (const XMLElement* j = robot->FirstChildElement("joint"); j;
+       j = j->NextSiblingElement("joint")) {
     const char* name = j->Attribute("name");
     if (!name || !*name) c.fail("a <joint>", "has no name");
     const std::string who = std::string("joint '") + name + "'";
@@ -189,14 +191,15 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
     const Origin o = origin_of(c, ji.e, who);
     Json joint = {{"name", ji.name},
                   {"type", type == "continuous" ? "revolute" : type},
-                  {"origin", {{"xyz", vec(o.xyz)}, {"rpy", vec(o.rpy)}}}};
+                  {"origin", {{"xyz", vec3_json(o.xyz)}, {"rpy", vec3_json(o.rpy)}}}};
     if (type != "fixed") {
       const Vec3 axis = vec_attr(c, ji.e->FirstChildElement("axis"), "xyz", Vec3::UnitX(), who);
       if (!(axis.norm() > 1e-12)) c.fail(who, "axis is zero");
-      joint["axis"] = vec(axis.normalized());
+      joint["axis"] = vec3_json(axis.normalized());
       const XMLElement* lim = ji.e->FirstChildElement("limit");
       if (type != "continuous" && lim && (lim->Attribute("lower") || lim->Attribute("upper"))) {
-        const double lo = number_attr(c, lim, "lower", 0, who), hi = number_attr(c, lim, "upper", 0, who);
+        const double lo = number_attr(c, lim, "lower", 0, who),
+                     hi = number_attr(c, lim, "upper", 0, who);
         if (lo > hi) c.fail(who, "limit lower > upper");
         if (lo < hi) joint["limits"] = {lo, hi};
       }
@@ -212,16 +215,16 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
       if (const XMLElement* mimic = ji.e->FirstChildElement("mimic")) {
         const char* leader = mimic->Attribute("joint");
         if (!leader) c.fail(who, "<mimic> has no joint");
-        if (!joint_names.count(leader)) c.fail(who, std::string("mimics unknown joint '") + leader + "'");
+        if (!joint_names.count(leader))
+          c.fail(who, std::string("mimics unknown joint '") + leader + "'");
         couplings.push_back({{"joint", ji.name},
                              {"follows", leader},
                              {"ratio", number_attr(c, mimic, "multiplier", 1.0, who)},
                              {"offset", number_attr(c, mimic, "offset", 0.0, who)}});
       }
     }
-    Json body = {{"name", ji.child},
-                 {"parent", ji.parent == root ? "world" : ji.parent},
-                 {"joint", joint}};
+    Json body = {
+        {"name", ji.child}, {"parent", ji.parent == root ? "world" : ji.parent}, {"joint", joint}};
     const Json element = inertial_element(c, links.at(ji.child), "link '" + ji.child + "'");
     if (!element.is_null()) body["elements"] = Json::array({element});
     bodies.push_back(body);
@@ -229,10 +232,11 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
   // The root link's own inertia never moves (it is welded to the world); still check it.
   (void)inertial_element(c, links.at(root), "link '" + root + "'");
   const char* name = robot->Attribute("name");
-  out.model = {{"name", name ? name : root},
-               {"description", "imported from " + source + "; root link '" + root + "' welded to the world"},
-               {"gravity", {0, 0, -9.81}},
-               {"bodies", bodies}};
+  out.model = {
+      {"name", name ? name : root},
+      {"description", "imported from " + source + "; root link '" + root + "' welded to the world"},
+      {"gravity", {0, 0, -9.81}},
+      {"bodies", bodies}};
   if (!couplings.empty()) out.model["couplings"] = couplings;
   return out;
 }

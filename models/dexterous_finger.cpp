@@ -19,7 +19,8 @@ std::array<double, N> numbers_or(const Params& p, const char* key, std::array<do
   } else {
     if (!v.is_array() || v.size() != N)
       p.fail(key, "expected a number or an array of " + std::to_string(N) + " numbers");
-    for (std::size_t i = 0; i < N; ++i) out[i] = json_number(v[i], p.path(key) + "/" + std::to_string(i));
+    for (std::size_t i = 0; i < N; ++i)
+      out[i] = json_number(v[i], p.path(key) + "/" + std::to_string(i));
   }
   for (double x : out) {
     if (sign == Sign::Positive && !(x > 0)) p.fail(key, "must be positive");
@@ -27,8 +28,6 @@ std::array<double, N> numbers_or(const Params& p, const char* key, std::array<do
   }
   return out;
 }
-
-Json vec(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
 
 // The paper's correlation table N_m, as printed (4 units x 12).
 const int kPaperTable[4][12] = {{0, 0, 0, 0, 0, 1, 2, 3, 0, 4, 0, 0},
@@ -39,8 +38,8 @@ const int kPaperTable[4][12] = {{0, 0, 0, 0, 0, 1, 2, 3, 0, 4, 0, 0},
 }  // namespace
 
 FingerParams FingerParams::from(const Params& p) {
-  p.allow_only({"lengths", "width", "height", "density", "limits", "stiffness", "rest",
-                "damping", "coupling", "tip_force", "lumping"});
+  p.allow_only({"lengths", "width", "height", "density", "limits", "stiffness", "rest", "damping",
+                "coupling", "tip_force", "lumping"});
   FingerParams f;
   f.length = numbers_or<4>(p, "lengths", f.length, Sign::Positive);
   f.width = numbers_or<4>(p, "width", f.width, Sign::Positive);
@@ -79,16 +78,16 @@ void append_finger(const FingerParams& f, const std::string& prefix, const std::
   static const char* body[] = {"base", "proximal", "middle", "distal"};
   static const char* joint[] = {"abduction", "mcp", "pip", "dip"};
   // Unit k runs from its joint to the next: the base radially along −y, knuckles along +z.
-  const Vec3 along[] = {Vec3(0, -f.length[0], 0), Vec3(0, 0, f.length[1]),
-                        Vec3(0, 0, f.length[2]), Vec3(0, 0, f.length[3])};
+  const Vec3 along[] = {Vec3(0, -f.length[0], 0), Vec3(0, 0, f.length[1]), Vec3(0, 0, f.length[2]),
+                        Vec3(0, 0, f.length[3])};
   for (int k = 0; k < 4; ++k) {
     Json j = {{"name", prefix + joint[k]},
               {"type", "revolute"},
-              {"axis", k == 0 ? vec(Vec3::UnitZ()) : vec(Vec3::UnitX())},
+              {"axis", k == 0 ? vec3_json(Vec3::UnitZ()) : vec3_json(Vec3::UnitX())},
               {"limits", Json::array({f.limits[k][0], f.limits[k][1]})}};
     // Base joint: the mount, then a quarter turn so that the body x is the flexion axis.
-    j["origin"] = k == 0 ? Json{{"xyz", vec(xyz)}, {"rpy", vec(rpy)}}
-                         : Json{{"xyz", vec(along[k - 1])}};
+    j["origin"] = k == 0 ? Json{{"xyz", vec3_json(xyz)}, {"rpy", vec3_json(rpy)}}
+                         : Json{{"xyz", vec3_json(along[k - 1])}};
     if (f.stiffness[k] > 0) j["spring"] = {{"stiffness", f.stiffness[k]}, {"rest", f.rest[k]}};
     if (f.damping[k] > 0) j["damping"] = f.damping[k];
     // Section: width w along the flexion axis (body x), height h across it. In the bar frame
@@ -105,7 +104,7 @@ void append_finger(const FingerParams& f, const std::string& prefix, const std::
       bar["Iz"] = radial ? h * w * w * w / 12 : w * h * h * h / 12;
       bar["lumping"] = "paper";
     } else {
-      bar["section_y"] = vec(Vec3::UnitX());
+      bar["section_y"] = vec3_json(Vec3::UnitX());
       // x̂ × ŷ = ẑ: for the base (x̂ = −y) ẑ = −y × x = z; for knuckles (x̂ = z) ẑ = z × x = y.
       bar["Iy"] = w * h * h * h / 12;  // ∫ z² dA, z (body y) across the height
       bar["Iz"] = h * w * w * w / 12;
@@ -113,7 +112,7 @@ void append_finger(const FingerParams& f, const std::string& prefix, const std::
     Json b = {{"name", prefix + body[k]},
               {"parent", k == 0 ? parent : prefix + body[k - 1]},
               {"joint", j},
-              {"nodes", {{"a", vec(Vec3::Zero())}, {"b", vec(along[k])}}},
+              {"nodes", {{"a", vec3_json(Vec3::Zero())}, {"b", vec3_json(along[k])}}},
               {"elements", Json::array({bar})}};
     bodies.push_back(b);
   }
@@ -123,7 +122,9 @@ void append_finger(const FingerParams& f, const std::string& prefix, const std::
                          {"ratio", f.ratio},
                          {"offset", f.offset}});
   if (!f.tip_force.isZero(0))
-    loads.push_back({{"body", prefix + "distal"}, {"point", vec(along[3])}, {"force", vec(f.tip_force)}});
+    loads.push_back({{"body", prefix + "distal"},
+                     {"point", vec3_json(along[3])},
+                     {"force", vec3_json(f.tip_force)}});
 }
 
 Json dexterous_finger(const Params& params) {
@@ -131,9 +132,9 @@ Json dexterous_finger(const Params& params) {
   Json bodies = Json::array(), couplings = Json::array(), loads = Json::array();
   append_finger(f, "", "world", Vec3::Zero(), Vec3(0, 0, std::numbers::pi / 2), bodies, couplings,
                 loads);
-  Json model = {{"name", f.paper_lumping ? "dexterous finger (paper's discretisation)"
-                                         : "dexterous finger"},
-                {"bodies", bodies}};
+  Json model = {
+      {"name", f.paper_lumping ? "dexterous finger (paper's discretisation)" : "dexterous finger"},
+      {"bodies", bodies}};
   if (!couplings.empty()) model["couplings"] = couplings;
   if (!loads.empty()) model["loads"] = loads;
   if (f.paper_lumping) {

@@ -20,25 +20,34 @@ Json dexterous_hand(const Params& p) {
   const Json palm_body = {{"type", "rigid_body"},
                           {"mass", m},
                           {"com", {0, 0, 0.05}},
-                          {"inertia", {{"ixx", m * (b * b + c * c) / 12},
-                                       {"iyy", m * (a * a + c * c) / 12},
-                                       {"izz", m * (a * a + b * b) / 12}}}};
+                          {"inertia",
+                           {{"ixx", m * (b * b + c * c) / 12},
+                            {"iyy", m * (a * a + c * c) / 12},
+                            {"izz", m * (a * a + b * b) / 12}}}};
   std::string palm_parent = "world";
   if (wrist) {
     // Wrist: deviation about z then flexion about x; the carpal link is small.
-    bodies.push_back({{"name", "carpus"},
-                      {"parent", "world"},
-                      {"joint", {{"name", "wrist_deviation"}, {"type", "revolute"},
-                                 {"axis", {0, 0, 1}}, {"limits", {-0.4, 0.4}}}},
-                      {"elements", Json::array({{{"type", "rigid_body"}, {"mass", 0.05},
-                                                 {"com", {0, 0, 0.005}},
-                                                 {"inertia", {{"ixx", 1e-5}, {"iyy", 1e-5}, {"izz", 1e-5}}}}})}});
+    bodies.push_back(
+        {{"name", "carpus"},
+         {"parent", "world"},
+         {"joint",
+          {{"name", "wrist_deviation"},
+           {"type", "revolute"},
+           {"axis", {0, 0, 1}},
+           {"limits", {-0.4, 0.4}}}},
+         {"elements",
+          Json::array({{{"type", "rigid_body"},
+                        {"mass", 0.05},
+                        {"com", {0, 0, 0.005}},
+                        {"inertia", {{"ixx", 1e-5}, {"iyy", 1e-5}, {"izz", 1e-5}}}}})}});
     palm_parent = "carpus";
   }
   bodies.push_back({{"name", "palm"},
                     {"parent", palm_parent},
-                    {"joint", wrist ? Json{{"name", "wrist_flexion"}, {"type", "revolute"},
-                                           {"axis", {1, 0, 0}}, {"limits", {-1.0, 1.0}},
+                    {"joint", wrist ? Json{{"name", "wrist_flexion"},
+                                           {"type", "revolute"},
+                                           {"axis", {1, 0, 0}},
+                                           {"limits", {-1.0, 1.0}},
                                            {"origin", {{"xyz", {0, 0, 0.01}}}}}
                                     : Json{{"name", "palm_mount"}, {"type", "fixed"}}},
                     {"elements", Json::array({palm_body})}});
@@ -49,12 +58,12 @@ Json dexterous_hand(const Params& p) {
   for (int i = 0; i < 4; ++i)
     // Finger frame: abduction axis along the palm's z (the fingers' pointing direction at
     // rest is +z). The plugin's base yaw of π/2 makes the flexion axis the palm's x.
-    append_finger(f, names[i], "palm", Vec3(x[i], 0, 0.10), Vec3(0, 0, half_pi + splay[i]),
-                  bodies, couplings, loads);
+    append_finger(f, names[i], "palm", Vec3(x[i], 0, 0.10), Vec3(0, 0, half_pi + splay[i]), bodies,
+                  couplings, loads);
   if (thumb)
     // Thumb on the side of the palm, its abduction axis tilted towards the palm normal.
-    append_finger(f, "thumb_", "palm", Vec3(0.045, 0.01, 0.03), Vec3(0, 0.9, half_pi - 0.6),
-                  bodies, couplings, loads);
+    append_finger(f, "thumb_", "palm", Vec3(0.045, 0.01, 0.03), Vec3(0, 0.9, half_pi - 0.6), bodies,
+                  couplings, loads);
   Json model = {{"name", "dexterous hand"}, {"bodies", bodies}};
   if (!couplings.empty()) model["couplings"] = couplings;
   if (!loads.empty()) model["loads"] = loads;

@@ -10,20 +10,17 @@ namespace femdyn {
 
 // The one place model plugins are registered.
 static const std::array kPlugins = {
-    ModelPlugin{"dexterous_finger", &dexterous_finger,
-                "the paper's 4-joint finger of space bars (lumping exact or the paper's)"},
-    ModelPlugin{"dexterous_hand", &dexterous_hand,
-                "a palm on a 2-DOF wrist with four fingers and a thumb"},
-    ModelPlugin{"random_tree", &random_tree,
-                "a seeded random tree or chain of rigid bodies (tests, studies, benchmarks)"},
+    // the paper's 4-joint finger of space bars (lumping exact or the paper's)
+    ModelPlugin{"dexterous_finger", &dexterous_finger},
+    // a palm on a 2-DOF wrist with four fingers and a thumb
+    ModelPlugin{"dexterous_hand", &dexterous_hand},
+    // a seeded random tree or chain of rigid bodies (tests, studies, benchmarks)
+    ModelPlugin{"random_tree", &random_tree},
 };
 
-std::span<const ModelPlugin> model_plugins() { return kPlugins; }
-
-const ModelPlugin* find_model_plugin(std::string_view name) {
-  for (const ModelPlugin& p : kPlugins)
-    if (p.name == name) return &p;
-  return nullptr;
+const Registry<ModelPlugin>& model_plugins() {
+  static const Registry<ModelPlugin> registry{kPlugins};
+  return registry;
 }
 
 }  // namespace femdyn

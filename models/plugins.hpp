@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "io/params.hpp"
+#include "io/registry.hpp"
 
 namespace femdyn {
 
@@ -16,10 +17,8 @@ using ModelFactory = Json (*)(const Params& params);
 struct ModelPlugin {
   std::string_view name;
   ModelFactory expand;
-  std::string_view summary;
 };
 
-std::span<const ModelPlugin> model_plugins();
-const ModelPlugin* find_model_plugin(std::string_view name);
+const Registry<ModelPlugin>& model_plugins();
 
 }  // namespace femdyn

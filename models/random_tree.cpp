@@ -43,16 +43,18 @@ Json random_tree(const Params& p) {
     bodies.push_back(
         {{"name", "b" + std::to_string(b)},
          {"parent", parent < 0 ? std::string("world") : "b" + std::to_string(parent)},
-         {"joint", {{"name", "j" + std::to_string(b)},
-                    {"type", slide ? "prismatic" : "revolute"},
-                    {"axis", vec(a0, a1, a2)},
-                    {"origin", {{"xyz", vec(0.5 * x0, 0.5 * x1, 0.5 * x2)}, {"rpy", vec(r0, r1, r2)}}}}},
-         {"elements", Json::array({{{"type", "rigid_body"},
-                                    {"mass", mass},
-                                    {"com", vec(0.3 * c0, 0.3 * c1, 0.3 * c2)},
-                                    {"inertia", {vec(I(0, 0), I(0, 1), I(0, 2)),
-                                                 vec(I(1, 0), I(1, 1), I(1, 2)),
-                                                 vec(I(2, 0), I(2, 1), I(2, 2))}}}})}});
+         {"joint",
+          {{"name", "j" + std::to_string(b)},
+           {"type", slide ? "prismatic" : "revolute"},
+           {"axis", vec(a0, a1, a2)},
+           {"origin", {{"xyz", vec(0.5 * x0, 0.5 * x1, 0.5 * x2)}, {"rpy", vec(r0, r1, r2)}}}}},
+         {"elements",
+          Json::array({{{"type", "rigid_body"},
+                        {"mass", mass},
+                        {"com", vec(0.3 * c0, 0.3 * c1, 0.3 * c2)},
+                        {"inertia",
+                         {vec(I(0, 0), I(0, 1), I(0, 2)), vec(I(1, 0), I(1, 1), I(1, 2)),
+                          vec(I(2, 0), I(2, 1), I(2, 2))}}}})}});
   }
   return {{"name", "random tree " + std::to_string(static_cast<unsigned>(seed))},
           {"gravity", vec(0, 0, -9.81)},

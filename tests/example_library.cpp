@@ -19,7 +19,8 @@ int main(int argc, char** argv) {
     std::cerr << path << ": " << st.message << "\n";
     return 1;
   }
-  std::cout << "M^s =\n" << ws.Ms << "\nh = " << ws.h.transpose() << "\nQ = " << ws.Q.transpose()
+  std::cout << "M^s =\n"
+            << ws.Ms << "\nh = " << ws.h.transpose() << "\nQ = " << ws.Q.transpose()
             << "\nqdd = " << ws.qdd.transpose() << "\n";
 
   // Inverse dynamics of that acceleration gives back the actuation (zero).

@@ -1,13 +1,12 @@
 #include "tests/helpers.hpp"
 
-#include <array>
-#include <cstdio>
-#include <stdexcept>
-
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <sstream>
+#include <stdexcept>
 
 namespace femdyn::test {
 
@@ -17,7 +16,8 @@ std::string model_path(const std::string& name) {
 
 std::vector<std::string> bundled_models() {
   std::vector<std::string> out;
-  for (const auto& e : std::filesystem::directory_iterator(std::string(FEMDYN_SOURCE_DIR) + "/models"))
+  for (const auto& e :
+       std::filesystem::directory_iterator(std::string(FEMDYN_SOURCE_DIR) + "/models"))
     if (e.path().extension() == ".json") out.push_back(e.path().filename().string());
   std::sort(out.begin(), out.end());
   return out;
@@ -28,10 +28,11 @@ Model load_text(const std::string& json_text) { return compile(parse_spec(json_t
 std::string random_tree_json(unsigned seed, int bodies, double branching, bool prismatic,
                              double gravity) {
   // The random_tree model plugin (models/random_tree.hpp), with a gravity off the axes.
-  const Json doc = {{"model", "random_tree"},
-                    {"params", {{"seed", seed}, {"bodies", bodies}, {"branching", branching},
-                                {"prismatic", prismatic}}},
-                    {"gravity", {0.1, -0.2, -gravity}}};
+  const Json doc = {
+      {"model", "random_tree"},
+      {"params",
+       {{"seed", seed}, {"bodies", bodies}, {"branching", branching}, {"prismatic", prismatic}}},
+      {"gravity", {0.1, -0.2, -gravity}}};
   return doc.dump();
 }
 
@@ -47,16 +48,7 @@ Run run_shell(const std::string& command) {
 
 Run run(const std::string& args) { return run_shell(std::string(FEMDYN_BINARY) + " " + args); }
 
-VecX random_vector(std::mt19937& rng, int n, double scale) {
-  std::uniform_real_distribution<double> u(-scale, scale);
-  VecX v(n);
-  for (int i = 0; i < n; ++i) v[i] = u(rng);
-  return v;
-}
-
-double rel_error(const MatX& a, const MatX& b, double floor) {
-  return (a - b).cwiseAbs().maxCoeff() / std::max(b.cwiseAbs().maxCoeff(), floor);
-}
+double rel_error(const MatX& a, const MatX& b, double floor) { return relative_error(a, b, floor); }
 
 double translation_value(const Model& m, const Workspace& ws, int i) {
   const SystemDof& d = m.dofs[i];
@@ -64,6 +56,5 @@ double translation_value(const Model& m, const Workspace& ws, int i) {
   const BodyState& B = ws.body[n.body];
   return (B.p + B.R * n.r)[d.axis];
 }
-
 
 }  // namespace femdyn::test

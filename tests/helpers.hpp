@@ -6,12 +6,13 @@
 
 #include "core/equations.hpp"
 #include "core/kinematics.hpp"
+#include "core/sampling.hpp"
 #include "io/model_loader.hpp"
 
 namespace femdyn::test {
 
 std::string model_path(const std::string& name);  // FEMDYN_SOURCE_DIR/models/name
-std::vector<std::string> bundled_models();          // file names of models/*.json, sorted
+std::vector<std::string> bundled_models();        // file names of models/*.json, sorted
 Model load_text(const std::string& json_text);
 
 // A seeded random tree as JSON text: random axes, offsets and rpy, full physical inertia
@@ -19,8 +20,6 @@ Model load_text(const std::string& json_text);
 // body hangs from an earlier body instead of the last one.
 std::string random_tree_json(unsigned seed, int bodies, double branching, bool prismatic,
                              double gravity = 9.81);
-
-VecX random_vector(std::mt19937& rng, int n, double scale);
 
 // max |a − b| / max(|b|, floor)
 double rel_error(const MatX& a, const MatX& b, double floor = 1e-12);

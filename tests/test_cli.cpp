@@ -1,14 +1,14 @@
 // The femdyn command end to end: JSON output equals the library, bad input exits non-zero
 // with one line naming file and path.
-#include <catch2/catch.hpp>
 #include <array>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <set>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "tests/helpers.hpp"
 
@@ -27,7 +27,8 @@ VecX vec(const nlohmann::json& j) {
 
 TEST_CASE("femdyn equations --json equals the library on the spatial double pendulum", "[cli]") {
   const std::string path = model_path("spatial_double_pendulum.json");
-  const Run r = run("equations " + path + " --q 0.4,-1.1 --qd 1.5,-0.7 --tau 0.2,0.1 --json --tensor");
+  const Run r =
+      run("equations " + path + " --q 0.4,-1.1 --qd 1.5,-0.7 --tau 0.2,0.1 --json --tensor");
   REQUIRE(r.code == 0);
   const auto j = nlohmann::json::parse(r.out);
   const Model m = load_model(path);
@@ -55,7 +56,8 @@ TEST_CASE("femdyn equations --json equals the library on the spatial double pend
 }
 
 TEST_CASE("the gravity option overrides the model's gravity", "[cli]") {
-  const Run r = run("equations " + model_path("pendulum.json") + " --q 0.5 --gravity 0,0,-1 --json");
+  const Run r =
+      run("equations " + model_path("pendulum.json") + " --q 0.5 --gravity 0,0,-1 --json");
   REQUIRE(r.code == 0);
   CHECK(std::abs(nlohmann::json::parse(r.out)["Q"][0].get<double>() + std::sin(0.5)) < 1e-14);
 }
@@ -72,18 +74,22 @@ TEST_CASE("bad command lines and bad models: one line, non-zero exit", "[cli]") 
   CHECK(r.code == 2);
   r = run("equations /nonexistent.json");
   CHECK(r.code == 1);
-  CHECK(r.out == "femdyn equations: /nonexistent.json: cannot open file: No such file or directory\n");
+  CHECK(r.out ==
+        "femdyn equations: /nonexistent.json: cannot open file: No such file or directory\n");
   const std::string bad = "femdyn_test_bad.json";
-  std::ofstream(bad) << R"({"bodies": [{"name": "a", "parent": "world", "joint": {"type": "revolute", "axis": [0, 0, 1]}, "elements": [{"type": "rigid_body", "mass": 1, "inertia": {"ixx": NaN}}]}]})";
+  std::ofstream(bad)
+      << R"({"bodies": [{"name": "a", "parent": "world", "joint": {"type": "revolute", "axis": [0, 0, 1]}, "elements": [{"type": "rigid_body", "mass": 1, "inertia": {"ixx": NaN}}]}]})";
   r = run("info " + bad);
   CHECK(r.code == 1);
-  CHECK_THAT(r.out, Catch::StartsWith("femdyn info: femdyn_test_bad.json: malformed JSON at line 1"));
+  CHECK_THAT(r.out,
+             Catch::StartsWith("femdyn info: femdyn_test_bad.json: malformed JSON at line 1"));
   CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
   std::remove(bad.c_str());
 }
 
 TEST_CASE("every command has --help, info lists the correlation table", "[cli]") {
-  for (const char* cmd : {"info", "equations", "compare", "track", "validate", "import", "simulate", "check", "study", "stress", "bench"}) {
+  for (const char* cmd : {"info", "equations", "compare", "track", "validate", "import", "simulate",
+                          "check", "study", "stress", "bench"}) {
     const Run r = run(std::string(cmd) + " --help");
     CHECK(r.code == 0);
     CHECK_THAT(r.out, Catch::StartsWith("usage: femdyn " + std::string(cmd)));
@@ -113,8 +119,8 @@ TEST_CASE("track: feed-forward torques from inverse dynamics reproduce the motio
                       " --duration 0.4 --steps 400 --json --csv " + csv);
     REQUIRE(r.code == 0);
     const auto j = nlohmann::json::parse(r.out);
-    CHECK(j["max_abs_tau"].get<double>() > 1e-4);            // it needed torque
-    CHECK(j["max_tracking_error"].get<double>() < 1e-8);      // RK4 error only
+    CHECK(j["max_abs_tau"].get<double>() > 1e-4);         // it needed torque
+    CHECK(j["max_tracking_error"].get<double>() < 1e-8);  // RK4 error only
     std::ifstream f(csv);
     std::string header;
     std::getline(f, header);
@@ -127,11 +133,13 @@ TEST_CASE("track: feed-forward torques from inverse dynamics reproduce the motio
 }
 
 TEST_CASE("compare: a model against itself is exact, the paper's finger is not", "[cli]") {
-  Run r = run("compare " + model_path("finger.json") + " " + model_path("finger.json") + " --states 5 --json");
+  Run r = run("compare " + model_path("finger.json") + " " + model_path("finger.json") +
+              " --states 5 --json");
   REQUIRE(r.code == 0);
   auto j = nlohmann::json::parse(r.out);
   CHECK(j["max_rel_error"]["M"].get<double>() == 0.0);
-  r = run("compare " + model_path("finger_paper.json") + " " + model_path("finger.json") + " --states 20 --json");
+  r = run("compare " + model_path("finger_paper.json") + " " + model_path("finger.json") +
+          " --states 20 --json");
   REQUIRE(r.code == 0);
   j = nlohmann::json::parse(r.out);
   CHECK(j["max_rel_error"]["M"].get<double>() > 0.01);
@@ -155,7 +163,8 @@ TEST_CASE("validate: table and exit 0 on a good model, JSON, exit 1 when it cann
   const auto j = nlohmann::json::parse(js.out);
   CHECK(j.at("states") == 4);
   CHECK(j.at("pass") == true);
-  for (const char* q : {"M", "h", "Q", "qdd", "tau"}) CHECK(j.at("max_rel_error").at(q).get<double>() < 1e-10);
+  for (const char* q : {"M", "h", "Q", "qdd", "tau"})
+    CHECK(j.at("max_rel_error").at(q).get<double>() < 1e-10);
   CHECK(j.at("trajectory").at("t_end") == 0.05);
   CHECK(j.at("trajectory").at("max_state_error").get<double>() < 1e-6);
   const auto& traj = j.at("trajectory");
@@ -168,8 +177,9 @@ TEST_CASE("validate: table and exit 0 on a good model, JSON, exit 1 when it cann
   const Run urdf = run("validate " + model_path("urdf/arm7.urdf") + " --states 3 --t-end 0.05");
   CHECK(urdf.code == 0);
   CHECK_THAT(urdf.out, Catch::Contains("import "));  // the import against the XML twin
-  CHECK(run("validate " + model_path("urdf/arm7.urdf") +
-            " --states 2 --t-end 0 --gravity 0,-9.81,0").code == 0);
+  CHECK(
+      run("validate " + model_path("urdf/arm7.urdf") + " --states 2 --t-end 0 --gravity 0,-9.81,0")
+          .code == 0);
 
   const Run paper = run("validate " + model_path("finger_paper.json") + " --states 2");
   CHECK(paper.code == 1);
@@ -239,16 +249,19 @@ TEST_CASE("bench: every quantity timed on both engines, D skipped as documented,
   CHECK(bad.out == "femdyn bench: --states expects one integer >= 1\n");
   bad = run("bench /nonexistent.json --quick");
   CHECK(bad.code == 1);
-  CHECK(bad.out == "femdyn bench: /nonexistent.json: cannot open file: No such file or directory\n");
+  CHECK(bad.out ==
+        "femdyn bench: /nonexistent.json: cannot open file: No such file or directory\n");
 }
 #endif
 
 TEST_CASE("import writes JSON that loads back, atomically, or nothing at all", "[cli][urdf]") {
-  const std::string out = (std::filesystem::temp_directory_path() / "femdyn_cli_arm7.json").string();
+  const std::string out =
+      (std::filesystem::temp_directory_path() / "femdyn_cli_arm7.json").string();
   std::filesystem::remove(out);
   const Run ok = run("import " + model_path("urdf/arm7.urdf") + " -o " + out);
   REQUIRE(ok.code == 0);
-  const Run a = run("equations " + model_path("urdf/arm7.urdf") + " --q 0.1,0.2,0.3,0.4,0.5,0.6,0.7 --json");
+  const Run a =
+      run("equations " + model_path("urdf/arm7.urdf") + " --q 0.1,0.2,0.3,0.4,0.5,0.6,0.7 --json");
   const Run b = run("equations " + out + " --q 0.1,0.2,0.3,0.4,0.5,0.6,0.7 --json");
   REQUIRE(a.code == 0);
   CHECK(a.out == b.out);  // the same equations, digit for digit

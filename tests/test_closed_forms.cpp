@@ -9,8 +9,8 @@
 
 using namespace femdyn;
 using namespace femdyn::test;
-using Catch::Matchers::WithinRel;
 using Catch::Matchers::WithinAbs;
+using Catch::Matchers::WithinRel;
 
 TEST_CASE("single pendulum: M = m l², Q = −m g l sin θ, h = 0", "[closed-form]") {
   const Model m = load_model(model_path("pendulum.json"));
@@ -48,7 +48,7 @@ TEST_CASE("planar double pendulum of space bars matches the Lagrange closed form
   Workspace ws(m);
   std::mt19937 rng(7);
   for (int k = 0; k < 10; ++k) {
-    const VecX q = random_vector(rng, 2, 3.0), qd = random_vector(rng, 2, 4.0);
+    const VecX q = random_uniform(2, 3.0, rng), qd = random_uniform(2, 4.0, rng);
     REQUIRE(forward_dynamics(m, ws, q, qd, VecX::Zero(2)).ok);
     evaluate(m, ws, q, qd, VecX::Zero(2));
     const double s2 = std::sin(q[1]), cs2 = std::cos(q[1]);
@@ -60,7 +60,8 @@ TEST_CASE("planar double pendulum of space bars matches the Lagrange closed form
     h[0] = -mass[1] * l1 * c2 * s2 * (2 * qd[0] * qd[1] + qd[1] * qd[1]);
     h[1] = mass[1] * l1 * c2 * s2 * qd[0] * qd[0];
     // V = g (m1 c1 sin θ1 + m2 (l1 sin θ1 + c2 sin(θ1+θ2))),  Q = −∂V/∂θ
-    Q[0] = -g * ((mass[0] * c1 + mass[1] * l1) * std::cos(q[0]) + mass[1] * c2 * std::cos(q[0] + q[1]));
+    Q[0] = -g *
+           ((mass[0] * c1 + mass[1] * l1) * std::cos(q[0]) + mass[1] * c2 * std::cos(q[0] + q[1]));
     Q[1] = -g * mass[1] * c2 * std::cos(q[0] + q[1]);
     CHECK(rel_error(ws.Ms, M) < 1e-13);
     CHECK(rel_error(ws.h, h) < 1e-12);
@@ -85,7 +86,7 @@ TEST_CASE("gimbal: asymmetric body on yaw then pitch, gyroscopic terms by hand",
   Workspace ws(m);
   std::mt19937 rng(11);
   for (int k = 0; k < 10; ++k) {
-    VecX q = random_vector(rng, 2, 3.0), qd = random_vector(rng, 2, 5.0);
+    VecX q = random_uniform(2, 3.0, rng), qd = random_uniform(2, 5.0, rng);
     q[1] = std::clamp(q[1], -1.2, 1.2);  // away from sin φ = 0, where M11 → C only
     evaluate(m, ws, q, qd, VecX());
     const double s = std::sin(q[1]), c = std::cos(q[1]);

@@ -71,20 +71,21 @@ TEST_CASE("space bar, rigid body and four equimomental points give the same equa
      << "], \"density\": " << bar.rho << ", \"area\": " << bar.A << ", \"Iy\": " << bar.Iy
      << ", \"Iz\": " << bar.Iz << ", \"section_y\": " << v3(bar.y_hint) << "}]";
   const std::string by_mass = "[{\"type\": \"space_bar\", \"nodes\": [" + v3(bar.a) + ", " +
-                              v3(bar.b) + "], \"mass\": " + num(m) +
-                              ", \"inertia\": " + m3(Ic) + "}]";
+                              v3(bar.b) + "], \"mass\": " + num(m) + ", \"inertia\": " + m3(Ic) +
+                              "}]";
   const std::string rigid = "[{\"type\": \"rigid_body\", \"mass\": " + num(m) +
                             ", \"com\": " + v3(c) + ", \"inertia\": " + m3(Ic) + "}]";
-  const std::string four = "[{\"type\": \"rigid_body\", \"equivalent\": \"four_points\", "
-                           "\"mass\": " + num(m) + ", \"com\": " + v3(c) +
-                           ", \"inertia\": " + m3(Ic) + "}]";
+  const std::string four =
+      "[{\"type\": \"rigid_body\", \"equivalent\": \"four_points\", "
+      "\"mass\": " +
+      num(m) + ", \"com\": " + v3(c) + ", \"inertia\": " + m3(Ic) + "}]";
   const Model ref = load_text(chain_with(sb.str()));
   const Model models[] = {load_text(chain_with(by_mass)), load_text(chain_with(rigid)),
                           load_text(chain_with(four))};
   Workspace wr(ref);
   std::mt19937 rng(5);
   for (int k = 0; k < 5; ++k) {
-    const VecX q = random_vector(rng, 3, 3.0), qd = random_vector(rng, 3, 3.0);
+    const VecX q = random_uniform(3, 3.0, rng), qd = random_uniform(3, 3.0, rng);
     evaluate(ref, wr, q, qd, VecX());
     for (const Model& other : models) {
       Workspace wo(other);
@@ -111,8 +112,10 @@ TEST_CASE("four equimomental points reproduce the pseudo-inertia", "[elements]")
   CHECK((P - pseudo_inertia(2.0, c, I)).cwiseAbs().maxCoeff() < 1e-15);
 }
 
-TEST_CASE("every registered element type: symmetric mass, physical total, FD-checked "
-          "velocity force", "[elements]") {
+TEST_CASE(
+    "every registered element type: symmetric mass, physical total, FD-checked "
+    "velocity force",
+    "[elements]") {
   // One representative parameter set per type; the conformance checks are type-agnostic.
   const std::map<std::string, std::string> examples = {
       {"lumped_point", R"({"type": "lumped_point", "node": [0.1, 0.2, 0.3], "mass": 0.7})"},
@@ -122,7 +125,7 @@ TEST_CASE("every registered element type: symmetric mass, physical total, FD-che
          "density": 2700, "area": 1e-4, "Iy": 1e-9, "Iz": 2e-9})"},
       {"rigid_body", R"({"type": "rigid_body", "mass": 1.2, "com": [0.1, 0, 0],
          "inertia": {"ixx": 0.01, "iyy": 0.02, "izz": 0.025, "ixy": 0.001}})"}};
-  for (const ElementType& t : element_types()) {
+  for (const ElementType& t : element_types().entries()) {
     INFO("element type " << t.name);
     REQUIRE(examples.count(std::string(t.name)));
     const Json j = Json::parse(examples.at(std::string(t.name)));

@@ -20,15 +20,15 @@ std::string error_of(const std::string& json) {
 }
 
 // A valid two-body chain with one replaceable piece.
-std::string chain(const std::string& joint2 = R"({"type": "revolute", "axis": [0, 1, 0]})",
-                  const std::string& elements2 =
-                      R"([{"type": "lumped_point", "node": [0.3, 0, 0], "mass": 1}])",
-                  const std::string& parent2 = "a") {
+std::string chain(
+    const std::string& joint2 = R"({"type": "revolute", "axis": [0, 1, 0]})",
+    const std::string& elements2 = R"([{"type": "lumped_point", "node": [0.3, 0, 0], "mass": 1}])",
+    const std::string& parent2 = "a") {
   return R"({"name": "t", "bodies": [
     {"name": "a", "parent": "world", "joint": {"type": "revolute", "axis": [0, 0, 1]},
      "elements": [{"type": "lumped_point", "node": [0.5, 0, 0], "mass": 1}]},
-    {"name": "b", "parent": ")" + parent2 + R"(", "joint": )" + joint2 + R"(, "elements": )" +
-         elements2 + "}]}";
+    {"name": "b", "parent": ")" +
+         parent2 + R"(", "joint": )" + joint2 + R"(, "elements": )" + elements2 + "}]}";
 }
 
 }  // namespace
@@ -57,18 +57,21 @@ TEST_CASE("bad-input classes give their pinned messages", "[errors]") {
                             R"([{"type": "lumped_point", "node": [0.3, 0, 0], "mass": -2}])")),
              Equals("bad.json: /bodies/1/elements/0/mass: must be positive, got -2"));
   CHECK_THAT(
-      error_of(chain(R"({"type": "revolute", "axis": [0, 1, 0]})",
-                     R"([{"type": "rigid_body", "mass": 1, "inertia": {"ixx": 1, "iyy": 1, "izz": 3}}])")),
+      error_of(chain(
+          R"({"type": "revolute", "axis": [0, 1, 0]})",
+          R"([{"type": "rigid_body", "mass": 1, "inertia": {"ixx": 1, "iyy": 1, "izz": 3}}])")),
       Equals("bad.json: /bodies/1/elements/0/inertia: inertia violates the triangle inequality "
              "(principal moments 1, 1, 3)"));
   CHECK_THAT(
-      error_of(chain(R"({"type": "revolute", "axis": [0, 1, 0]})",
-                     R"([{"type": "rotary_node", "node": [0, 0, 0], "inertia": {"ixx": -1, "iyy": 1, "izz": 1}}])")),
+      error_of(chain(
+          R"({"type": "revolute", "axis": [0, 1, 0]})",
+          R"([{"type": "rotary_node", "node": [0, 0, 0], "inertia": {"ixx": -1, "iyy": 1, "izz": 1}}])")),
       Catch::StartsWith("bad.json: /bodies/1/elements/0/inertia: inertia has a negative principal "
                         "moment"));
-  CHECK_THAT(error_of(chain(R"({"type": "revolute", "axis": [0, 1, 0]})",
-                            R"([{"type": "lumped_point", "node": [0.3, 0, 0], "mass": 1, "mas": 2}])")),
-             Equals("bad.json: /bodies/1/elements/0/mas: unknown key 'mas'"));
+  CHECK_THAT(
+      error_of(chain(R"({"type": "revolute", "axis": [0, 1, 0]})",
+                     R"([{"type": "lumped_point", "node": [0.3, 0, 0], "mass": 1, "mas": 2}])")),
+      Equals("bad.json: /bodies/1/elements/0/mas: unknown key 'mas'"));
   CHECK_THAT(error_of(chain(R"({"type": "revolute", "axis": [0, 1, 0]})",
                             R"([{"type": "lumped_point", "node": "tip", "mass": 1}])")),
              Equals("bad.json: /bodies/1/elements/0/node: unknown node 'tip' (not in the body's "
@@ -109,14 +112,17 @@ TEST_CASE("duplicate names and cycles are rejected", "[errors]") {
 
 TEST_CASE("a massless chain end makes M^s singular: named at its joint", "[errors]") {
   // Body b has no elements: its joint moves nothing.
-  CHECK_THAT(error_of(chain(R"({"name": "wrist", "type": "revolute", "axis": [0, 1, 0]})", "[]")),
-             Equals("bad.json: /bodies/1/joint: the mass matrix M^s is singular: coordinate "
-                    "'wrist' moves no inertia (a massless chain end, or all its mass on the joint axis?)"));
+  CHECK_THAT(
+      error_of(chain(R"({"name": "wrist", "type": "revolute", "axis": [0, 1, 0]})", "[]")),
+      Equals(
+          "bad.json: /bodies/1/joint: the mass matrix M^s is singular: coordinate "
+          "'wrist' moves no inertia (a massless chain end, or all its mass on the joint axis?)"));
   // A point mass on the joint axis also moves no inertia with that joint.
-  CHECK_THAT(error_of(chain(R"({"name": "spin", "type": "revolute", "axis": [1, 0, 0]})",
-                            R"([{"type": "lumped_point", "node": [0.3, 0, 0], "mass": 1}])")),
-             Equals("bad.json: /bodies/1/joint: the mass matrix M^s is singular: coordinate "
-                    "'spin' moves no inertia (a massless chain end, or all its mass on the joint axis?)"));
+  CHECK_THAT(
+      error_of(chain(R"({"name": "spin", "type": "revolute", "axis": [1, 0, 0]})",
+                     R"([{"type": "lumped_point", "node": [0.3, 0, 0], "mass": 1}])")),
+      Equals("bad.json: /bodies/1/joint: the mass matrix M^s is singular: coordinate "
+             "'spin' moves no inertia (a massless chain end, or all its mass on the joint axis?)"));
 }
 
 TEST_CASE("explicit correlation tables are checked", "[errors]") {
@@ -139,19 +145,21 @@ TEST_CASE("a mechanism without motion, an empty coupling, and a load a table dro
   CHECK_THAT(error_of(R"({"bodies": [{"name": "a", "parent": "world", "joint": {"type": "fixed"},
       "elements": [{"type": "lumped_point", "node": [0, 0, 0], "mass": 1}]}]})"),
              Equals("bad.json: has no movable joint: there is no motion to compute"));
-  CHECK_THAT(error_of(R"({"bodies": [
+  CHECK_THAT(
+      error_of(R"({"bodies": [
       {"name": "a", "parent": "world", "joint": {"name": "j1", "type": "revolute", "axis": [0, 0, 1]},
        "elements": [{"type": "lumped_point", "node": [1, 0, 0], "mass": 1}]},
       {"name": "b", "parent": "a", "joint": {"name": "j2", "type": "revolute", "axis": [0, 0, 1]},
        "elements": [{"type": "lumped_point", "node": [1, 0, 0], "mass": 1}]}],
       "couplings": [{"joint": "j2", "follows": []}]})"),
-             Equals("bad.json: /couplings/0/follows: names no joint (to fix a joint, make it fixed)"));
+      Equals("bad.json: /couplings/0/follows: names no joint (to fix a joint, make it fixed)"));
   const auto pendulum = [](const std::string& table) {
     return R"({"bodies": [{"name": "a", "parent": "world",
         "joint": {"type": "revolute", "axis": [0, 0, 1]},
         "elements": [{"type": "lumped_point", "node": [0.5, 0, 0], "mass": 1}]}],
       "loads": [{"body": "a", "point": [0.5, 0, 0], "force": [0, 2, 0]}],
-      "correlation_table": )" + table + "}";
+      "correlation_table": )" +
+           table + "}";
   };
   CHECK(error_of(pendulum("[[1, 2, 0, 0, 0, 0]]")) == "(no error)");
   CHECK_THAT(error_of(pendulum("[[1, 0, 0, 0, 0, 0]]")),
@@ -189,5 +197,6 @@ TEST_CASE("random_tree plugin parameters are checked", "[errors]") {
              Equals("bad.json: /params/branching: expected a number in [0, 1]"));
   CHECK_THAT(error_of(R"({"model": "random_tree", "params": {"seed": 1.5}})"),
              Equals("bad.json: /params/seed: expected an integer >= 0"));
-  CHECK(error_of(R"({"model": "random_tree", "params": {"seed": 3, "bodies": 30}})") == "(no error)");
+  CHECK(error_of(R"({"model": "random_tree", "params": {"seed": 3, "bodies": 30}})") ==
+        "(no error)");
 }

@@ -18,7 +18,8 @@ const double rho = 2700;
 std::string finger_json(const std::string& extra) {
   return R"({"model": "dexterous_finger", "params": {"lengths": [0.015, 0.045, 0.030, 0.022],
     "width": [0.012, 0.012, 0.011, 0.010], "height": [0.010, 0.010, 0.009, 0.008],
-    "density": 2700)" + extra + "}}";
+    "density": 2700)" +
+         extra + "}}";
 }
 
 }  // namespace
@@ -54,7 +55,8 @@ TEST_CASE("the paper's N_m and diagonal system mass are reproduced entry by entr
     CHECK(std::abs(M(i, i) - 0.5 * diag[i]) <= 1e-15 * std::abs(diag[i]));
   }
   CHECK((M - MatX(M.diagonal().asDiagonal())).cwiseAbs().maxCoeff() == 0.0);
-  // The paper's u (first, consistent form): u1 = θ1 rate, u4 = θ2, u8 = θ2+θ3, u12 = u16 = θ2+θ3+θ4.
+  // The paper's u (first, consistent form): u1 = θ1 rate, u4 = θ2, u8 = θ2+θ3, u12 = u16 =
+  // θ2+θ3+θ4.
   Workspace ws(m);
   VecX q(4);
   q << 0.3, 0.4, 0.5, 0.6;
@@ -101,7 +103,7 @@ TEST_CASE("finger with θ1 fixed: the flexion block is a planar 3-link arm", "[f
     Ik[k] = rho * (A * std::pow(l[k], 3) / 12 + l[k] * w[k + 1] * std::pow(hh[k + 1], 3) / 12);
   }
   for (int trial = 0; trial < 10; ++trial) {
-    VecX q = random_vector(rng, 4, 2.0), qd = random_vector(rng, 4, 3.0);
+    VecX q = random_uniform(4, 2.0, rng), qd = random_uniform(4, 3.0, rng);
     q[0] = 0;
     qd[0] = 0;
     evaluate(m, ws, q, qd, VecX());
@@ -119,7 +121,8 @@ TEST_CASE("finger with θ1 fixed: the flexion block is a planar 3-link arm", "[f
       for (int j = 0; j <= k; ++j) {
         const double len = j < k ? l[j] : l[k] / 2;
         // ∂/∂θ_i of len d(φ_j) = len d'(φ_j) for i ≤ j;  bias −len φ̇_j² d(φ_j)
-        for (int i = 0; i <= j; ++i) J.col(i) += len * Eigen::Vector2d(std::cos(phi[j]), -std::sin(phi[j]));
+        for (int i = 0; i <= j; ++i)
+          J.col(i) += len * Eigen::Vector2d(std::cos(phi[j]), -std::sin(phi[j]));
         bias -= len * phid[j] * phid[j] * Eigen::Vector2d(std::sin(phi[j]), std::cos(phi[j]));
       }
       Eigen::RowVector3d ak = Eigen::RowVector3d::Zero();
@@ -148,7 +151,8 @@ TEST_CASE("coupled finger: M^s, h, Q are the exact reduction Cᵀ(·)C of the fr
   Workspace wf(free), wc(coupled);
   std::mt19937 rng(9);
   for (int k = 0; k < 5; ++k) {
-    const VecX q = random_vector(rng, 3, 1.5), qd = random_vector(rng, 3, 2), tau = random_vector(rng, 3, 0.1);
+    const VecX q = random_uniform(3, 1.5, rng), qd = random_uniform(3, 2, rng),
+               tau = random_uniform(3, 0.1, rng);
     evaluate(coupled, wc, q, qd, tau);
     evaluate(free, wf, C * q + theta0, C * qd, VecX());
     CHECK(rel_error(wc.Ms, C.transpose() * wf.Ms * C) < 1e-13);

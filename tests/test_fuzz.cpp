@@ -24,16 +24,26 @@ void pointers(const json& j, const json::json_pointer& at, std::vector<json::jso
 
 json replacement(std::mt19937& rng) {
   switch (rng() % 10) {
-    case 0: return nullptr;
-    case 1: return "text";
-    case 2: return json::array();
-    case 3: return json::object();
-    case 4: return -1.0;
-    case 5: return 0;
-    case 6: return 1e300;
-    case 7: return json::array({1, 2});
-    case 8: return json::array({0.0, 0.0, 0.0});
-    default: return true;
+    case 0:
+      return nullptr;
+    case 1:
+      return "text";
+    case 2:
+      return json::array();
+    case 3:
+      return json::object();
+    case 4:
+      return -1.0;
+    case 5:
+      return 0;
+    case 6:
+      return 1e300;
+    case 7:
+      return json::array({1, 2});
+    case 8:
+      return json::array({0.0, 0.0, 0.0});
+    default:
+      return true;
   }
 }
 

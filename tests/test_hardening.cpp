@@ -1,10 +1,10 @@
 // Hostile input (issue 12): every case ends in a one-line error naming the place, or succeeds;
 // never a crash, a hang, a foreign exception text, or NaN printed as an answer.
-#include <catch2/catch.hpp>
 #include <pthread.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <catch2/catch.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -56,10 +56,11 @@ json pendulum() {
 std::string planar_chain(int n) {
   json bodies = json::array();
   for (int i = 0; i < n; ++i)
-    bodies.push_back({{"name", "b" + std::to_string(i)},
-                      {"parent", i == 0 ? std::string("world") : "b" + std::to_string(i - 1)},
-                      {"joint", {{"type", "revolute"}, {"axis", {0, 0, 1}}, {"origin", {{"xyz", {0.1, 0, 0}}}}}},
-                      {"elements", {{{"type", "lumped_point"}, {"node", {0.1, 0, 0}}, {"mass", 1}}}}});
+    bodies.push_back(
+        {{"name", "b" + std::to_string(i)},
+         {"parent", i == 0 ? std::string("world") : "b" + std::to_string(i - 1)},
+         {"joint", {{"type", "revolute"}, {"axis", {0, 0, 1}}, {"origin", {{"xyz", {0.1, 0, 0}}}}}},
+         {"elements", {{{"type", "lumped_point"}, {"node", {0.1, 0, 0}}, {"mass", 1}}}}});
   return json{{"name", "chain"}, {"gravity", {0, -9.81, 0}}, {"bodies", bodies}}.dump();
 }
 
@@ -70,9 +71,12 @@ TEST_CASE("a FIFO or a device or a directory is refused at once", "[hardening]")
   fs::remove(fifo);
   REQUIRE(mkfifo(fifo.c_str(), 0600) == 0);
   // Without a writer, reading a FIFO would block for ever: it is refused before any read.
-  CHECK(load_error(fifo) == fifo.string() + ": is not a regular file (a FIFO, device or socket): femdyn reads files only");
+  CHECK(load_error(fifo) ==
+        fifo.string() +
+            ": is not a regular file (a FIFO, device or socket): femdyn reads files only");
   fs::remove(fifo);
-  CHECK(load_error("/dev/zero") == "/dev/zero: is not a regular file (a FIFO, device or socket): femdyn reads files only");
+  CHECK(load_error("/dev/zero") ==
+        "/dev/zero: is not a regular file (a FIFO, device or socket): femdyn reads files only");
   CHECK(load_error(scratch().string()) == scratch().string() + ": is a directory, not a file");
   CHECK(load_error("/dev/zero.urdf").find("cannot open file") != std::string::npos);
 }
@@ -88,7 +92,8 @@ TEST_CASE("a file over the size limit is refused before it is read", "[hardening
 TEST_CASE("JSON nested deeper than the limit is refused without recursion", "[hardening]") {
   for (const int depth : {65, 100000}) {
     INFO(depth);
-    const std::string text = "{\"name\": " + std::string(depth, '[') + std::string(depth, ']') + "}";
+    const std::string text =
+        "{\"name\": " + std::string(depth, '[') + std::string(depth, ']') + "}";
     CHECK(text_error(text) == "test: JSON nested deeper than 64 levels (femdyn's limit)");
   }
 }
@@ -96,14 +101,18 @@ TEST_CASE("JSON nested deeper than the limit is refused without recursion", "[ha
 TEST_CASE("out-of-range numbers are refused naming the field", "[hardening]") {
   json g = pendulum();
   g["gravity"] = {0, 0, -1e308};
-  CHECK(text_error(g.dump()) == "test: /gravity: gravity -1e+308 is out of range (|x| ≤ 1e100: "
-                               "beyond it the equations' products overflow double precision)");
+  CHECK(text_error(g.dump()) ==
+        "test: /gravity: gravity -1e+308 is out of range (|x| ≤ 1e100: "
+        "beyond it the equations' products overflow double precision)");
   json k = pendulum();
   k["bodies"][0]["joint"]["spring"] = {{"stiffness", 1e308}};
-  CHECK_THAT(text_error(k.dump()), Catch::StartsWith("test: /bodies/0/joint: stiffness 1e+308 is out of range"));
+  CHECK_THAT(text_error(k.dump()),
+             Catch::StartsWith("test: /bodies/0/joint: stiffness 1e+308 is out of range"));
   json m = pendulum();
   m["bodies"][0]["elements"][0]["mass"] = 1e308;
-  CHECK_THAT(text_error(m.dump()), Catch::StartsWith("test: /bodies/0/elements/0: element mass matrix entry 1e+308 is out of range"));
+  CHECK_THAT(text_error(m.dump()),
+             Catch::StartsWith(
+                 "test: /bodies/0/elements/0: element mass matrix entry 1e+308 is out of range"));
   // The same from the command line: one line, exit 1 or 2, no NaN printed.
   const Run cli = run("equations " + model_path("finger.json") + " --gravity 0,0,1e308");
   CHECK(cli.code != 0);
@@ -113,6 +122,18 @@ TEST_CASE("out-of-range numbers are refused naming the field", "[hardening]") {
   CHECK_THAT(qd.out, Catch::Contains("--qd: '1e200' is out of range"));
   // Underflow is not out of range: 1e-400 is read as its nearest double (0).
   CHECK(run("equations " + model_path("pendulum.json") + " --q 1e-400").code == 0);
+  // Integers beyond int are refused before any cast.
+  const std::string finger = model_path("finger.json");
+  const Run states = run("compare " + finger + " " + finger + " --states 3e9");
+  CHECK(states.code == 2);
+  CHECK(states.out == "femdyn compare: --states expects one integer <= 2147483647\n");
+  // Gravity given in place of the file's is named as such, not as the file's /gravity.
+  LoadOptions options;
+  options.gravity = Vec3(0, 0, 1e200);
+  options.gravity_source = "--gravity";
+  const std::string path = model_path("pendulum.json");
+  CHECK_THROWS_WITH(load_model(path, options),
+                    Catch::StartsWith(path + ": --gravity: gravity 1e+200 is out of range"));
 }
 
 TEST_CASE("names with control characters are refused and user text is echoed escaped",
@@ -120,15 +141,21 @@ TEST_CASE("names with control characters are refused and user text is echoed esc
   json j = pendulum();
   j["bodies"][0]["name"] = "arm\x1b[31m";
   const std::string e = text_error(j.dump());
-  CHECK(e == "test: /bodies/0/name: body name 'arm\\x1b[31m' contains a control character "
-             "(names must be printable)");
+  CHECK(e ==
+        "test: /bodies/0/name: body name 'arm\\x1b[31m' contains a control character "
+        "(names must be printable)");
   json p = pendulum();
   p["bodies"][0]["parent"] = "w\x1b]0;title\x07";
-  CHECK(text_error(p.dump()) == "test: /bodies/0/parent: unknown parent body 'w\\x1b]0;title\\x07'");
+  CHECK(text_error(p.dump()) ==
+        "test: /bodies/0/parent: unknown parent body 'w\\x1b]0;title\\x07'");
   json c1 = pendulum();  // U+009B, the one-byte CSI of 8-bit terminals
-  c1["bodies"][0]["joint"]["name"] = "hinge\xc2\x9b" "2J";
-  CHECK_THAT(text_error(c1.dump()), Catch::Contains("'hinge\\xc2\\x9b2J' contains a control character"));
-  const Run cli = run("equations " + model_path("finger.json") + " --q \"$(printf '0,0,0,1\\033[2J')\"");
+  c1["bodies"][0]["joint"]["name"] =
+      "hinge\xc2\x9b"
+      "2J";
+  CHECK_THAT(text_error(c1.dump()),
+             Catch::Contains("'hinge\\xc2\\x9b2J' contains a control character"));
+  const Run cli =
+      run("equations " + model_path("finger.json") + " --q \"$(printf '0,0,0,1\\033[2J')\"");
   CHECK(cli.code == 2);
   CHECK(cli.out.find('\x1b') == std::string::npos);
 }
@@ -151,7 +178,8 @@ TEST_CASE("deep trees and long coupling chains compile on a small stack", "[hard
   json j = json::parse(planar_chain(5000));
   json couplings = json::array();
   for (int i = 1; i < 5000; ++i)
-    couplings.push_back({{"joint", "b" + std::to_string(i)}, {"follows", "b" + std::to_string(i - 1)}});
+    couplings.push_back(
+        {{"joint", "b" + std::to_string(i)}, {"follows", "b" + std::to_string(i - 1)}});
   j["couplings"] = couplings;
   struct Job {
     std::string text;
@@ -221,26 +249,35 @@ TEST_CASE("outputs never clobber an input or an existing file without --force", 
   const fs::path urdf = dir / "robot.urdf", json_out = dir / "robot.json";
   fs::copy_file(model_path("urdf/hand16.urdf"), urdf, fs::copy_options::overwrite_existing);
   fs::remove(json_out);
-  const std::string before = [&] { std::ifstream in(urdf); return std::string(std::istreambuf_iterator<char>(in), {}); }();
+  const std::string before = [&] {
+    std::ifstream in(urdf);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }();
   const Run self = run("import " + urdf.string() + " -o " + urdf.string());
   CHECK(self.code == 2);
   CHECK(self.out == "femdyn import: -o " + urdf.string() + " is the model file itself\n");
-  const std::string after = [&] { std::ifstream in(urdf); return std::string(std::istreambuf_iterator<char>(in), {}); }();
+  const std::string after = [&] {
+    std::ifstream in(urdf);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }();
   CHECK(after == before);
   CHECK(run("import " + urdf.string() + " -o " + json_out.string()).code == 0);
   const Run again = run("import " + urdf.string() + " -o " + json_out.string());
-  CHECK(again.out == "femdyn import: " + json_out.string() + ": exists (use --force to replace it)\n");
+  CHECK(again.out ==
+        "femdyn import: " + json_out.string() + ": exists (use --force to replace it)\n");
   CHECK(run("import " + urdf.string() + " -o " + json_out.string() + " --force").code == 0);
   // A device is never renamed over, even with --force (as root, that would replace /dev/full).
   const Run dev = run("import " + urdf.string() + " -o /dev/full --force");
-  CHECK(dev.out == "femdyn import: /dev/full: is not a regular file (femdyn writes regular files only)\n");
+  CHECK(dev.out ==
+        "femdyn import: /dev/full: is not a regular file (femdyn writes regular files only)\n");
   fs::remove(urdf);
   fs::remove(json_out);
 }
 
 TEST_CASE("the D tensor is refused before allocating past the limit", "[hardening]") {
   const fs::path big = scratch() / "tree300.json";
-  std::ofstream(big.string()) << R"({"model": "random_tree", "params": {"seed": 1, "bodies": 300}})";
+  std::ofstream(big.string())
+      << R"({"model": "random_tree", "params": {"seed": 1, "bodies": 300}})";
   const Run r = run("equations " + big.string() + " --tensor");
   CHECK(r.code == 2);
   CHECK_THAT(r.out, Catch::StartsWith("femdyn equations: --tensor: D needs "));
@@ -256,12 +293,16 @@ TEST_CASE("correlation-table integers are range-checked before narrowing", "[har
     d["correlation_table"]["rows"][0][5] = value;
     return text_error(d.dump());
   };
-  CHECK(with_entry(std::int64_t{1} << 31) ==
-        "test: /correlation_table/rows/0/5: DOF number 2147483648 is out of range (0 to 2147483647)");
+  CHECK(
+      with_entry(std::int64_t{1} << 31) ==
+      "test: /correlation_table/rows/0/5: DOF number 2147483648 is out of range (0 to 2147483647)");
   CHECK(with_entry(std::uint64_t{1} << 63) ==
-        "test: /correlation_table/rows/0/5: DOF number 9223372036854775808 is out of range (0 to 2147483647)");
-  CHECK(with_entry(-1) == "test: /correlation_table/rows/0/5: DOF number -1 is out of range (0 to 2147483647)");
-  CHECK_THAT(with_entry(999999), Catch::Contains("system DOF number 999999 exceeds the 48 entries"));
+        "test: /correlation_table/rows/0/5: DOF number 9223372036854775808 is out of range (0 to "
+        "2147483647)");
+  CHECK(with_entry(-1) ==
+        "test: /correlation_table/rows/0/5: DOF number -1 is out of range (0 to 2147483647)");
+  CHECK_THAT(with_entry(999999),
+             Catch::Contains("system DOF number 999999 exceeds the 48 entries"));
 }
 
 TEST_CASE("an interrupted simulate leaves the old output file intact", "[hardening]") {
@@ -270,9 +311,10 @@ TEST_CASE("an interrupted simulate leaves the old output file intact", "[hardeni
   const fs::path out = dir / "traj.csv";
   std::ofstream(out.string()) << "old\n";
   // A run of a simulated hour at a 1 µs step takes far longer than the 1 s before SIGINT.
-  const Run r = run_shell("sh -c '" + std::string(FEMDYN_BINARY) + " simulate " +
-                          model_path("finger.json") + " --t-end 3600 --integrator rk4 --dt 1e-6 --out " +
-                          out.string() + " --force & pid=$!; sleep 1; kill -INT $pid; wait $pid; echo exit=$?'");
+  const Run r =
+      run_shell("sh -c '" + std::string(FEMDYN_BINARY) + " simulate " + model_path("finger.json") +
+                " --t-end 3600 --integrator rk4 --dt 1e-6 --out " + out.string() +
+                " --force & pid=$!; sleep 1; kill -INT $pid; wait $pid; echo exit=$?'");
   INFO(r.out);
   CHECK(r.out.find("exit=130") != std::string::npos);  // stopped by the signal, as documented
   std::ifstream in(out.string());

@@ -1,37 +1,22 @@
 // The hot path allocates nothing: evaluate / forward / inverse dynamics on a warm workspace.
-// Counted by interposing malloc in this test binary (glibc); skipped under sanitizers (ASan owns
-// malloc there: tools/sanitize.sh).
+// Counted by interposing malloc (validation/alloc_counter.hpp); skipped under sanitizers (ASan
+// owns malloc there: tools/sanitize.sh), which ctest reports as Skipped
+// (SKIP_REGULAR_EXPRESSION in tests/CMakeLists.txt).
 #include <catch2/catch.hpp>
 #include <cstdlib>
 
 #include "core/integrator.hpp"
 #include "tests/helpers.hpp"
+#include "validation/alloc_counter.hpp"
 
-namespace {
-thread_local bool g_counting = false;
-thread_local long g_mallocs = 0;
-}  // namespace
-#ifdef FEMDYN_SANITIZED
-// Under ASan (tools/sanitize.sh) malloc is the sanitizer's: an interposer would take its place
-// (ASan aborts at start-up) and nothing here could be counted. Each test says so and returns;
-// ctest reports it as Skipped (SKIP_REGULAR_EXPRESSION in tests/CMakeLists.txt).
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-extern "C" void* __libc_malloc(std::size_t);
-extern "C" void* malloc(std::size_t n) {
-  if (g_counting) ++g_mallocs;
-  return __libc_malloc(n);
-}
-#endif
+using femdyn::alloc_counter::kAvailable;
 constexpr const char* kSkipped = "skipped under sanitizers: ASan owns malloc, nothing is counted";
 
 using namespace femdyn;
 using namespace femdyn::test;
 
-TEST_CASE("no heap allocation in evaluate, forward and inverse dynamics",
-          "[hot-path]") {
-  if (kSanitized) {
+TEST_CASE("no heap allocation in evaluate, forward and inverse dynamics", "[hot-path]") {
+  if (!kAvailable) {
     WARN(kSkipped);
     return;
   }
@@ -41,47 +26,45 @@ TEST_CASE("no heap allocation in evaluate, forward and inverse dynamics",
     const Model m = load_model(model_path(name));
     Workspace ws(m);
     std::mt19937 rng(3);
-    const VecX q = random_vector(rng, m.n(), 1), qd = random_vector(rng, m.n(), 1),
-               tau = random_vector(rng, m.n(), 1), qdd = random_vector(rng, m.n(), 1);
+    const VecX q = random_uniform(m.n(), 1, rng), qd = random_uniform(m.n(), 1, rng),
+               tau = random_uniform(m.n(), 1, rng), qdd = random_uniform(m.n(), 1, rng);
     // Warm-up: buffers a route needs are sized on its first call.
     REQUIRE(forward_dynamics(m, ws, q, qd, tau).ok);
     evaluate(m, ws, q, qd, tau);
     inverse_dynamics(m, ws, q, qd, qdd);
-    g_mallocs = 0;
-    g_counting = true;
+    alloc_counter::start();
     evaluate(m, ws, q, qd, tau);
     const bool ok = forward_dynamics(m, ws, q, qd, tau).ok;
     inverse_dynamics(m, ws, q, qd, qdd);
     evaluate_bias(m, ws, q, qd);
-    g_counting = false;
+    const long mallocs = alloc_counter::stop();
     CHECK(ok);
-    CHECK(g_mallocs == 0);
+    CHECK(mallocs == 0);
   }
 }
 
 TEST_CASE("no heap allocation per step after the first, for every integrator", "[hot-path]") {
-  if (kSanitized) {
+  if (!kAvailable) {
     WARN(kSkipped);
     return;
   }
   for (const char* name : {"branched_tree.json", "hand.json", "urdf/hand16.urdf"}) {
     const Model m = load_model(model_path(name));
     std::mt19937 rng(5);
-    const VecX q = random_vector(rng, m.n(), 0.5), qd = random_vector(rng, m.n(), 0.5),
-               tau = random_vector(rng, m.n(), 0.1);
+    const VecX q = random_uniform(m.n(), 0.5, rng), qd = random_uniform(m.n(), 0.5, rng),
+               tau = random_uniform(m.n(), 0.1, rng);
     for (IntegratorKind kind : kIntegrators) {
       INFO(name << " " << integrator_name(kind));
       IntegratorOptions o{.kind = kind, .fixed = {.dt = 1e-4}, .adaptive = {.rtol = 1e-8}};
       auto integ = make_integrator(m, o, [&tau](double, VecX& out) { out = tau; });
       integ->reset(0, q, qd, 1.0);
       for (int k = 0; k < 5; ++k) REQUIRE(integ->step().ok);  // warm-up
-      g_mallocs = 0;
-      g_counting = true;
+      alloc_counter::start();
       bool ok = true;
       for (int k = 0; k < 20; ++k) ok = ok && integ->step().ok;
-      g_counting = false;
+      const long mallocs = alloc_counter::stop();
       CHECK(ok);
-      CHECK(g_mallocs == 0);
+      CHECK(mallocs == 0);
     }
   }
 }
@@ -93,7 +76,7 @@ TEST_CASE("no heap allocation per step after the first, for every integrator", "
 // count so that a regression shows.
 TEST_CASE("the sparse (CHOLMOD) path allocates only CHOLMOD's own few work arrays per call",
           "[hot-path]") {
-  if (kSanitized) {
+  if (!kAvailable) {
     WARN(kSkipped);
     return;
   }
@@ -103,14 +86,13 @@ TEST_CASE("the sparse (CHOLMOD) path allocates only CHOLMOD's own few work array
     Workspace ws(m);
     ws.solver = MassSolver(m, SolverKind::Sparse);  // (a tree would take the tree LTDL)
     std::mt19937 rng(3);
-    const VecX q = random_vector(rng, m.n(), 1), qd = random_vector(rng, m.n(), 1),
-               tau = random_vector(rng, m.n(), 1);
+    const VecX q = random_uniform(m.n(), 1, rng), qd = random_uniform(m.n(), 1, rng),
+               tau = random_uniform(m.n(), 1, rng);
     REQUIRE(forward_dynamics(m, ws, q, qd, tau).ok);
-    g_mallocs = 0;
-    g_counting = true;
+    alloc_counter::start();
     const bool ok = forward_dynamics(m, ws, q, qd, tau).ok;
-    g_counting = false;
+    const long mallocs = alloc_counter::stop();
     CHECK(ok);
-    CHECK(g_mallocs <= 4);  // independent of the size
+    CHECK(mallocs <= 4);  // independent of the size
   }
 }

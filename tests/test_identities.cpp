@@ -12,14 +12,23 @@ using namespace femdyn::test;
 namespace {
 
 // vee(S) for a skew matrix S = [w]×.
-Vec3 vee(const Mat3& S) { return Vec3(S(2, 1) - S(1, 2), S(0, 2) - S(2, 0), S(1, 0) - S(0, 1)) / 2; }
+Vec3 vee(const Mat3& S) {
+  return Vec3(S(2, 1) - S(1, 2), S(0, 2) - S(2, 0), S(1, 0) - S(0, 1)) / 2;
+}
 
 struct Case {
   unsigned seed;
   int bodies;
   double branching;
 };
-const Case kCases[] = {{1, 3, 0.0, }, {2, 6, 0.5}, {3, 9, 1.0}, {4, 12, 0.3}};
+const Case kCases[] = {{
+                           1,
+                           3,
+                           0.0,
+                       },
+                       {2, 6, 0.5},
+                       {3, 9, 1.0},
+                       {4, 12, 0.3}};
 
 }  // namespace
 
@@ -30,7 +39,7 @@ TEST_CASE("T = ∂u/∂q and T'[q̇,q̇] match central differences on random tre
     std::mt19937 rng(c.seed + 100);
     const int n = m.n(), N = m.n_u();
     for (int k = 0; k < 3; ++k) {
-      const VecX q = random_vector(rng, n, 2.0), qd = random_vector(rng, n, 1.5);
+      const VecX q = random_uniform(n, 2.0, rng), qd = random_uniform(n, 1.5, rng);
       propagate(m, ws, q, qd, {.jacobian = true, .bias = true});
       const double eps = 1e-6;
       // T by columns: translations from positions, rotations from vee(Rᵀ ∂R/∂q_a).
@@ -90,7 +99,7 @@ TEST_CASE("sym(D) equals the Christoffel symbols of M^s, h = D[q̇,q̇], Ṁ −
     Workspace ws(m), wp(m), wm(m);
     std::mt19937 rng(c.seed + 200);
     const int n = m.n();
-    const VecX q = random_vector(rng, n, 2.0), qd = random_vector(rng, n, 1.5);
+    const VecX q = random_uniform(n, 2.0, rng), qd = random_uniform(n, 1.5, rng);
     const std::vector<MatX> D = third_order_tensor(m, ws, q);
     // ∂M^s/∂q_c by central differences.
     const double eps = 1e-6;
@@ -137,7 +146,7 @@ TEST_CASE("energy is conserved by a conservative model (RK4, tight step)", "[ide
     const Model m = load_text(random_tree_json(seed, 5, 0.5, true));
     const int n = m.n();
     std::mt19937 rng(seed);
-    const VecX q0 = random_vector(rng, n, 1.0), v0 = random_vector(rng, n, 1.0);
+    const VecX q0 = random_uniform(n, 1.0, rng), v0 = random_uniform(n, 1.0, rng);
     Rk4 rk4(m, {.dt = 2e-4});
     rk4.reset(0, q0, v0);
     const double E0 = rk4.motion().energy_at(rk4.y().data()).total();
@@ -149,7 +158,7 @@ TEST_CASE("energy is conserved by a conservative model (RK4, tight step)", "[ide
       scale = std::max(scale, E.kinetic);
     }
     INFO("seed " << seed << " drift " << drift << " max kinetic " << scale);
-    CHECK(scale > 1e-2);              // it really moved
+    CHECK(scale > 1e-2);  // it really moved
     CHECK(drift < 1e-8 * scale);
   }
 }
@@ -175,7 +184,7 @@ TEST_CASE("loads and springs: Q is the virtual work of the applied forces", "[id
   std::mt19937 rng(8);
   const Vec3 F(1.0, -2.0, 0.5), tau(0.3, 0.2, -0.4), p_c(0.2, -0.1, 0.05);
   for (int k = 0; k < 5; ++k) {
-    const VecX q = random_vector(rng, 3, 2), qd = random_vector(rng, 3, 2);
+    const VecX q = random_uniform(3, 2, rng), qd = random_uniform(3, 2, rng);
     evaluate(m, ws, q, qd, VecX());
     VecX Q(3);
     for (int a = 0; a < 3; ++a) {
@@ -185,8 +194,8 @@ TEST_CASE("loads and springs: Q is the virtual work of the applied forces", "[id
       qm[a] -= eps;
       propagate(m, wp, qp, qd, {.jacobian = false, .bias = false});
       propagate(m, wm, qm, qd, {.jacobian = false, .bias = false});
-      const Vec3 dp = ((wp.body[2].p + wp.body[2].R * p_c) - (wm.body[2].p + wm.body[2].R * p_c)) /
-                      (2 * eps);
+      const Vec3 dp =
+          ((wp.body[2].p + wp.body[2].R * p_c) - (wm.body[2].p + wm.body[2].R * p_c)) / (2 * eps);
       const Mat3 W = (wp.body[1].R - wm.body[1].R) / (2 * eps) * ws.body[1].R.transpose();
       const Vec3 w(W(2, 1), W(0, 2), W(1, 0));
       Q[a] = F.dot(dp) + tau.dot(w);

@@ -29,7 +29,8 @@ std::vector<VecX> samples(const Model& m, const IntegratorOptions& o, const VecX
 // The state error along the trajectory: max over the samples of ‖x − x_ref‖∞.
 double max_error(const std::vector<VecX>& x, const std::vector<VecX>& ref) {
   double e = 0;
-  for (std::size_t i = 0; i < ref.size(); ++i) e = std::max(e, (x[i] - ref[i]).cwiseAbs().maxCoeff());
+  for (std::size_t i = 0; i < ref.size(); ++i)
+    e = std::max(e, (x[i] - ref[i]).cwiseAbs().maxCoeff());
   return e;
 }
 
@@ -45,7 +46,8 @@ IntegratorOptions adaptive(IntegratorKind kind, double rtol, double atol) {
 std::string spring_json(double k, double damping = 0) {
   return R"({"name": "stiff spring", "gravity": [0, 0, 0], "bodies": [{"name": "arm",
     "parent": "world", "joint": {"name": "theta", "type": "revolute", "axis": [0, 1, 0],
-    "spring": {"stiffness": )" + std::to_string(k) + R"(}, "damping": )" + std::to_string(damping) + R"(},
+    "spring": {"stiffness": )" +
+         std::to_string(k) + R"(}, "damping": )" + std::to_string(damping) + R"(},
     "elements": [{"type": "lumped_point", "node": [1, 0, 0], "mass": 1.0}]}]})";
 }
 
@@ -179,7 +181,7 @@ TEST_CASE("energy: conservative finger, symplectic Euler over 1e5 steps, damped 
       (k <= 10000 ? early : late) = std::max(k <= 10000 ? early : late, e);
     }
     INFO("max |E - E0| over the first 1e4 steps " << early << " J, over the rest " << late);
-    CHECK(late <= 1.5 * early);  // bounded: no secular growth
+    CHECK(late <= 1.5 * early);                    // bounded: no secular growth
     CHECK(early <= 0.1 * std::abs(E0 - (-9.81)));  // O(dt) of the swing energy 9.81(1 - cos 1)
     // RK4 at the same step drifts (dissipates) secularly: the contrast the test is about.
     auto rk4 = make_integrator(m, fixed(IntegratorKind::Rk4, 1e-2));
@@ -208,8 +210,8 @@ TEST_CASE("energy: conservative finger, symplectic Euler over 1e5 steps, damped 
         scale = std::max({scale, E.kinetic, std::abs(E.total())});
         work = std::max(work, std::abs(integ->work()));
       }
-      INFO(integrator_name(k) << ": balance " << balance << " J, |W| up to " << work
-                              << " J, scale " << scale << " J");
+      INFO(integrator_name(k) << ": balance " << balance << " J, |W| up to " << work << " J, scale "
+                              << scale << " J");
       CHECK(work > 1e-3 * scale);  // the forces did real work
       INFO(integrator_name(k) << ": balance " << balance << " scale " << scale);
       CHECK(balance <= (k == IntegratorKind::Bdf ? 100 : 10) * tol * scale);

@@ -1,9 +1,8 @@
-// The routes compile() chooses (Model::mass_route, force_route, dynamics_route, the mass solver) give
-// the same equations: each new route is checked against the one it replaces, on random trees of
-// every element type, with fixed joints, springs, dampers, loads and couplings, and at the sizes
+// The routes compile() chooses (Model::mass_route, force_route, dynamics_route, the mass solver)
+// give the same equations: each new route is checked against the one it replaces, on random trees
+// of every element type, with fixed joints, springs, dampers, loads and couplings, and at the sizes
 // where the choice switches.
 #include <catch2/catch.hpp>
-
 #include <nlohmann/json.hpp>
 
 #include "core/mass_solver.hpp"
@@ -42,30 +41,42 @@ std::string mixed_tree_json(unsigned seed, int bodies, double branching, bool co
     const double mass = pos(rng);
     elements.push_back({{"type", "lumped_point"}, {"node", v3(0.3)}, {"mass", mass}});
     if (rng() % 2)
-      elements.push_back({{"type", "rotary_node"},
-                          {"node", v3(0.3)},
-                          {"inertia", {{"ixx", 0.02}, {"iyy", 0.03}, {"izz", 0.04}, {"ixy", 0.004}}}});
+      elements.push_back(
+          {{"type", "rotary_node"},
+           {"node", v3(0.3)},
+           {"inertia", {{"ixx", 0.02}, {"iyy", 0.03}, {"izz", 0.04}, {"ixy", 0.004}}}});
     if (rng() % 2)
-      elements.push_back({{"type", "space_bar"}, {"nodes", {v3(0.2), v3(0.5)}}, {"density", 2700},
-                          {"area", 2e-4}, {"Iy", 2e-9}, {"Iz", 3e-9}});
+      elements.push_back({{"type", "space_bar"},
+                          {"nodes", {v3(0.2), v3(0.5)}},
+                          {"density", 2700},
+                          {"area", 2e-4},
+                          {"Iy", 2e-9},
+                          {"Iz", 3e-9}});
     else
-      elements.push_back({{"type", "rigid_body"}, {"mass", mass}, {"com", v3(0.2)},
-                          {"inertia", {{"ixx", 0.05}, {"iyy", 0.06}, {"izz", 0.07}, {"iyz", -0.01}}}});
+      elements.push_back(
+          {{"type", "rigid_body"},
+           {"mass", mass},
+           {"com", v3(0.2)},
+           {"inertia", {{"ixx", 0.05}, {"iyy", 0.06}, {"izz", 0.07}, {"iyz", -0.01}}}});
     list.push_back({{"name", "b" + std::to_string(b)},
                     {"parent", parent < 0 ? std::string("world") : "b" + std::to_string(parent)},
                     {"joint", joint},
                     {"elements", elements}});
     if (rng() % 4 == 0)
-      loads.push_back({{"body", "b" + std::to_string(b)}, {"point", v3(0.3)}, {"force", v3(2.0)},
+      loads.push_back({{"body", "b" + std::to_string(b)},
+                       {"point", v3(0.3)},
+                       {"force", v3(2.0)},
                        {"torque", v3(0.5)}});
   }
   // Couplings: about one movable joint in five follows an earlier one (or two).
   if (couplings)
     for (std::size_t k = 2; k < movable.size(); k += 5) {
-      const std::string a = "j" + std::to_string(movable[k - 1]), c = "j" + std::to_string(movable[k - 2]);
-      coupled.push_back({{"joint", "j" + std::to_string(movable[k])},
-                         {"follows", {{{"joint", a}, {"ratio", u(rng)}}, {{"joint", c}, {"ratio", u(rng)}}}},
-                         {"offset", 0.1 * u(rng)}});
+      const std::string a = "j" + std::to_string(movable[k - 1]),
+                        c = "j" + std::to_string(movable[k - 2]);
+      coupled.push_back(
+          {{"joint", "j" + std::to_string(movable[k])},
+           {"follows", {{{"joint", a}, {"ratio", u(rng)}}, {{"joint", c}, {"ratio", u(rng)}}}},
+           {"offset", 0.1 * u(rng)}});
     }
   return Json{{"name", "mixed tree " + std::to_string(seed)},
               {"gravity", {0.3, -0.2, -9.81}},
@@ -80,8 +91,8 @@ void check_same_equations(const Model& a, const Model& b, unsigned seed, double 
   Workspace wa(a), wb(b);
   std::mt19937 rng(seed);
   for (int k = 0; k < 3; ++k) {
-    const VecX q = random_vector(rng, a.n(), 2), qd = random_vector(rng, a.n(), 2),
-               tau = random_vector(rng, a.n(), 3), qdd = random_vector(rng, a.n(), 3);
+    const VecX q = random_uniform(a.n(), 2, rng), qd = random_uniform(a.n(), 2, rng),
+               tau = random_uniform(a.n(), 3, rng), qdd = random_uniform(a.n(), 3, rng);
     REQUIRE(forward_dynamics(a, wa, q, qd, tau).ok);
     REQUIRE(forward_dynamics(b, wb, q, qd, tau).ok);
     CHECK(rel_error(wa.qdd, wb.qdd) < tol);
@@ -149,8 +160,8 @@ TEST_CASE("articulated route equals the tree LTDL and dense and CHOLMOD Cholesky
     check_same_equations(art, chol, bodies, 1e-10);
     Workspace wa(art), wc(chol);
     std::mt19937 rng(bodies);
-    const VecX q = random_vector(rng, art.n(), 2), qd = random_vector(rng, art.n(), 2),
-               tau = random_vector(rng, art.n(), 3);
+    const VecX q = random_uniform(art.n(), 2, rng), qd = random_uniform(art.n(), 2, rng),
+               tau = random_uniform(art.n(), 3, rng);
     REQUIRE(forward_dynamics(art, wa, q, qd, tau).ok);
     for (const SolverKind kind : {SolverKind::Dense, SolverKind::Sparse}) {
       wc.solver = MassSolver(chol, kind);
@@ -176,8 +187,8 @@ TEST_CASE("couplings within a branch keep the tree LTDL and across branches do n
     CHECK((m.mass_pattern.solver == SolverKind::Tree) == tree);
     Workspace ws(m);
     std::mt19937 rng(seed);
-    const VecX q = random_vector(rng, m.n(), 2), qd = random_vector(rng, m.n(), 2),
-               tau = random_vector(rng, m.n(), 3);
+    const VecX q = random_uniform(m.n(), 2, rng), qd = random_uniform(m.n(), 2, rng),
+               tau = random_uniform(m.n(), 3, rng);
     ws.solver = MassSolver(m, SolverKind::Dense);
     REQUIRE(forward_dynamics(m, ws, q, qd, tau).ok);
     const VecX dense = ws.qdd;
@@ -220,8 +231,8 @@ TEST_CASE("chains and trees of 10000 bodies compile and run on the O(n) routes",
     Workspace ws(m);
     CHECK(ws.Ms.size() == 0);
     std::mt19937 rng(5);
-    const VecX q = random_vector(rng, m.n(), 1), qd = random_vector(rng, m.n(), 1),
-               tau = random_vector(rng, m.n(), 1);
+    const VecX q = random_uniform(m.n(), 1, rng), qd = random_uniform(m.n(), 1, rng),
+               tau = random_uniform(m.n(), 1, rng);
     REQUIRE(forward_dynamics(m, ws, q, qd, tau).ok);
     CHECK(ws.qdd.allFinite());
     // Inverse dynamics of that q̈ gives back τ, to round-off of the forces that balance in it

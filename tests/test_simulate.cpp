@@ -52,8 +52,7 @@ std::string slurp(const fs::path& p) {
 // A scratch directory for one test case, removed afterwards.
 struct Scratch {
   fs::path dir;
-  explicit Scratch(const std::string& name)
-      : dir(fs::temp_directory_path() / ("femdyn_" + name)) {
+  explicit Scratch(const std::string& name) : dir(fs::temp_directory_path() / ("femdyn_" + name)) {
     fs::remove_all(dir);
     fs::create_directories(dir);
   }
@@ -70,8 +69,9 @@ TEST_CASE("simulate: CSV columns name the coordinates, energy balance holds row 
           "[simulate]") {
   Scratch s("sim_balance");
   // A driven, damped tree: τ from a table, linear between rows.
-  std::ofstream(s / "tau.csv") << "t,tau_rail,yaw,left_shoulder,left_wrist,right_shoulder,probe_slide\n"
-                                  "0,0.5,0.2,0.1,0,-0.1,0.3\n1,-0.5,0.1,0,0.2,0.1,-0.3\n";
+  std::ofstream(s / "tau.csv")
+      << "t,tau_rail,yaw,left_shoulder,left_wrist,right_shoulder,probe_slide\n"
+         "0,0.5,0.2,0.1,0,-0.1,0.3\n1,-0.5,0.1,0,0.2,0.1,-0.3\n";
   const Run r = run("simulate " + model_path("branched_tree.json") +
                     " --t-end 1 --rtol 1e-9 --atol 1e-9 --tau-csv " + (s / "tau.csv") +
                     " --q0 0.1,0.2,0.3,0.1,-0.2,0.05 --out " + (s / "traj.csv") + " --json");
@@ -110,8 +110,8 @@ TEST_CASE("simulate: a 1e4 rad/s spring breaks RK4 at 1e-3 s cleanly, BDF runs i
     "bodies": [{"name": "arm", "parent": "world", "joint": {"name": "theta", "type": "revolute",
     "axis": [0, 1, 0], "spring": {"stiffness": 1e8}}, "elements": [{"type": "lumped_point",
     "node": [1, 0, 0], "mass": 1.0}]}]})";
-  Run r = run("simulate " + (s / "spring.json") + " --t-end 1 --integrator rk4 --dt 1e-3 --q0 0.1 --out " +
-              (s / "rk4.csv"));
+  Run r = run("simulate " + (s / "spring.json") +
+              " --t-end 1 --integrator rk4 --dt 1e-3 --q0 0.1 --out " + (s / "rk4.csv"));
   INFO(r.out);
   CHECK(r.code == 1);
   CHECK_THAT(r.out, Catch::Contains("femdyn simulate: ") && Catch::Contains(": at t = ") &&
@@ -121,11 +121,13 @@ TEST_CASE("simulate: a 1e4 rad/s spring breaks RK4 at 1e-3 s cleanly, BDF runs i
   CHECK(text.find("nan") == std::string::npos);
   CHECK(text.find("inf") == std::string::npos);
   r = run("simulate " + (s / "spring.json") +
-          " --t-end 0.01 --integrator bdf --rtol 1e-10 --atol 1e-12 --q0 0.1 --out " + (s / "bdf.csv"));
+          " --t-end 0.01 --integrator bdf --rtol 1e-10 --atol 1e-12 --q0 0.1 --out " +
+          (s / "bdf.csv"));
   REQUIRE(r.code == 0);
   const Csv c = read_csv(s / "bdf.csv");
   double err = 0;
-  for (const auto& row : c.rows) err = std::max(err, std::abs(row[1] - 0.1 * std::cos(1e4 * row[0])));
+  for (const auto& row : c.rows)
+    err = std::max(err, std::abs(row[1] - 0.1 * std::cos(1e4 * row[0])));
   INFO("BDF against θ0 cos ωt: " << err);
   CHECK(err < 1e-5);
 }
@@ -140,8 +142,8 @@ TEST_CASE("simulate: existing files kept without --force, SIGINT leaves the old 
   CHECK(r.out == "femdyn simulate: --out " + out + ": exists (use --force to replace it)\n");
   CHECK(slurp(out) == "old content\n");
   // A long run interrupted after 1 s: exit 130, the old file intact, no temporary file left.
-  r = run_shell("timeout --preserve-status -s INT 1 " + std::string(FEMDYN_BINARY) +
-                " simulate " + model_path("hand.json") +
+  r = run_shell("timeout --preserve-status -s INT 1 " + std::string(FEMDYN_BINARY) + " simulate " +
+                model_path("hand.json") +
                 " --t-end 1000 --integrator rk4 --dt 1e-5 --force --out " + out);
   INFO(r.out);
   CHECK(r.code == 130);
@@ -160,7 +162,9 @@ TEST_CASE("simulate: bad options and bad actuation tables get one line", "[simul
   const std::string pend = model_path("pendulum.json");
   Run r = run("simulate " + pend + " --t-end 1 --integrator dopri --dt 1e-3");
   CHECK(r.code == 2);
-  CHECK(r.out == "femdyn simulate: --dt sets the step of rk4 and euler; dopri is adaptive: use --rtol and --atol\n");
+  CHECK(r.out ==
+        "femdyn simulate: --dt sets the step of rk4 and euler; dopri is adaptive: use --rtol and "
+        "--atol\n");
   r = run("simulate " + pend + " --t-end 1 --rtol -1");
   CHECK(r.code == 2);
   CHECK(r.out == "femdyn simulate: --rtol: the relative tolerance must be in (0, 1), got -1\n");
@@ -172,7 +176,8 @@ TEST_CASE("simulate: bad options and bad actuation tables get one line", "[simul
   std::ofstream(s / "tau.csv") << "t,elbow\n0,1\n";
   r = run("simulate " + pend + " --t-end 1 --tau-csv " + (s / "tau.csv"));
   CHECK(r.code == 1);
-  CHECK(r.out == "femdyn simulate: " + (s / "tau.csv") + ":1: column 2 'elbow' is not a coordinate of single pendulum\n");
+  CHECK(r.out == "femdyn simulate: " + (s / "tau.csv") +
+                     ":1: column 2 'elbow' is not a coordinate of single pendulum\n");
   std::ofstream(s / "tau2.csv") << "t,theta\n0,1\n0.5,x\n";
   r = run("simulate " + pend + " --t-end 1 --tau-csv " + (s / "tau2.csv"));
   CHECK(r.out == "femdyn simulate: " + (s / "tau2.csv") + ":3: column 2: 'x' is not a number\n");
@@ -188,15 +193,16 @@ TEST_CASE("simulate matches Simbody's trajectory on a random tree", "[simulate][
   std::ofstream(s / "tree.json") << random_tree_json(11, 7, 0.5, true);
   const Model m = load_model(s / "tree.json");
   std::mt19937 rng(4);
-  const VecX q0 = random_vector(rng, m.n(), 0.5), qd0 = random_vector(rng, m.n(), 1.0);
+  const VecX q0 = random_uniform(m.n(), 0.5, rng), qd0 = random_uniform(m.n(), 1.0, rng);
   const auto list = [](const VecX& v) {
     std::ostringstream o;
     o.precision(17);
     for (Eigen::Index i = 0; i < v.size(); ++i) o << (i ? "," : "") << v[i];
     return o.str();
   };
-  const Run r = run("simulate " + (s / "tree.json") + " --t-end 0.5 --rtol 1e-11 --atol 1e-12 --q0 " +
-                    list(q0) + " --qd0 " + list(qd0) + " --every 5 --out " + (s / "traj.csv"));
+  const Run r =
+      run("simulate " + (s / "tree.json") + " --t-end 0.5 --rtol 1e-11 --atol 1e-12 --q0 " +
+          list(q0) + " --qd0 " + list(qd0) + " --every 5 --out " + (s / "traj.csv"));
   INFO(r.out);
   REQUIRE(r.code == 0);
   const Csv c = read_csv(s / "traj.csv");
@@ -217,14 +223,16 @@ TEST_CASE("simulate matches Simbody's trajectory on a random tree", "[simulate][
     energy_gap = std::max(energy_gap, std::abs((c.rows[k][2 * n + 3] - c.rows[0][2 * n + 3]) -
                                                (sim[k].energy - sim[0].energy)));
   }
-  INFO(c.rows.size() << " rows; max state difference " << err << ", energy change gap " << energy_gap);
+  INFO(c.rows.size() << " rows; max state difference " << err << ", energy change gap "
+                     << energy_gap);
   CHECK(err < 1e-7);
   CHECK(energy_gap < 1e-8);
 }
 #endif
 
 #ifdef FEMDYN_WITH_SIMBODY
-TEST_CASE("study: a quick work-precision run writes the CSV, plot and summary", "[simulate][study]") {
+TEST_CASE("study: a quick work-precision run writes the CSV, plot and summary",
+          "[simulate][study]") {
   Scratch s("study");
   const std::string dir = s / "out";
 #ifndef NDEBUG  // a build with asserts (Debug, tools/sanitize.sh): study refuses to time it
@@ -244,7 +252,8 @@ TEST_CASE("study: a quick work-precision run writes the CSV, plot and summary", 
   std::ifstream csv(fs::path(dir) / "study.csv");
   std::string line;
   std::getline(csv, line);
-  CHECK(line.rfind("engine,integrator,setting,value,error,final_error,energy_drift,wall_time", 0) == 0);
+  CHECK(line.rfind("engine,integrator,setting,value,error,final_error,energy_drift,wall_time", 0) ==
+        0);
   std::set<std::string> integrators;
   double smallest_resolved = INFINITY;
   while (std::getline(csv, line)) {
@@ -266,7 +275,8 @@ TEST_CASE("study: a quick work-precision run writes the CSV, plot and summary", 
   INFO("reference error " << reference_error << ", smallest resolved error " << smallest_resolved);
   CHECK(reference_error < 1e-11);
   CHECK(100 * reference_error <= smallest_resolved);
-  for (const char* target : {"| 1e-03 |", "| 1e-06 |", "| 1e-09 |"}) CHECK_THAT(md, Catch::Contains(target));
+  for (const char* target : {"| 1e-03 |", "| 1e-06 |", "| 1e-09 |"})
+    CHECK_THAT(md, Catch::Contains(target));
   // Existing outputs are kept without --force.
   r = run("study " + model_path("pendulum.json") + " --quick --out " + dir);
   CHECK(r.code == 2);

@@ -12,8 +12,8 @@ TEST_CASE("inverse dynamics inverts forward dynamics", "[solver]") {
   Workspace ws(m);
   std::mt19937 rng(31);
   for (int k = 0; k < 5; ++k) {
-    const VecX q = random_vector(rng, m.n(), 2), qd = random_vector(rng, m.n(), 2),
-               tau = random_vector(rng, m.n(), 3);
+    const VecX q = random_uniform(m.n(), 2, rng), qd = random_uniform(m.n(), 2, rng),
+               tau = random_uniform(m.n(), 3, rng);
     REQUIRE(forward_dynamics(m, ws, q, qd, tau).ok);
     const VecX qdd = ws.qdd;
     evaluate(m, ws, q, qd, tau);
@@ -32,7 +32,7 @@ TEST_CASE("tree LTDL and CHOLMOD and dense Cholesky agree on a 90-DOF bushy tree
   Workspace ws(m);
   std::mt19937 rng(41);
   for (int k = 0; k < 3; ++k) {
-    const VecX q = random_vector(rng, m.n(), 2), y = random_vector(rng, m.n(), 1);
+    const VecX q = random_uniform(m.n(), 2, rng), y = random_uniform(m.n(), 1, rng);
     evaluate(m, ws, q, VecX::Zero(m.n()), VecX());
     REQUIRE(dense.factorize(ws.Ms).ok);
     REQUIRE(sparse.factorize(ws.Ms).ok);
@@ -77,7 +77,7 @@ TEST_CASE("the structural pattern of M^s holds: different branches decouple exac
   const Model m = load_text(random_tree_json(43, 20, 1.0, false));
   Workspace ws(m);
   std::mt19937 rng(43);
-  evaluate(m, ws, random_vector(rng, m.n(), 2), VecX::Zero(m.n()), VecX());
+  evaluate(m, ws, random_uniform(m.n(), 2, rng), VecX::Zero(m.n()), VecX());
   int zeros = 0;
   for (int a = 0; a < m.n(); ++a)
     for (int b = 0; b < m.n(); ++b) zeros += ws.Ms(a, b) == 0.0;
@@ -118,8 +118,8 @@ TEST_CASE("O(n) inverse dynamics and bias (Tᵀ by a backward sweep) equal the m
     INFO(m.name);
     Workspace ws(m);
     for (int k = 0; k < 3; ++k) {
-      const VecX q = random_vector(rng, m.n(), 1.0), qd = random_vector(rng, m.n(), 2.0),
-                 qdd = random_vector(rng, m.n(), 3.0);
+      const VecX q = random_uniform(m.n(), 1.0, rng), qd = random_uniform(m.n(), 2.0, rng),
+                 qdd = random_uniform(m.n(), 3.0, rng);
       evaluate(m, ws, q, qd, VecX());
       const VecX h = ws.h, Q = ws.Q, expected = ws.Ms * qdd + ws.h - ws.Q;
       evaluate_bias(m, ws, q, qd);
@@ -146,7 +146,7 @@ TEST_CASE("M^s by composite inertias (composite route) equals Tᵀ M T", "[solve
     condensed += m.mass_route == MassRoute::Composite;
     if (m.condensable) m.mass_route = MassRoute::Composite;  // wherever it is exact
     Workspace ws(m);
-    const VecX q = random_vector(rng, m.n(), 1.0), qd = random_vector(rng, m.n(), 1.0);
+    const VecX q = random_uniform(m.n(), 1.0, rng), qd = random_uniform(m.n(), 1.0, rng);
     evaluate(m, ws, q, qd, VecX());
     const MatX Ms = ws.Ms;
     propagate(m, ws, q, qd, {.jacobian = true, .bias = false});  // forms T

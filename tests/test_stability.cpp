@@ -19,8 +19,9 @@ namespace {
 Model arm(double k, double damping, double gravity) {
   return load_text(R"({"name": "arm", "gravity": [0, 0, )" + std::to_string(-gravity) +
                    R"(], "bodies": [{"name": "arm", "parent": "world", "joint": {"name": "theta",
-    "type": "revolute", "axis": [0, 1, 0], "spring": {"stiffness": )" + std::to_string(k) +
-                   R"(}, "damping": )" + std::to_string(damping) + R"(}, "elements": [
+    "type": "revolute", "axis": [0, 1, 0], "spring": {"stiffness": )" +
+                   std::to_string(k) + R"(}, "damping": )" + std::to_string(damping) +
+                   R"(}, "elements": [
     {"type": "lumped_point", "node": [1, 0, 0], "mass": 1.0}]}]})");
 }
 
@@ -42,19 +43,22 @@ TEST_CASE("linearisation and stable steps match the closed forms of an oscillato
   CHECK(std::abs(lin.A(1, 1)) < 1e-6);
   CHECK(std::abs(lin.stiffest) == Approx(w).epsilon(1e-6));
   // RK4 on the imaginary axis: |R(iy)| ≤ 1 up to y = 2√2; symplectic Euler: ω h < 2.
-  CHECK(*largest_stable_step(lin, IntegratorKind::Rk4) * w == Approx(2 * std::sqrt(2.0)).epsilon(1e-4));
+  CHECK(*largest_stable_step(lin, IntegratorKind::Rk4) * w ==
+        Approx(2 * std::sqrt(2.0)).epsilon(1e-4));
   CHECK(*largest_stable_step(lin, IntegratorKind::Euler) * w == Approx(2).epsilon(1e-4));
   CHECK(std::isinf(*largest_stable_step(lin, IntegratorKind::Bdf)));
   // Overdamped (ζ = 100): the fast real mode λ ≈ −2ζω limits RK4 to h |λ| ≤ 2.785.
   const Model damped = arm(w * w, 2 * 100 * w, 0);
   Workspace wd(damped);
-  const Linearization fast = linearize(damped, wd, VecX::Constant(1, 0.1), VecX::Zero(1), VecX::Zero(1));
+  const Linearization fast =
+      linearize(damped, wd, VecX::Constant(1, 0.1), VecX::Zero(1), VecX::Zero(1));
   CHECK(*largest_stable_step(fast, IntegratorKind::Rk4) * std::abs(fast.stiffest) ==
         Approx(2.785).epsilon(1e-3));
   // The arm under gravity, horizontal at θ = 0 (θ̈ = g cos θ): A = [[0, 1], [−g sin θ, 0]].
   const Model pendulum = arm(0, 0, 9.81);
   Workspace wp(pendulum);
-  const Linearization p = linearize(pendulum, wp, VecX::Constant(1, 0.4), VecX::Zero(1), VecX::Zero(1));
+  const Linearization p =
+      linearize(pendulum, wp, VecX::Constant(1, 0.4), VecX::Zero(1), VecX::Zero(1));
   CHECK(p.A(1, 0) == Approx(-9.81 * std::sin(0.4)).epsilon(1e-6));
 }
 
@@ -66,9 +70,11 @@ TEST_CASE("at cond(M^s) = 1e10 the backward error of q̈ is below 1e-14", "[stab
        "elements": [{"type": "lumped_point", "node": [0.5, 0, 0], "mass": 1.0}]},
       {"name": "light", "parent": "heavy", "joint": {"name": "j2", "type": "revolute", "axis": [0, 0, 1],
        "origin": {"xyz": [0.5, 0, 0]}}, "elements": [{"type": "lumped_point", "node": [0.3, 0, 0],
-       "mass": )" + number(1.0 / ratio) + R"(}]}]})");
+       "mass": )" + number(1.0 / ratio) +
+                              R"(}]}]})");
     Workspace ws(m);
-    const VecX q = Eigen::Vector2d(0.3, 0.7), qd = Eigen::Vector2d(1.0, -2.0), tau = Eigen::Vector2d(0.1, 1e-9);
+    const VecX q = Eigen::Vector2d(0.3, 0.7), qd = Eigen::Vector2d(1.0, -2.0),
+               tau = Eigen::Vector2d(0.1, 1e-9);
     REQUIRE(forward_dynamics(m, ws, q, qd, tau).ok);
     evaluate(m, ws, q, qd, tau);
     const MassMatrixHealth h = mass_matrix_health(ws.Ms);
@@ -77,15 +83,18 @@ TEST_CASE("at cond(M^s) = 1e10 the backward error of q̈ is below 1e-14", "[stab
     CHECK(h.condition < 1e12);
     // ‖M q̈ − (Q − h)‖∞ / (‖M‖∞ ‖q̈‖∞ + ‖Q − h‖∞): Cholesky is backward stable.
     const VecX r = ws.Ms * ws.qdd - (ws.Q - ws.h);
-    const double scale = ws.Ms.cwiseAbs().rowwise().sum().maxCoeff() * ws.qdd.cwiseAbs().maxCoeff() +
-                         (ws.Q - ws.h).cwiseAbs().maxCoeff();
+    const double scale =
+        ws.Ms.cwiseAbs().rowwise().sum().maxCoeff() * ws.qdd.cwiseAbs().maxCoeff() +
+        (ws.Q - ws.h).cwiseAbs().maxCoeff();
     INFO("backward error " << r.cwiseAbs().maxCoeff() / scale);
     CHECK(r.cwiseAbs().maxCoeff() / scale <= 1e-14);
   }
 }
 
-TEST_CASE("femdyn check names the culprit body of a model with a 1e-9 kg link", "[stability][cli]") {
-  const std::string path = (std::filesystem::temp_directory_path() / "femdyn_check_culprit.json").string();
+TEST_CASE("femdyn check names the culprit body of a model with a 1e-9 kg link",
+          "[stability][cli]") {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "femdyn_check_culprit.json").string();
   std::ofstream(path) << R"({"name": "culprit", "gravity": [0, 0, -9.81], "bodies": [
     {"name": "upper", "parent": "world", "joint": {"name": "j1", "type": "revolute", "axis": [0, 1, 0]},
      "elements": [{"type": "rigid_body", "mass": 1.0, "com": [0.2, 0, 0], "inertia": {"ixx": 1e-3, "iyy": 1e-2, "izz": 1e-2}}]},
@@ -137,7 +146,8 @@ TEST_CASE("stress springs: 1e1 to 1e5 rad/s, RK4 unstable and BDF stable at 1e5"
     CHECK(c["dt"] == 1e-4);
     CHECK(c["integrators"][0]["integrator"] == "rk4");
     CHECK(c["integrators"][0]["error"] == -1);  // failed: unstable
-    CHECK_THAT(c["integrators"][0]["failure"].get<std::string>(), Catch::Contains("stability limit"));
+    CHECK_THAT(c["integrators"][0]["failure"].get<std::string>(),
+               Catch::Contains("stability limit"));
     CHECK(c["integrators"][3]["integrator"] == "bdf");
     CHECK(c["integrators"][3]["error"].get<double>() >= 0);
     CHECK(c["integrators"][3]["error"].get<double>() < 1e-2);
@@ -147,8 +157,12 @@ TEST_CASE("stress ratios: a mass ratio of 1e6 is ill-conditioned", "[stress]") {
   const auto cases = stress_class("ratios");
   CHECK_THAT(cases[0]["verdict"].get<std::string>(), Catch::Contains("digits"));
 }
-TEST_CASE("stress speeds: 1e3 rad/s joints and a fast gyroscope", "[stress]") { stress_class("speeds"); }
-TEST_CASE("stress slender bars with negative lumped rotary inertia", "[stress]") { stress_class("slender bars"); }
+TEST_CASE("stress speeds: 1e3 rad/s joints and a fast gyroscope", "[stress]") {
+  stress_class("speeds");
+}
+TEST_CASE("stress slender bars with negative lumped rotary inertia", "[stress]") {
+  stress_class("slender bars");
+}
 TEST_CASE("stress near-singular postures", "[stress]") { stress_class("postures"); }
 TEST_CASE("stress a long chain", "[stress]") { stress_class("size"); }
 TEST_CASE("stress zero gravity and 1000 g", "[stress]") { stress_class("gravity"); }

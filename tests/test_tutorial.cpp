@@ -1,8 +1,8 @@
 // docs/tutorial.md never goes stale: its JSON files are written to a scratch directory, every
 // command of its sh blocks is run there (femdyn on the PATH, models/ linked), and its C++
 // example is the file the build compiles.
-#include <catch2/catch.hpp>
 #include <array>
+#include <catch2/catch.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>

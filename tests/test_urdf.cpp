@@ -1,7 +1,8 @@
 // URDF import: closed forms for the conventions (inertial rpy, joint rpy, mimic, order),
 // round trip through `femdyn import`, real robots and bundled URDFs, every bad-URDF class.
-#include <catch2/catch.hpp>
 #include <unistd.h>
+
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -24,17 +25,15 @@ namespace {
 
 std::string write_temp(const std::string& name, const std::string& text) {
   // One folder per process: ctest runs the test cases in parallel processes.
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("femdyn_urdf_tests." + std::to_string(getpid()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("femdyn_urdf_tests." + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
   const std::string path = (dir / name).string();
   std::ofstream(path) << text;
   return path;
 }
 
-Model load_urdf_text(const std::string& text) {
-  return load_model(write_temp("robot.urdf", text));
-}
+Model load_urdf_text(const std::string& text) { return load_model(write_temp("robot.urdf", text)); }
 
 std::string error_of(const std::string& text) {
   const std::string path = write_temp("bad.urdf", text);
@@ -60,7 +59,8 @@ std::string one_link(const std::string& link_inertial, const std::string& joint_
                      const std::string& axis = "1 0 0", const std::string& type = "revolute") {
   return R"(<robot name="r"><link name="base"/><link name="l">)" + link_inertial +
          R"(</link><joint name="j" type=")" + type + R"("><parent link="base"/><child link="l"/>
-         <axis xyz=")" + axis + R"("/>)" + joint_extra + "</joint></robot>";
+         <axis xyz=")" +
+         axis + R"("/>)" + joint_extra + "</joint></robot>";
 }
 
 std::vector<std::string> urdf_files() {
@@ -77,9 +77,9 @@ std::vector<std::string> urdf_files() {
 TEST_CASE("URDF <inertial> rpy rotates the inertia into the link frame", "[urdf]") {
   // Inertia (ixx, iyy, izz) = (1, 2, 3) turned by yaw π/2: about the link's x it is iyy = 2.
   const double pi = std::numbers::pi;
-  for (const auto& [rpy, expected] : {std::pair{std::string("0 0 0"), 1.0},
-                                      std::pair{"0 0 " + std::to_string(pi / 2), 2.0},
-                                      std::pair{"0 " + std::to_string(pi / 2) + " 0", 3.0}}) {
+  for (const auto& [rpy, expected] :
+       {std::pair{std::string("0 0 0"), 1.0}, std::pair{"0 0 " + std::to_string(pi / 2), 2.0},
+        std::pair{"0 " + std::to_string(pi / 2) + " 0", 3.0}}) {
     INFO("inertial rpy " << rpy);
     const Model m = load_urdf_text(one_link(inertial(2.0, "0 0.1 0", rpy, 1, 2, 3)));
     Workspace ws(m);
@@ -93,7 +93,8 @@ TEST_CASE("URDF <inertial> rpy rotates the inertia into the link frame", "[urdf]
   const Mat3 R = Rot(2, 1.1) * Rot(1, -0.4) * Rot(0, 0.3);
   const Mat3 I = Vec3(1, 2, 3).asDiagonal();
   const double expected = (R * I * R.transpose())(0, 0) + 2.0 * 0.01;
-  REQUIRE(std::abs((R.transpose() * I * R)(0, 0) + 2.0 * 0.01 - expected) > 0.1);  // tells them apart
+  REQUIRE(std::abs((R.transpose() * I * R)(0, 0) + 2.0 * 0.01 - expected) >
+          0.1);  // tells them apart
   const Model m = load_urdf_text(one_link(inertial(2.0, "0 0.1 0", "0.3 -0.4 1.1", 1, 2, 3)));
   Workspace ws(m);
   evaluate(m, ws, VecX::Zero(1), VecX::Zero(1), VecX::Zero(1));
@@ -111,8 +112,8 @@ TEST_CASE("URDF joint origin rpy is R = Rz(yaw) Ry(pitch) Rx(roll), axis in the 
          <limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>)");
   const auto R = [](int axis, double a) { return Mat3(Eigen::AngleAxisd(a, Vec3::Unit(axis))); };
   const Mat3 Rj = R(2, 1.1) * R(1, -0.4) * R(0, 0.3);
-  const Vec3 w = Rj * Vec3::UnitZ();          // world axis of the joint (unit: axis normalised)
-  const Vec3 r = Rj * Vec3(0.5, 0, 0);        // point from the joint at q = 0
+  const Vec3 w = Rj * Vec3::UnitZ();    // world axis of the joint (unit: axis normalised)
+  const Vec3 r = Rj * Vec3(0.5, 0, 0);  // point from the joint at q = 0
   Workspace ws(m);
   const VecX q = VecX::Zero(1), qd = VecX::Constant(1, 2.0);
   evaluate(m, ws, q, qd, VecX::Zero(1));
@@ -126,10 +127,14 @@ TEST_CASE("URDF joint origin rpy is R = Rz(yaw) Ry(pitch) Rx(roll), axis in the 
 TEST_CASE("URDF mimic becomes θ = C q + θ0, coordinates in depth-first file order", "[urdf]") {
   const std::string urdf = R"(<robot name="tree">
     <link name="root"/>
-    <link name="a">)" + inertial(1, "0.2 0 0", "0 0 0", 0.01, 0.01, 0.01) + R"(</link>
-    <link name="b">)" + inertial(1, "0.2 0 0", "0 0 0", 0.01, 0.01, 0.01) + R"(</link>
-    <link name="c">)" + inertial(1, "0.2 0 0", "0 0 0", 0.01, 0.01, 0.01) + R"(</link>
-    <link name="d">)" + inertial(1, "0.2 0 0", "0 0 0", 0.01, 0.01, 0.01) + R"(</link>
+    <link name="a">)" + inertial(1, "0.2 0 0", "0 0 0", 0.01, 0.01, 0.01) +
+                           R"(</link>
+    <link name="b">)" + inertial(1, "0.2 0 0", "0 0 0", 0.01, 0.01, 0.01) +
+                           R"(</link>
+    <link name="c">)" + inertial(1, "0.2 0 0", "0 0 0", 0.01, 0.01, 0.01) +
+                           R"(</link>
+    <link name="d">)" + inertial(1, "0.2 0 0", "0 0 0", 0.01, 0.01, 0.01) +
+                           R"(</link>
     <joint name="j_d" type="revolute"><parent link="a"/><child link="d"/><axis xyz="0 1 0"/>
       <origin xyz="0.4 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/>
       <mimic joint="j_b" multiplier="-0.5" offset="0.1"/></joint>
@@ -170,8 +175,9 @@ TEST_CASE("every URDF: import writes JSON that loads back to the same equations"
     Workspace wa(direct), wb(back);
     std::mt19937 rng(7);
     for (int k = 0; k < 3; ++k) {
-      const VecX q = random_vector(rng, direct.n(), 1.0), qd = random_vector(rng, direct.n(), 2.0),
-                 tau = random_vector(rng, direct.n(), 1.0);
+      const VecX q = random_uniform(direct.n(), 1.0, rng),
+                 qd = random_uniform(direct.n(), 2.0, rng),
+                 tau = random_uniform(direct.n(), 1.0, rng);
       REQUIRE(forward_dynamics(direct, wa, q, qd, tau).ok);
       REQUIRE(forward_dynamics(back, wb, q, qd, tau).ok);
       evaluate(direct, wa, q, qd, tau);
@@ -204,8 +210,10 @@ TEST_CASE("every URDF (bundled and the real robots) matches Simbody", "[urdf][va
 #endif
 
 #ifdef FEMDYN_WITH_SIMBODY
-TEST_CASE("the import itself: femdyn's equations of a URDF equal an independent Simbody model "
-          "built from the XML", "[urdf][validation]") {
+TEST_CASE(
+    "the import itself: femdyn's equations of a URDF equal an independent Simbody model "
+    "built from the XML",
+    "[urdf][validation]") {
   // validation::UrdfTwin reads the XML on its own and uses Simbody's rpy sequence, inertia
   // re-expression and shift: a wrong convention in io/urdf_loader would show here (the twin of
   // `femdyn validate` is built from femdyn's model, so it cannot see import errors).
@@ -216,7 +224,7 @@ TEST_CASE("the import itself: femdyn's equations of a URDF equal an independent 
     Workspace ws(m);
     std::mt19937 rng(21);
     for (int k = 0; k < 4; ++k) {
-      const VecX q = random_vector(rng, m.n(), 1.5), qd = random_vector(rng, m.n(), 2.0);
+      const VecX q = random_uniform(m.n(), 1.5, rng), qd = random_uniform(m.n(), 2.0, rng);
       evaluate(m, ws, q, qd, VecX());
       const validation::UrdfTwinEquations s = twin.equations(m.coordinate_names, q, qd);
       CHECK(rel_error(ws.Ms, s.M) < 1e-10);
@@ -227,8 +235,10 @@ TEST_CASE("the import itself: femdyn's equations of a URDF equal an independent 
 }
 #endif
 
-TEST_CASE("bundled URDFs: the arm has 7 DOF, the hand 16 joints and 12 coordinates, the "
-          "gantry 3 prismatic axes", "[urdf]") {
+TEST_CASE(
+    "bundled URDFs: the arm has 7 DOF, the hand 16 joints and 12 coordinates, the "
+    "gantry 3 prismatic axes",
+    "[urdf]") {
   const Model arm = load_model(model_path("urdf/arm7.urdf"));
   CHECK(arm.n() == 7);
   const Model hand = load_model(model_path("urdf/hand16.urdf"));
@@ -269,17 +279,21 @@ TEST_CASE("bad URDF: one line naming the file, the link or joint, and the proble
   CHECK_THAT(error_of(one_link(inertial(1, "0 0 0", "0 0 0", 0.01, 0.01, 0.05))),
              Equals("bad.urdf: link 'l': inertia violates the triangle inequality (principal "
                     "moments 0.01, 0.01, 0.05)"));
-  CHECK_THAT(error_of(one_link(
-                 "<inertial><mass value=\"nan\"/><inertia ixx=\"1\" iyy=\"1\" izz=\"1\"/></inertial>")),
-             Equals("bad.urdf: link 'l': value is NaN or Inf"));
-  CHECK_THAT(error_of(one_link(ok_inertial, "", "0 0 0")), Equals("bad.urdf: joint 'j': axis is zero"));
+  CHECK_THAT(
+      error_of(one_link(
+          "<inertial><mass value=\"nan\"/><inertia ixx=\"1\" iyy=\"1\" izz=\"1\"/></inertial>")),
+      Equals("bad.urdf: link 'l': value is NaN or Inf"));
+  CHECK_THAT(error_of(one_link(ok_inertial, "", "0 0 0")),
+             Equals("bad.urdf: joint 'j': axis is zero"));
   CHECK_THAT(error_of(one_link(ok_inertial, "", "1 0 0", "floating")),
              Equals("bad.urdf: joint 'j': type 'floating' is not supported (revolute, continuous, "
                     "prismatic, fixed)"));
   CHECK_THAT(error_of(one_link(ok_inertial, "", "1 0 0", "planar")),
              Catch::StartsWith("bad.urdf: joint 'j': type 'planar' is not supported"));
-  CHECK_THAT(error_of(R"(<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:macro name="m"/></robot>)"),
-             Catch::StartsWith("bad.urdf: xacro is not supported"));
+  CHECK_THAT(
+      error_of(
+          R"(<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:macro name="m"/></robot>)"),
+      Catch::StartsWith("bad.urdf: xacro is not supported"));
   CHECK_THAT(error_of(one_link(ok_inertial, "<mimic joint=\"ghost\"/>")),
              Equals("bad.urdf: joint 'j': mimics unknown joint 'ghost'"));
   // A movable massless leaf: M^s singular, named by the URDF joint and link, not a JSON path.
@@ -289,7 +303,8 @@ TEST_CASE("bad URDF: one line naming the file, the link or joint, and the proble
 TEST_CASE("a mimic of a fixed joint is named by the URDF joint", "[urdf]") {
   const std::string urdf = R"(<robot name="r"><link name="base"/><link name="a">)" +
                            inertial(1, "0.1 0 0", "0 0 0", 0.01, 0.01, 0.01) + R"(</link>
-    <link name="b">)" + inertial(1, "0.1 0 0", "0 0 0", 0.01, 0.01, 0.01) + R"(</link>
+    <link name="b">)" + inertial(1, "0.1 0 0", "0 0 0", 0.01, 0.01, 0.01) +
+                           R"(</link>
     <joint name="weld" type="fixed"><parent link="base"/><child link="a"/></joint>
     <joint name="j" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>
       <mimic joint="weld"/></joint></robot>)";
@@ -314,7 +329,8 @@ TEST_CASE("mutated URDFs load or fail with one line, never crash", "[urdf][fuzz]
         } else {  // replace one attribute value
           const std::size_t at = t.find("=\"", rng() % t.size());
           const std::size_t end = at == std::string::npos ? at : t.find('"', at + 2);
-          if (end != std::string::npos) t.replace(at + 2, end - at - 2, values[rng() % std::size(values)]);
+          if (end != std::string::npos)
+            t.replace(at + 2, end - at - 2, values[rng() % std::size(values)]);
         }
       }
       try {

@@ -1,13 +1,12 @@
 // femdyn against Simbody (validation/): every bundled model, seeded random trees, one body in
 // every element description, loads/couplings, and a deliberately wrong element that must fail.
-#include <catch2/catch.hpp>
-
-#include "core/body_inertia.hpp"
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <fstream>
 #include <iterator>
 #include <sstream>
 
+#include "core/body_inertia.hpp"
 #include "core/inertia.hpp"
 #include "elements/rotary_node.hpp"
 #include "tests/helpers.hpp"
@@ -51,7 +50,8 @@ std::string chain_with(const std::string& elements) {
                    "inertia": {"ixx": 0.01, "iyy": 0.02, "izz": 0.025}}]},
     {"name": "b", "parent": "a", "joint": {"type": "revolute", "axis": [0, 1, 0.2],
      "origin": {"xyz": [0.4, 0, 0], "rpy": [0.1, 0.2, 0.3]}, "spring": {"stiffness": 2, "rest": 0.3}},
-     "elements": )" + elements + R"(},
+     "elements": )" +
+         elements + R"(},
     {"name": "c", "parent": "b", "joint": {"type": "prismatic", "axis": [1, 0.2, 0],
      "origin": {"xyz": [0.5, 0.05, 0.02]}},
      "elements": [{"type": "lumped_point", "node": [0.1, 0.02, 0.0], "mass": 0.3},
@@ -106,15 +106,17 @@ TEST_CASE("seeded random 3D trees up to 20 DOF match Simbody", "[validation]") {
   }
 }
 
-TEST_CASE("one body in every element description matches Simbody, with the same mass "
-          "properties", "[validation]") {
+TEST_CASE(
+    "one body in every element description matches Simbody, with the same mass "
+    "properties",
+    "[validation]") {
   // The middle body: mass, centroid, centroidal inertia, and a bar along (a, b).
   const double m = 0.8;
   const Vec3 a(0.02, 0.01, -0.01), b(0.47, 0.06, 0.03), c = 0.5 * (a + b);
   Mat3 Ic;
   Ic << 0.004, 0.0002, -0.0001, 0.0002, 0.015, 0.0003, -0.0001, 0.0003, 0.016;
-  const std::string I = "[" + v3(Ic.row(0).transpose()) + ", " + v3(Ic.row(1).transpose()) +
-                        ", " + v3(Ic.row(2).transpose()) + "]";
+  const std::string I = "[" + v3(Ic.row(0).transpose()) + ", " + v3(Ic.row(1).transpose()) + ", " +
+                        v3(Ic.row(2).transpose()) + "]";
   const std::string M = std::to_string(m);
   // Two points of m/2 at c ± d and the rotary inertia they leave: J = I_c − m (|d|² 1 − d dᵀ).
   const Vec3 d(0.01, 0.004, -0.002);
@@ -130,10 +132,10 @@ TEST_CASE("one body in every element description matches Simbody, with the same 
       {"space bar", R"([{"type": "space_bar", "nodes": [)" + v3(a) + ", " + v3(b) +
                         R"(], "mass": )" + M + R"(, "inertia": )" + I + "}]"},
       {"points and rotary node",
-       R"([{"type": "lumped_point", "node": )" + v3(c - d) + R"(, "mass": )" + std::to_string(m / 2) +
-           R"(}, {"type": "lumped_point", "node": )" + v3(c + d) + R"(, "mass": )" +
-           std::to_string(m / 2) + R"(}, {"type": "rotary_node", "node": )" + v3(c) +
-           R"(, "inertia": )" + Js + "}]"}};
+       R"([{"type": "lumped_point", "node": )" + v3(c - d) + R"(, "mass": )" +
+           std::to_string(m / 2) + R"(}, {"type": "lumped_point", "node": )" + v3(c + d) +
+           R"(, "mass": )" + std::to_string(m / 2) + R"(}, {"type": "rotary_node", "node": )" +
+           v3(c) + R"(, "inertia": )" + Js + "}]"}};
   for (const auto& [label, elements] : variants) {
     INFO(label);
     const Model model = load_text(chain_with(elements));
@@ -198,7 +200,7 @@ TEST_CASE("a rotary node without its gyroscopic term fails validation", "[valida
   for (const auto& q : r.quantities) {
     INFO(q.name << " " << q.max_rel);
     if (q.name == "M" || q.name == "Q") CHECK(q.max_rel < 1e-10);  // inertia itself is right
-    if (q.name == "h") CHECK(q.max_rel > 1e-3);                      // the velocity term is not
+    if (q.name == "h") CHECK(q.max_rel > 1e-3);                    // the velocity term is not
   }
   CHECK(r.trajectory.max_state_error > r.trajectory.tolerance);
 }
@@ -209,11 +211,13 @@ TEST_CASE("docs/validation.md lists every bundled model with its current result"
   REQUIRE(in);
   const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   std::vector<std::string> names = bundled_models();
-  for (const char* urdf : {"urdf/arm7.urdf", "urdf/gantry.urdf", "urdf/hand16.urdf"}) names.push_back(urdf);
+  for (const char* urdf : {"urdf/arm7.urdf", "urdf/gantry.urdf", "urdf/hand16.urdf"})
+    names.push_back(urdf);
   for (const std::string& name : names) {
     const std::string key = "| `models/" + name + "` |";
     const auto at = doc.find(key);
-    INFO(name << " (regenerate: ./build/femdyn validate models/*.json models/urdf/*.urdf --markdown)");
+    INFO(name
+         << " (regenerate: ./build/femdyn validate models/*.json models/urdf/*.urdf --markdown)");
     REQUIRE(at != std::string::npos);
     const std::string row = doc.substr(at, doc.find('\n', at) - at);
     CHECK_THAT(row, Catch::Contains(name == "finger_paper.json" ? "| FAIL" : "| PASS |"));
@@ -233,9 +237,10 @@ TEST_CASE("extreme scales (mass ratio 1e6, length ratio 1e3, a stiff spring) mat
     const double m = heavy ? 1e3 : 1e-3, L = heavy ? 1.0 : 1e-3, I = m * L * L / 12;
     j << (i ? ", " : "") << R"({"name": "b)" << i << R"(", "parent": ")"
       << (i ? "b" + std::to_string(i - 1) : std::string("world")) << R"(", "joint": {"type": ")"
-      << (i % 3 ? "revolute" : "prismatic") << R"(", "axis": [)" << u(rng) << ", " << u(rng)
-      << ", " << u(rng) << R"(], "origin": {"xyz": [)" << L << ", " << 0.1 * L << R"(, 0],
-         "rpy": [)" << 3 * u(rng) << ", " << 3 * u(rng) << ", " << 3 * u(rng) << "]}"
+      << (i % 3 ? "revolute" : "prismatic") << R"(", "axis": [)" << u(rng) << ", " << u(rng) << ", "
+      << u(rng) << R"(], "origin": {"xyz": [)" << L << ", " << 0.1 * L << R"(, 0],
+         "rpy": [)"
+      << 3 * u(rng) << ", " << 3 * u(rng) << ", " << 3 * u(rng) << "]}"
       << (i == 5 ? R"(, "spring": {"stiffness": 1e4, "rest": 0.1})" : "")
       << R"(}, "elements": [{"type": "rigid_body", "mass": )" << m << R"(, "com": [)" << L / 2
       << ", " << 0.01 * L << R"(, 0], "inertia": {"ixx": )" << 0.1 * I << R"(, "iyy": )" << I
@@ -286,10 +291,14 @@ TEST_CASE("every Simbody integrator the twin offers follows a tight RungeKuttaMe
 
   const auto bound = [](SimbodyIntegrator which) {
     switch (which) {
-      case SimbodyIntegrator::Verlet: return 1e-3;
-      case SimbodyIntegrator::SemiExplicitEuler2: return 2e-2;  // first order
-      case SimbodyIntegrator::CPodes: return 1e-3;  // where it runs (see below)
-      default: return 1e-4;  // Runge–Kutta of orders 3 to 5
+      case SimbodyIntegrator::Verlet:
+        return 1e-3;
+      case SimbodyIntegrator::SemiExplicitEuler2:
+        return 2e-2;  // first order
+      case SimbodyIntegrator::CPodes:
+        return 1e-3;  // where it runs (see below)
+      default:
+        return 1e-4;  // Runge–Kutta of orders 3 to 5
     }
   };
   const std::vector<SimbodyIntegrator> all = validation::simbody_integrators();
@@ -297,9 +306,9 @@ TEST_CASE("every Simbody integrator the twin offers follows a tight RungeKuttaMe
   for (const SimbodyIntegrator which : all) {
     const validation::TwinRun run = twin.simulate(q0, qd0, times, 1e-6, which);
     const validation::TwinRunStats& s = run.stats;
-    INFO(validation::simbody_integrator_name(which) << ": " << s.failure << " steps " << s.steps
-         << " attempts " << s.attempts << " realizations " << s.realizations << " wall "
-         << s.wall_time << " s");
+    INFO(validation::simbody_integrator_name(which)
+         << ": " << s.failure << " steps " << s.steps << " attempts " << s.attempts
+         << " realizations " << s.realizations << " wall " << s.wall_time << " s");
     REQUIRE(s.ok);
     REQUIRE(run.samples.size() == times.size());
     double error = 0;  // max over the samples of ‖(θ, θ̇) − (θ, θ̇)_reference‖∞

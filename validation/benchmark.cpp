@@ -6,8 +6,10 @@
 //   femdyn/mass/M       mass_matrix(): M^s alone     simbody/mass/M      calcM
 //   femdyn/evaluate/M   evaluate(): M^s, h, Q          simbody/evaluate/M  calcM + residual (h − Q)
 //   femdyn/bias/M       evaluate_bias(): h             simbody/bias/M      residual, no forces (h)
-//   femdyn/forward/M    forward_dynamics(): q̈          simbody/forward/M   calcAccelerationIgnoringConstraints
-//   femdyn/inverse/M    inverse_dynamics(): τ          simbody/inverse/M   residual with θ̈
+//   femdyn/forward/M    forward_dynamics(): q̈
+//   simbody/forward/M   calcAccelerationIgnoringConstraints
+//   femdyn/inverse/M    inverse_dynamics(): τ
+//   simbody/inverse/M   residual with θ̈
 //   femdyn/rest/M       evaluate() at q̇ = 0 (h not computed)
 //   femdyn/weightless/M evaluate() on the model without gravity (models with gravity only)
 //   reference/{mass,bias,forward,inverse}/M: femdyn on the reference routes (Tᵀ M T, node-level
@@ -16,7 +18,7 @@
 // does not include Simbody, so it is compiled like the rest of femdyn (C++20, NDEBUG).
 // Exits 1 if an engine disagrees with Simbody or femdyn allocates in a timed call.
 //
-// Heap allocations are counted by interposing malloc (glibc) and reported per iteration as the
+// Heap allocations are counted (validation/alloc_counter.hpp) and reported per iteration as the
 // counter `allocs`; femdyn's hot path is documented allocation-free and must show 0.
 #include <benchmark/benchmark.h>
 
@@ -35,30 +37,9 @@
 #include "core/math.hpp"
 #include "core/sampling.hpp"
 #include "io/model_loader.hpp"
+#include "validation/alloc_counter.hpp"
 #include "validation/twin.hpp"
 #include "validation/validate.hpp"
-
-extern "C" void* __libc_malloc(std::size_t);
-extern "C" void* __libc_calloc(std::size_t, std::size_t);
-extern "C" void* __libc_realloc(void*, std::size_t);
-
-namespace {
-thread_local bool g_counting = false;
-thread_local long g_allocs = 0;
-}  // namespace
-
-extern "C" void* malloc(std::size_t n) {
-  if (g_counting) ++g_allocs;
-  return __libc_malloc(n);
-}
-extern "C" void* calloc(std::size_t n, std::size_t size) {
-  if (g_counting) ++g_allocs;
-  return __libc_calloc(n, size);
-}
-extern "C" void* realloc(void* p, std::size_t n) {
-  if (g_counting) ++g_allocs;
-  return __libc_realloc(p, n);
-}
 
 namespace {
 
@@ -91,10 +72,6 @@ std::set<std::string>& failures() {
 std::vector<std::unique_ptr<Case>>& cases() {
   static std::vector<std::unique_ptr<Case>> all;
   return all;
-}
-
-double rel_diff(const MatX& a, const MatX& b) {
-  return (a - b).cwiseAbs().maxCoeff() / std::max(b.cwiseAbs().maxCoeff(), 1e-6);
 }
 
 // The state of femdyn validate's first sample: seed 1, q within the joint limits,
@@ -131,8 +108,10 @@ void add_case(std::string name, Spec spec) {
   const fv::TwinEquations s = c->twin->equations(c->q, c->qd, c->tau);
   const bool ok = forward_dynamics(m, *c->ws, c->q, c->qd, c->tau).ok;
   evaluate(m, *c->ws, c->q, c->qd, c->tau);  // M^s, h, Q (the articulated route forms none)
-  const double e = std::max({rel_diff(c->ws->Ms, s.M), rel_diff(c->ws->h, s.h),
-                             rel_diff(c->ws->Q, s.Q), ok ? rel_diff(c->ws->qdd, s.qdd) : INFINITY});
+  const double e =
+      std::max({relative_error(c->ws->Ms, s.M, 1e-6), relative_error(c->ws->h, s.h, 1e-6),
+                relative_error(c->ws->Q, s.Q, 1e-6),
+                ok ? relative_error(c->ws->qdd, s.qdd, 1e-6) : INFINITY});
   if (!(e < 1e-8)) {  // timing two engines that disagree would mean nothing
     std::fprintf(stderr, "femdyn_bench: %s: femdyn and Simbody differ (relative %.3g)\n",
                  c->name.c_str(), e);
@@ -149,16 +128,15 @@ void timed(benchmark::State& state, const Case& c, const std::string& name, bool
   body();
   long allocs = 0;
   for (auto _ : state) {
-    g_allocs = 0;
-    g_counting = true;
+    alloc_counter::start();
     body();
-    g_counting = false;
-    allocs += g_allocs;
+    allocs += alloc_counter::stop();
     benchmark::ClobberMemory();
   }
   state.counters["n"] = c.model.n();
   state.counters["allocs"] =
-      state.iterations() ? static_cast<double>(allocs) / static_cast<double>(state.iterations()) : 0;
+      state.iterations() ? static_cast<double>(allocs) / static_cast<double>(state.iterations())
+                         : 0;
   if (femdyn && allocs > 0) failures().insert(name + ": femdyn allocated");
 }
 
@@ -166,11 +144,9 @@ void register_case(Case* c) {
   const std::string& name = c->name;
   auto reg = [&](const std::string& lib, const std::string& op, auto fn) {
     const std::string full = lib + "/" + op + "/" + name;
-    benchmark::RegisterBenchmark(full.c_str(),
-                                 [c, fn, full, lib](benchmark::State& st) {
-                                   timed(st, *c, full, lib == "femdyn", [&] { fn(*c); });
-                                 })
-        ->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(full.c_str(), [c, fn, full, lib](benchmark::State& st) {
+      timed(st, *c, full, lib == "femdyn", [&] { fn(*c); });
+    })->Unit(benchmark::kMicrosecond);
   };
   // femdyn and Simbody alternate, so drifts of a noisy machine hit both alike.
   reg("femdyn", "mass", [](Case& c) { mass_matrix(c.model, *c.ws, c.q); });

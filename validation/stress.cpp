@@ -42,7 +42,8 @@ Run integrate(const Model& m, const IntegratorOptions& o, const StressScenario& 
 double max_error(const std::vector<VecX>& x, const std::vector<VecX>& ref) {
   if (x.size() != ref.size()) return -1;
   double e = 0;
-  for (std::size_t k = 0; k < ref.size(); ++k) e = std::max(e, (x[k] - ref[k]).cwiseAbs().maxCoeff());
+  for (std::size_t k = 0; k < ref.size(); ++k)
+    e = std::max(e, (x[k] - ref[k]).cwiseAbs().maxCoeff());
   return std::isfinite(e) ? e : -1;
 }
 
@@ -72,9 +73,9 @@ StressResult run_stress(const Model& m, const StressScenario& s) {
   }
 
   // Reference: Dormand–Prince, or BDF when Dormand–Prince cannot (stiff).
-  IntegratorOptions ref_options{.kind = IntegratorKind::Dopri,
-                                .adaptive = {.rtol = 1e-10, .atol = 1e-12, .max_steps = 200'000,
-                                             .stop_at_outputs = true}};
+  IntegratorOptions ref_options{
+      .kind = IntegratorKind::Dopri,
+      .adaptive = {.rtol = 1e-10, .atol = 1e-12, .max_steps = 200'000, .stop_at_outputs = true}};
   if (s.large) ref_options = {.kind = IntegratorKind::Rk4, .fixed = {.dt = s.dt / 2}};
   Run ref = integrate(m, ref_options, s, times, true);
   r.reference = s.large ? "rk4 at dt/2" : "dopri rtol 1e-10";
@@ -83,7 +84,8 @@ StressResult run_stress(const Model& m, const StressScenario& s) {
     ref = integrate(m, ref_options, s, times, true);
     r.reference = "bdf rtol 1e-10";
   }
-  if (!ref.status.ok) return refused_case("no integrator resolves the motion: " + ref.status.message);
+  if (!ref.status.ok)
+    return refused_case("no integrator resolves the motion: " + ref.status.message);
   double state_scale = 1;
   for (const VecX& x : ref.x) state_scale = std::max(state_scale, x.cwiseAbs().maxCoeff());
   for (std::size_t k = 0; k < ref.balance.size(); ++k)
@@ -121,8 +123,10 @@ StressResult run_stress(const Model& m, const StressScenario& s) {
       o.fixed = {.dt = s.dt};
     const Run run = integrate(m, o, s, times, false);
     it.steps = run.stats.steps;
-    if (run.status.ok) it.error = max_error(run.x, ref.x) / state_scale;
-    else it.failure = run.status.message;
+    if (run.status.ok)
+      it.error = max_error(run.x, ref.x) / state_scale;
+    else
+      it.failure = run.status.message;
     if (!is_adaptive(kind) && !s.large && r.stiffest > 0) {
       // Bracket around the linearised estimate by factors of 2, then bisect (8 halvings).
       double lo = 0.5 * 2.0 / r.stiffest, hi = lo;
@@ -150,8 +154,8 @@ StressResult run_stress(const Model& m, const StressScenario& s) {
       if (!twin.can_simulate(&why)) {
         r.simbody_note = why;
       } else {
-        const TwinRun run = twin.simulate(s.q0, s.qd0, with_zero, 1e-12,
-                                          SimbodyIntegrator::RungeKuttaMerson);
+        const TwinRun run =
+            twin.simulate(s.q0, s.qd0, with_zero, 1e-12, SimbodyIntegrator::RungeKuttaMerson);
         if (!run.stats.ok) {
           r.simbody_note = "Simbody failed: " + run.stats.failure;
         } else {
@@ -182,10 +186,11 @@ StressResult run_stress(const Model& m, const StressScenario& s) {
   if (!r.positive_definite)
     r.verdict = "refused: M^s loses definiteness along the motion";
   else if (r.cond_max > 1e12)
-    r.verdict = "ill-conditioned: cond(M^s) up to " + format_short(r.cond_max) + ", q̈ loses about " +
-                format_short(std::log10(r.cond_max)) + " of 16 digits";
+    r.verdict = "ill-conditioned: cond(M^s) up to " + format_short(r.cond_max) +
+                ", q̈ loses about " + format_short(std::log10(r.cond_max)) + " of 16 digits";
   else if (stiff)
-    r.verdict = "stable only with bdf: rk4 needs dt < " + format_short(rk4.largest_stable_step) + " s";
+    r.verdict =
+        "stable only with bdf: rk4 needs dt < " + format_short(rk4.largest_stable_step) + " s";
   else
     r.verdict = "stable";
   return r;

@@ -24,8 +24,6 @@ struct Sweep {
   bool active = true;
 };
 
-double max_norm(const VecX& x) { return x.size() ? x.cwiseAbs().maxCoeff() : 0.0; }
-
 struct Sampled {
   States x;
   std::vector<double> energy;
@@ -40,7 +38,8 @@ Sampled femdyn_run(const Model& m, const IntegratorOptions& o, const StudyOption
   const auto begin = std::chrono::steady_clock::now();  // set-up counts, as Simbody's does
   auto integ = make_integrator(m, o);
   integ->reset(0, so.q0, so.qd0, so.t_end);
-  const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  const double setup =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   const auto sample = [&] {
     VecX x(2 * m.n_theta());
     x << m.C * integ->q() + m.theta0, m.C * integ->qd();
@@ -64,10 +63,10 @@ void score(StudyRun& r, const States& x, const std::vector<double>& energy, cons
     return;
   }
   for (std::size_t k = 0; k < ref.size(); ++k) {
-    r.error = std::max(r.error, max_norm(x[k] - ref[k]));
+    r.error = std::max(r.error, max_abs(x[k] - ref[k]));
     r.energy_drift = std::max(r.energy_drift, std::abs(energy[k] - energy[0]));
   }
-  r.final_error = max_norm(x.back() - ref.back());
+  r.final_error = max_abs(x.back() - ref.back());
   if (!std::isfinite(r.error)) r.ok = false;
 }
 
@@ -96,19 +95,22 @@ StudyReport run_study(const Model& m, const StudyOptions& o,
 
   // Reference: Dormand–Prince landing on every sample, at rtol 1e-14 and 1e-13.
   const auto reference = [&](double rtol) {
-    IntegratorOptions ro{.kind = IntegratorKind::Dopri,
-                         .adaptive = {.rtol = rtol, .atol = rtol, .max_steps = 100'000'000,
-                                      .stop_at_outputs = true}};
+    IntegratorOptions ro{
+        .kind = IntegratorKind::Dopri,
+        .adaptive = {
+            .rtol = rtol, .atol = rtol, .max_steps = 100'000'000, .stop_at_outputs = true}};
     Sampled s = femdyn_run(m, ro, o, times);
-    if (!s.status.ok) throw std::runtime_error("the reference solution failed: " + s.status.message);
+    if (!s.status.ok)
+      throw std::runtime_error("the reference solution failed: " + s.status.message);
     return s;
   };
   rep.reference_rtol = 1e-14;
-  rep.reference_method = "femdyn dopri (Dormand-Prince 5(4), SUNDIALS ARKODE) landing on each "
-                         "sample, rtol = atol = 1e-14";
+  rep.reference_method =
+      "femdyn dopri (Dormand-Prince 5(4), SUNDIALS ARKODE) landing on each "
+      "sample, rtol = atol = 1e-14";
   const Sampled ref = reference(rep.reference_rtol), coarse = reference(10 * rep.reference_rtol);
   for (std::size_t k = 0; k < ref.x.size(); ++k)
-    rep.reference_error = std::max(rep.reference_error, max_norm(ref.x[k] - coarse.x[k]));
+    rep.reference_error = std::max(rep.reference_error, max_abs(ref.x[k] - coarse.x[k]));
   rep.resolution = 100 * rep.reference_error;
 
   // femdyn sweeps. Fixed steps: N = samples·2^k steps, so the samples lie on the grid.
@@ -130,8 +132,10 @@ StudyReport run_study(const Model& m, const StudyOptions& o,
       else
         io.fixed = {.dt = value};
       const Sampled r = femdyn_run(m, io, o, times);
-      StudyRun run{.engine = "femdyn", .integrator = integrator_name(kind),
-                   .setting = is_adaptive(kind) ? "rtol" : "dt", .value = value};
+      StudyRun run{.engine = "femdyn",
+                   .integrator = integrator_name(kind),
+                   .setting = is_adaptive(kind) ? "rtol" : "dt",
+                   .value = value};
       run.wall_time = r.stats.wall_time;
       run.steps = r.stats.steps;
       run.rhs_evals = r.stats.rhs_evals;
@@ -148,12 +152,17 @@ StudyReport run_study(const Model& m, const StudyOptions& o,
   std::string why_not;
   if (twin.can_simulate(&why_not)) {
     for (SimbodyIntegrator which : simbody_integrators()) {
-      Sweep s{"Simbody", simbody_integrator_name(which), "accuracy",
-              o.quick ? decades(2, 8) : decades(2, 10), {}};
+      Sweep s{"Simbody",
+              simbody_integrator_name(which),
+              "accuracy",
+              o.quick ? decades(2, 8) : decades(2, 10),
+              {}};
       s.run = [&, which](double accuracy) {
         const TwinRun r = twin.simulate(o.q0, o.qd0, with_zero, accuracy, which);
-        StudyRun run{.engine = "Simbody", .integrator = simbody_integrator_name(which),
-                     .setting = "accuracy", .value = accuracy};
+        StudyRun run{.engine = "Simbody",
+                     .integrator = simbody_integrator_name(which),
+                     .setting = "accuracy",
+                     .value = accuracy};
         run.wall_time = r.stats.wall_time;
         run.steps = r.stats.steps;
         run.rhs_evals = r.stats.realizations;
@@ -197,7 +206,8 @@ StudyReport run_study(const Model& m, const StudyOptions& o,
       r.resolved = r.ok && r.error >= rep.resolution;
       if (log)
         log(r.engine + " " + r.integrator + " " + r.setting + " " + format_number(r.value, "%.3g") +
-            (r.ok ? ": error " + format_number(r.error, "%.2e") + ", " + format_number(r.wall_time, "%.3g s")
+            (r.ok ? ": error " + format_number(r.error, "%.2e") + ", " +
+                        format_number(r.wall_time, "%.3g s")
                   : ": failed: " + r.failure));
       s->active = r.wall_time < budget && (!r.ok || r.error >= rep.resolution);
       rep.runs.push_back(std::move(r));

@@ -9,9 +9,9 @@
 //   error is below 100x that estimate is "unresolved" and kept out of plots and tables.
 //
 // Timing: femdyn's time is the integrator's set-up and its advance_to calls, Simbody's its
-// TimeStepper's initialize and stepTo calls (neither counts sampling or energies). Sweeps advance round-robin with femdyn and Simbody alternating;
-// runs shorter than `repeat_below` are repeated up to `repeats` times, in rounds that
-// alternate the engines again, and the median is kept.
+// TimeStepper's initialize and stepTo calls (neither counts sampling or energies). Sweeps advance
+// round-robin with femdyn and Simbody alternating; runs shorter than `repeat_below` are repeated up
+// to `repeats` times, in rounds that alternate the engines again, and the median is kept.
 #pragma once
 #include <functional>
 #include <string>
@@ -36,10 +36,10 @@ struct StudyRun {
   std::string integrator;  // "rk4", "euler", "dopri", "bdf", or Simbody's class name
   std::string setting;     // "dt", "rtol" or "accuracy"
   double value = 0;
-  double error = 0;         // max over the samples of ‖x − x_ref‖∞
-  double final_error = 0;   // at t_end
-  double energy_drift = 0;  // max |E(t_k) − E(0)| (J); meaningful for conservative models
-  double wall_time = 0;     // median over the repeats (s)
+  double error = 0;           // max over the samples of ‖x − x_ref‖∞
+  double final_error = 0;     // at t_end
+  double energy_drift = 0;    // max |E(t_k) − E(0)| (J); meaningful for conservative models
+  double wall_time = 0;       // median over the repeats (s)
   std::vector<double> times;  // every repeat's wall time
   long steps = 0, rhs_evals = 0;
   bool ok = true;
@@ -55,7 +55,7 @@ struct StudyReport {
   bool conservative = true;
   std::string reference_method;
   double reference_rtol = 0, reference_error = 0;  // the estimate
-  double resolution = 0;                            // 100x reference_error
+  double resolution = 0;                           // 100x reference_error
   std::vector<StudyRun> runs;
   std::vector<std::string> notes;
 };

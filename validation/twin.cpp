@@ -1,7 +1,6 @@
 // The Simbody twin (twin.hpp). Compiled without NDEBUG: Debian's Simbody 3.7 is built without
 // it and some of its header classes change layout with it (see CMakeLists.txt).
 #include "validation/twin.hpp"
-#include "core/names.hpp"
 
 #include <Simbody.h>
 #include <dlfcn.h>
@@ -11,6 +10,8 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+
+#include "core/names.hpp"
 
 namespace femdyn::validation {
 
@@ -63,8 +64,8 @@ std::string defining_library(const char* symbol) {
 const std::string& cpodes_conflict() {
   static const std::string why = [] {
     const std::string simbody = defining_library("CPodeCreate");  // only in libSimTKmath
-    for (const char* name : {"N_VSpace", "N_VClone", "N_VLinearSum", "N_VWrmsNorm",
-                             "DenseGETRF", "newDenseMat"}) {
+    for (const char* name :
+         {"N_VSpace", "N_VClone", "N_VLinearSum", "N_VWrmsNorm", "DenseGETRF", "newDenseMat"}) {
       const std::string where = defining_library(name);
       if (!simbody.empty() && where == simbody) continue;
       return std::string("CPodes cannot run in this process: its SUNDIALS symbol ") + name +
@@ -96,8 +97,9 @@ std::string one_line(const std::string& text) {
 
 SimTK::MassProperties mass_properties(const TwinBody& p) {
   const Mat3& I = p.inertia_origin;  // Simbody wants the inertia about the body origin
-  return SimTK::MassProperties(p.mass, to_simtk(p.com),
-                               SimTK::Inertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)));
+  return SimTK::MassProperties(
+      p.mass, to_simtk(p.com),
+      SimTK::Inertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)));
 }
 
 }  // namespace
@@ -135,7 +137,8 @@ struct SimbodyTwin::Impl {
       try {
         add_body(j);
       } catch (const std::exception& e) {
-        throw std::runtime_error("Simbody refuses body '" + escaped(j.name) + "': " + one_line(e.what()));
+        throw std::runtime_error("Simbody refuses body '" + escaped(j.name) +
+                                 "': " + one_line(e.what()));
       }
     }
     finish_system();
@@ -145,8 +148,8 @@ struct SimbodyTwin::Impl {
   void add_body(const TwinBody& j) {
     using namespace SimTK;
     {
-      MobilizedBody& parent = j.parent < 0 ? static_cast<MobilizedBody&>(matter.updGround())
-                                                 : mobod[j.parent];
+      MobilizedBody& parent =
+          j.parent < 0 ? static_cast<MobilizedBody&>(matter.updGround()) : mobod[j.parent];
       const SimTK::Body::Rigid rigid(mass_properties(j));
       const Rotation R_pj = to_simtk(j.R_pj);
       const SimTK::Vec3 p_pj = to_simtk(j.p_pj);
@@ -169,7 +172,8 @@ struct SimbodyTwin::Impl {
       }
       if (j.theta >= 0) {
         if (j.stiffness != 0)
-          Force::MobilityLinearSpring(forces, mobod.back(), MobilizerQIndex(0), j.stiffness, j.rest);
+          Force::MobilityLinearSpring(forces, mobod.back(), MobilizerQIndex(0), j.stiffness,
+                                      j.rest);
         if (j.damping != 0)
           Force::MobilityLinearDamper(forces, mobod.back(), MobilizerUIndex(0), j.damping);
       }
@@ -227,7 +231,8 @@ struct SimbodyTwin::Impl {
     }
     const int nu = state.getNU();
     zero_mobility = Vector(nu, 0.0);
-    zero_body = Vector_<SpatialVec>(matter.getNumBodies(), SpatialVec(SimTK::Vec3(0), SimTK::Vec3(0)));
+    zero_body =
+        Vector_<SpatialVec>(matter.getNumBodies(), SpatialVec(SimTK::Vec3(0), SimTK::Vec3(0)));
   }
 
   VecX reduce(const SimTK::Vector& f_theta) const {  // Cᵀ f_θ
@@ -239,8 +244,8 @@ struct SimbodyTwin::Impl {
   // Buffers of the timing entry points (time_*).
   SimTK::Vector bench_applied, bench_udot, bench_theta_ddot, bench_out;
   SimTK::Vector_<SimTK::SpatialVec> bench_A_GB;
-  VecX bench_rest;                        // q̇ = 0
-  SimTK::Matrix bench_h1, bench_D;        // h(e_b) by columns; D_sym(·, b, c) in column b n + c
+  VecX bench_rest;                  // q̇ = 0
+  SimTK::Matrix bench_h1, bench_D;  // h(e_b) by columns; D_sym(·, b, c) in column b n + c
 
   const VecX& rest() {  // q̇ = 0, sized by the first call
     if (bench_rest.size() != model.n()) bench_rest = VecX::Zero(model.n());
@@ -462,19 +467,26 @@ void SimbodyTwin::time_tensor(const VecX& q) {
 
 bool SimbodyTwin::can_simulate(std::string* why_not) const {
   if (!impl_->couplers && why_not)
-    *why_not = "a coordinate drives no joint directly, so the coupling is not a set of "
-               "coordinate couplers";
+    *why_not =
+        "a coordinate drives no joint directly, so the coupling is not a set of "
+        "coordinate couplers";
   return impl_->couplers;
 }
 
 const char* simbody_integrator_name(SimbodyIntegrator which) {
   switch (which) {
-    case SimbodyIntegrator::RungeKuttaMerson: return "RungeKuttaMerson";
-    case SimbodyIntegrator::RungeKutta3: return "RungeKutta3";
-    case SimbodyIntegrator::RungeKuttaFeldberg: return "RungeKuttaFeldberg";
-    case SimbodyIntegrator::Verlet: return "Verlet";
-    case SimbodyIntegrator::SemiExplicitEuler2: return "SemiExplicitEuler2";
-    case SimbodyIntegrator::CPodes: return "CPodes";
+    case SimbodyIntegrator::RungeKuttaMerson:
+      return "RungeKuttaMerson";
+    case SimbodyIntegrator::RungeKutta3:
+      return "RungeKutta3";
+    case SimbodyIntegrator::RungeKuttaFeldberg:
+      return "RungeKuttaFeldberg";
+    case SimbodyIntegrator::Verlet:
+      return "Verlet";
+    case SimbodyIntegrator::SemiExplicitEuler2:
+      return "SemiExplicitEuler2";
+    case SimbodyIntegrator::CPodes:
+      return "CPodes";
   }
   return "unknown";
 }
@@ -528,9 +540,9 @@ std::string stopped_early(SimbodyIntegrator which, const SimTK::Integrator& inte
       integ.isSimulationOver()
           ? SimTK::Integrator::getTerminationReasonString(integ.getTerminationReason())
           : std::string("no termination reason");
-  return std::string(simbody_integrator_name(which)) + " stopped at t = " +
-         std::to_string(integ.getTime()) + " short of " + std::to_string(t) + ": " +
-         one_line(reason);
+  return std::string(simbody_integrator_name(which)) +
+         " stopped at t = " + std::to_string(integ.getTime()) + " short of " + std::to_string(t) +
+         ": " + one_line(reason);
 }
 
 void count(const SimTK::Integrator& integ, TwinRunStats& stats) {
@@ -588,8 +600,7 @@ TwinRun SimbodyTwin::simulate(const VecX& q0, const VecX& qd0, const std::vector
     }
   } catch (const std::exception& e) {
     stats.ok = false;
-    stats.failure =
-        std::string(simbody_integrator_name(which)) + " failed: " + one_line(e.what());
+    stats.failure = std::string(simbody_integrator_name(which)) + " failed: " + one_line(e.what());
   }
   if (integ) count(*integ, stats);
   return run;

@@ -16,11 +16,10 @@
 //   forces; coupling θ = C q + θ0 -> exact reduction (pointwise) and
 //   Constraint::CoordinateCoupler (trajectories).
 #pragma once
+#include <Eigen/Dense>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <Eigen/Dense>
 
 namespace femdyn::validation {
 
@@ -31,16 +30,16 @@ using Vec3 = Eigen::Vector3d;
 
 // What the twin needs of a femdyn Model (built by twin_model() in validate.cpp).
 struct TwinBody {
-  std::string name;              // for messages ("Simbody refuses body 'x': …")
-  int parent = -1;               // -1: the ground
+  std::string name;  // for messages ("Simbody refuses body 'x': …")
+  int parent = -1;   // -1: the ground
   enum class Joint { Revolute, Prismatic, Fixed } joint = Joint::Fixed;
   Mat3 R_pj = Mat3::Identity();  // joint frame in the parent body frame
   Vec3 p_pj = Vec3::Zero();
-  Vec3 axis = Vec3::UnitZ();     // unit, joint frame
-  int theta = -1;                // index in θ
+  Vec3 axis = Vec3::UnitZ();  // unit, joint frame
+  int theta = -1;             // index in θ
   double stiffness = 0, rest = 0, damping = 0;
-  double mass = 0;               // Σ of the body's equivalent elements:
-  Vec3 com = Vec3::Zero();       //   centre of mass (body frame)
+  double mass = 0;                     // Σ of the body's equivalent elements:
+  Vec3 com = Vec3::Zero();             //   centre of mass (body frame)
   Mat3 inertia_origin = Mat3::Zero();  // inertia about the body origin (body frame)
 };
 
@@ -101,7 +100,7 @@ struct TwinRunStats {
   long convergence_failures = 0;  // getNumConvergenceTestFailures() (iterative methods; else 0)
   double wall_time = 0;  // s in TimeStepper::initialize and stepTo only (not samples, energy)
   bool ok = true;
-  std::string failure;   // one line: why the run stopped early, if it did (then ok = false)
+  std::string failure;  // one line: why the run stopped early, if it did (then ok = false)
 };
 
 struct TwinRun {
@@ -135,8 +134,8 @@ class SimbodyTwin {
   // Timing entry points (validation/benchmark.cpp, femdyn bench): Simbody's own work only,
   // on buffers allocated by the first call. Each sets θ = C q + θ0, θ̇ = C q̇ (a plain loop)
   // and realizes the stage it needs; nothing is reduced to q or converted to Eigen, and the
-  // results stay inside the twin. With a coupling (n < nθ) Simbody's M, h and τ are those of the tree of
-  // nθ joints (the reduction by C is not timed).
+  // results stay inside the twin. With a coupling (n < nθ) Simbody's M, h and τ are those of the
+  // tree of nθ joints (the reduction by C is not timed).
   //   mass_and_bias: realize Dynamics (forces), calcM, and the residual with the applied forces
   //                  and θ̈ = 0 (that is h − Q), the counterpart of femdyn's evaluate();
   //   bias:          realize Velocity, the residual with no force and θ̈ = 0 (h);

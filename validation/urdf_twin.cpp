@@ -33,7 +33,8 @@ double number(const tinyxml2::XMLElement* e, const char* attr, double fallback) 
 Transform origin(const tinyxml2::XMLElement* parent) {
   const tinyxml2::XMLElement* o = parent ? parent->FirstChildElement("origin") : nullptr;
   const Vec3 xyz = triple(o, "xyz", Vec3(0)), rpy = triple(o, "rpy", Vec3(0));
-  return Transform(Rotation(SpaceRotationSequence, rpy[0], XAxis, rpy[1], YAxis, rpy[2], ZAxis), xyz);
+  return Transform(Rotation(SpaceRotationSequence, rpy[0], XAxis, rpy[1], YAxis, rpy[2], ZAxis),
+                   xyz);
 }
 
 // <inertial>: mass, centre of mass at the origin's xyz, inertia about the centre of mass in the
@@ -103,7 +104,7 @@ UrdfTwin::UrdfTwin(const std::string& path, const Eigen::Vector3d& gravity)
         const Rotation R_a(UnitVec3(axis), XAxis);  // Slider moves along x
         mb = MobilizedBody::Slider(parent, Transform(X_PJ.R() * R_a, X_PJ.p()), body,
                                    Transform(R_a, Vec3(0)));
-      } else {  // revolute, continuous
+      } else {                                      // revolute, continuous
         const Rotation R_a(UnitVec3(axis), ZAxis);  // Pin turns about z
         mb = MobilizedBody::Pin(parent, Transform(X_PJ.R() * R_a, X_PJ.p()), body,
                                 Transform(R_a, Vec3(0)));

@@ -6,11 +6,10 @@
 // none; femdyn's default for URDF is (0, 0, −9.81)).
 // Like twin.hpp, this header uses only Eigen; urdf_twin.cpp is C++17 without NDEBUG.
 #pragma once
+#include <Eigen/Dense>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <Eigen/Dense>
 
 namespace femdyn::validation {
 

@@ -6,12 +6,12 @@
 #include <random>
 #include <stdexcept>
 
-#include "core/equations.hpp"
-#include "core/model.hpp"
-#include "core/inertia.hpp"
-#include "core/fixed_step.hpp"
-#include "core/sampling.hpp"
 #include "core/body_inertia.hpp"
+#include "core/equations.hpp"
+#include "core/fixed_step.hpp"
+#include "core/inertia.hpp"
+#include "core/model.hpp"
+#include "core/sampling.hpp"
 #include "validation/twin.hpp"
 #include "validation/urdf_twin.hpp"
 
@@ -45,14 +45,14 @@ TwinModel twin_model(const Model& m) {
   t.C = MatX(m.C);
   t.theta0 = m.theta0;
   t.gravity = m.gravity;
-  for (const PointLoad& l : m.point_loads) t.loads.push_back({l.body, l.point, l.force, Vec3::Zero()});
-  for (const BodyTorque& q : m.torques) t.loads.push_back({q.body, Vec3::Zero(), Vec3::Zero(), q.torque});
+  for (const PointLoad& l : m.point_loads)
+    t.loads.push_back({l.body, l.point, l.force, Vec3::Zero()});
+  for (const BodyTorque& q : m.torques)
+    t.loads.push_back({q.body, Vec3::Zero(), Vec3::Zero(), q.torque});
   return t;
 }
 
 namespace {
-
-double max_abs(const MatX& x) { return x.size() ? x.cwiseAbs().maxCoeff() : 0.0; }
 
 void accumulate(QuantityError& e, const MatX& femdyn, const MatX& simbody) {
   const double d = max_abs(femdyn - simbody);
@@ -137,7 +137,8 @@ TrajectoryReport compare_trajectory(const Model& m, SimbodyTwin& twin, const Vec
     r.rk4_error_estimate = std::max(r.rk4_error_estimate, max_abs(x[i] - x_half[i]) / 15);
     r.simbody_error_estimate = std::max(r.simbody_error_estimate, max_abs(xs - xt));
     r.energy_change_femdyn = std::max(r.energy_change_femdyn, std::abs(e_half[i] - e_half[0]));
-    r.energy_change_simbody = std::max(r.energy_change_simbody, std::abs(tight[i].energy - tight[0].energy));
+    r.energy_change_simbody =
+        std::max(r.energy_change_simbody, std::abs(tight[i].energy - tight[0].energy));
     scale = std::max(scale, max_abs(xt));
   }
   // The two runs may differ by what each integrator gets wrong (with a margin of 10), plus
@@ -163,25 +164,26 @@ ValidationReport validate(const Model& m, const ValidationOptions& o) {
   r.n = m.n();
   r.states = o.states;
   if (m.explicit_table)
-    r.notes.push_back("the model gives its correlation table explicitly; DOFs it leaves out or "
-                      "joins are approximations of the rigid bodies Simbody simulates");
+    r.notes.push_back(
+        "the model gives its correlation table explicitly; DOFs it leaves out or "
+        "joins are approximations of the rigid bodies Simbody simulates");
   for (const std::string& a : m.approximations) r.notes.push_back("approximation: " + a);
 
   // Each body's elements must sum to a rigid body: nothing else can be built in Simbody.
   const TwinModel tm = twin_model(m);
   for (std::size_t b = 0; b < tm.bodies.size(); ++b) {
     const TwinBody& tb = tm.bodies[b];
-    const Mat3 I_com = tb.inertia_origin - tb.mass * (tb.com.squaredNorm() * Mat3::Identity() -
-                                                      tb.com * tb.com.transpose());
+    const Mat3 I_com = tb.inertia_origin - point_inertia(tb.mass, tb.com);  // parallel axis
     if (tb.mass == 0 && !tb.inertia_origin.isZero(0)) {
-      r.failure += (r.failure.empty() ? "" : "; ") +
-                   ("body '" + m.bodies[b].name + "' has a rotary inertia but no mass, which a "
-                    "Simbody body cannot have");
+      r.failure += (r.failure.empty() ? "" : "; ") + ("body '" + m.bodies[b].name +
+                                                      "' has a rotary inertia but no mass, which a "
+                                                      "Simbody body cannot have");
       continue;
     }
     if (const auto problem = inertia_problem(I_com, tb.inertia_origin.cwiseAbs().maxCoeff()))
-      r.failure += (r.failure.empty() ? "" : "; ") + ("body '" + m.bodies[b].name +
-                   "': its elements sum to no rigid body (" + *problem + ")");
+      r.failure +=
+          (r.failure.empty() ? "" : "; ") +
+          ("body '" + m.bodies[b].name + "': its elements sum to no rigid body (" + *problem + ")");
   }
   if (!r.failure.empty()) return r;
   std::unique_ptr<SimbodyTwin> twin_ptr;
@@ -193,7 +195,8 @@ ValidationReport validate(const Model& m, const ValidationOptions& o) {
   }
   SimbodyTwin& twin = *twin_ptr;
   Workspace ws(m);
-  for (const char* name : {"M", "h", "Q", "qdd", "tau"}) r.quantities.push_back({name, 0, 0, o.tolerance});
+  for (const char* name : {"M", "h", "Q", "qdd", "tau"})
+    r.quantities.push_back({name, 0, 0, o.tolerance});
   QuantityError &eM = r.quantities[0], &eh = r.quantities[1], &eQ = r.quantities[2],
                 &eqdd = r.quantities[3], &etau = r.quantities[4];
 
