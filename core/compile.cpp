@@ -5,6 +5,7 @@
 #include <set>
 
 #include "core/body_inertia.hpp"
+#include "core/compile_level.hpp"
 #include "core/correlation.hpp"
 #include "core/errors.hpp"
 #include "core/limits.hpp"
@@ -189,6 +190,7 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
 }  // namespace
 
 Model compile(MechanismSpec spec) {
+  if (has_coupling_law(spec)) return compile_with_coupling_level(std::move(spec));
   Model m;
   m.name = spec.name;
   m.where = spec.where.size() >= 2 ? spec.where.substr(0, spec.where.size() - 2) : spec.where;

@@ -8,6 +8,7 @@
 #include "core/body_inertia.hpp"
 #include "core/coupled_dynamics.hpp"
 #include "core/coupling.hpp"
+#include "core/coupling_chain.hpp"
 #include "core/joint.hpp"
 #include "core/kinematics.hpp"
 #include "core/mass_solver.hpp"
@@ -102,12 +103,14 @@ void form_mass_matrix(const Model& model, Workspace& ws) {
 }  // namespace
 
 void mass_matrix(const Model& model, Workspace& ws, const VecX& q) {
+  if (model.coupling_level) return chain::mass_matrix(model, ws, q);
   const bool composite = model.mass_route == MassRoute::Composite;
   propagate(model, ws, q, q, {.jacobian = !composite, .bias = false, .rows = !composite});
   form_mass_matrix(model, ws);
 }
 
 void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau) {
+  if (model.coupling_level) return chain::evaluate(model, ws, q, qd, tau);
   const bool moving = !is_zero(qd);
   // The composite route needs only the body poses; the transform route the rows of T. The
   // body-level force route computes h by Newton–Euler, which leaves the poses.
@@ -133,6 +136,7 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
 }
 
 void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
+  if (model.coupling_level) return chain::evaluate_bias(model, ws, q, qd);
   if (is_zero(qd)) {
     ws.h.setZero();
     return;
@@ -150,7 +154,9 @@ void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX&
 Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                         const VecX& tau) {
   Status st;
-  if (model.dynamics_route == DynamicsRoute::Articulated) {
+  if (model.coupling_level) {
+    st = chain::forward_dynamics(model, ws, q, qd, tau);
+  } else if (model.dynamics_route == DynamicsRoute::Articulated) {
     st = articulated_forward_dynamics(model, ws, q, qd, tau);
   } else if (model.force_route == ForceRoute::Bodies && model.mass_route == MassRoute::Composite) {
     st = coupled_forward_dynamics(model, ws, q, qd, tau);
@@ -175,6 +181,7 @@ Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const 
 
 void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                       const VecX& qdd) {
+  if (model.coupling_level) return chain::inverse_dynamics(model, ws, q, qd, qdd);
   // τ = M^s q̈ + h − Q(τ = 0) = Tᵀ (M (T q̈ + T'[q̇,q̇]) + g(u̇,u̇) − F) − Cᵀ(spring + damper),
   // by body-level Newton–Euler, or by two kinematic sweeps and one sweep of Tᵀ:
   // O(N_u + bodies), neither T nor M^s formed.
@@ -196,6 +203,7 @@ void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const Ve
 }
 
 std::vector<MatX> transform_hessian(const Model& model, Workspace& ws, const VecX& q) {
+  if (model.coupling_level) return chain::transform_hessian(model, ws, q);
   // T'_{·bc} = ∂T_{·b}/∂q_c = T'[e_b, e_c]: one bilinear sweep per pair.
   const int n = model.n(), N = model.n_u();
   std::vector<MatX> H(N, MatX::Zero(n, n));
@@ -213,6 +221,7 @@ std::vector<MatX> transform_hessian(const Model& model, Workspace& ws, const Vec
 }
 
 std::vector<MatX> third_order_tensor(const Model& model, Workspace& ws, const VecX& q) {
+  if (model.coupling_level) return chain::third_order_tensor(model, ws, q);
   const int n = model.n(), N = model.n_u();
   const std::vector<MatX> Tp = transform_hessian(model, ws, q);
   propagate(model, ws, q, VecX::Zero(n), {.jacobian = true, .bias = false});
@@ -232,6 +241,7 @@ std::vector<MatX> third_order_tensor(const Model& model, Workspace& ws, const Ve
 }
 
 Energy energy(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
+  if (model.coupling_level) return chain::energy(model, ws, q, qd);
   evaluate(model, ws, q, qd, VecX());
   Energy E;
   E.kinetic = 0.5 * qd.dot(ws.Ms * qd);

@@ -1,6 +1,7 @@
 #include "core/kinematics.hpp"
 
 #include "core/coupling.hpp"
+#include "core/coupling_chain.hpp"
 #include "core/joint.hpp"
 
 namespace femdyn {
@@ -110,6 +111,7 @@ void propagate_nodes(const Model& model, Workspace& ws, KinematicsRequest req) {
 
 void propagate_bilinear(const Model& model, Workspace& ws, const VecX& q, const VecX& x,
                         const VecX& y, KinematicsRequest request) {
+  if (model.coupling_level) return chain::propagate_bilinear(model, ws, q, x, y, request);
   // Coupling level.
   coupling_apply(model, q, ws.theta, true);
   if (request.bias) {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "core/coupling_level.hpp"
 #include "core/element.hpp"
 #include "core/spatial.hpp"
 #include "core/spec.hpp"
@@ -60,7 +61,7 @@ struct SystemDof {
 };
 
 struct ElementEntry {
-  std::unique_ptr<Element> element;
+  std::shared_ptr<const Element> element;  // immutable, shared by copies of a spec
   int body = -1;
   std::vector<std::string> node_labels;
   std::vector<int> table_row;  // N_m row: 6 per node, 1-based system DOF number, 0 = left out
@@ -153,6 +154,14 @@ struct Model {
   ForceRoute force_route = ForceRoute::Nodes;              // how h and τ are computed
   DynamicsRoute dynamics_route = DynamicsRoute::Cholesky;  // how forward_dynamics() finds q̈
   MassPattern mass_pattern;                                // the Cholesky route's solver
+
+  // A nonlinear coupling level θ = g(q) (core/coupling_level.hpp), or null. With one, C and θ0
+  // above are only g's linearisation at compile time (its structure, for analyses and reports;
+  // a zero slope there is stored as 1 so that no dependence is lost) and the equations are
+  // those of `tree`, this mechanism with every joint a coordinate, reduced through g
+  // (core/coupling_chain.hpp).
+  std::shared_ptr<const CouplingLevel> coupling_level;
+  std::shared_ptr<const Model> tree;
 
   bool has_nodal_forces = false;     // gravity or loads present
   bool has_velocity_forces = false;  // some element has a gyroscopic term

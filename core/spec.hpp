@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/coupling_function.hpp"
 #include "core/element.hpp"
 
 namespace femdyn {
@@ -28,8 +29,8 @@ struct JointSpec {
 };
 
 struct ElementSpec {
-  std::unique_ptr<Element> element;
-  std::vector<std::string> node_labels;  // one per element node (for tables)
+  std::shared_ptr<const Element> element;  // immutable, shared by copies of a spec
+  std::vector<std::string> node_labels;    // one per element node (for tables)
   std::string where;
 };
 
@@ -41,11 +42,14 @@ struct BodySpec {
   std::string where;
 };
 
-// θ_joint = Σ ratio_i θ_{follows_i} + offset   (the coupling level θ = C q + θ0)
+// θ_joint = Σ ratio_i θ_{follows_i} + offset   (the coupling level θ = C q + θ0), or with a
+// `law`: θ_joint = law(θ_{follows_1}, θ_{follows_2}, …) (the level θ = g(q)).
 struct CouplingSpec {
   std::string joint;
-  std::vector<std::pair<std::string, double>> terms;
+  std::vector<std::pair<std::string, double>> terms;  // linear
   double offset = 0;
+  std::shared_ptr<const CouplingFunction> law;  // nonlinear (then `terms` is empty)
+  std::vector<std::string> follows;             // the law's arguments, in order
   std::string where;
 };
 

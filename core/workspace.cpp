@@ -35,6 +35,12 @@ Workspace::Workspace(const Model& model) : solver(model) {
   // M^s (n x n) is sized on first use: the articulated route never forms it, and a chain of
   // 10,000 bodies would need 800 MB for it.
   h = Q = qdd = tau = VecX::Zero(n);
+  if (model.coupling_level) {
+    tree = std::make_unique<Workspace>(*model.tree);
+    level = std::make_unique<CouplingLevelState>(*model.coupling_level);
+    Ms = MatX::Zero(n, n);
+    reduced = Eigen::LLT<MatX>(n);
+  }
 }
 
 }  // namespace femdyn

@@ -59,6 +59,12 @@ struct Workspace {
   MatX Ms;  // sized on first use (evaluate, mass_matrix)
   VecX h, Q, qdd, tau;
   MassSolver solver;  // factorisation of M^s (dense or CHOLMOD, chosen for the model)
+
+  // With a nonlinear coupling level (Model::tree): the tree's workspace, g's derivatives, and
+  // the factorisation of the reduced M^s = Gᵀ M_θ G.
+  std::unique_ptr<Workspace> tree;
+  std::unique_ptr<CouplingLevelState> level;
+  Eigen::LLT<MatX> reduced;
 };
 
 }  // namespace femdyn

@@ -124,7 +124,14 @@ std::string info_text(const Model& model) {
                                                         : "fixed";
     out << "  " << j.name << " (" << type << ") "
         << (b.parent < 0 ? std::string("world") : model.bodies[b.parent].name) << " -> " << b.name;
-    if (j.theta >= 0) {
+    const CoupledJoint* law = nullptr;
+    if (model.coupling_level)
+      for (const CoupledJoint& c : model.coupling_level->coupled)
+        if (c.theta == j.theta) law = &c;
+    if (law) {  // θ = f(θ_followed…)
+      out << "   theta = " << law->law->form() << " of";
+      for (int s : law->sources) out << " " << model.bodies[model.theta_joint[s]].joint.name;
+    } else if (j.theta >= 0) {
       out << "   theta =";
       bool first = true;
       for (SpRowMat::InnerIterator it(model.C_sparse, j.theta); it; ++it) {

@@ -59,10 +59,17 @@ FingerParams FingerParams::from(const Params& p) {
   }
   if (p.has("coupling") && !p.json().at("coupling").is_null()) {
     const Params c = p.child("coupling");
-    c.allow_only({"ratio", "offset"});
+    c.allow_only({"ratio", "offset", "four_bar", "polynomial", "spline"});
     f.coupled = true;
     f.ratio = c.number_or("ratio", 1.0);
     f.offset = c.number_or("offset", 0.0);
+    for (const char* law : {"four_bar", "polynomial", "spline"})
+      if (c.has(law)) {
+        if (!f.law.is_null()) c.fail(law, "give one law: ratio, four_bar, polynomial or spline");
+        if (c.has("ratio") || c.has("offset"))
+          c.fail(law, "ratio and offset belong to a linear coupling, not to a law");
+        f.law = Json{{law, c.json().at(law)}};
+      }
   }
   f.tip_force = p.vec3_or("tip_force", Vec3::Zero());
   if (p.has("lumping")) {
@@ -116,11 +123,17 @@ void append_finger(const FingerParams& f, const std::string& prefix, const std::
               {"elements", Json::array({bar})}};
     bodies.push_back(b);
   }
-  if (f.coupled)
+  if (f.coupled && !f.law.is_null()) {
+    Json c = f.law;  // the law's key and value, checked when the model is loaded
+    c["joint"] = prefix + "dip";
+    c["follows"] = prefix + "pip";
+    couplings.push_back(c);
+  } else if (f.coupled) {
     couplings.push_back({{"joint", prefix + "dip"},
                          {"follows", prefix + "pip"},
                          {"ratio", f.ratio},
                          {"offset", f.offset}});
+  }
   if (!f.tip_force.isZero(0))
     loads.push_back({{"body", prefix + "distal"},
                      {"point", vec3_json(along[3])},

@@ -21,8 +21,9 @@ struct FingerParams {
   std::array<double, 4> stiffness{0, 0, 0, 0};  // N·m/rad, about the rest angles
   std::array<double, 4> rest{0, 0, 0, 0};
   std::array<double, 4> damping{0, 0, 0, 0};  // N·m·s/rad
-  bool coupled = false;                       // θ4 = ratio·θ3 + offset
+  bool coupled = false;                       // θ4 = ratio·θ3 + offset, or
   double ratio = 1.0, offset = 0.0;
+  Json law;  // {"four_bar" | "polynomial" | "spline": …}: θ4 = law(θ3) (docs/model-format.md)
   Vec3 tip_force = Vec3::Zero();  // constant external force at the fingertip (world, N)
   bool paper_lumping = false;     // the paper's own discretisation (table N_m, lumping)
 

@@ -5,8 +5,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
+
+#include "models/random_tree.hpp"
 
 namespace femdyn::test {
 
@@ -47,6 +50,20 @@ Run run_shell(const std::string& command) {
 }
 
 Run run(const std::string& args) { return run_shell(std::string(FEMDYN_BINARY) + " " + args); }
+
+std::string nonlinear_coupled_tree_json(unsigned seed) {
+  const Json params = {{"seed", seed}, {"bodies", 6}, {"branching", 0.3}, {"prismatic", true}};
+  Json doc = random_tree(Params(params, "random_tree: "));  // the plugin's plain document
+  doc["gravity"] = {0.1, -0.2, -9.81};
+  doc["couplings"] = nlohmann::json::parse(R"([
+    {"joint": "j2", "follows": "j1", "four_bar": {"ground": 3, "input": 1, "coupler": 3.5,
+     "output": 2, "branch": 1, "input_offset": 0.4, "output_offset": 1.2}},
+    {"joint": "j4", "follows": ["j0", "j3"],
+     "polynomial": [[0.3, 1, 0], [0.2, 1, 1], [-0.1, 0, 2], [0.05, 2, 0], [0.1, 0, 0]]},
+    {"joint": "j5", "follows": "j2",
+     "spline": [[-3, -1], [-1, 0.2], [0, 0], [1, 0.7], [3, 1.2]]}])");
+  return doc.dump();
+}
 
 double rel_error(const MatX& a, const MatX& b, double floor) { return relative_error(a, b, floor); }
 

@@ -21,6 +21,11 @@ Model load_text(const std::string& json_text);
 std::string random_tree_json(unsigned seed, int bodies, double branching, bool prismatic,
                              double gravity = 9.81);
 
+// A seeded random 6-body tree whose joints j2, j4, j5 follow the coordinates j0, j1, j3 through
+// nonlinear laws: a four-bar (j2 of j1), a polynomial in two joints (j4 of j0 and j3) and a
+// spline of a coupled joint (j5 of j2).
+std::string nonlinear_coupled_tree_json(unsigned seed);
+
 // max |a − b| / max(|b|, floor)
 double rel_error(const MatX& a, const MatX& b, double floor = 1e-12);
 

@@ -71,13 +71,13 @@ std::string v3(const Vec3& v) {
 // A rotary node that forgets its gyroscopic term ω × (J ω): the classic error of the paper.
 class RotaryWithoutGyroscopic final : public Element {
  public:
-  explicit RotaryWithoutGyroscopic(std::unique_ptr<Element> e) : e_(std::move(e)) {}
+  explicit RotaryWithoutGyroscopic(std::shared_ptr<const Element> e) : e_(std::move(e)) {}
   std::string_view type_name() const override { return "rotary_node_without_gyroscopic"; }
   std::span<const ElementNode> nodes() const override { return e_->nodes(); }
   MatX local_mass() const override { return e_->local_mass(); }
 
  private:
-  std::unique_ptr<Element> e_;
+  std::shared_ptr<const Element> e_;
 };
 
 }  // namespace
@@ -87,6 +87,10 @@ TEST_CASE("every bundled model matches Simbody (the paper's discretisation canno
   for (const std::string& name : bundled_models()) {
     const Model m = load_model(model_path(name));
     const ValidationReport r = validation::validate(m, quick(10, 0.2));
+    if (m.coupling_level) {  // (the closed-loop twin is not built yet: issue 13)
+      CHECK_THAT(r.failure, Catch::Contains("has a nonlinear coupling law"));
+      continue;
+    }
     if (name == "finger_paper.json") {
       // Its lumping is the paper's: no rigid body has these element sums (docs/finger.md).
       CHECK_FALSE(r.pass());
@@ -220,7 +224,8 @@ TEST_CASE("docs/validation.md lists every bundled model with its current result"
          << " (regenerate: ./build/femdyn validate models/*.json models/urdf/*.urdf --markdown)");
     REQUIRE(at != std::string::npos);
     const std::string row = doc.substr(at, doc.find('\n', at) - at);
-    CHECK_THAT(row, Catch::Contains(name == "finger_paper.json" ? "| FAIL" : "| PASS |"));
+    const bool fails = name == "finger_paper.json" || name == "finger_fourbar.json";
+    CHECK_THAT(row, Catch::Contains(fails ? "| FAIL" : "| PASS |"));
   }
 }
 

@@ -1,0 +1,171 @@
+#include "core/compile_level.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+
+#include "core/errors.hpp"
+#include "core/names.hpp"
+
+namespace femdyn {
+
+bool has_coupling_law(const MechanismSpec& spec) {
+  return std::any_of(spec.couplings.begin(), spec.couplings.end(),
+                     [](const CouplingSpec& c) { return c.law != nullptr; });
+}
+
+namespace {
+
+// One coupling's arguments (θ indices) and law; a linear coupling becomes a LinearCoupling.
+CoupledJoint coupled_joint(const CouplingSpec& c, const std::map<std::string, int>& theta_of,
+                           int theta) {
+  CoupledJoint j;
+  j.theta = theta;
+  j.name = c.joint;
+  j.where = c.where;
+  const auto source = [&](const std::string& name) {
+    const auto it = theta_of.find(name);
+    if (it == theta_of.end())
+      throw ModelError(c.where + "/follows", "unknown or fixed joint " + quoted_text(name));
+    return it->second;
+  };
+  if (c.law) {
+    for (const std::string& f : c.follows) j.sources.push_back(source(f));
+    if (static_cast<int>(j.sources.size()) != c.law->arity())
+      throw ModelError(c.where + "/follows", "the law takes " + std::to_string(c.law->arity()) +
+                                                 " joints, " + std::to_string(j.sources.size()) +
+                                                 " are named");
+    j.law = c.law;
+  } else {
+    std::vector<double> ratios;
+    for (const auto& [name, ratio] : c.terms) {
+      j.sources.push_back(source(name));
+      ratios.push_back(ratio);
+    }
+    j.law = std::make_shared<LinearCoupling>(std::move(ratios), c.offset);
+  }
+  if (j.sources.empty())
+    throw ModelError(c.where + "/follows", "names no joint (to fix a joint, make it fixed)");
+  return j;
+}
+
+// The coupled joints with every joint they follow before them: depth-first with an explicit
+// stack (no recursion), cycles reported.
+std::vector<CoupledJoint> dependency_order(std::map<int, CoupledJoint> coupled, const Model& m) {
+  std::vector<CoupledJoint> order;
+  std::map<int, int> state;  // θ -> 1 in progress, 2 done
+  for (const auto& [t0, unused] : coupled) {
+    std::vector<std::pair<int, std::size_t>> stack = {{t0, 0}};
+    while (!stack.empty()) {
+      auto& [t, k] = stack.back();
+      const auto it = coupled.find(t);
+      if (it == coupled.end() || state[t] == 2) {  // a coordinate, or resolved
+        stack.pop_back();
+        continue;
+      }
+      state[t] = 1;
+      if (k == it->second.sources.size()) {
+        state[t] = 2;
+        order.push_back(it->second);
+        stack.pop_back();
+        continue;
+      }
+      const int s = it->second.sources[k++];
+      if (state[s] == 1)
+        throw ModelError(coupled.at(s).where, "couplings form a cycle through joint '" +
+                                                  m.bodies[m.theta_joint[s]].joint.name + "'");
+      stack.emplace_back(s, 0);
+    }
+  }
+  return order;
+}
+
+// A one-argument law must be defined over the whole range of the joint it follows (its
+// limits, or a full turn without): a four-bar that cannot assemble or locks is refused.
+void check_range(const CoupledJoint& j, const Model& m) {
+  if (j.sources.size() != 1) return;
+  const Joint& in = m.bodies[m.theta_joint[j.sources[0]]].joint;
+  const bool limited = std::isfinite(in.lower) && std::isfinite(in.upper);
+  const double lo = limited ? in.lower : -std::numbers::pi,
+               hi = limited ? in.upper : std::numbers::pi;
+  if (const auto at = j.law->lock_angle(lo, hi))
+    throw ModelError(j.where, "the linkage of joint '" + j.name + "' cannot assemble or locks at " +
+                                  in.name + " = " + format_number(*at) + " rad, within " +
+                                  (limited ? "its limits [" : "a full turn [") + format_number(lo) +
+                                  ", " + format_number(hi) + "]" +
+                                  (limited ? "" : " (give " + in.name + " limits)"));
+}
+
+}  // namespace
+
+Model compile_with_coupling_level(MechanismSpec spec) {
+  MechanismSpec tree_spec = spec;  // (elements are shared, immutable)
+  tree_spec.couplings.clear();
+  Model tree = compile(tree_spec);
+  Model m = compile(std::move(tree_spec));
+
+  std::map<std::string, int> theta_of;  // joint name -> θ index
+  for (int t = 0; t < m.n_theta(); ++t) theta_of[m.bodies[m.theta_joint[t]].joint.name] = t;
+  std::map<int, CoupledJoint> coupled;
+  for (const CouplingSpec& c : spec.couplings) {
+    const auto it = theta_of.find(c.joint);
+    if (it == theta_of.end())
+      throw ModelError(c.where + "/joint", "unknown or fixed joint " + quoted_text(c.joint));
+    if (coupled.count(it->second))
+      throw ModelError(c.where + "/joint", "joint '" + c.joint + "' is coupled twice");
+    coupled.emplace(it->second, coupled_joint(c, theta_of, it->second));
+  }
+  auto level = std::make_shared<CouplingLevel>();
+  level->n_theta = m.n_theta();
+  m.coordinate_names.clear();
+  for (int t = 0; t < m.n_theta(); ++t)
+    if (!coupled.count(t)) {
+      level->coordinate_theta.push_back(t);
+      m.coordinate_names.push_back(m.bodies[m.theta_joint[t]].joint.name);
+    }
+  level->n = static_cast<int>(level->coordinate_theta.size());
+  level->coupled = dependency_order(std::move(coupled), m);
+  if (level->n == 0) throw ModelError(m.where, "every joint is coupled: there is no coordinate");
+  for (const CoupledJoint& j : level->coupled) {
+    level->largest_arity = std::max(level->largest_arity, static_cast<int>(j.sources.size()));
+    check_range(j, m);
+  }
+
+  // C and θ0: g's linearisation at q_ref (each coordinate at 0, or its nearest limit), for the
+  // reports and structure analyses only; a dependence with zero slope there is stored as 1.
+  const int n = level->n, nt = level->n_theta;
+  VecX q_ref(n);
+  for (int a = 0; a < n; ++a) {
+    const Joint& J = m.bodies[m.theta_joint[level->coordinate_theta[a]]].joint;
+    q_ref[a] = std::clamp(0.0, J.lower, J.upper);
+  }
+  CouplingLevelState s(*level);
+  const VecX zero = VecX::Zero(n);
+  if (!evaluate_level(*level, q_ref, zero, zero, s))
+    throw ModelError(level->coupled[s.failed].where,
+                     "the law of joint '" + level->coupled[s.failed].name +
+                         "' is not defined at the reference posture (every coordinate at 0 or "
+                         "its nearest limit)");
+  std::vector<std::vector<bool>> depends(nt, std::vector<bool>(n, false));
+  for (int a = 0; a < n; ++a) depends[level->coordinate_theta[a]][a] = true;
+  for (const CoupledJoint& j : level->coupled)
+    for (int src : j.sources)
+      for (int a = 0; a < n; ++a) depends[j.theta][a] = depends[j.theta][a] || depends[src][a];
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int t = 0; t < nt; ++t)
+    for (int a = 0; a < n; ++a)
+      if (depends[t][a]) entries.emplace_back(t, a, s.G(t, a) != 0 ? s.G(t, a) : 1.0);
+  m.C.resize(nt, n);
+  m.C.setFromTriplets(entries.begin(), entries.end());
+  m.C_sparse = m.C;
+  m.theta0 = s.theta - s.G * q_ref;
+  m.identity_coupling = false;
+  m.mass_pattern = MassPattern{};  // (M^s is reduced and factorised densely: coupling_chain)
+  m.dynamics_route = DynamicsRoute::Cholesky;
+  m.coupling_level = std::move(level);
+  m.tree = std::make_shared<const Model>(std::move(tree));
+  return m;
+}
+
+}  // namespace femdyn

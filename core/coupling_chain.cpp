@@ -1,0 +1,163 @@
+#include "core/coupling_chain.hpp"
+
+#include "core/errors.hpp"
+
+namespace femdyn::chain {
+
+namespace {
+
+const VecX kNoActuation;  // the tree is not actuated: τ acts on q, added after the reduction
+
+// g, G, G x, G y, g''[x, y] at q into ws.level; throws where a law is not defined.
+CouplingLevelState& level_at(const Model& m, Workspace& ws, const VecX& q, const VecX& x,
+                             const VecX& y, bool hessian = false) {
+  CouplingLevelState& s = *ws.level;
+  if (!evaluate_level(*m.coupling_level, q, x, y, s, hessian)) {
+    const CoupledJoint& j = m.coupling_level->coupled[s.failed];
+    std::string at;
+    for (int k : j.sources)
+      at += (at.empty() ? "" : ", ") + m.bodies[m.theta_joint[k]].joint.name + " = " +
+            format_number(s.theta[k]);
+    throw ModelError(j.where, "the law of joint '" + j.name + "' is not defined at " + at +
+                                  " (a linkage that cannot assemble or is at its dead point)");
+  }
+  ws.theta = s.theta;
+  ws.theta_dot = s.theta_dot;
+  return s;
+}
+
+// The body states of the tree are this model's.
+void share_bodies(Workspace& ws) { ws.body = ws.tree->body; }
+
+// M^s = Gᵀ M_θ G from the tree's M_θ.
+void reduce_mass(Workspace& ws, CouplingLevelState& s) {
+  s.MG.noalias() = ws.tree->Ms * s.G;
+  ws.Ms.noalias() = s.G.transpose() * s.MG;
+}
+
+}  // namespace
+
+void evaluate(const Model& m, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau) {
+  CouplingLevelState& s = level_at(m, ws, q, qd, qd);
+  Workspace& t = *ws.tree;
+  femdyn::evaluate(*m.tree, t, s.theta, s.theta_dot, kNoActuation);
+  reduce_mass(ws, s);
+  s.f_theta = t.h;
+  s.f_theta.noalias() += t.Ms * s.gamma;  // h_θ + M_θ γ
+  ws.h.noalias() = s.G.transpose() * s.f_theta;
+  ws.Q.noalias() = s.G.transpose() * t.Q;
+  if (tau.size()) ws.Q += tau;
+  share_bodies(ws);
+}
+
+void mass_matrix(const Model& m, Workspace& ws, const VecX& q) {
+  CouplingLevelState& s = level_at(m, ws, q, q, q);
+  femdyn::mass_matrix(*m.tree, *ws.tree, s.theta);
+  reduce_mass(ws, s);
+  share_bodies(ws);
+}
+
+void evaluate_bias(const Model& m, Workspace& ws, const VecX& q, const VecX& qd) {
+  CouplingLevelState& s = level_at(m, ws, q, qd, qd);
+  Workspace& t = *ws.tree;
+  femdyn::evaluate(*m.tree, t, s.theta, s.theta_dot, kNoActuation);
+  s.f_theta = t.h;
+  s.f_theta.noalias() += t.Ms * s.gamma;
+  ws.h.noalias() = s.G.transpose() * s.f_theta;
+  share_bodies(ws);
+}
+
+Status forward_dynamics(const Model& m, Workspace& ws, const VecX& q, const VecX& qd,
+                        const VecX& tau) {
+  try {
+    chain::evaluate(m, ws, q, qd, tau);
+  } catch (const ModelError& e) {
+    return {false, e.what()};
+  }
+  ws.reduced.compute(ws.Ms);
+  if (ws.reduced.info() != Eigen::Success)
+    return {false,
+            "the mass matrix M^s = Gᵀ M_θ G is not positive definite at this state (the coupling "
+            "level loses rank: a law with zero slope in every coordinate it follows?)"};
+  ws.qdd = ws.Q - ws.h;
+  ws.reduced.solveInPlace(ws.qdd);
+  return {};
+}
+
+void inverse_dynamics(const Model& m, Workspace& ws, const VecX& q, const VecX& qd,
+                      const VecX& qdd) {
+  CouplingLevelState& s = level_at(m, ws, q, qd, qd);
+  s.theta_ddot = s.gamma;
+  s.theta_ddot.noalias() += s.G * qdd;  // θ̈ = G q̈ + γ
+  femdyn::inverse_dynamics(*m.tree, *ws.tree, s.theta, s.theta_dot, s.theta_ddot);
+  ws.tau.noalias() = s.G.transpose() * ws.tree->tau;
+  share_bodies(ws);
+}
+
+void propagate_bilinear(const Model& m, Workspace& ws, const VecX& q, const VecX& x, const VecX& y,
+                        KinematicsRequest request) {
+  CouplingLevelState& s = level_at(m, ws, q, x, y);
+  ws.theta_dot_y = s.theta_dot_y;
+  Workspace& t = *ws.tree;
+  // T_θ is needed for the bias too (T_θ γ).
+  femdyn::propagate_bilinear(*m.tree, t, s.theta, s.theta_dot, s.theta_dot_y,
+                             {.jacobian = true, .bias = request.bias, .rows = true});
+  if (request.jacobian) {
+    ws.Jw.noalias() = t.Jw * s.G;
+    ws.Jv.noalias() = t.Jv * s.G;
+    if (request.rows) ws.T.noalias() = t.T * s.G;
+  }
+  if (request.bias) {
+    ws.bias = t.bias;
+    ws.bias.noalias() += t.T * s.gamma;  // T'_θ[G x, G y] + T_θ g''[x, y]
+    ws.u_dot = t.u_dot;
+  }
+  share_bodies(ws);
+}
+
+std::vector<MatX> transform_hessian(const Model& m, Workspace& ws, const VecX& q) {
+  const VecX zero = VecX::Zero(m.n());
+  CouplingLevelState& s = level_at(m, ws, q, zero, zero, true);
+  Workspace& t = *ws.tree;
+  std::vector<MatX> H = femdyn::transform_hessian(*m.tree, t, s.theta);
+  femdyn::propagate(*m.tree, t, s.theta, VecX::Zero(m.n_theta()),
+                    {.jacobian = true, .bias = false});
+  for (std::size_t i = 0; i < H.size(); ++i) {
+    MatX Hi = s.G.transpose() * H[i] * s.G;  // T'_θ[G e_b, G e_c]
+    for (int j = 0; j < m.n_theta(); ++j)
+      if (t.T(i, j) != 0) Hi += t.T(i, j) * s.H[j];  // + T_θ ∂²θ/∂q_b∂q_c
+    H[i] = std::move(Hi);
+  }
+  share_bodies(ws);
+  return H;
+}
+
+std::vector<MatX> third_order_tensor(const Model& m, Workspace& ws, const VecX& q) {
+  const VecX zero = VecX::Zero(m.n());
+  CouplingLevelState& s = level_at(m, ws, q, zero, zero, true);
+  Workspace& t = *ws.tree;
+  const std::vector<MatX> Dt = femdyn::third_order_tensor(*m.tree, t, s.theta);
+  femdyn::mass_matrix(*m.tree, t, s.theta);
+  const int n = m.n(), nt = m.n_theta();
+  std::vector<MatX> inner(nt);  // per θ row i: Gᵀ D^θ_i G + Σ_l M_θ(i, l) H_l
+  for (int i = 0; i < nt; ++i) {
+    inner[i] = s.G.transpose() * Dt[i] * s.G;
+    for (int l = 0; l < nt; ++l)
+      if (t.Ms(i, l) != 0) inner[i] += t.Ms(i, l) * s.H[l];
+  }
+  std::vector<MatX> D(n, MatX::Zero(n, n));
+  for (int a = 0; a < n; ++a)
+    for (int i = 0; i < nt; ++i)
+      if (s.G(i, a) != 0) D[a] += s.G(i, a) * inner[i];
+  share_bodies(ws);
+  return D;
+}
+
+Energy energy(const Model& m, Workspace& ws, const VecX& q, const VecX& qd) {
+  CouplingLevelState& s = level_at(m, ws, q, qd, qd);
+  const Energy E = femdyn::energy(*m.tree, *ws.tree, s.theta, s.theta_dot);
+  share_bodies(ws);
+  return E;
+}
+
+}  // namespace femdyn::chain

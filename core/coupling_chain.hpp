@@ -1,0 +1,31 @@
+// The equations of a model with a nonlinear coupling level θ = g(q), chained from those of its
+// tree (Model::tree, every joint a coordinate) at θ = g(q), θ̇ = G q̇ (docs/design.md):
+//   M^s = Gᵀ M_θ G,   h = Gᵀ (h_θ + M_θ γ),   Q = Gᵀ Q_θ + τ,   τ = Gᵀ τ_θ(θ̈ = G q̈ + γ)
+//   T = T_θ G,   T'[x, y] = T'_θ[G x, G y] + T_θ g''[x, y]
+//   D_abc = Σ_i G_ia (Σ_jk D^θ_ijk G_jb G_kc + Σ_l M_θ,il H_lbc)
+// Called by the functions of core/equations.hpp and core/kinematics.hpp when
+// Model::coupling_level is set; linear couplings never come here. A state where a law is not
+// defined (a linkage that cannot assemble) throws ModelError from the void functions and is a
+// failed Status from forward_dynamics.
+#pragma once
+#include <vector>
+
+#include "core/equations.hpp"
+#include "core/kinematics.hpp"
+
+namespace femdyn::chain {
+
+void evaluate(const Model& m, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau);
+void mass_matrix(const Model& m, Workspace& ws, const VecX& q);
+void evaluate_bias(const Model& m, Workspace& ws, const VecX& q, const VecX& qd);
+Status forward_dynamics(const Model& m, Workspace& ws, const VecX& q, const VecX& qd,
+                        const VecX& tau);
+void inverse_dynamics(const Model& m, Workspace& ws, const VecX& q, const VecX& qd,
+                      const VecX& qdd);
+void propagate_bilinear(const Model& m, Workspace& ws, const VecX& q, const VecX& x, const VecX& y,
+                        KinematicsRequest request);
+std::vector<MatX> transform_hessian(const Model& m, Workspace& ws, const VecX& q);
+std::vector<MatX> third_order_tensor(const Model& m, Workspace& ws, const VecX& q);
+Energy energy(const Model& m, Workspace& ws, const VecX& q, const VecX& qd);
+
+}  // namespace femdyn::chain

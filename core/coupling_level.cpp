@@ -1,0 +1,69 @@
+#include "core/coupling_level.hpp"
+
+namespace femdyn {
+
+CouplingLevelState::CouplingLevelState(const CouplingLevel& level)
+    : theta(VecX::Zero(level.n_theta)),
+      theta_dot(VecX::Zero(level.n_theta)),
+      theta_dot_y(VecX::Zero(level.n_theta)),
+      gamma(VecX::Zero(level.n_theta)),
+      G(MatX::Zero(level.n_theta, level.n)),
+      x(level.largest_arity),
+      df(level.largest_arity),
+      d2f(level.largest_arity * level.largest_arity),
+      MG(MatX::Zero(level.n_theta, level.n)),
+      f_theta(VecX::Zero(level.n_theta)),
+      theta_ddot(VecX::Zero(level.n_theta)) {}
+
+bool evaluate_level(const CouplingLevel& level, const VecX& q, const VecX& x, const VecX& y,
+                    CouplingLevelState& s, bool hessian) {
+  if (hessian && s.H.size() != static_cast<std::size_t>(level.n_theta))
+    s.H.assign(level.n_theta, MatX::Zero(level.n, level.n));  // first request only
+  s.failed = -1;
+  for (int a = 0; a < level.n; ++a) {  // the coordinates: θ_t = q_a
+    const int t = level.coordinate_theta[a];
+    s.theta[t] = q[a];
+    s.theta_dot[t] = x[a];
+    s.theta_dot_y[t] = y[a];
+    s.gamma[t] = 0;
+    s.G.row(t).setZero();
+    s.G(t, a) = 1;
+    if (hessian) s.H[t].setZero();
+  }
+  for (std::size_t c = 0; c < level.coupled.size(); ++c) {
+    const CoupledJoint& j = level.coupled[c];
+    const int k = static_cast<int>(j.sources.size());
+    for (int i = 0; i < k; ++i) s.x[i] = s.theta[j.sources[i]];
+    double f = 0;
+    if (!j.law->evaluate({s.x.data(), static_cast<std::size_t>(k)}, f,
+                         {s.df.data(), static_cast<std::size_t>(k)},
+                         {s.d2f.data(), static_cast<std::size_t>(k * k)})) {
+      s.failed = static_cast<int>(c);
+      return false;
+    }
+    const int t = j.theta;
+    s.theta[t] = f;
+    s.G.row(t).setZero();
+    s.theta_dot[t] = s.theta_dot_y[t] = s.gamma[t] = 0;
+    if (hessian) s.H[t].setZero();
+    for (int i = 0; i < k; ++i) {
+      const int si = j.sources[i];
+      const double fi = s.df[i];
+      s.G.row(t) += fi * s.G.row(si);
+      s.theta_dot[t] += fi * s.theta_dot[si];
+      s.theta_dot_y[t] += fi * s.theta_dot_y[si];
+      s.gamma[t] += fi * s.gamma[si];
+      if (hessian) s.H[t] += fi * s.H[si];
+      for (int l = 0; l < k; ++l) {
+        const int sl = j.sources[l];
+        const double fil = s.d2f[i * k + l];
+        if (fil == 0) continue;
+        s.gamma[t] += fil * s.theta_dot[si] * s.theta_dot_y[sl];
+        if (hessian) s.H[t].noalias() += fil * s.G.row(si).transpose() * s.G.row(sl);
+      }
+    }
+  }
+  return true;
+}
+
+}  // namespace femdyn
