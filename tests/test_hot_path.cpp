@@ -20,8 +20,9 @@ TEST_CASE("no heap allocation in evaluate, forward and inverse dynamics", "[hot-
     WARN(kSkipped);
     return;
   }
-  for (const char* name : {"branched_tree.json", "spatial_double_pendulum.json", "hand.json",
-                           "finger_coupled.json", "finger_paper.json", "urdf/hand16.urdf"}) {
+  for (const char* name :
+       {"branched_tree.json", "spatial_double_pendulum.json", "hand.json", "finger_coupled.json",
+        "finger_paper.json", "finger_fourbar.json", "urdf/hand16.urdf"}) {
     INFO(name);
     const Model m = load_model(model_path(name));
     Workspace ws(m);
