@@ -213,6 +213,14 @@ TEST_CASE("the four-bar finger runs in info, equations, simulate and check, and 
     mass_matrix(m, ws, (VecX(3) << 0, 0, pip).finished());
     CHECK(std::abs(ws.theta[3] - 2.0 / 3.0 * pip) < 0.02);
   }
+  // The same linkage in every finger of the hand: 17 coordinates, energy conserved.
+  const Run hand = run("simulate " + model_path("hand_fourbar.json") +
+                       " --t-end 0.3 --integrator dopri --rtol 1e-10 --atol 1e-12 --qd0 "
+                       "0.5,0.5,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1 --json");
+  REQUIRE(hand.code == 0);
+  const auto jh = nlohmann::json::parse(hand.out);
+  CHECK(jh["coordinates"] == 17);
+  CHECK(jh["energy_balance_relative"].get<double>() < 1e-9);
   // validate and study say plainly that the Simbody twin of a law is not built yet.
   const Run v = run("validate " + model);
   CHECK(v.code != 0);

@@ -22,7 +22,7 @@ TEST_CASE("no heap allocation in evaluate, forward and inverse dynamics", "[hot-
   }
   for (const char* name :
        {"branched_tree.json", "spatial_double_pendulum.json", "hand.json", "finger_coupled.json",
-        "finger_paper.json", "finger_fourbar.json", "urdf/hand16.urdf"}) {
+        "finger_paper.json", "finger_fourbar.json", "hand_fourbar.json", "urdf/hand16.urdf"}) {
     INFO(name);
     const Model m = load_model(model_path(name));
     Workspace ws(m);
