@@ -57,6 +57,10 @@ void condense_body_inertia(Model& m) {
     const MatX me = e.element->local_mass();
     for (Eigen::Index k = 0; k < me.size(); ++k)
       check_magnitude(me.data()[k], e.where, "element mass matrix entry");
+    if (e.spans) {  // not rigid with one body: only the node-level route is exact
+      m.condensable = false;
+      continue;
+    }
     const MatX X0 = twist_map(*e.element, Mat3::Identity()), X1 = twist_map(*e.element, tilt);
     const Mat6 L0 = X0.transpose() * me * X0, L1 = X1.transpose() * me * X1;
     if ((L0 - L1).cwiseAbs().maxCoeff() > 1e-12 * std::max(L0.cwiseAbs().maxCoeff(), 1e-300))

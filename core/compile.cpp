@@ -191,6 +191,12 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
 
 Model compile(MechanismSpec spec) {
   if (has_coupling_law(spec)) return compile_with_coupling_level(std::move(spec));
+  Model m = compile_tree(std::move(spec));
+  check_rigid_spans(m);
+  return m;
+}
+
+Model compile_tree(MechanismSpec spec) {
   Model m;
   m.name = spec.name;
   m.where = spec.where.size() >= 2 ? spec.where.substr(0, spec.where.size() - 2) : spec.where;

@@ -6,7 +6,10 @@
 #include <numbers>
 
 #include "core/errors.hpp"
+#include "core/kinematics.hpp"
 #include "core/names.hpp"
+#include "core/sampling.hpp"
+#include "core/workspace.hpp"
 
 namespace femdyn {
 
@@ -102,8 +105,8 @@ void check_range(const CoupledJoint& j, const Model& m) {
 Model compile_with_coupling_level(MechanismSpec spec) {
   MechanismSpec tree_spec = spec;  // (elements are shared, immutable)
   tree_spec.couplings.clear();
-  Model tree = compile(tree_spec);
-  Model m = compile(std::move(tree_spec));
+  Model tree = compile_tree(tree_spec);
+  Model m = compile_tree(std::move(tree_spec));
 
   std::map<std::string, int> theta_of;  // joint name -> θ index
   for (int t = 0; t < m.n_theta(); ++t) theta_of[m.bodies[m.theta_joint[t]].joint.name] = t;
@@ -135,7 +138,7 @@ Model compile_with_coupling_level(MechanismSpec spec) {
   // C and θ0: g's linearisation at q_ref (each coordinate at 0, or its nearest limit), for the
   // reports and structure analyses only; a dependence with zero slope there is stored as 1.
   const int n = level->n, nt = level->n_theta;
-  VecX q_ref(n);
+  VecX q_ref(n);  // (as reference_posture, before m.n() is the level's)
   for (int a = 0; a < n; ++a) {
     const Joint& J = m.bodies[m.theta_joint[level->coordinate_theta[a]]].joint;
     q_ref[a] = std::clamp(0.0, J.lower, J.upper);
@@ -165,7 +168,51 @@ Model compile_with_coupling_level(MechanismSpec spec) {
   m.dynamics_route = DynamicsRoute::Cholesky;
   m.coupling_level = std::move(level);
   m.tree = std::make_shared<const Model>(std::move(tree));
+  check_rigid_spans(m);
   return m;
+}
+
+void check_rigid_spans(const Model& m) {
+  const bool any = std::any_of(m.elements.begin(), m.elements.end(),
+                               [](const ElementEntry& e) { return e.spans; });
+  if (!any) return;
+  Workspace ws(m);
+  const auto length = [&](const ElementEntry& e) {
+    const auto nodes = e.element->nodes();
+    const auto world = [&](int l) {
+      const BodyState& B = ws.body[e.node_body[l]];
+      return Vec3(B.p + B.R * nodes[l].position);
+    };
+    return (world(0) - world(1)).norm();
+  };
+  VecX q(m.n());
+  std::mt19937 rng(12345);
+  const VecX zero = VecX::Zero(m.n());
+  std::vector<double> L0;
+  for (int k = 0; k <= 64; ++k) {
+    q = k == 0 ? reference_posture(m) : random_posture(m, rng);
+    propagate(m, ws, q, zero, {.jacobian = false, .bias = false});
+    std::size_t s = 0;
+    for (const ElementEntry& e : m.elements) {
+      if (!e.spans || e.node_body.size() != 2) continue;
+      const double L = length(e);
+      if (k == 0) {
+        L0.push_back(L);
+        continue;
+      }
+      const double change = L - L0[s++];
+      if (std::abs(change) > 1e-9 * L0[s - 1] + 1e-12) {
+        std::string at;
+        for (int a = 0; a < m.n(); ++a)
+          at += (a ? ", " : "") + m.coordinate_names[a] + " = " + format_number(q[a]);
+        throw ModelError(e.where, std::string(e.element->type_name()) +
+                                      " spanning two bodies does not keep its length: " +
+                                      format_number(L0[s - 1]) + " m at the reference posture, " +
+                                      format_number(L) + " m at " + at + " (a change of " +
+                                      format_number(change) + " m)");
+      }
+    }
+  }
 }
 
 }  // namespace femdyn

@@ -8,5 +8,11 @@ namespace femdyn {
 
 bool has_coupling_law(const MechanismSpec& spec);
 Model compile_with_coupling_level(MechanismSpec spec);
+// compile() without the check below (the tree of a model with a law moves its joints freely).
+Model compile_tree(MechanismSpec spec);
+// Each element that spans two bodies (a rod) must keep its length under the model's
+// kinematics: checked at the reference posture and 64 seeded postures within the limits;
+// otherwise ModelError naming the element, the posture and the change in length.
+void check_rigid_spans(const Model& m);
 
 }  // namespace femdyn

@@ -228,6 +228,17 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
   NodesOfBody nodes_of(m.bodies.size());
   std::vector<std::vector<int>> local_cand;  // per element: 6k, -1 where unused
   std::vector<std::vector<int>> all_cand;    // per element: 6k, also for unused local DOFs
+  // A node labelled "other_body/node" lies on that body (an element that spans bodies).
+  std::map<std::string, int> body_named;
+  for (std::size_t k = 0; k < m.bodies.size(); ++k) body_named.emplace(m.bodies[k].name, k);
+  const auto body_of_label = [&](const std::string& label, int own) {
+    for (std::size_t cut = label.rfind('/'); cut != std::string::npos && cut > 0;
+         cut = label.rfind('/', cut - 1)) {
+      const auto it = body_named.find(label.substr(0, cut));
+      if (it != body_named.end()) return it->second;
+    }
+    return own;
+  };
   for (std::size_t s = 0; s < spec.bodies.size(); ++s) {
     const int b = body_of_spec[s];
     for (ElementSpec& es : spec.bodies[s].elements) {
@@ -243,7 +254,17 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
         check_name(label, es.where, "node label");
         if (label.find('/') == std::string::npos) label = m.bodies[b].name + "/" + label;
         check_magnitude(nodes[l].position, es.where, "element node position");
-        const int node = find_or_add_node(m, nodes_of, b, nodes[l].position, label);
+        const int nb = body_of_label(label, b);
+        if (nb != b) {
+          e.spans = true;
+          for (int k = 3; k < kNodeDofs; ++k)
+            if (nodes[l].uses[k])
+              throw ModelError(es.where, "node '" + label +
+                                             "' is on another body: an element uses only its "
+                                             "translation there (no rotation)");
+        }
+        e.node_body.push_back(nb);
+        const int node = find_or_add_node(m, nodes_of, nb, nodes[l].position, label);
         for (int k = 0; k < kNodeDofs; ++k) {
           const bool use = nodes[l].uses[k];
           const int c = k < 3 ? cand.add(DofKind::Translation, node, k, use)

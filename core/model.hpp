@@ -65,6 +65,8 @@ struct ElementEntry {
   int body = -1;
   std::vector<std::string> node_labels;
   std::vector<int> table_row;  // N_m row: 6 per node, 1-based system DOF number, 0 = left out
+  std::vector<int> node_body;  // the body each node is fixed on (e.body unless it spans)
+  bool spans = false;          // some node lies on another body (no body-level condensation)
   std::string where;
 };
 

@@ -8,13 +8,31 @@
 
 namespace femdyn {
 
-VecX random_posture(const Model& m, std::mt19937& rng) {
-  std::vector<const Joint*> joint_of(m.n(), nullptr);  // coordinate -> its joint (by name)
+namespace {
+
+// Coordinate -> its joint (by name).
+std::vector<const Joint*> coordinate_joints(const Model& m) {
+  std::vector<const Joint*> joint_of(m.n(), nullptr);
   std::map<std::string, int> coordinate;
   for (int a = 0; a < m.n(); ++a) coordinate.emplace(m.coordinate_names[a], a);
   for (const Body& b : m.bodies)
     if (const auto it = coordinate.find(b.joint.name); it != coordinate.end())
       joint_of[it->second] = &b.joint;
+  return joint_of;
+}
+
+}  // namespace
+
+VecX reference_posture(const Model& m) {
+  const std::vector<const Joint*> joint_of = coordinate_joints(m);
+  VecX q(m.n());
+  for (int a = 0; a < m.n(); ++a)
+    q[a] = joint_of[a] ? std::clamp(0.0, joint_of[a]->lower, joint_of[a]->upper) : 0.0;
+  return q;
+}
+
+VecX random_posture(const Model& m, std::mt19937& rng) {
+  const std::vector<const Joint*> joint_of = coordinate_joints(m);
   VecX q(m.n());
   for (int a = 0; a < m.n(); ++a) {
     const Joint* joint = joint_of[a];

@@ -8,6 +8,8 @@
 namespace femdyn {
 
 VecX random_posture(const Model& model, std::mt19937& rng);
+// Each coordinate at 0, or at its joint's nearest limit when 0 is outside them.
+VecX reference_posture(const Model& model);
 VecX random_uniform(int n, double scale, std::mt19937& rng);  // each entry in ±scale
 
 }  // namespace femdyn

@@ -72,7 +72,7 @@ Status Adaptive::failure(int flag) {
     Status st = rhs_failure_;
     if (st.non_finite)
       st.message += "; likely cause: the state overflowed (forces or speeds beyond double range)";
-    else
+    else if (st.message.find("M^s") != std::string::npos)  // (not a law's failure: says its own)
       st.message += "; likely cause: M^s lost positive definiteness along the motion";
     return st;
   }

@@ -4,6 +4,7 @@
 
 #include "elements/lumped_point.hpp"
 #include "elements/rigid_body.hpp"
+#include "elements/rod.hpp"
 #include "elements/rotary_node.hpp"
 #include "elements/space_bar.hpp"
 
@@ -15,6 +16,7 @@ static const std::array kTypes = {
     ElementType{"space_bar", &SpaceBar::from_params},  // a rigid bar lumped to its two end nodes
     ElementType{"rotary_node", &RotaryNode::from_params},         // a rotary inertia at a node
     ElementType{"rigid_body", &RigidBodyShorthand::from_params},  // mass, com, inertia
+    ElementType{"rod", &Rod::from_params},  // a slender rod, its ends possibly on two bodies
 };
 
 const Registry<ElementType>& element_types() {

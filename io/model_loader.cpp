@@ -70,7 +70,26 @@ JointSpec read_joint(const Params& p) {
   return j;
 }
 
-BodySpec read_body(const Json& jb, const std::string& where) {
+// Every body's named nodes as "body/node" (body frame of that body): an element may reach a
+// node of another body by that name (an element that spans bodies, docs/model-format.md).
+std::map<std::string, Vec3> qualified_nodes(const Json& bodies) {
+  std::map<std::string, Vec3> all;
+  for (const Json& jb : bodies) {
+    if (!jb.is_object() || !jb.contains("nodes") || !jb["nodes"].is_object() ||
+        !jb.contains("name") || !jb["name"].is_string())
+      continue;  // (reported where the body is read)
+    const std::string name = jb["name"].get<std::string>();
+    for (auto it = jb["nodes"].begin(); it != jb["nodes"].end(); ++it)
+      if (it.value().is_array() && it.value().size() == 3 && it.value()[0].is_number() &&
+          it.value()[1].is_number() && it.value()[2].is_number())
+        all[name + "/" + it.key()] = {it.value()[0].get<double>(), it.value()[1].get<double>(),
+                                      it.value()[2].get<double>()};
+  }
+  return all;
+}
+
+BodySpec read_body(const Json& jb, const std::string& where,
+                   const std::map<std::string, Vec3>& other_nodes) {
   const Params p(jb, where);
   p.allow_only({"name", "parent", "joint", "nodes", "elements"});
   BodySpec b;
@@ -78,7 +97,7 @@ BodySpec read_body(const Json& jb, const std::string& where) {
   b.name = p.string("name");
   b.parent = p.string("parent");
   b.joint = read_joint(p.child("joint"));
-  std::map<std::string, Vec3> nodes;
+  std::map<std::string, Vec3> nodes = other_nodes;  // "body/node", and this body's by name
   if (p.has("nodes")) {
     const Json& jn = jb.at("nodes");
     if (!jn.is_object()) p.fail("nodes", "expected an object {name: [x, y, z]}");
@@ -305,8 +324,9 @@ MechanismSpec parse_document(const Json& root, const std::string& source) {
   if (!root.contains("bodies") || !root["bodies"].is_array())
     throw ModelError(path("bodies"), "expected an array of bodies");
   const Json& bodies = root["bodies"];
+  const std::map<std::string, Vec3> qualified = qualified_nodes(bodies);
   for (std::size_t i = 0; i < bodies.size(); ++i)
-    spec.bodies.push_back(read_body(bodies[i], path("bodies/" + std::to_string(i))));
+    spec.bodies.push_back(read_body(bodies[i], path("bodies/" + std::to_string(i)), qualified));
   if (root.contains("couplings")) {
     if (!root["couplings"].is_array()) throw ModelError(path("couplings"), "expected an array");
     for (std::size_t i = 0; i < root["couplings"].size(); ++i)

@@ -102,7 +102,8 @@ NodeRef Params::node_from(const Json& v, const std::string& where) const {
     const std::string name = v.get<std::string>();
     if (!nodes_ || !nodes_->count(name))
       throw ModelError(where, "unknown node '" + name + "' (not in the body's \"nodes\")");
-    return {nodes_->at(name), body_ + "/" + name};
+    // "other_body/node": a node of another body (its frame), labelled as such.
+    return {nodes_->at(name), name.find('/') == std::string::npos ? body_ + "/" + name : name};
   }
   const Vec3 p = json_vec3(v, where);
   char buf[96];

@@ -13,7 +13,8 @@ namespace femdyn {
 
 using Json = nlohmann::json;
 
-// A node an element refers to: by name from its body's "nodes" table, or inline [x, y, z].
+// A node an element refers to: by name from its body's "nodes" table, as "body/node" from
+// another body's (in that body's frame; the label says which body), or inline [x, y, z].
 struct NodeRef {
   Vec3 position;
   std::string label;

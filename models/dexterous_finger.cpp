@@ -3,6 +3,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/coupling_function.hpp"
+
 namespace femdyn {
 namespace {
 
@@ -35,6 +37,46 @@ const int kPaperTable[4][12] = {{0, 0, 0, 0, 0, 1, 2, 3, 0, 4, 0, 0},
                                 {5, 6, 7, 8, 0, 0, 9, 10, 11, 12, 0, 0},
                                 {9, 10, 11, 12, 0, 0, 13, 14, 15, 16, 0, 0}};
 
+// The four-bar's coupler as a rod from the input lever's tip (on the proximal phalanx, at the
+// PIP axis) to the output lever's tip (on the distal phalanx, at the DIP axis). The linkage's
+// plane is the flexion plane: a planar angle α from the middle phalanx's direction (+z) towards
+// −y is the point (0, −r sin α, r cos α); the proximal phalanx turns by −θ3 seen from the middle
+// one and the distal by +θ4, so the law needs input_sign −1 and output_sign +1, and its ground
+// is the middle phalanx. compile() then checks that the rod keeps its length.
+void append_coupler(const FingerParams& f, const std::string& prefix, const Vec3& pip,
+                    Json& bodies) {
+  const Json& g = f.law.at("four_bar");
+  const auto number = [&](const char* key, double fallback) {
+    return g.contains(key) && g[key].is_number() ? g[key].get<double>() : fallback;
+  };
+  const double a = number("input", 0), c = number("output", 0);
+  const double phi0 = number("input_offset", 0), branch = number("branch", 1);
+  double psi0 = number("output_offset", NAN);
+  if (std::isnan(psi0)) {  // the default: θ4 = 0 at θ3 = 0
+    const FourBarCoupling law({.ground = number("ground", 0),
+                               .input = a,
+                               .coupler = number("coupler", 0),
+                               .output = c,
+                               .branch = static_cast<int>(branch),
+                               .input_offset = phi0});
+    const double x = 0;
+    double d1, d2;
+    if (!law.evaluate({&x, 1}, psi0, {&d1, 1}, {&d2, 1})) psi0 = 0;  // (refused at load)
+  }
+  const auto planar = [](double r, double alpha) {
+    return Vec3(0, -r * std::sin(alpha), r * std::cos(alpha));
+  };
+  for (Json& b : bodies) {
+    if (b["name"] == prefix + "proximal") b["nodes"]["lever"] = vec3_json(pip + planar(a, phi0));
+    if (b["name"] == prefix + "distal") b["nodes"]["lever"] = vec3_json(planar(c, psi0));
+  }
+  for (Json& b : bodies)
+    if (b["name"] == prefix + "proximal")
+      b["elements"].push_back({{"type", "rod"},
+                               {"nodes", {"lever", prefix + "distal/lever"}},
+                               {"mass", f.coupler_mass}});
+}
+
 }  // namespace
 
 FingerParams FingerParams::from(const Params& p) {
@@ -59,7 +101,7 @@ FingerParams FingerParams::from(const Params& p) {
   }
   if (p.has("coupling") && !p.json().at("coupling").is_null()) {
     const Params c = p.child("coupling");
-    c.allow_only({"ratio", "offset", "four_bar", "polynomial", "spline"});
+    c.allow_only({"ratio", "offset", "four_bar", "polynomial", "spline", "coupler_mass"});
     f.coupled = true;
     f.ratio = c.number_or("ratio", 1.0);
     f.offset = c.number_or("offset", 0.0);
@@ -70,6 +112,10 @@ FingerParams FingerParams::from(const Params& p) {
           c.fail(law, "ratio and offset belong to a linear coupling, not to a law");
         f.law = Json{{law, c.json().at(law)}};
       }
+    if (c.has("coupler_mass")) {
+      if (!f.law.contains("four_bar")) c.fail("coupler_mass", "belongs to a four_bar coupling");
+      f.coupler_mass = c.positive("coupler_mass");
+    }
   }
   f.tip_force = p.vec3_or("tip_force", Vec3::Zero());
   if (p.has("lumping")) {
@@ -128,6 +174,7 @@ void append_finger(const FingerParams& f, const std::string& prefix, const std::
     c["joint"] = prefix + "dip";
     c["follows"] = prefix + "pip";
     couplings.push_back(c);
+    if (f.coupler_mass > 0) append_coupler(f, prefix, along[1], bodies);
   } else if (f.coupled) {
     couplings.push_back({{"joint", prefix + "dip"},
                          {"follows", prefix + "pip"},

@@ -24,6 +24,7 @@ struct FingerParams {
   bool coupled = false;                       // θ4 = ratio·θ3 + offset, or
   double ratio = 1.0, offset = 0.0;
   Json law;  // {"four_bar" | "polynomial" | "spline": …}: θ4 = law(θ3) (docs/model-format.md)
+  double coupler_mass = 0;        // with a four_bar: its coupler as a rod between the two levers
   Vec3 tip_force = Vec3::Zero();  // constant external force at the fingertip (world, N)
   bool paper_lumping = false;     // the paper's own discretisation (table N_m, lumping)
 

@@ -1,5 +1,7 @@
 // Nonlinear coupling laws θ_out = f(θ_in) (core/coupling_function.hpp) and the coupling level
 // θ = g(q) they make (core/coupling_level.hpp, core/coupling_chain.hpp).
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <fstream>
@@ -194,13 +196,13 @@ TEST_CASE("the four-bar finger runs in info, equations, simulate and check, and 
   const Run info = run("info " + model);
   REQUIRE(info.code == 0);
   CHECK_THAT(info.out, Catch::Contains("dip (revolute) middle -> distal   theta = four-bar (ground "
-                                       "0.03, input 0.005, coupler 0.03, output 0.007, branch "
-                                       "-1) of pip"));
+                                       "0.03, input 0.005, coupler 0.028, output 0.007, branch "
+                                       "1) of pip"));
   CHECK(run("equations " + model + " --q 0.1,0.5,1 --qd 0.5,1,1 --tensor").code == 0);
   CHECK(run("check " + model).code == 0);
   // A drift in the energy would show a wrong γ = g''[q̇, q̇] in h.
   const Run sim = run("simulate " + model +
-                      " --q0 0,0.5,0.5 --qd0 0,1,1 --t-end 0.5 --gravity 0,0,-9.81 "
+                      " --q0 0,0.5,0.9 --qd0 0,0.5,0.5 --t-end 0.5 "
                       "--integrator dopri --rtol 1e-10 --atol 1e-12 --json");
   REQUIRE(sim.code == 0);
   const auto j = nlohmann::json::parse(sim.out);
@@ -213,6 +215,15 @@ TEST_CASE("the four-bar finger runs in info, equations, simulate and check, and 
     mass_matrix(m, ws, (VecX(3) << 0, 0, pip).finished());
     CHECK(std::abs(ws.theta[3] - 2.0 / 3.0 * pip) < 0.02);
   }
+  // Under gravity the finger falls past pip's limits (femdyn has no joint stops) to where
+  // the linkage cannot assemble: the run stops there with a one-line message.
+  const Run fall = run("simulate " + model +
+                       " --q0 0,0.5,0.9 --qd0 0,1,1 --t-end 0.5 --gravity 0,0,-9.81 "
+                       "--integrator dopri");
+  CHECK(fall.code != 0);
+  CHECK_THAT(fall.out, Catch::Contains("/couplings/0: the law of joint 'dip' is not defined at "
+                                       "pip = ") &&
+                           !Catch::Contains("likely cause"));
   // The same linkage in every finger of the hand: 17 coordinates, energy conserved.
   const Run hand = run("simulate " + model_path("hand_fourbar.json") +
                        " --t-end 0.3 --integrator dopri --rtol 1e-10 --atol 1e-12 --qd0 "
@@ -225,4 +236,79 @@ TEST_CASE("the four-bar finger runs in info, equations, simulate and check, and 
   const Run v = run("validate " + model);
   CHECK(v.code != 0);
   CHECK_THAT(v.out, Catch::Contains("nonlinear coupling law"));
+}
+
+namespace {
+
+// A planar four-bar as a tree: crank (j1) and rocker (j2) both hinged on the ground at
+// O = 0 and P = (d, 0, 0), j2 = four_bar(j1); with `rod_mass` > 0 the coupler is a rod from
+// the crank's tip to the rocker's tip (spanning the two bodies).
+std::string four_bar_json(double coupler_in_law, double rod_mass) {
+  Json doc = Json::parse(R"({"name": "four-bar", "gravity": [0, -9.81, 0], "bodies": [
+    {"name": "crank", "parent": "world", "joint": {"name": "j1", "type": "revolute",
+     "axis": [0, 0, 1]}, "nodes": {"tip": [0.1, 0, 0]},
+     "elements": [{"type": "lumped_point", "node": "tip", "mass": 0.2}]},
+    {"name": "rocker", "parent": "world", "joint": {"name": "j2", "type": "revolute",
+     "axis": [0, 0, 1], "origin": {"xyz": [0.3, 0, 0]}}, "nodes": {"tip": [0.2, 0, 0]},
+     "elements": [{"type": "lumped_point", "node": "tip", "mass": 0.3}]}]})");
+  doc["couplings"] = Json::array({{{"joint", "j2"},
+                                   {"follows", "j1"},
+                                   {"four_bar",
+                                    {{"ground", 0.3},
+                                     {"input", 0.1},
+                                     {"coupler", coupler_in_law},
+                                     {"output", 0.2},
+                                     {"output_offset", 0}}}}});
+  if (rod_mass > 0)
+    doc["bodies"][0]["elements"].push_back(
+        {{"type", "rod"}, {"nodes", {"tip", "rocker/tip"}}, {"mass", rod_mass}});
+  return doc.dump();
+}
+
+}  // namespace
+
+TEST_CASE("a rod spanning two bodies: its length is kept and its M^s is (m/6)(2JaᵀJa + …)",
+          "[coupling][elements]") {
+  const Model bare = load_text(four_bar_json(0.35, 0)), with = load_text(four_bar_json(0.35, 0.4));
+  REQUIRE(with.n() == 1);
+  Workspace wb(bare), ww(with), wp(with), wm(with);
+  const auto tips = [&](Workspace& ws, double q) {  // the rod's ends in world, from the poses
+    mass_matrix(with, ws, VecX::Constant(1, q));
+    const BodyState &c = ws.body[0], &r = ws.body[1];
+    return std::pair<Vec3, Vec3>{c.p + c.R * Vec3(0.1, 0, 0), r.p + r.R * Vec3(0.2, 0, 0)};
+  };
+  for (double q : {-2.5, -1.0, 0.0, 0.7, 2.0}) {
+    const auto [a, b] = tips(ww, q);
+    CHECK((a - b).norm() == Approx(0.35).epsilon(1e-12));  // the loop closes at the rod
+    // Independent: the rod's kinetic energy (m/6)(|v_a|² + v_a·v_b + |v_b|²) with the end
+    // Jacobians by central differences of the end positions.
+    const double h = 1e-6;
+    const auto [ap, bp] = tips(wp, q + h);
+    const auto [am, bm] = tips(wm, q - h);
+    const Vec3 Ja = (ap - am) / (2 * h), Jb = (bp - bm) / (2 * h);
+    const double rod = 0.4 / 3 * (Ja.dot(Ja) + Ja.dot(Jb) + Jb.dot(Jb));  // ½ M q̇² = T
+    mass_matrix(bare, wb, VecX::Constant(1, q));
+    mass_matrix(with, ww, VecX::Constant(1, q));
+    CHECK(ww.Ms(0, 0) - wb.Ms(0, 0) == Approx(rod).epsilon(1e-8));
+  }
+  // Energy is conserved with the rod's gravity and velocity terms.
+  const Run sim = run_shell("echo '" + four_bar_json(0.35, 0.4) + "' > /tmp/femdyn_fourbar_" +
+                            std::to_string(getpid()) + ".json && " + FEMDYN_BINARY +
+                            " simulate /tmp/femdyn_fourbar_" + std::to_string(getpid()) +
+                            ".json --t-end 1 --qd0 3 --integrator dopri --rtol 1e-10 "
+                            "--atol 1e-12 --json");
+  REQUIRE(sim.code == 0);
+  CHECK(Json::parse(sim.out)["energy_balance_relative"].get<double>() < 1e-9);
+}
+
+TEST_CASE("a spanning rod whose length the kinematics change is refused", "[coupling]") {
+  // A rod to the rocker's middle instead of its tip: not a link of the loop.
+  Json doc = Json::parse(four_bar_json(0.35, 0.4));
+  doc["bodies"][1]["nodes"]["mid"] = {0.1, 0, 0};
+  doc["bodies"][0]["elements"][1]["nodes"] = {"tip", "rocker/mid"};
+  CHECK_THROWS_WITH(load_text(doc.dump()),
+                    Catch::Contains("/bodies/0/elements/1: rod spanning two bodies does not keep "
+                                    "its length: ") &&
+                        Catch::Contains(" m at the reference posture, ") &&
+                        Catch::Contains(" m at j1 = "));
 }

@@ -124,7 +124,8 @@ TEST_CASE(
       {"space_bar", R"({"type": "space_bar", "nodes": [[0, 0, 0], [0.3, 0.1, 0]],
          "density": 2700, "area": 1e-4, "Iy": 1e-9, "Iz": 2e-9})"},
       {"rigid_body", R"({"type": "rigid_body", "mass": 1.2, "com": [0.1, 0, 0],
-         "inertia": {"ixx": 0.01, "iyy": 0.02, "izz": 0.025, "ixy": 0.001}})"}};
+         "inertia": {"ixx": 0.01, "iyy": 0.02, "izz": 0.025, "ixy": 0.001}})"},
+      {"rod", R"({"type": "rod", "nodes": [[0, 0, 0], [0.3, 0.1, -0.2]], "mass": 0.5})"}};
   for (const ElementType& t : element_types().entries()) {
     INFO("element type " << t.name);
     REQUIRE(examples.count(std::string(t.name)));

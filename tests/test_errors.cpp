@@ -49,7 +49,7 @@ TEST_CASE("bad-input classes give their pinned messages", "[errors]") {
   CHECK_THAT(error_of(chain(R"({"type": "revolute", "axis": [0, 1, 0]})",
                             R"([{"type": "blob", "node": [0, 0, 0]}])")),
              Equals("bad.json: /bodies/1/elements/0/type: unknown element type 'blob' (known: "
-                    "lumped_point, space_bar, rotary_node, rigid_body)"));
+                    "lumped_point, space_bar, rotary_node, rigid_body, rod)"));
   CHECK_THAT(error_of(chain(R"({"type": "revolute", "axis": [0, 1, 0]})",
                             R"([{"type": "lumped_point", "node": [0, 0, 0], "mass": 1}])", "arm")),
              Equals("bad.json: /bodies/1/parent: unknown parent body 'arm'"));

@@ -23,9 +23,14 @@ constexpr const char* kNoTwinForLaws =
     "has a nonlinear coupling law: its Simbody twin (a closed loop, or a coordinate coupler with "
     "a function) is not built yet, so only linear couplings are validated";
 
+constexpr const char* kNoTwinForSpans =
+    "an element spans two bodies: its Simbody twin (a closed loop) is not built yet";
+
 // What the twin reads of the model; each body's mass properties are the sum of its elements'.
 TwinModel twin_model(const Model& m) {
   if (m.coupling_level) throw ModelError(m.where, kNoTwinForLaws);
+  for (const ElementEntry& e : m.elements)
+    if (e.spans) throw ModelError(e.where, kNoTwinForSpans);
   TwinModel t;
   for (std::size_t b = 0; b < m.bodies.size(); ++b) {
     const Joint& j = m.bodies[b].joint;
@@ -179,6 +184,11 @@ ValidationReport validate(const Model& m, const ValidationOptions& o) {
     r.failure = kNoTwinForLaws;
     return r;
   }
+  for (const ElementEntry& e : m.elements)
+    if (e.spans) {
+      r.failure = kNoTwinForSpans;
+      return r;
+    }
 
   // Each body's elements must sum to a rigid body: nothing else can be built in Simbody.
   const TwinModel tm = twin_model(m);
