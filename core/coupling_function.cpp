@@ -116,7 +116,8 @@ bool FourBarCoupling::solve(double phi, double& psi, double& dpsi, double& d2psi
   const double A = 2 * c * (a * cf - d), B = 2 * a * c * sf;
   const double C = a * a + c * c + d * d - b * b - 2 * a * d * cf;
   const double r2 = A * A + B * B, disc = r2 - C * C;
-  // Locked where the transmission angle is within 1e-6 rad of 0 or π: F_ψ = ±√(A² + B² − C²).
+  // Locked within 1e-6 rad of a dead point (ψ − atan2(B, A) at 0 or π), where
+  // F_ψ = ±√(A² + B² − C²) vanishes: |F_ψ| ≤ 1e-6 √(A² + B²).
   if (!(disc > 1e-12 * r2)) return false;
   psi = std::atan2(B, A) + g_.branch * std::acos(C / std::sqrt(r2));
   const double cp = std::cos(psi), sp = std::sin(psi);

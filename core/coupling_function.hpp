@@ -97,7 +97,8 @@ class FourBarCoupling final : public CouplingFunction {
   // The loop-closure residual |O + a e(φ) − P − c e(ψ)| − b at θ_in, for tests.
   double closure_residual(double theta_in) const;
   // The first input angle in [lo, hi] (finite) where the linkage cannot assemble or locks (its
-  // transmission angle reaches 0 or π: F_ψ = 0), to 1e-9 rad; nullopt if it moves freely.
+  // reaches a dead point: ψ − atan2(B, A) at 0 or π, F_ψ = 0), to 1e-9 rad; nullopt if it
+  // moves freely.
   std::optional<double> lock_angle(double lo, double hi) const override;
   const Geometry& geometry() const { return g_; }
 
