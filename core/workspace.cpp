@@ -39,7 +39,9 @@ Workspace::Workspace(const Model& model) : solver(model) {
     tree = std::make_unique<Workspace>(*model.tree);
     level = std::make_unique<CouplingLevelState>(*model.coupling_level);
     Ms = MatX::Zero(n, n);
-    reduced = Eigen::LLT<MatX>(n);
+    // Factorised once here: sizes its storage and sets its status (Eigen's LLT(n) leaves the
+    // status unset, and copying it is undefined behaviour, which UBSan reports).
+    reduced.compute(MatX::Identity(n, n));
   }
 }
 
