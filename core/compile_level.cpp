@@ -138,11 +138,7 @@ Model compile_with_coupling_level(MechanismSpec spec) {
   // C and θ0: g's linearisation at q_ref (each coordinate at 0, or its nearest limit), for the
   // reports and structure analyses only; a dependence with zero slope there is stored as 1.
   const int n = level->n, nt = level->n_theta;
-  VecX q_ref(n);  // (as reference_posture, before m.n() is the level's)
-  for (int a = 0; a < n; ++a) {
-    const Joint& J = m.bodies[m.theta_joint[level->coordinate_theta[a]]].joint;
-    q_ref[a] = std::clamp(0.0, J.lower, J.upper);
-  }
+  const VecX q_ref = reference_posture(m);  // (by m.coordinate_names, already the level's)
   CouplingLevelState s(*level);
   const VecX zero = VecX::Zero(n);
   if (!evaluate_level(*level, q_ref, zero, zero, s))

@@ -35,6 +35,13 @@ void reduce_mass(Workspace& ws, CouplingLevelState& s) {
   ws.Ms.noalias() = s.G.transpose() * s.MG;
 }
 
+// h = Gᵀ (h_θ + M_θ γ) from the tree's h_θ and M_θ.
+void reduce_bias(Workspace& ws, CouplingLevelState& s) {
+  s.f_theta = ws.tree->h;
+  s.f_theta.noalias() += ws.tree->Ms * s.gamma;
+  ws.h.noalias() = s.G.transpose() * s.f_theta;
+}
+
 }  // namespace
 
 void evaluate(const Model& m, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau) {
@@ -42,9 +49,7 @@ void evaluate(const Model& m, Workspace& ws, const VecX& q, const VecX& qd, cons
   Workspace& t = *ws.tree;
   femdyn::evaluate(*m.tree, t, s.theta, s.theta_dot, kNoActuation);
   reduce_mass(ws, s);
-  s.f_theta = t.h;
-  s.f_theta.noalias() += t.Ms * s.gamma;  // h_θ + M_θ γ
-  ws.h.noalias() = s.G.transpose() * s.f_theta;
+  reduce_bias(ws, s);
   ws.Q.noalias() = s.G.transpose() * t.Q;
   if (tau.size()) ws.Q += tau;
   share_bodies(ws);
@@ -59,11 +64,8 @@ void mass_matrix(const Model& m, Workspace& ws, const VecX& q) {
 
 void evaluate_bias(const Model& m, Workspace& ws, const VecX& q, const VecX& qd) {
   CouplingLevelState& s = level_at(m, ws, q, qd, qd);
-  Workspace& t = *ws.tree;
-  femdyn::evaluate(*m.tree, t, s.theta, s.theta_dot, kNoActuation);
-  s.f_theta = t.h;
-  s.f_theta.noalias() += t.Ms * s.gamma;
-  ws.h.noalias() = s.G.transpose() * s.f_theta;
+  femdyn::evaluate(*m.tree, *ws.tree, s.theta, s.theta_dot, kNoActuation);
+  reduce_bias(ws, s);
   share_bodies(ws);
 }
 

@@ -141,6 +141,14 @@ bool FourBarCoupling::evaluate(std::span<const double> x, double& f, std::span<d
   return true;
 }
 
+std::optional<double> FourBarCoupling::output_angle_at_zero(Geometry g) {
+  g.output_offset = 0;
+  g.output_sign = 1;
+  double psi, dpsi, d2psi;
+  if (!FourBarCoupling(g).solve(g.input_offset, psi, dpsi, d2psi)) return std::nullopt;
+  return wrap(psi);
+}
+
 double FourBarCoupling::closure_residual(double theta_in) const {
   double psi, dpsi, d2psi;
   const double phi = g_.input_offset + g_.input_sign * theta_in;

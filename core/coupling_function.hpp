@@ -101,6 +101,9 @@ class FourBarCoupling final : public CouplingFunction {
   // moves freely.
   std::optional<double> lock_angle(double lo, double hi) const override;
   const Geometry& geometry() const { return g_; }
+  // ψ at θ_in = 0 (the default output_offset: θ_out = 0 there), or nullopt where the linkage
+  // cannot assemble at θ_in = 0. Ignores g's output offset and sign.
+  static std::optional<double> output_angle_at_zero(Geometry g);
 
  private:
   // ψ, ψ', ψ'' at φ; false where it cannot assemble or locks.

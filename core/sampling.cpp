@@ -11,10 +11,12 @@ namespace femdyn {
 namespace {
 
 // Coordinate -> its joint (by name).
+// (By the coordinates' names, so that compile may call it before C has its final width.)
 std::vector<const Joint*> coordinate_joints(const Model& m) {
-  std::vector<const Joint*> joint_of(m.n(), nullptr);
+  const int n = static_cast<int>(m.coordinate_names.size());
+  std::vector<const Joint*> joint_of(n, nullptr);
   std::map<std::string, int> coordinate;
-  for (int a = 0; a < m.n(); ++a) coordinate.emplace(m.coordinate_names[a], a);
+  for (int a = 0; a < n; ++a) coordinate.emplace(m.coordinate_names[a], a);
   for (const Body& b : m.bodies)
     if (const auto it = coordinate.find(b.joint.name); it != coordinate.end())
       joint_of[it->second] = &b.joint;
@@ -25,8 +27,9 @@ std::vector<const Joint*> coordinate_joints(const Model& m) {
 
 VecX reference_posture(const Model& m) {
   const std::vector<const Joint*> joint_of = coordinate_joints(m);
-  VecX q(m.n());
-  for (int a = 0; a < m.n(); ++a)
+  const int n = static_cast<int>(joint_of.size());
+  VecX q(n);
+  for (int a = 0; a < n; ++a)
     q[a] = joint_of[a] ? std::clamp(0.0, joint_of[a]->lower, joint_of[a]->upper) : 0.0;
   return q;
 }

@@ -193,19 +193,12 @@ std::shared_ptr<const CouplingFunction> read_law(const Params& p, int arity) {
   if (f.has("output_offset")) {
     g.output_offset = f.number("output_offset");
   } else {  // θ_out = 0 where θ_in = 0: ψ0 = ψ(φ0)
-    const FourBarCoupling zero({.ground = g.ground,
-                                .input = g.input,
-                                .coupler = g.coupler,
-                                .output = g.output,
-                                .branch = g.branch,
-                                .input_offset = g.input_offset});
-    const double x = 0;
-    double psi0, d1, d2;
-    if (!zero.evaluate({&x, 1}, psi0, {&d1, 1}, {&d2, 1}))
+    const auto psi0 = FourBarCoupling::output_angle_at_zero(g);
+    if (!psi0)
       f.fail("input_offset",
              "the linkage cannot assemble at θ_in = 0, so θ_out = 0 there cannot be the default: "
              "give output_offset");
-    g.output_offset = psi0;
+    g.output_offset = *psi0;
   }
   check_magnitude(g.input_offset, f.path("input_offset"), "input_offset");
   check_magnitude(g.output_offset, f.path("output_offset"), "output_offset");

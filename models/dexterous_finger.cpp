@@ -52,17 +52,15 @@ void append_coupler(const FingerParams& f, const std::string& prefix, const Vec3
   const double a = number("input", 0), c = number("output", 0);
   const double phi0 = number("input_offset", 0), branch = number("branch", 1);
   double psi0 = number("output_offset", NAN);
-  if (std::isnan(psi0)) {  // the default: θ4 = 0 at θ3 = 0
-    const FourBarCoupling law({.ground = number("ground", 0),
-                               .input = a,
-                               .coupler = number("coupler", 0),
-                               .output = c,
-                               .branch = static_cast<int>(branch),
-                               .input_offset = phi0});
-    const double x = 0;
-    double d1, d2;
-    if (!law.evaluate({&x, 1}, psi0, {&d1, 1}, {&d2, 1})) psi0 = 0;  // (refused at load)
-  }
+  if (std::isnan(
+          psi0))  // the default: θ4 = 0 at θ3 = 0 (0 where it cannot assemble: refused at load)
+    psi0 = FourBarCoupling::output_angle_at_zero({.ground = number("ground", 0),
+                                                  .input = a,
+                                                  .coupler = number("coupler", 0),
+                                                  .output = c,
+                                                  .branch = static_cast<int>(branch),
+                                                  .input_offset = phi0})
+               .value_or(0.0);
   const auto planar = [](double r, double alpha) {
     return Vec3(0, -r * std::sin(alpha), r * std::cos(alpha));
   };
