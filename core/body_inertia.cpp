@@ -97,7 +97,7 @@ MassProperties body_mass_properties(const Model& m, int body) {
   MassProperties sum;
   Vec3 first_moment = Vec3::Zero();
   for (const ElementEntry& e : m.elements) {
-    if (e.body != body) continue;
+    if (e.body != body || e.spans) continue;  // a spanning element moves with no one body
     const MassProperties p = e.element->mass_properties();
     sum.mass += p.mass;
     first_moment += p.mass * p.com;

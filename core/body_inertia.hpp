@@ -33,7 +33,8 @@ void condense_body_inertia(Model& model);
 // Model::mass_route and Model::dynamics_route from the structure and an operation count.
 void choose_routes(Model& model);
 
-// The sum of the body's elements' mass properties (body frame).
+// The sum of the body's elements' mass properties (body frame); an element that spans bodies
+// (a rod) moves with no single body and is left out.
 MassProperties body_mass_properties(const Model& model, int body);
 
 // ws.composite: the composite inertias I^c_b (world axes, about the origin) from the body poses.

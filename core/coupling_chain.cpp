@@ -155,6 +155,10 @@ std::vector<MatX> third_order_tensor(const Model& m, Workspace& ws, const VecX& 
   return D;
 }
 
+void joint_state(const Model& m, Workspace& ws, const VecX& q, const VecX& qd) {
+  level_at(m, ws, q, qd, qd);  // sets ws.theta, ws.theta_dot
+}
+
 Energy energy(const Model& m, Workspace& ws, const VecX& q, const VecX& qd) {
   CouplingLevelState& s = level_at(m, ws, q, qd, qd);
   const Energy E = femdyn::energy(*m.tree, *ws.tree, s.theta, s.theta_dot);

@@ -27,5 +27,6 @@ void propagate_bilinear(const Model& m, Workspace& ws, const VecX& q, const VecX
 std::vector<MatX> transform_hessian(const Model& m, Workspace& ws, const VecX& q);
 std::vector<MatX> third_order_tensor(const Model& m, Workspace& ws, const VecX& q);
 Energy energy(const Model& m, Workspace& ws, const VecX& q, const VecX& qd);
+void joint_state(const Model& m, Workspace& ws, const VecX& q, const VecX& qd);
 
 }  // namespace femdyn::chain

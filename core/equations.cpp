@@ -240,6 +240,12 @@ std::vector<MatX> third_order_tensor(const Model& model, Workspace& ws, const Ve
   return D;
 }
 
+void joint_state(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
+  if (model.coupling_level) return chain::joint_state(model, ws, q, qd);
+  coupling_apply(model, q, ws.theta, true);
+  coupling_apply(model, qd, ws.theta_dot, false);
+}
+
 Energy energy(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
   if (model.coupling_level) return chain::energy(model, ws, q, qd);
   evaluate(model, ws, q, qd, VecX());

@@ -87,10 +87,6 @@ TEST_CASE("every bundled model matches Simbody (the paper's discretisation canno
   for (const std::string& name : bundled_models()) {
     const Model m = load_model(model_path(name));
     const ValidationReport r = validation::validate(m, quick(10, 0.2));
-    if (m.coupling_level) {  // (the closed-loop twin is not built yet: issue 13)
-      CHECK_THAT(r.failure, Catch::Contains("has a nonlinear coupling law"));
-      continue;
-    }
     if (name == "finger_paper.json") {
       // Its lumping is the paper's: no rigid body has these element sums (docs/finger.md).
       CHECK_FALSE(r.pass());
@@ -209,6 +205,124 @@ TEST_CASE("a rotary node without its gyroscopic term fails validation", "[valida
   CHECK(r.trajectory.max_state_error > r.trajectory.tolerance);
 }
 
+// A ground parallelogram: cranks a and b hinged 0.3 m apart on the world z axis, b following a
+// (θ_b = θ_a, a linear coupling), their tips joined by a 40 g rod that spans both bodies and
+// stays 0.3 m long; gravity across the plane and along it. The states stay away from the
+// parallelogram's change points (a and b in line with the ground, θ_a = 0 or π), where the
+// loop could fold into its other branch (an anti-parallelogram).
+std::string parallelogram() {
+  return R"({"name": "parallelogram", "gravity": [0.5, -9.81, -2.0], "bodies": [
+    {"name": "a", "parent": "world", "joint": {"type": "revolute", "axis": [0, 0, 1],
+     "damping": 0.01, "limits": [0.7, 2.4]},
+     "nodes": {"tip": [0.2, 0, 0]},
+     "elements": [{"type": "rigid_body", "mass": 0.3, "com": [0.1, 0.01, 0],
+                   "inertia": {"ixx": 0.001, "iyy": 0.002, "izz": 0.0025}},
+                  {"type": "rod", "nodes": ["tip", "b/tip"], "mass": 0.04}]},
+    {"name": "b", "parent": "world", "joint": {"type": "revolute", "axis": [0, 0, 1],
+     "origin": {"xyz": [0.3, 0, 0]}},
+     "nodes": {"tip": [0.2, 0, 0]},
+     "elements": [{"type": "rigid_body", "mass": 0.2, "com": [0.12, 0, 0.01],
+                   "inertia": {"ixx": 0.0008, "iyy": 0.0015, "izz": 0.002}}]},
+    {"name": "c", "parent": "b", "joint": {"type": "revolute", "axis": [1, 0, 0.3],
+     "origin": {"xyz": [0.2, 0, 0.05]}},
+     "elements": [{"type": "lumped_point", "node": [0, 0.1, 0], "mass": 0.1}]}],
+    "couplings": [{"joint": "b", "follows": "a"}]})";
+}
+
+TEST_CASE("closed loops match Simbody: four-bar laws with and without their coupler rod",
+          "[validation][coupling]") {
+  for (const char* name :
+       {"finger_fourbar.json", "finger_fourbar_massless.json", "hand_fourbar.json"}) {
+    const Model m = load_model(model_path(name));
+    const ValidationReport r = validation::validate(m, quick(10, 0.2));
+    require_pass(r, name);
+    // The loop closes at femdyn's θ = g(q): Simbody's rod and coupler constraint errors.
+    const auto loop = std::find_if(r.quantities.begin(), r.quantities.end(),
+                                   [](const auto& q) { return q.name == "loop"; });
+    REQUIRE(loop != r.quantities.end());
+    CHECK(loop->max_rel < 1e-12);
+  }
+  // Under gravity (the finger models have none): Q, q̈ and the trajectory with the rod's weight.
+  const Model tilted =
+      load_model(model_path("finger_fourbar.json"), {.gravity = Vec3(0.0, -9.81, 3.0)});
+  require_pass(validation::validate(tilted, quick(10, 0.2)), "finger_fourbar under gravity");
+}
+
+TEST_CASE("laws of every form, chained, match Simbody's coordinate couplers",
+          "[validation][coupling]") {
+  // A four-bar, a polynomial in two joints and a spline of a coupled joint (tests/helpers.hpp).
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    const Model m = load_text(nonlinear_coupled_tree_json(seed));
+    require_pass(validation::validate(m, quick(8, 0.1)), "seed " + std::to_string(seed));
+  }
+}
+
+TEST_CASE("a rod closing a linear coupling's loop (a parallelogram) matches Simbody",
+          "[validation][coupling]") {
+  const Model m = load_text(parallelogram());
+  REQUIRE(m.coupling_level == nullptr);
+  require_pass(validation::validate(m, quick(10, 0.2)), "parallelogram");
+}
+
+TEST_CASE("the closed-loop twin sees a wrong coupler mass and a wrong law", "[validation]") {
+  const Model m = load_model(model_path("finger_fourbar.json"));
+  Workspace ws(m);
+  const VecX q = (VecX(3) << 0.1, 0.4, 0.9).finished(), qd = (VecX(3) << 0.3, -1, 2).finished();
+  const VecX tau = VecX::Zero(3);
+  evaluate(m, ws, q, qd, tau);
+  {  // the rod 2 % heavier in Simbody: M^s moves by about the rod's share
+    validation::TwinModel tm = validation::twin_model(m);
+    REQUIRE(tm.rods.size() == 1);
+    tm.rods[0].mass *= 1.02;
+    validation::SimbodyTwin twin(tm);
+    const validation::TwinEquations s = twin.equations(q, qd, tau);
+    CHECK(rel_error(ws.Ms, s.M) > 1e-4);
+  }
+  {  // the law's output 1 mrad off: the rod no longer closes the loop
+    validation::TwinModel tm = validation::twin_model(m);
+    REQUIRE(tm.laws.size() == 1);
+    const auto law = tm.laws[0].law;
+    tm.laws[0].law = [law](const double* x, double& f, double* df, double* d2f) {
+      const bool ok = law(x, f, df, d2f);
+      f += 1e-3;
+      return ok;
+    };
+    validation::SimbodyTwin twin(tm);
+    CHECK(twin.equations(q, qd, tau).loop_position_error > 1e-6);
+  }
+  {  // without the rod (the massless model), a slope 1 % off changes q̈ through the coupler
+    const Model massless = load_model(model_path("finger_fourbar_massless.json"));
+    Workspace wm(massless);
+    REQUIRE(forward_dynamics(massless, wm, q, qd, tau).ok);
+    validation::TwinModel tm = validation::twin_model(massless);
+    REQUIRE(tm.rods.empty());
+    const auto law = tm.laws[0].law;
+    tm.laws[0].law = [law](const double* x, double& f, double* df, double* d2f) {
+      const bool ok = law(x, f, df, d2f);
+      df[0] *= 1.01;
+      return ok;
+    };
+    validation::SimbodyTwin twin(tm);
+    CHECK(rel_error(wm.qdd, twin.equations(q, qd, tau).qdd) > 1e-4);
+  }
+}
+
+TEST_CASE("the closed-loop twin refuses a rod that closes no loop", "[validation][coupling]") {
+  // A rod between two bodies welded together: rigid, but it closes no loop of the tree's, so
+  // its Ball constraint would repeat what the weld already imposes.
+  const Model m = load_text(R"({"name": "welded rod", "gravity": [0, 0, -9.81], "bodies": [
+    {"name": "a", "parent": "world", "joint": {"type": "revolute", "axis": [0, 0, 1]},
+     "nodes": {"tip": [0.2, 0, 0]},
+     "elements": [{"type": "lumped_point", "node": [0.1, 0, 0], "mass": 0.3},
+                  {"type": "rod", "nodes": ["tip", "b/tip"], "mass": 0.04}]},
+    {"name": "b", "parent": "a", "joint": {"type": "fixed", "origin": {"xyz": [0.3, 0, 0]}},
+     "nodes": {"tip": [0, 0.2, 0]},
+     "elements": [{"type": "lumped_point", "node": [0, 0.1, 0], "mass": 0.2}]}]})");
+  const ValidationReport r = validation::validate(m, quick(2, 0));
+  CHECK_FALSE(r.pass());
+  CHECK_THAT(r.failure, Catch::Contains("closes no loop"));
+}
+
 TEST_CASE("docs/validation.md lists every bundled model with its current result",
           "[validation][docs]") {
   std::ifstream in(std::string(FEMDYN_SOURCE_DIR) + "/docs/validation.md");
@@ -224,8 +338,7 @@ TEST_CASE("docs/validation.md lists every bundled model with its current result"
          << " (regenerate: ./build/femdyn validate models/*.json models/urdf/*.urdf --markdown)");
     REQUIRE(at != std::string::npos);
     const std::string row = doc.substr(at, doc.find('\n', at) - at);
-    const bool fails =  // the paper's lumping, and laws (no Simbody twin yet)
-        name == "finger_paper.json" || load_model(model_path(name)).coupling_level != nullptr;
+    const bool fails = name == "finger_paper.json";  // the paper's lumping
     CHECK_THAT(row, Catch::Contains(fails ? "| FAIL" : "| PASS |"));
   }
 }

@@ -31,7 +31,7 @@ struct Sampled {
   Status status;
 };
 
-// femdyn's run: advance_to each sample time, x = (C q + θ0, C q̇).
+// femdyn's run: advance_to each sample time, x = (θ, θ̇) of every joint (core joint_state).
 Sampled femdyn_run(const Model& m, const IntegratorOptions& o, const StudyOptions& so,
                    const std::vector<double>& times) {
   Sampled s;
@@ -40,9 +40,11 @@ Sampled femdyn_run(const Model& m, const IntegratorOptions& o, const StudyOption
   integ->reset(0, so.q0, so.qd0, so.t_end);
   const double setup =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  Workspace ws(m);
   const auto sample = [&] {
+    joint_state(m, ws, integ->q(), integ->qd());
     VecX x(2 * m.n_theta());
-    x << m.C * integ->q() + m.theta0, m.C * integ->qd();
+    x << ws.theta, ws.theta_dot;
     s.x.push_back(std::move(x));
     s.energy.push_back(integ->motion().energy_at(integ->y().data()).total());
   };

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "core/names.hpp"
+#include "validation/twin_loops.hpp"
 
 namespace femdyn::validation {
 
@@ -113,12 +114,16 @@ int independent_theta(const TwinModel& model, int k) {
   return -1;
 }
 
+constexpr bool kTiming = false;  // set_state's fit_rods in the timing entry points
+
 struct SimbodyTwin::Impl {
   const TwinModel model;
   SimTK::MultibodySystem system;
   SimTK::SimbodyMatterSubsystem matter{system};
   SimTK::GeneralForceSubsystem forces{system};
   std::vector<SimTK::MobilizedBody> mobod;  // per femdyn body
+  std::vector<SimTK::MobilizedBody> rods;   // closed loop: per TwinModel::rods
+  VecX loop_theta, loop_theta_dot;          // closed loop: θ = g(q), θ̇ = G q̇
   std::vector<int> theta_q, theta_u;        // θ index -> Simbody q / u index
   std::vector<int> independent;             // q index -> θ index, -1 if none
   bool couplers = true;
@@ -140,6 +145,11 @@ struct SimbodyTwin::Impl {
         throw std::runtime_error("Simbody refuses body '" + escaped(j.name) +
                                  "': " + one_line(e.what()));
       }
+    }
+    try {
+      rods = loops::add_rods(m, mobod);
+    } catch (const std::exception& e) {
+      throw std::runtime_error("Simbody refuses a rod: " + one_line(e.what()));
     }
     finish_system();
   }
@@ -192,13 +202,17 @@ struct SimbodyTwin::Impl {
       if (!l.torque.isZero(0)) Force::ConstantTorque(forces, mobod[l.body], to_simtk(l.torque));
     }
 
-    // Couplings θ_j = Σ_k C_jk q_k + θ0_j as constraints among the mobilities, for trajectories.
     independent.resize(m.n());
-    for (int k = 0; k < m.n(); ++k) {
+    if (m.closed_loop()) {  // the laws and rods as constraints, pointwise and for trajectories
+      for (int k = 0; k < m.n(); ++k) independent[k] = m.coordinate_theta[k];
+      loops::add_constraints(matter, m, mobod, rods);
+    }
+    // Couplings θ_j = Σ_k C_jk q_k + θ0_j as constraints among the mobilities, for trajectories.
+    for (int k = 0; k < m.n() && !m.closed_loop(); ++k) {
       independent[k] = independent_theta(m, k);
       if (independent[k] < 0) couplers = false;
     }
-    if (couplers) {
+    if (couplers && !m.closed_loop()) {
       for (int j = 0; j < m.n_theta(); ++j) {
         bool is_independent = false;
         for (int k = 0; k < m.n(); ++k) is_independent |= independent[k] == j;
@@ -261,10 +275,22 @@ struct SimbodyTwin::Impl {
   }
 
   // Sets θ = C q + θ0, θ̇ = C q̇ (without temporaries: the timing entry points use it too) and
-  // realizes `stage`.
-  void set_state(const VecX& q, const VecX& qd, SimTK::Stage stage) {
+  // realizes `stage`. Closed loop: θ = g(q), θ̇ = G q̇, and each rod fitted between its ends
+  // unless `fit_rods` is false (the timing entry points: a rod left as the last call set it
+  // changes none of the work Simbody does, only its constraint errors).
+  void set_state(const VecX& q, const VecX& qd, SimTK::Stage stage, bool fit_rods = true) {
     SimTK::Vector& sq = state.updQ();
     SimTK::Vector& su = state.updU();
+    if (model.closed_loop()) {  // θ = g(q), θ̇ = G q̇, then the rods between their ends
+      loops::joint_state(model, q, qd, loop_theta, loop_theta_dot);
+      for (int j = 0; j < model.n_theta(); ++j) {
+        sq[theta_q[j]] = loop_theta[j];
+        su[theta_u[j]] = loop_theta_dot[j];
+      }
+      if (fit_rods) loops::fit_rods(system, state, model, mobod, rods);
+      system.realize(state, stage);
+      return;
+    }
     for (int j = 0; j < model.n_theta(); ++j) {
       double theta = model.theta0[j], theta_dot = 0;
       for (int k = 0; k < model.n(); ++k) {
@@ -293,6 +319,31 @@ struct SimbodyTwin::Impl {
     return out;
   }
 
+  // Closed loop: q̈ of the coordinates by Simbody's constrained forward dynamics under these
+  // applied forces.
+  VecX constrained_qdd(const SimTK::Vector& applied,
+                       const SimTK::Vector_<SimTK::SpatialVec>& body) {
+    matter.calcAcceleration(state, applied, body, udot, A_GB);
+    VecX out(model.n());
+    for (int k = 0; k < model.n(); ++k) out[k] = udot[theta_u[model.coordinate_theta[k]]];
+    return out;
+  }
+
+  // Closed loop: M^s as the inverse of q̈'s response to a unit force on each coordinate,
+  // (M^s)⁻¹ e_k = q̈(e_k) − q̈(0), with a0 = q̈(no force).
+  MatX constrained_mass(const VecX& a0) {
+    const int n = model.n();
+    MatX response(n, n);
+    SimTK::Vector unit = zero_mobility;
+    for (int k = 0; k < n; ++k) {
+      const int u = theta_u[model.coordinate_theta[k]];
+      unit[u] = 1;
+      response.col(k) = constrained_qdd(unit, zero_body) - a0;
+      unit[u] = 0;
+    }
+    return response.partialPivLu().inverse();
+  }
+
   SimTK::Vector expand(const VecX& x) const {  // C x on Simbody's u layout
     SimTK::Vector out(state.getNU(), 0.0);
     const VecX y = model.C * x;
@@ -318,6 +369,7 @@ TwinEquations SimbodyTwin::equations_unguarded(const VecX& q, const VecX& qd, co
   const int n = m.n(), nt = m.n_theta();
   TwinEquations out;
   s.set_state(q, qd, SimTK::Stage::Dynamics);
+  if (m.closed_loop()) return closed_loop_equations(tau);
 
   // M = Cᵀ M_θ C
   s.matter.calcM(s.state, s.M_theta);
@@ -353,6 +405,30 @@ TwinEquations SimbodyTwin::equations_unguarded(const VecX& q, const VecX& qd, co
   return out;
 }
 
+// The closed loop's equations at the state set by equations_unguarded, from Simbody's
+// constrained forward dynamics alone (twin.hpp).
+TwinEquations SimbodyTwin::closed_loop_equations(const VecX& tau) {
+  Impl& s = *impl_;
+  const TwinModel& m = s.model;
+  TwinEquations out;
+  for (int i = 0; i < s.state.getNQErr(); ++i)
+    out.loop_position_error = std::max(out.loop_position_error, std::abs(s.state.getQErr()[i]));
+  for (int i = 0; i < s.state.getNUErr(); ++i)
+    out.loop_velocity_error = std::max(out.loop_velocity_error, std::abs(s.state.getUErr()[i]));
+  const SimTK::Vector& mob = s.system.getMobilityForces(s.state, SimTK::Stage::Dynamics);
+  const SimTK::Vector_<SimTK::SpatialVec>& body =
+      s.system.getRigidBodyForces(s.state, SimTK::Stage::Dynamics);
+  const VecX a0 = s.constrained_qdd(s.zero_mobility, s.zero_body);  // −(M^s)⁻¹ h
+  const VecX a_forces = s.constrained_qdd(mob, body);               // (M^s)⁻¹ (Q − τ − h)
+  out.M = s.constrained_mass(a0);
+  out.h = -out.M * a0;
+  out.Q = out.M * (a_forces - a0) + tau;
+  SimTK::Vector applied = mob;
+  for (int k = 0; k < m.n(); ++k) applied[s.theta_u[m.coordinate_theta[k]]] += tau[k];
+  out.qdd = s.constrained_qdd(applied, body);
+  return out;
+}
+
 VecX SimbodyTwin::inverse_dynamics(const VecX& q, const VecX& qd, const VecX& qdd) {
   try {
     return inverse_dynamics_unguarded(q, qd, qdd);
@@ -367,6 +443,11 @@ VecX SimbodyTwin::inverse_dynamics_unguarded(const VecX& q, const VecX& qd, cons
   const SimTK::Vector& mob = s.system.getMobilityForces(s.state, SimTK::Stage::Dynamics);
   const SimTK::Vector_<SimTK::SpatialVec>& body =
       s.system.getRigidBodyForces(s.state, SimTK::Stage::Dynamics);
+  if (s.model.closed_loop()) {  // τ = M^s (q̈ − q̈(Simbody's forces))
+    const VecX a_forces = s.constrained_qdd(mob, body);
+    const MatX M = s.constrained_mass(s.constrained_qdd(s.zero_mobility, s.zero_body));
+    return M * (qdd - a_forces);
+  }
   // residual = M_θ θ̈ + h_θ − Q_θ with θ̈ = C q̈;  τ = Cᵀ residual
   s.matter.calcResidualForceIgnoringConstraints(s.state, mob, body, s.expand(qdd), s.residual);
   return s.reduce(s.residual);
@@ -374,7 +455,7 @@ VecX SimbodyTwin::inverse_dynamics_unguarded(const VecX& q, const VecX& qd, cons
 
 void SimbodyTwin::time_mass_and_bias(const VecX& q, const VecX& qd) {
   Impl& s = *impl_;
-  s.set_state(q, qd, SimTK::Stage::Dynamics);
+  s.set_state(q, qd, SimTK::Stage::Dynamics, kTiming);
   s.matter.calcM(s.state, s.M_theta);
   s.matter.calcResidualForceIgnoringConstraints(
       s.state, s.system.getMobilityForces(s.state, SimTK::Stage::Dynamics),
@@ -383,14 +464,14 @@ void SimbodyTwin::time_mass_and_bias(const VecX& q, const VecX& qd) {
 
 void SimbodyTwin::time_bias(const VecX& q, const VecX& qd) {
   Impl& s = *impl_;
-  s.set_state(q, qd, SimTK::Stage::Velocity);
+  s.set_state(q, qd, SimTK::Stage::Velocity, kTiming);
   s.matter.calcResidualForceIgnoringConstraints(s.state, s.zero_mobility, s.zero_body,
                                                 s.zero_mobility, s.bench_out);
 }
 
 void SimbodyTwin::time_forward(const VecX& q, const VecX& qd, const VecX& tau) {
   Impl& s = *impl_;
-  s.set_state(q, qd, SimTK::Stage::Dynamics);
+  s.set_state(q, qd, SimTK::Stage::Dynamics, kTiming);
   const SimTK::Vector& mob = s.system.getMobilityForces(s.state, SimTK::Stage::Dynamics);
   s.bench_applied = mob;  // allocates on the first call only
   for (int k = 0; k < s.model.n(); ++k)
@@ -406,7 +487,7 @@ void SimbodyTwin::time_forward(const VecX& q, const VecX& qd, const VecX& tau) {
 
 void SimbodyTwin::time_inverse(const VecX& q, const VecX& qd, const VecX& qdd) {
   Impl& s = *impl_;
-  s.set_state(q, qd, SimTK::Stage::Dynamics);
+  s.set_state(q, qd, SimTK::Stage::Dynamics, kTiming);
   const int nu = s.state.getNU();
   if (s.bench_theta_ddot.size() != nu) s.bench_theta_ddot = SimTK::Vector(nu, 0.0);
   for (int j = 0; j < s.model.n_theta(); ++j) {
@@ -422,13 +503,13 @@ void SimbodyTwin::time_inverse(const VecX& q, const VecX& qd, const VecX& qdd) {
 
 void SimbodyTwin::time_mass(const VecX& q) {
   Impl& s = *impl_;
-  s.set_state(q, s.rest(), SimTK::Stage::Position);
+  s.set_state(q, s.rest(), SimTK::Stage::Position, kTiming);
   s.matter.calcM(s.state, s.M_theta);
 }
 
 void SimbodyTwin::time_gravity(const VecX& q) {
   Impl& s = *impl_;
-  s.set_state(q, s.rest(), SimTK::Stage::Dynamics);
+  s.set_state(q, s.rest(), SimTK::Stage::Dynamics, kTiming);
   s.matter.calcResidualForceIgnoringConstraints(
       s.state, s.system.getMobilityForces(s.state, SimTK::Stage::Dynamics),
       s.system.getRigidBodyForces(s.state, SimTK::Stage::Dynamics), s.zero_mobility, s.bench_out);
@@ -437,7 +518,7 @@ void SimbodyTwin::time_gravity(const VecX& q) {
 void SimbodyTwin::time_tensor(const VecX& q) {
   Impl& s = *impl_;
   const int n = s.model.n(), nu = s.state.getNU();
-  s.set_state(q, s.rest(), SimTK::Stage::Position);
+  s.set_state(q, s.rest(), SimTK::Stage::Position, kTiming);
   if (s.bench_h1.nrow() != nu || s.bench_h1.ncol() != n) {  // first call only
     s.bench_h1.resize(nu, n);
     s.bench_D.resize(nu, n * n);

@@ -15,8 +15,18 @@
 //   point loads and torques -> Force::ConstantForce / ConstantTorque; τ -> applied mobility
 //   forces; coupling θ = C q + θ0 -> exact reduction (pointwise) and
 //   Constraint::CoordinateCoupler (trajectories).
+// A model with a nonlinear coupling law or an element spanning two bodies is built closed-loop
+// (TwinModel::closed_loop()): the tree of every joint; each coupled joint a
+// Constraint::CoordinateCoupler whose Function is θ_t − f(θ_s…) with the law's exact gradient
+// and Hessian, except the joint whose loop a spanning rod closes; each rod a rigid slender body
+// on a MobilizedBody::LineOrientation at its first end (no inertia about its axis) and a
+// Constraint::Ball at its second. Its equations come from Simbody's constrained forward
+// dynamics alone (SimbodyMatterSubsystem::calcAcceleration), never from femdyn's reduction:
+//   q̈ directly; (M^s)⁻¹ e_k = q̈(unit force on q_k) − q̈(no force); h = −M^s q̈(no force);
+//   Q = M^s (q̈(Simbody's forces) − q̈(no force)) + τ;   τ(q̈) = M^s (q̈ − q̈(Simbody's forces)).
 #pragma once
 #include <Eigen/Dense>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -43,6 +53,27 @@ struct TwinBody {
   Mat3 inertia_origin = Mat3::Zero();  // inertia about the body origin (body frame)
 };
 
+// A coupled joint of the closed-loop twin: θ_theta = f(θ_sources…), f with its exact gradient
+// and Hessian (a core CouplingFunction, passed as a callable: this header is read as C++17).
+// `law` returns false where f is not defined; d2f is arity × arity, row-major.
+struct TwinLaw {
+  int theta = -1;
+  std::vector<int> sources;  // θ indices, each a coordinate or a joint resolved before
+  std::function<bool(const double* x, double& f, double* df, double* d2f)> law;
+  std::string name;  // the coupled joint, for messages
+};
+
+// A uniform slender rigid rod (no inertia about its axis) of `mass` between point_a on body_a
+// and point_b on body_b (body frames), `length` apart: an element that spans two bodies. It
+// closes the loop of coupled joint θ `closes` (its Constraint::Ball replaces that coupler).
+struct TwinRod {
+  int body_a = -1, body_b = -1;
+  Vec3 point_a = Vec3::Zero(), point_b = Vec3::Zero();
+  double mass = 0, length = 0;
+  int closes = -1;
+  std::string name;  // the element's place in the file, for messages
+};
+
 struct TwinModel {
   std::vector<TwinBody> bodies;  // parents first
   std::vector<int> theta_body;   // θ index -> body
@@ -54,7 +85,13 @@ struct TwinModel {
     Vec3 point, force, torque;  // point in the body frame; force, torque in the world frame
   };
   std::vector<Load> loads;
-  int n() const { return static_cast<int>(C.cols()); }
+  // The closed-loop form (nonlinear coupling laws or rods): q_k = θ_{coordinate_theta[k]}, the
+  // other joints follow `laws` (dependency order); C and θ0 are then unused.
+  std::vector<int> coordinate_theta;
+  std::vector<TwinLaw> laws;
+  std::vector<TwinRod> rods;
+  bool closed_loop() const { return !laws.empty() || !rods.empty(); }
+  int n() const { return static_cast<int>(closed_loop() ? coordinate_theta.size() : C.cols()); }
   int n_theta() const { return static_cast<int>(theta_body.size()); }
 };
 
@@ -62,6 +99,9 @@ struct TwinModel {
 struct TwinEquations {
   MatX M;
   VecX h, Q, qdd;
+  // Closed loop: Simbody's constraint errors at the state set from q, q̇ (max |qerr|, |uerr|:
+  // m and m/s for a rod's ball, rad and rad/s for a coupler); 0 otherwise.
+  double loop_position_error = 0, loop_velocity_error = 0;
 };
 
 struct TwinSample {
@@ -164,6 +204,7 @@ class SimbodyTwin {
   // The same without the guard that turns SimTK's exceptions into one line.
   TwinEquations equations_unguarded(const VecX& q, const VecX& qd, const VecX& tau);
   VecX inverse_dynamics_unguarded(const VecX& q, const VecX& qd, const VecX& qdd);
+  TwinEquations closed_loop_equations(const VecX& tau);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -11,6 +11,7 @@
 #include "core/errors.hpp"
 #include "core/fixed_step.hpp"
 #include "core/inertia.hpp"
+#include "core/kinematics.hpp"
 #include "core/model.hpp"
 #include "core/sampling.hpp"
 #include "validation/twin.hpp"
@@ -18,19 +19,119 @@
 
 namespace femdyn::validation {
 
-// What a model with a nonlinear coupling law gets (issue 13: the closed-loop twin is next).
-constexpr const char* kNoTwinForLaws =
-    "has a nonlinear coupling law: its Simbody twin (a closed loop, or a coordinate coupler with "
-    "a function) is not built yet, so only linear couplings are validated";
+namespace {
 
-constexpr const char* kNoTwinForSpans =
-    "an element spans two bodies: its Simbody twin (a closed loop) is not built yet";
+// The θ of the joints on the tree path between bodies a and b.
+std::vector<int> path_joints(const Model& m, int a, int b) {
+  std::vector<int> up_a, up_b;
+  for (int x = a; x >= 0; x = m.bodies[x].parent) up_a.push_back(x);
+  for (int x = b; x >= 0; x = m.bodies[x].parent) up_b.push_back(x);
+  while (!up_a.empty() && !up_b.empty() && up_a.back() == up_b.back())
+    up_a.pop_back(), up_b.pop_back();  // the common ancestors
+  std::vector<int> out;
+  for (const auto* side : {&up_a, &up_b})
+    for (int x : *side)
+      if (m.bodies[x].joint.theta >= 0) out.push_back(m.bodies[x].joint.theta);
+  return out;
+}
+
+// An element spanning two bodies as the twin's rod: it must be a uniform rod
+// (m_e = (m/6)[[2·1, 1], [1, 2·1]] on its two ends' translations) and close the loop of exactly
+// one coupled joint on the tree path between its ends.
+TwinRod twin_rod(const Model& m, const ElementEntry& e, const TwinModel& t) {
+  const auto nodes = e.element->nodes();
+  if (nodes.size() != 2 || e.node_body[0] == e.node_body[1])
+    throw ModelError(e.where,
+                     "the Simbody twin builds an element spanning bodies only as a rod "
+                     "between two bodies");
+  const MatX me = e.element->local_mass();
+  TwinRod r;
+  r.mass = 3 * me(0, 0);
+  MatX rod = MatX::Zero(12, 12);
+  for (int i = 0; i < 3; ++i) {
+    rod(i, i) = rod(6 + i, 6 + i) = r.mass / 3;
+    rod(i, 6 + i) = rod(6 + i, i) = r.mass / 6;
+  }
+  if (me.rows() != 12 || max_abs(me - rod) > 1e-12 * std::max(max_abs(rod), 1e-300))
+    throw ModelError(e.where,
+                     "the Simbody twin builds an element spanning bodies only as a "
+                     "uniform rod (m_e = (m/6)[[2, 1], [1, 2]] on its ends)");
+  r.name = e.where;
+  r.body_a = e.node_body[0], r.body_b = e.node_body[1];
+  r.point_a = nodes[0].position, r.point_b = nodes[1].position;
+  Workspace ws(m);  // its length, kept by every posture (compile checks it)
+  propagate(m, ws, reference_posture(m), VecX::Zero(m.n()), {.jacobian = false, .bias = false});
+  const auto world = [&](int l) {
+    const BodyState& B = ws.body[e.node_body[l]];
+    return Vec3(B.p + B.R * nodes[l].position);
+  };
+  r.length = (world(1) - world(0)).norm();
+  for (int theta : path_joints(m, r.body_a, r.body_b))
+    for (const TwinLaw& law : t.laws)
+      if (law.theta == theta) {
+        if (r.closes >= 0)
+          throw ModelError(e.where, "the rod spans more than one coupled joint ('" +
+                                        t.laws[0].name +
+                                        "' …): the Simbody twin cannot tell "
+                                        "which loop it closes");
+        r.closes = theta;
+      }
+  if (r.closes < 0)
+    throw ModelError(e.where,
+                     "the rod spans no coupled joint, so it closes no loop the Simbody "
+                     "twin can build (its constraint would repeat the couplings)");
+  for (const TwinRod& other : t.rods)
+    if (other.closes == r.closes)
+      throw ModelError(e.where, "two rods close the loop of the same joint");
+  return r;
+}
+
+// The closed-loop form of the twin (twin.hpp): every coupled joint a law of the joints it
+// follows, every element that spans bodies a rod.
+void add_loops(const Model& m, TwinModel& t) {
+  if (m.coupling_level) {
+    t.coordinate_theta = m.coupling_level->coordinate_theta;
+    for (const CoupledJoint& j : m.coupling_level->coupled)
+      t.laws.push_back({j.theta, j.sources,
+                        [law = j.law](const double* x, double& f, double* df, double* d2f) {
+                          const std::size_t k = law->arity();
+                          return law->evaluate({x, k}, f, {df, k}, {d2f, k * k});
+                        },
+                        j.name});
+  } else {  // linear couplings, each coordinate a joint of its own
+    for (int k = 0; k < m.n(); ++k) {
+      const int j = independent_theta(t, k);
+      if (j < 0)
+        throw ModelError(m.where, "coordinate '" + m.coordinate_names[k] +
+                                      "' drives no joint directly: the closed-loop Simbody twin "
+                                      "needs each coordinate to be a joint");
+      t.coordinate_theta.push_back(j);
+    }
+    for (int j = 0; j < m.n_theta(); ++j) {
+      if (std::find(t.coordinate_theta.begin(), t.coordinate_theta.end(), j) !=
+          t.coordinate_theta.end())
+        continue;
+      TwinLaw law{j, {}, {}, m.bodies[m.theta_joint[j]].joint.name};
+      std::vector<double> ratios;
+      for (int k = 0; k < m.n(); ++k)
+        if (t.C(j, k) != 0)
+          law.sources.push_back(t.coordinate_theta[k]), ratios.push_back(t.C(j, k));
+      auto linear = std::make_shared<LinearCoupling>(std::move(ratios), t.theta0[j]);
+      law.law = [linear](const double* x, double& f, double* df, double* d2f) {
+        const std::size_t k = linear->arity();
+        return linear->evaluate({x, k}, f, {df, k}, {d2f, k * k});
+      };
+      t.laws.push_back(std::move(law));
+    }
+  }
+  for (const ElementEntry& e : m.elements)
+    if (e.spans) t.rods.push_back(twin_rod(m, e, t));
+}
+
+}  // namespace
 
 // What the twin reads of the model; each body's mass properties are the sum of its elements'.
 TwinModel twin_model(const Model& m) {
-  if (m.coupling_level) throw ModelError(m.where, kNoTwinForLaws);
-  for (const ElementEntry& e : m.elements)
-    if (e.spans) throw ModelError(e.where, kNoTwinForSpans);
   TwinModel t;
   for (std::size_t b = 0; b < m.bodies.size(); ++b) {
     const Joint& j = m.bodies[b].joint;
@@ -61,6 +162,9 @@ TwinModel twin_model(const Model& m) {
     t.loads.push_back({l.body, l.point, l.force, Vec3::Zero()});
   for (const BodyTorque& q : m.torques)
     t.loads.push_back({q.body, Vec3::Zero(), Vec3::Zero(), q.torque});
+  const bool spans = std::any_of(m.elements.begin(), m.elements.end(),
+                                 [](const ElementEntry& e) { return e.spans; });
+  if (m.coupling_level || spans) add_loops(m, t);
   return t;
 }
 
@@ -80,12 +184,14 @@ bool integrate(const Model& m, const VecX& q0, const VecX& qd0, const std::vecto
                double dt, std::vector<VecX>& state, std::vector<double>& energy) {
   Rk4 rk4(m, {.dt = dt});
   rk4.reset(0, q0, qd0);
+  Workspace ws(m);
   for (double target : times) {
     const Status st = rk4.advance_to(target);
     if (st.non_finite) throw std::runtime_error("along the trajectory: " + st.message);
     if (!st.ok) return false;
+    joint_state(m, ws, rk4.q(), rk4.qd());
     VecX x(2 * m.n_theta());
-    x << m.C * rk4.q() + m.theta0, m.C * rk4.qd();
+    x << ws.theta, ws.theta_dot;
     state.push_back(std::move(x));
     energy.push_back(rk4.motion().energy_at(rk4.y().data()).total());
   }
@@ -180,18 +286,19 @@ ValidationReport validate(const Model& m, const ValidationOptions& o) {
         "the model gives its correlation table explicitly; DOFs it leaves out or "
         "joins are approximations of the rigid bodies Simbody simulates");
   for (const std::string& a : m.approximations) r.notes.push_back("approximation: " + a);
-  if (m.coupling_level) {
-    r.failure = kNoTwinForLaws;
-    return r;
-  }
-  for (const ElementEntry& e : m.elements)
-    if (e.spans) {
-      r.failure = kNoTwinForSpans;
-      return r;
-    }
 
   // Each body's elements must sum to a rigid body: nothing else can be built in Simbody.
-  const TwinModel tm = twin_model(m);
+  TwinModel tm;
+  try {
+    tm = twin_model(m);
+  } catch (const ModelError& e) {
+    r.failure = e.what();
+    return r;
+  }
+  if (tm.closed_loop())
+    r.notes.push_back("closed loop: " + std::to_string(tm.laws.size()) + " coupled joint(s), " +
+                      std::to_string(tm.rods.size()) +
+                      " rod(s); Simbody's equations from its constrained forward dynamics");
   for (std::size_t b = 0; b < tm.bodies.size(); ++b) {
     const TwinBody& tb = tm.bodies[b];
     const Mat3 I_com = tb.inertia_origin - point_inertia(tb.mass, tb.com);  // parallel axis
@@ -218,8 +325,16 @@ ValidationReport validate(const Model& m, const ValidationOptions& o) {
   Workspace ws(m);
   for (const char* name : {"M", "h", "Q", "qdd", "tau"})
     r.quantities.push_back({name, 0, 0, o.tolerance});
+  if (tm.closed_loop()) r.quantities.push_back({"loop", 0, 0, o.tolerance});
   QuantityError &eM = r.quantities[0], &eh = r.quantities[1], &eQ = r.quantities[2],
                 &eqdd = r.quantities[3], &etau = r.quantities[4];
+  // The loop's closure at femdyn's θ = g(q), θ̇ = G q̇: Simbody's constraint errors relative to
+  // the longest rod (m) and its speed, or in rad and rad/s for couplers alone.
+  double length = 1;
+  if (!tm.rods.empty()) {
+    length = 0;
+    for (const TwinRod& rod : tm.rods) length = std::max(length, rod.length);
+  }
 
   std::mt19937 rng(o.seed);
   VecX q0, qd0;
@@ -231,6 +346,13 @@ ValidationReport validate(const Model& m, const ValidationOptions& o) {
     if (k == 0) q0 = q, qd0 = qd;
 
     const TwinEquations s = twin.equations(q, qd, tau);
+    if (tm.closed_loop()) {
+      QuantityError& loop = r.quantities[5];
+      const double speed = length * std::max(1.0, max_abs(qd));
+      loop.max_abs = std::max({loop.max_abs, s.loop_position_error, s.loop_velocity_error});
+      loop.max_rel =
+          std::max({loop.max_rel, s.loop_position_error / length, s.loop_velocity_error / speed});
+    }
     const Status st = forward_dynamics(m, ws, q, qd, tau);
     evaluate(m, ws, q, qd, tau);
     accumulate(eM, ws.Ms, s.M);
