@@ -6,11 +6,10 @@
 #include <sstream>
 
 #include "core/limits.hpp"
-#include "elements/registry.hpp"
+#include "io/catalog.hpp"
 #include "io/input_file.hpp"
 #include "io/params.hpp"
 #include "io/urdf_loader.hpp"
-#include "models/plugins.hpp"
 
 namespace femdyn {
 namespace {
@@ -88,7 +87,7 @@ std::map<std::string, Vec3> qualified_nodes(const Json& bodies) {
   return all;
 }
 
-BodySpec read_body(const Json& jb, const std::string& where,
+BodySpec read_body(const Catalog& catalog, const Json& jb, const std::string& where,
                    const std::map<std::string, Vec3>& other_nodes) {
   const Params p(jb, where);
   p.allow_only({"name", "parent", "joint", "nodes", "elements"});
@@ -110,10 +109,10 @@ BodySpec read_body(const Json& jb, const std::string& where,
     for (std::size_t e = 0; e < je.size(); ++e) {
       const Params ep(je[e], p.path("elements") + "/" + std::to_string(e), b.name, &nodes);
       const std::string type = ep.string("type");
-      const ElementType* t = element_types().find(type);
+      const ElementType* t = catalog.elements.find(type);
       if (!t)
         ep.fail("type",
-                "unknown element type '" + type + "' (known: " + element_types().names() + ")");
+                "unknown element type '" + type + "' (known: " + catalog.elements.names() + ")");
       ElementSink sink(b.elements, ep.where());
       t->make(ep, sink);
     }
@@ -277,15 +276,15 @@ LoadSpec read_load(const Params& p, const Json& bodies) {
 
 // {"model": NAME, "params": {…}, "name", "description", "gravity", "loads"}: the plugin writes
 // the bodies (and couplings, loads, table); the file's own name, gravity and loads apply on top.
-MechanismSpec parse_document(const Json& root, const std::string& source);
+MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std::string& source);
 
-Json expand_plugin(const Json& root, const std::string& source) {
+Json expand_plugin(const Catalog& catalog, const Json& root, const std::string& source) {
   const Params p(root, source + ": ");
   p.allow_only({"model", "params", "name", "description", "gravity", "loads", "$schema"});
   const std::string name = p.string("model");
-  const ModelPlugin* plugin = model_plugins().find(name);
+  const ModelPlugin* plugin = catalog.plugins.find(name);
   if (!plugin)
-    p.fail("model", "unknown model plugin '" + name + "' (known: " + model_plugins().names() + ")");
+    p.fail("model", "unknown model plugin '" + name + "' (known: " + catalog.plugins.names() + ")");
   static const Json empty = Json::object();
   Json doc = plugin->expand(p.has("params") ? p.child("params") : Params(empty, p.path("params")));
   for (const char* key : {"name", "description", "gravity"})
@@ -298,7 +297,7 @@ Json expand_plugin(const Json& root, const std::string& source) {
   return doc;
 }
 
-MechanismSpec parse_document(const Json& root, const std::string& source) {
+MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std::string& source) {
   MechanismSpec spec;
   spec.where = source + ": ";
   const auto path = [&](const std::string& s) { return source + ": /" + s; };
@@ -319,7 +318,8 @@ MechanismSpec parse_document(const Json& root, const std::string& source) {
   const Json& bodies = root["bodies"];
   const std::map<std::string, Vec3> qualified = qualified_nodes(bodies);
   for (std::size_t i = 0; i < bodies.size(); ++i)
-    spec.bodies.push_back(read_body(bodies[i], path("bodies/" + std::to_string(i)), qualified));
+    spec.bodies.push_back(
+        read_body(catalog, bodies[i], path("bodies/" + std::to_string(i)), qualified));
   if (root.contains("couplings")) {
     if (!root["couplings"].is_array()) throw ModelError(path("couplings"), "expected an array");
     for (std::size_t i = 0; i < root["couplings"].size(); ++i)
@@ -375,7 +375,8 @@ MechanismSpec parse_document(const Json& root, const std::string& source) {
 
 }  // namespace
 
-MechanismSpec parse_spec(const std::string& text, const std::string& source) {
+MechanismSpec parse_spec(const std::string& text, const std::string& source,
+                         const Catalog& catalog) {
   Json root;
   try {
     // The nesting depth is bounded while parsing (core/limits.hpp), before a deep document
@@ -397,13 +398,15 @@ MechanismSpec parse_spec(const std::string& text, const std::string& source) {
     throw ModelError(source, "malformed JSON: " +
                                  (bracket == std::string::npos ? what : what.substr(bracket + 2)));
   }
-  return parse_model_json(root, source);
+  return parse_model_json(root, source, catalog);
 }
 
-MechanismSpec parse_model_json(const Json& root, const std::string& source) {
+MechanismSpec parse_model_json(const Json& root, const std::string& source,
+                               const Catalog& catalog) {
   if (!root.is_object()) throw ModelError(source, "expected a JSON object at the top level");
-  if (root.contains("model")) return parse_document(expand_plugin(root, source), source);
-  return parse_document(root, source);
+  if (root.contains("model"))
+    return parse_document(catalog, expand_plugin(catalog, root, source), source);
+  return parse_document(catalog, root, source);
 }
 
 namespace {
@@ -443,16 +446,18 @@ Json model_document(const std::string& path, const LoadOptions& options) {
   }
   Json root;
   const std::string text = read_text(path);
-  (void)parse_spec(text, path);  // reports malformed JSON and every model error with its path
+  const Catalog& catalog = options.catalog ? *options.catalog : default_catalog();
+  (void)parse_spec(text, path, catalog);  // reports malformed JSON, every model error by path
   root = Json::parse(text);
-  return root.contains("model") ? expand_plugin(root, path) : root;
+  return root.contains("model") ? expand_plugin(catalog, root, path) : root;
 }
 
 MechanismSpec read_spec(const std::string& path, const LoadOptions& options) {
-  if (!is_urdf_path(path)) return parse_spec(read_text(path), path);
+  const Catalog& catalog = options.catalog ? *options.catalog : default_catalog();
+  if (!is_urdf_path(path)) return parse_spec(read_text(path), path, catalog);
   const Json doc = model_document(path, options);
   try {
-    return parse_model_json(doc, path);
+    return parse_model_json(doc, path, catalog);
   } catch (const ModelError& e) {
     rethrow_for_urdf(e, doc, path);
   }
@@ -468,7 +473,7 @@ Model load_model(const std::string& path, const LoadOptions& options) {
   try {
     return compile(std::move(spec));
   } catch (const ModelError& e) {
-    rethrow_for_urdf(e, model_document(path), path);
+    rethrow_for_urdf(e, model_document(path, options), path);
   }
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/model.hpp"
+#include "io/catalog.hpp"
 #include "io/params.hpp"
 
 namespace femdyn {
@@ -14,13 +15,16 @@ struct LoadOptions {
   std::optional<Vec3> gravity;                          // overrides the model's gravity
   std::string gravity_source = "LoadOptions::gravity";  // names it in messages ("--gravity")
   std::function<void(const std::string&)> warn;  // non-fatal notes (e.g. URDF friction ignored)
+  const Catalog* catalog = nullptr;  // element types and model plugins; null: default_catalog()
 };
 
 // A model file: femdyn JSON, or URDF by its extension .urdf (io/urdf_loader.hpp).
 MechanismSpec read_spec(const std::string& path, const LoadOptions& options = {});
-MechanismSpec parse_spec(const std::string& text, const std::string& source_name);
+MechanismSpec parse_spec(const std::string& text, const std::string& source_name,
+                         const Catalog& catalog = default_catalog());
 // A parsed JSON model document (plain or {"model": plugin, "params": …}).
-MechanismSpec parse_model_json(const Json& root, const std::string& source_name);
+MechanismSpec parse_model_json(const Json& root, const std::string& source_name,
+                               const Catalog& catalog = default_catalog());
 Model load_model(const std::string& path, const LoadOptions& options = {});
 
 // The model document a file describes (a URDF converted, a plugin expanded), as JSON that

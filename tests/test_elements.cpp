@@ -1,11 +1,16 @@
 // Element equivalence: one body given as a rigid body, as a space bar with its rotary inertia,
 // and as four equimomental points gives the same M^s and h. Conformance over every type.
+#include <array>
 #include <catch2/catch.hpp>
 #include <sstream>
 
+#include "core/equations.hpp"
 #include "core/inertia.hpp"
+#include "elements/lumped_point.hpp"
 #include "elements/registry.hpp"
 #include "elements/space_bar.hpp"
+#include "io/model_loader.hpp"
+#include "models/plugins.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;
@@ -185,4 +190,38 @@ TEST_CASE("rotary node: leaving out the gyroscopic term changes h on a 3D chain"
   const VecX without_gyro = ws.T.transpose() * (m.M * ws.bias);
   REQUIRE(without_gyro.size() == 2);
   CHECK((h_full - without_gyro).norm() > 0.1 * h_full.norm());
+}
+
+TEST_CASE("the loader builds elements and plugins from the catalog it is given", "[elements][io]") {
+  // A catalog with one extra element type, "heavy_point": a lumped point of twice its mass.
+  static const std::array types = {ElementType{
+      "heavy_point", +[](const Params& p, ElementSink& sink) {
+        p.allow_only({"type", "node", "mass"});
+        const NodeRef n = p.node("node");
+        sink.add(std::make_unique<LumpedPoint>(n.position, 2 * p.positive("mass")), {n.label});
+      }}};
+  const Catalog custom{Registry<ElementType>(types), model_plugins()};
+  const auto pendulum = [](const std::string& element) {
+    return R"({"name": "p", "gravity": [0, 0, -9.81], "bodies": [{"name": "bob", "parent":
+      "world", "joint": {"type": "revolute", "axis": [0, 1, 0]}, "elements": [)" +
+           element + "]}]}";
+  };
+  const std::string heavy = pendulum(R"({"type": "heavy_point", "node": [0, 0, -1], "mass": 0.5})");
+  const Model a = compile(parse_spec(heavy, "custom.json", custom));
+  const Model b = load_text(pendulum(R"({"type": "lumped_point", "node": [0, 0, -1], "mass": 1})"));
+  Workspace wa(a), wb(b);
+  const VecX q = VecX::Constant(1, 0.7), qd = VecX::Constant(1, 1.3);
+  evaluate(a, wa, q, qd, VecX());
+  evaluate(b, wb, q, qd, VecX());
+  CHECK(wa.Ms(0, 0) == Approx(1.0));  // m l² with m = 2 × 0.5
+  CHECK(wa.Ms(0, 0) == wb.Ms(0, 0));
+  CHECK(wa.Q(0) == wb.Q(0));
+  // femdyn's own catalog does not know it, and says which types it knows.
+  CHECK_THROWS_WITH(parse_spec(heavy, "custom.json"),
+                    "custom.json: /bodies/0/elements/0/type: unknown element type 'heavy_point' "
+                    "(known: lumped_point, space_bar, rotary_node, rigid_body, rod)");
+  // Nor does the custom one know femdyn's plugins if it is not given them.
+  const Catalog no_plugins{Registry<ElementType>(types), Registry<ModelPlugin>({})};
+  CHECK_THROWS_WITH(parse_spec(R"({"model": "random_tree"})", "tree.json", no_plugins),
+                    Catch::Contains("unknown model plugin 'random_tree' (known: )"));
 }
