@@ -6,6 +6,11 @@
 
 namespace femdyn {
 
+void RigidBodyShorthand::point_rotary(double m, const Vec3& c, const Mat3& I, ElementSink& sink) {
+  sink.add(std::make_unique<LumpedPoint>(c, m), {"com"});
+  sink.add(std::make_unique<RotaryNode>(c, I), {"com"});
+}
+
 void RigidBodyShorthand::from_params(const Params& p, ElementSink& sink) {
   p.allow_only({"type", "mass", "com", "inertia", "equivalent"});
   const double m = p.positive("mass");
@@ -14,8 +19,7 @@ void RigidBodyShorthand::from_params(const Params& p, ElementSink& sink) {
   if (auto problem = inertia_problem(I)) p.fail("inertia", *problem);
   const std::string how = p.has("equivalent") ? p.string("equivalent") : "point_rotary";
   if (how == "point_rotary") {
-    sink.add(std::make_unique<LumpedPoint>(c, m), {"com"});
-    sink.add(std::make_unique<RotaryNode>(c, I), {"com"});
+    point_rotary(m, c, I, sink);
   } else if (how == "four_points") {
     const auto pts = equimomental_points(m, c, I);
     if (!pts)

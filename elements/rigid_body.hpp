@@ -10,6 +10,9 @@ namespace femdyn {
 
 struct RigidBodyShorthand {
   static void from_params(const Params& p, ElementSink& sink);
+  // The default variant: a lumped point m and a rotary node I (centroidal, body axes) at the
+  // centre of mass c, both at the node "com".
+  static void point_rotary(double m, const Vec3& c, const Mat3& I, ElementSink& sink);
 };
 
 }  // namespace femdyn

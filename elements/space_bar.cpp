@@ -46,6 +46,14 @@ Mat3 SpaceBar::bar_frame(const Vec3& a, const Vec3& b, const Vec3* y_hint) {
   return R;
 }
 
+std::unique_ptr<SpaceBar> SpaceBar::from_mass_properties(const Vec3& a, const Vec3& b, double m,
+                                                         const Mat3& I_c) {
+  const Vec3 half = 0.5 * (b - a);
+  Mat3 J = I_c - point_inertia(m, half);  // ends m/2 at ±(l/2) x
+  J = 0.5 * (J + J.transpose()).eval();
+  return std::make_unique<SpaceBar>(a, b, m, J);
+}
+
 // {"type": "space_bar", "nodes": [a, b], "density": ρ, "area": A, "Iy": …, "Iz": …,
 //  "section_y": [..]}  or  {"type": "space_bar", "nodes": [a, b], "mass": m, "inertia": I_c}
 void SpaceBar::from_params(const Params& p, ElementSink& sink) {
@@ -70,8 +78,8 @@ void SpaceBar::from_params(const Params& p, ElementSink& sink) {
     m = p.positive("mass");
     const Mat3 Ic = p.inertia("inertia");
     if (auto problem = inertia_problem(Ic)) p.fail("inertia", *problem);
-    J = Ic - point_inertia(m, 0.5 * l * x);  // ends m/2 at ±(l/2) x
-    J = 0.5 * (J + J.transpose()).eval();
+    sink.add(from_mass_properties(a.position, b.position, m, Ic), {a.label, b.label});
+    return;
   } else {
     if (p.has("inertia"))
       p.fail("inertia", "give either mass and inertia or density, area, Iy, Iz");

@@ -28,6 +28,11 @@ class SpaceBar final : public Element {
   // Bar frame (columns x̂ ŷ ẑ in body axes): x̂ along b − a; ŷ from the hint projected off x̂
   // (default: the body axis least aligned with x̂).
   static Mat3 bar_frame(const Vec3& a, const Vec3& b, const Vec3* y_hint);
+  // The bar of mass m and centroidal inertia I_c (body axes) between a and b: m/2 at each end
+  // and J_rot = I_c − (m l²/4)(1 − x̂ x̂ᵀ), the rest of I_c (the JSON form with "mass" and
+  // "inertia"; a ≠ b and I_c physical are checked by the caller).
+  static std::unique_ptr<SpaceBar> from_mass_properties(const Vec3& a, const Vec3& b, double m,
+                                                        const Mat3& I_c);
   static void from_params(const Params& p, ElementSink& sink);
 
  private:

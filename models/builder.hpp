@@ -1,0 +1,70 @@
+// MechanismBuilder: a mechanism described in code, without JSON — bodies with their joints,
+// named nodes and elements, couplings (linear or a law), loads — into the plain MechanismSpec
+// (core/spec.hpp) that compile() turns into a Model. The same model as the JSON file that says
+// the same things (tests/test_builder.cpp, python/tests). Each call checks its arguments as the
+// JSON loader does and throws ModelError naming the place as a JSON path would:
+//   "arm (builder): /bodies/1/elements/0/mass: must be > 0, got -1".
+// What compile() checks (unknown parents and joints, cycles, a rod that changes length) is
+// reported by compile() with the same paths.
+#pragma once
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "core/model.hpp"
+#include "core/spec.hpp"
+
+namespace femdyn {
+
+// A node of a body: a name from its node table ("tip"; "other_body/tip" for a rod's far end),
+// or a position in the body frame.
+using NodeDescription = std::variant<std::string, Vec3>;
+
+class MechanismBuilder {
+ public:
+  explicit MechanismBuilder(std::string name);
+
+  void gravity(const Vec3& g);
+  // A body hanging from `parent` ("world" for the ground) by `joint` (its name defaults to the
+  // body's; `where` is set here).
+  void body(const std::string& name, const std::string& parent, JointSpec joint);
+  // A named node of a body (its frame).
+  void node(const std::string& body, const std::string& name, const Vec3& position);
+
+  void lumped_point(const std::string& body, const NodeDescription& node, double mass);
+  void rotary_node(const std::string& body, const NodeDescription& node, const Mat3& inertia);
+  // Mass m, centre of mass c and inertia about c (body axes): a lumped point and a rotary node
+  // at "com" (the JSON rigid_body's default "point_rotary").
+  void rigid_body(const std::string& body, double mass, const Vec3& com, const Mat3& inertia);
+  // A rigid bar from a to b of mass m and centroidal inertia I_c (the JSON "mass"/"inertia"
+  // form of space_bar).
+  void space_bar(const std::string& body, const NodeDescription& a, const NodeDescription& b,
+                 double mass, const Mat3& inertia);
+  void rod(const std::string& body, const NodeDescription& a, const NodeDescription& b,
+           double mass);
+
+  // θ_joint = Σ ratio_i θ_{follows_i} + offset.
+  void coupling(const std::string& joint, const std::vector<std::pair<std::string, double>>& terms,
+                double offset = 0);
+  // θ_joint = law(θ_{follows_1}, …) (core/coupling_function.hpp).
+  void coupling(const std::string& joint, const std::vector<std::string>& follows,
+                std::shared_ptr<const CouplingFunction> law);
+  // A constant force (world frame) at `point` (body frame) and a torque (world frame).
+  void load(const std::string& body, const Vec3& point, const Vec3& force, const Vec3& torque);
+
+  const MechanismSpec& spec() const { return spec_; }
+  Model build() const;  // compile(spec())
+
+ private:
+  BodySpec& body_named(const std::string& name, const char* what);
+  std::string next_element(const BodySpec& b) const;  // "…/bodies/i/elements/k"
+  std::pair<Vec3, std::string> resolve(const BodySpec& b, const NodeDescription& node,
+                                       const std::string& where) const;
+  MechanismSpec spec_;
+  std::map<std::string, std::map<std::string, Vec3>> nodes_;  // body -> name -> position
+};
+
+}  // namespace femdyn
