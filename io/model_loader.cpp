@@ -375,6 +375,10 @@ MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std
 
 }  // namespace
 
+CouplingSpec parse_coupling(const Json& coupling, const std::string& where) {
+  return read_coupling(Params(coupling, where));
+}
+
 MechanismSpec parse_spec(const std::string& text, const std::string& source,
                          const Catalog& catalog) {
   Json root;

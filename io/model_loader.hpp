@@ -26,6 +26,10 @@ MechanismSpec parse_spec(const std::string& text, const std::string& source_name
 MechanismSpec parse_model_json(const Json& root, const std::string& source_name,
                                const Catalog& catalog = default_catalog());
 Model load_model(const std::string& path, const LoadOptions& options = {});
+// One entry of "couplings" as the JSON format writes it ({"joint", "follows", "ratio" |
+// "polynomial" | "spline" | "four_bar", …}), read and checked as in a file; `where` names it in
+// messages. For builders that take a coupling in that form (the Python module).
+CouplingSpec parse_coupling(const Json& coupling, const std::string& where);
 
 // The model document a file describes (a URDF converted, a plugin expanded), as JSON that
 // loads back to the same equations: what `femdyn import` writes.

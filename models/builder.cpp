@@ -154,7 +154,7 @@ void MechanismBuilder::coupling(const std::string& joint,
                                 const std::vector<std::pair<std::string, double>>& terms,
                                 double offset) {
   CouplingSpec c;
-  c.where = spec_.where + "/couplings/" + std::to_string(spec_.couplings.size());
+  c.where = next_coupling();
   c.joint = joint;
   for (const auto& [name, ratio] : terms) check_magnitude(ratio, c.where + "/follows", "ratio");
   check_magnitude(offset, c.where + "/offset", "offset");
@@ -168,11 +168,20 @@ void MechanismBuilder::coupling(const std::string& joint,
 void MechanismBuilder::coupling(const std::string& joint, const std::vector<std::string>& follows,
                                 std::shared_ptr<const CouplingFunction> law) {
   CouplingSpec c;
-  c.where = spec_.where + "/couplings/" + std::to_string(spec_.couplings.size());
+  c.where = next_coupling();
   if (!law) throw ModelError(c.where, "no law given");
   c.joint = joint;
   c.follows = follows;
   c.law = std::move(law);
+  spec_.couplings.push_back(std::move(c));
+}
+
+std::string MechanismBuilder::next_coupling() const {
+  return spec_.where + "/couplings/" + std::to_string(spec_.couplings.size());
+}
+
+void MechanismBuilder::coupling(CouplingSpec c) {
+  if (c.where.empty()) c.where = next_coupling();
   spec_.couplings.push_back(std::move(c));
 }
 

@@ -52,6 +52,11 @@ class MechanismBuilder {
   // θ_joint = law(θ_{follows_1}, …) (core/coupling_function.hpp).
   void coupling(const std::string& joint, const std::vector<std::string>& follows,
                 std::shared_ptr<const CouplingFunction> law);
+  // A coupling made elsewhere (e.g. read from its JSON form: io parse_coupling); its `where`
+  // is set here when empty.
+  void coupling(CouplingSpec coupling);
+  // Where the next coupling is, for a caller that names it before adding it.
+  std::string next_coupling() const;
   // A constant force (world frame) at `point` (body frame) and a torque (world frame).
   void load(const std::string& body, const Vec3& point, const Vec3& force, const Vec3& torque);
 
