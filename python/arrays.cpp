@@ -26,14 +26,17 @@ void check_finite(const double* data, Eigen::Index rows, const char* name, const
 
 }  // namespace
 
-VecX vector_arg(const std::optional<Array>& a, const char* name, const Model& model) {
+VecX vector_arg(const Array& a, const char* name, const Model& model) {
   const Eigen::Index n = model.n();
-  if (!a) return VecX::Zero(n);
-  if (a->ndim() != 1 || a->shape(0) != n)
+  if (a.ndim() != 1 || a.shape(0) != n)
     throw py::value_error(std::string(name) + ": expected shape (" + std::to_string(n) +
-                          ",), got " + shape_text(*a));
-  check_finite(a->data(), 1, name, model, false);
-  return Eigen::Map<const VecX>(a->data(), n);
+                          ",), got " + shape_text(a));
+  check_finite(a.data(), 1, name, model, false);
+  return Eigen::Map<const VecX>(a.data(), n);
+}
+
+VecX vector_arg(const std::optional<Array>& a, const char* name, const Model& model) {
+  return a ? vector_arg(*a, name, model) : VecX::Zero(model.n());
 }
 
 Eigen::Map<const RowMatX> batch_arg(const Array& a, const char* name, const Model& model,

@@ -28,7 +28,8 @@ class NumericalError : public std::runtime_error {
 // "(3,)", "(5, 4)".
 std::string shape_text(const py::array& a);
 
-// A state vector: shape (n,), every entry finite. Absent (None) is zero.
+// A state vector: shape (n,), every entry finite. Absent (None, where allowed) is zero.
+VecX vector_arg(const Array& a, const char* name, const Model& model);
 VecX vector_arg(const std::optional<Array>& a, const char* name, const Model& model);
 
 // A batch of states: shape (k, n) with finite entries, seen in place (row i = state i). `k` is

@@ -48,7 +48,7 @@ std::unique_ptr<PyModel> load(const std::string& path, const OptArray& gravity) 
   return model;
 }
 
-EquationsResult equations(PyModel& self, const OptArray& q_in, const OptArray& qd_in,
+EquationsResult equations(PyModel& self, const Array& q_in, const OptArray& qd_in,
                           const OptArray& tau_in) {
   const Model& m = *self.model;
   const VecX q = vector_arg(q_in, "q", m), qd = vector_arg(qd_in, "qd", m),
@@ -60,7 +60,7 @@ EquationsResult equations(PyModel& self, const OptArray& q_in, const OptArray& q
   return r;
 }
 
-VecX forward(PyModel& self, const OptArray& q, const OptArray& qd, const OptArray& tau) {
+VecX forward(PyModel& self, const Array& q, const OptArray& qd, const OptArray& tau) {
   const Model& m = *self.model;
   const Status st = forward_dynamics(m, self.ws, vector_arg(q, "q", m), vector_arg(qd, "qd", m),
                                      vector_arg(tau, "tau", m));
@@ -69,7 +69,7 @@ VecX forward(PyModel& self, const OptArray& q, const OptArray& qd, const OptArra
   return self.ws.qdd;
 }
 
-VecX inverse(PyModel& self, const OptArray& q, const OptArray& qd, const OptArray& qdd) {
+VecX inverse(PyModel& self, const Array& q, const OptArray& qd, const OptArray& qdd) {
   const Model& m = *self.model;
   inverse_dynamics(m, self.ws, vector_arg(q, "q", m), vector_arg(qd, "qd", m),
                    vector_arg(qdd, "qdd", m));
@@ -78,7 +78,7 @@ VecX inverse(PyModel& self, const OptArray& q, const OptArray& qd, const OptArra
 }
 
 // D as an (n, n, n) array, D[a, b, c] = D_abc, h_a = Σ_bc D_abc q̇_b q̇_c.
-py::array_t<double> tensor(PyModel& self, const OptArray& q_in) {
+py::array_t<double> tensor(PyModel& self, const Array& q_in) {
   const Model& m = *self.model;
   const VecX q = vector_arg(q_in, "q", m);
   const double n = m.n(), entries = std::max(n * n * n, m.n_u() * n * n);
@@ -96,7 +96,7 @@ py::array_t<double> tensor(PyModel& self, const OptArray& q_in) {
   return out;
 }
 
-py::dict energy_of(PyModel& self, const OptArray& q, const OptArray& qd) {
+py::dict energy_of(PyModel& self, const Array& q, const OptArray& qd) {
   const Model& m = *self.model;
   const Energy e = energy(m, self.ws, vector_arg(q, "q", m), vector_arg(qd, "qd", m));
   py::dict d;
@@ -181,14 +181,14 @@ void bind_model(py::module_& m) {
            py::arg("qdd") = py::none(), "τ such that M^s q̈ + h = Q(τ)")
       .def(
           "mass_matrix",
-          [](PyModel& s, const OptArray& q) {
+          [](PyModel& s, const Array& q) {
             mass_matrix(*s.model, s.ws, vector_arg(q, "q", *s.model));
             return MatX(s.ws.Ms);
           },
           py::arg("q"), "M^s(q), (n, n)")
       .def(
           "bias",
-          [](PyModel& s, const OptArray& q, const OptArray& qd) {
+          [](PyModel& s, const Array& q, const Array& qd) {
             evaluate_bias(*s.model, s.ws, vector_arg(q, "q", *s.model),
                           vector_arg(qd, "qd", *s.model));
             return VecX(s.ws.h);

@@ -51,7 +51,9 @@ py::dict validate(const PyModel& self, int states, unsigned seed, double toleran
   traj["energy_change_femdyn"] = t.energy_change_femdyn;
   traj["energy_change_simbody"] = t.energy_change_simbody;
   traj["t"] = t.t;
-  traj["error"] = t.error;
+  traj["state_error"] = t.error;
+  traj["energy_femdyn"] = t.energy_femdyn;
+  traj["energy_simbody"] = t.energy_simbody;
   traj["pass"] = t.pass();
   py::dict d;
   d["model"] = r.model;
@@ -73,8 +75,9 @@ void bind_validate(py::module_& m) {
   m.def("validate", &validate, py::arg("model"), py::arg("states") = 20, py::arg("seed") = 1,
         py::arg("tolerance") = 1e-10, py::arg("t_end") = 0.25, py::arg("samples") = 50,
         "The model against its Simbody twin (docs/validation.md): M, h, Q, qdd, tau at `states` "
-        "seeded random states and a passive trajectory of t_end s. Returns a dict: quantities "
-        "{name: {max_abs, max_rel, tolerance, pass}}, trajectory {...}, notes, failure, pass.");
+        "seeded random states and a passive trajectory of t_end s (what `femdyn validate` does, "
+        "less its URDF import check). Returns a dict: quantities {name: {max_abs, max_rel, "
+        "tolerance, pass}}, trajectory {...}, notes, failure, pass. The GIL is released.");
   m.attr("with_simbody") = true;
 #else
   m.attr("with_simbody") = false;
