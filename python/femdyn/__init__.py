@@ -18,11 +18,13 @@ from ._femdyn import (  # noqa: F401
     with_simbody,
 )
 
+from ._sweep import grid, sweep  # noqa: F401,E402  (pandas and dask are imported on use)
+
 if with_simbody:
     from ._femdyn import validate  # noqa: F401
 
-__all__ = ["Equations", "Model", "ModelError", "NumericalError", "load", "simulate",
-           "with_simbody"] + (["validate"] if with_simbody else [])
+__all__ = ["Equations", "Model", "ModelError", "NumericalError", "grid", "load", "simulate",
+           "sweep", "with_simbody"] + (["validate"] if with_simbody else [])
 
 for _cls in (Equations, Model, ModelError, NumericalError):
     _cls.__module__ = "femdyn"
