@@ -55,9 +55,10 @@ py::dict equations_batch(const PyModel& self, const Array& q, const OptArray& qd
          *pqdd = qdd.mutable_data();
   bool* pok = ok.mutable_data();
   std::vector<std::string> failures(k);
+  const int nthreads = batch_threads(k, threads);
   {
     py::gil_scoped_release release;
-    for_each_row(m, k, batch_threads(k, threads), [&](Workspace& ws, Eigen::Index i) {
+    for_each_row(m, k, nthreads, [&](Workspace& ws, Eigen::Index i) {
       thread_local RowState s;
       s.load(b, i);
       Status st;
@@ -96,9 +97,10 @@ py::array_t<double> dynamics_batch(const PyModel& self, const Array& q, const Op
   const py::ssize_t k = b.k, n = b.n;
   py::array_t<double> out = new_array({k, n});
   double* po = out.mutable_data();
+  const int nthreads = batch_threads(k, threads);
   {
     py::gil_scoped_release release;
-    for_each_row(m, k, batch_threads(k, threads), [&](Workspace& ws, Eigen::Index i) {
+    for_each_row(m, k, nthreads, [&](Workspace& ws, Eigen::Index i) {
       thread_local RowState s;
       s.load(b, i);
       const VecX* result = &ws.tau;

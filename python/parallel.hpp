@@ -3,15 +3,23 @@
 #pragma once
 #include <algorithm>
 #include <exception>
+#include <string>
 #include <thread>
 #include <vector>
 
 #include "core/workspace.hpp"
+#include "python/arrays.hpp"
 
 namespace femdyn::python {
 
-// The threads a batch of k rows uses: `requested` (0: the hardware's), at most one per row.
+// The threads a batch of k rows uses: `requested` (0: one per core), at most one per row and
+// kMaxBatchThreads. A negative request is a ValueError.
+inline constexpr int kMaxBatchThreads = 256;
 inline int batch_threads(Eigen::Index k, int requested) {
+  if (requested < 0 || requested > kMaxBatchThreads)
+    throw pybind11::value_error("threads: expected an integer in [0, " +
+                                std::to_string(kMaxBatchThreads) + "], got " +
+                                std::to_string(requested));
   const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const int t = requested > 0 ? requested : hw;
   return static_cast<int>(std::max<Eigen::Index>(1, std::min<Eigen::Index>(t, k)));

@@ -37,6 +37,8 @@ def test_exception_classes():
      "tau: expected shape (3, 4), got (3, 5)"),
     (lambda m: m.inverse_dynamics_batch(np.zeros((3, 4)), None, np.zeros(3)),
      "qdd: expected shape (3, 4), got (3,)"),
+    (lambda m: m.equations_batch(np.zeros((3, 4)), threads=-1),
+     "threads: expected an integer in [0, 256], got -1"),
     (lambda m: m.equations([0, 0, np.nan, 0]), "q: entry 2 ('pip') is NaN or Inf"),
     (lambda m: m.forward_dynamics(np.zeros(4), [0, np.inf, 0, 0]),
      "qd: entry 1 ('mcp') is NaN or Inf"),
