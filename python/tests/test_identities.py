@@ -84,3 +84,25 @@ def test_inputs_read_in_place_and_untouched(model):
                           model.forward_dynamics_batch(q, qd, tau))
     assert np.array_equal(model.equations([0] * model.n).M,
                           model.equations(np.zeros(model.n)).M)
+
+
+def test_batches_and_simulate_release_the_gil():
+    """While a batch (or a simulation) runs in one Python thread, another keeps running."""
+    import threading
+    import time
+
+    model = femdyn.load(model_path("models/hand.json"))
+    q, qd, tau = state(model.n, seed=3, k=20000)
+    calls = [lambda: model.equations_batch(q, qd, tau, threads=1),
+             lambda: femdyn.simulate(model, 2.0, q[0], qd[0], integrator="rk4", dt=1e-4)]
+    for call in calls:
+        worker = threading.Thread(target=call)
+        start = time.perf_counter()
+        worker.start()
+        count = 0
+        while worker.is_alive():
+            count += 1
+        worker.join()
+        elapsed = time.perf_counter() - start
+        assert elapsed > 0.02  # long enough to tell
+        assert count > 1000, (count, elapsed)
