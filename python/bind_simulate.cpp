@@ -2,6 +2,7 @@
 // core/integrator.hpp, as `femdyn simulate` runs it (cli/simulate.cpp), into arrays.
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -46,6 +47,41 @@ struct Rows {
   }
 };
 
+// τ(t) from samples (t_r, τ_r) as `femdyn simulate --tau-csv` reads them (io/actuation_table):
+//   τ(t) = τ_r + (t − t_r)/(t_{r+1} − t_r) (τ_{r+1} − τ_r) for t_r ≤ t < t_{r+1}, held outside.
+// The table must cover [0, t_end].
+Actuation tau_table(const Model& m, const Array& times, const Array& values, double t_end) {
+  const py::ssize_t rows = times.ndim() == 1 ? times.shape(0) : -1;
+  if (rows < 2)
+    throw py::value_error("tau_t: expected shape (m,) with m >= 2, got " + shape_text(times));
+  if (values.ndim() != 2 || values.shape(0) != rows || values.shape(1) != m.n())
+    throw py::value_error("tau: expected shape (" + std::to_string(rows) + ", " +
+                          std::to_string(m.n()) + ") with tau_t, got " + shape_text(values));
+  std::vector<double> t(times.data(), times.data() + rows);
+  for (py::ssize_t r = 0; r < rows; ++r)
+    if (!std::isfinite(t[r]) || (r > 0 && !(t[r] > t[r - 1])))
+      throw py::value_error("tau_t: expected finite, strictly increasing times; entry " +
+                            std::to_string(r) + " is not");
+  if (t.front() > 0 || t.back() < t_end)
+    throw py::value_error("tau_t: covers t in [" + std::to_string(t.front()) + ", " +
+                          std::to_string(t.back()) + "] s; it must cover [0, t_end]");
+  MatX tau = Eigen::Map<const RowMatX>(values.data(), rows, m.n()).transpose();  // n x samples
+  if (!tau.allFinite()) throw py::value_error("tau: NaN or Inf");
+  return [t = std::move(t), tau = std::move(tau)](double time, VecX& out) {
+    if (time <= t.front()) {
+      out = tau.col(0);
+      return;
+    }
+    if (time >= t.back()) {
+      out = tau.col(tau.cols() - 1);
+      return;
+    }
+    const auto r = std::upper_bound(t.begin(), t.end(), time) - t.begin() - 1;
+    const double s = (time - t[r]) / (t[r + 1] - t[r]);
+    out = (1 - s) * tau.col(r) + s * tau.col(r + 1);
+  };
+}
+
 py::array_t<double> vector_array(const std::vector<double>& x) {
   py::array_t<double> a = new_array({static_cast<py::ssize_t>(x.size())});
   std::copy(x.begin(), x.end(), a.mutable_data());
@@ -55,13 +91,12 @@ py::array_t<double> vector_array(const std::vector<double>& x) {
 py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, const OptArray& qd0_in,
                   const std::string& integrator, std::optional<double> dt,
                   std::optional<double> rtol, std::optional<double> atol, const OptArray& tau_in,
-                  const OptArray& t_eval_in, long every, bool check) {
+                  const OptArray& tau_t_in, const OptArray& t_eval_in, long every, bool check) {
   const Model& m = *self.model;
   if (!(t_end > 0) || t_end > 1e9) throw py::value_error("t_end: expected a time in (0, 1e9] s");
   if (every < 1) throw py::value_error("every: expected an integer >= 1");
   const IntegratorOptions o = options_of(integrator, dt, rtol, atol);
   const VecX q0 = vector_arg(q0_in, "q0", m), qd0 = vector_arg(qd0_in, "qd0", m);
-  const VecX u = vector_arg(tau_in, "tau", m);
   std::vector<double> t_eval;
   if (t_eval_in) {
     const Array& te = *t_eval_in;
@@ -72,9 +107,19 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
         throw py::value_error("t_eval: expected nondecreasing times in [0, t_end]; entry " +
                               std::to_string(i) + " is not");
   }
+  // τ: constant (n,), a table (tau_t (m,), tau (m, n)), or none (passive).
   Actuation tau;
-  if (!u.isZero(0)) tau = [u](double, VecX& out) { out = u; };
-  bool conservative = u.isZero(0) && m.torques.empty();
+  bool driven = false;
+  if (tau_t_in) {
+    if (!tau_in) throw py::value_error("tau_t: needs tau, shape (m, n)");
+    tau = tau_table(m, *tau_t_in, *tau_in, t_end);
+    driven = true;
+  } else {
+    const VecX u = vector_arg(tau_in, "tau", m);
+    driven = !u.isZero(0);
+    if (driven) tau = [u](double, VecX& out) { out = u; };
+  }
+  bool conservative = !driven && m.torques.empty();
   for (const Body& b : m.bodies) conservative = conservative && b.joint.damping == 0;
 
   std::unique_ptr<Integrator> integ = make_integrator(m, o, tau);
@@ -168,8 +213,11 @@ void bind_simulate(py::module_& m) {
   m.def("simulate", &simulate, py::arg("model"), py::arg("t_end"), py::arg("q0") = py::none(),
         py::arg("qd0") = py::none(), py::arg("integrator") = "dopri", py::arg("dt") = py::none(),
         py::arg("rtol") = py::none(), py::arg("atol") = py::none(), py::arg("tau") = py::none(),
-        py::arg("t_eval") = py::none(), py::arg("every") = 1, py::arg("check") = true,
-        "Integrates M^s q̈ + h = Q over [0, t_end] from (q0, qd0) under a constant tau by rk4, "
+        py::arg("tau_t") = py::none(), py::arg("t_eval") = py::none(), py::arg("every") = 1,
+        py::arg("check") = true,
+        "Integrates M^s q̈ + h = Q over [0, t_end] from (q0, qd0) under tau: constant (n,), or "
+        "sampled, tau (m, n) at the times tau_t (m,) covering [0, t_end], interpolated "
+        "linearly as --tau-csv; by rk4, "
         "euler (dt) or dopri, bdf (rtol, atol). Rows every `every` steps (first and last "
         "always), or at the times t_eval. Returns a dict: t, q, qd, kinetic, potential, total, "
         "work, stats. A numerical failure raises NumericalError, or with check=False returns the "

@@ -38,6 +38,33 @@ def test_simulate_equals_cli(tmp_path, integrator, opts):
     assert np.array_equal(data[:, -1], r["work"])
 
 
+@pytest.mark.parametrize("integrator", ["rk4", "dopri"])
+def test_sampled_tau_equals_cli_tau_csv(tmp_path, integrator):
+    name = model_path("models/urdf/arm7.urdf")
+    model = femdyn.load(name)
+    tau_t = np.linspace(0, 0.1, 7)
+    tau = np.outer(np.sin(40 * tau_t), np.linspace(1, 2, model.n))
+    table = tmp_path / "tau.csv"
+    with open(table, "w") as f:
+        f.write(",".join(["t"] + model.coordinates) + "\n")
+        for t, row in zip(tau_t, tau):
+            f.write(numbers([t, *row]) + "\n")
+    out = tmp_path / "traj.csv"
+    cli = cli_json("simulate", name, "--t-end=0.1", f"--integrator={integrator}",
+                   f"--tau-csv={table}", f"--out={out}", "--json")
+    r = femdyn.simulate(model, 0.1, integrator=integrator, tau=tau, tau_t=tau_t)
+    assert r["stats"]["steps"] == cli["steps"] and not r["stats"]["conservative"]
+    data = np.array([[float(x) for x in row] for row in list(csv.reader(open(out)))[1:]])
+    assert np.array_equal(data[:, 1:1 + model.n], r["q"])
+    assert np.array_equal(data[:, -1], r["work"])
+    with pytest.raises(ValueError, match=r"^tau_t: covers t in \[0.000000, 0.100000\] s; it "
+                                         r"must cover \[0, t_end\]$"):
+        femdyn.simulate(model, 0.2, integrator=integrator, tau=tau, tau_t=tau_t)
+    with pytest.raises(ValueError, match=r"^tau: expected shape \(7, 7\) with tau_t, got "
+                                         r"\(7, 6\)$"):
+        femdyn.simulate(model, 0.1, tau=tau[:, 1:], tau_t=tau_t)
+
+
 def test_simulate_outputs():
     model = femdyn.load(model_path("models/pendulum.json"))
     r = femdyn.simulate(model, 1.0, q0=[0.3], integrator="rk4", dt=1e-3, every=10)
