@@ -78,6 +78,14 @@ void bind_validate(py::module_& m) {
         "seeded random states and a passive trajectory of t_end s (what `femdyn validate` does, "
         "less its URDF import check). Returns a dict: quantities {name: {max_abs, max_rel, "
         "tolerance, pass}}, trajectory {...}, notes, failure, pass. The GIL is released.");
+  // The Simbody integrators that can run in this process: CPodes is among them only if no other
+  // SUNDIALS shadows Simbody's bundled copy (validation/twin.hpp); the tests check it is.
+  m.def("_simbody_integrators", [] {
+    std::vector<std::string> names;
+    for (const validation::SimbodyIntegrator i : validation::simbody_integrators())
+      names.emplace_back(validation::simbody_integrator_name(i));
+    return names;
+  });
   m.attr("with_simbody") = true;
 #else
   m.attr("with_simbody") = false;

@@ -92,3 +92,16 @@ def test_validate_equals_cli(name):
         assert v["pass"] and v["max_rel"] <= 1e-10
         assert v["max_rel"] == cli["max_rel_error"][q], q
     assert r["trajectory"]["run"] and r["trajectory"]["pass"]
+
+
+@pytest.mark.skipif(not femdyn.with_simbody, reason="built without Simbody")
+def test_sundials_does_not_shadow_simbody_cpodes():
+    """femdyn's SUNDIALS is linked into the extension statically with its symbols hidden: in the
+    interpreter too, Simbody's CPodes (its own SUNDIALS copy) stays usable, beside femdyn's
+    SUNDIALS integrators."""
+    from femdyn import _femdyn
+
+    assert "CPodes" in _femdyn._simbody_integrators()
+    model = femdyn.load(model_path("models/finger.json"))
+    assert femdyn.simulate(model, 0.01, qd0=np.ones(4), integrator="bdf")["stats"]["ok"]
+    assert femdyn.validate(model, states=2, t_end=0.01, samples=2)["pass"]
