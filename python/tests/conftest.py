@@ -49,3 +49,13 @@ def cli_json(*args):
     out = subprocess.run([str(BINARY), *map(str, args)], cwd=ROOT, capture_output=True,
                          text=True, check=True)
     return json.loads(out.stdout)
+
+
+def subprocess_env():
+    """The environment for a script run by a test: this femdyn first on an absolute PYTHONPATH
+    (a relative one, as in a by-hand run, would not survive another working directory)."""
+    import femdyn
+
+    package_dir = os.path.dirname(os.path.dirname(os.path.abspath(femdyn.__file__)))
+    path = [package_dir] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
+    return dict(os.environ, PYTHONPATH=os.pathsep.join(path), MPLBACKEND="Agg")

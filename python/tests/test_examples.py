@@ -1,13 +1,12 @@
 """The worked example of docs/python.md and the batch benchmark run."""
-import os
 import subprocess
 import sys
 
-from conftest import ROOT
+from conftest import ROOT, subprocess_env
 
 
 def run(*args):
-    env = dict(os.environ, MPLBACKEND="Agg")
+    env = subprocess_env()
     return subprocess.run([sys.executable, *map(str, args)], cwd=ROOT, env=env,
                           capture_output=True, text=True, check=True).stdout
 

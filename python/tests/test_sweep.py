@@ -1,6 +1,5 @@
 """femdyn.grid and femdyn.sweep; the Dask example on a LocalCluster of 2 workers on 127.0.0.1
 gives the numbers of the serial run."""
-import os
 import subprocess
 import sys
 
@@ -8,7 +7,7 @@ import pandas
 import pytest
 
 import femdyn
-from conftest import ROOT
+from conftest import ROOT, subprocess_env
 
 
 def square(x, y):
@@ -30,7 +29,7 @@ def test_sweep_refuses_clashing_keys():
 
 
 def test_dask_example_equals_serial(tmp_path):
-    env = dict(os.environ, MPLBACKEND="Agg")
+    env = subprocess_env()
     out = subprocess.run([sys.executable, str(ROOT / "examples" / "dask_sweep.py"), "--quick",
                           "--check-serial", "--out", str(tmp_path)], cwd=tmp_path, env=env,
                          capture_output=True, text=True, timeout=600)
