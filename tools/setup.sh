@@ -6,7 +6,9 @@ cd "$(dirname "$0")/.."
 
 packages=(cmake g++ make libeigen3-dev libsuitesparse-dev nlohmann-json3-dev catch2
           libsimbody-dev libtinyxml2-dev libbenchmark-dev libsundials-dev gnuplot-nox
-          fonts-dejavu-core clang libclang-rt-14-dev clang-format)
+          fonts-dejavu-core clang libclang-rt-14-dev clang-format
+          pybind11-dev python3-dev python3-numpy python3-pytest python3-pandas
+          python3-matplotlib python3-distributed)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -22,4 +24,4 @@ fi
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$(nproc)" >/dev/null
-echo "femdyn setup: built ./build/femdyn" >&2
+echo "femdyn setup: built ./build/femdyn and the Python module (PYTHONPATH=build/python)" >&2

@@ -1,0 +1,43 @@
+// numpy arguments of the Python module: shapes and values checked with messages that name the
+// argument ("q: expected shape (4,), got (3,)"), then seen by Eigen without a copy.
+#pragma once
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "core/model.hpp"
+
+namespace femdyn::python {
+
+namespace py = pybind11;
+
+// float64, C order: anything else (lists, int arrays, strided views) is converted once by
+// pybind11 on the way in; a float64 C-ordered array is used in place.
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using RowMatX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+// A numerical failure at a state (a singular M^s, a q̈ that overflows): femdyn.NumericalError.
+class NumericalError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// "(3,)", "(5, 4)".
+std::string shape_text(const py::array& a);
+
+// A state vector: shape (n,), every entry finite. Absent (None, where allowed) is zero.
+VecX vector_arg(const Array& a, const char* name, const Model& model);
+VecX vector_arg(const std::optional<Array>& a, const char* name, const Model& model);
+
+// A batch of states: shape (k, n) with finite entries, seen in place (row i = state i). `k` is
+// the number of rows required, or -1 for the first batch argument (which sets k).
+Eigen::Map<const RowMatX> batch_arg(const Array& a, const char* name, const Model& model,
+                                    Eigen::Index k);
+
+// A fresh C-ordered float64 array of the given shape.
+py::array_t<double> new_array(std::initializer_list<py::ssize_t> shape);
+
+}  // namespace femdyn::python

@@ -1,0 +1,142 @@
+// Batch forms: k states in (k, n) arrays, evaluated on several threads with the GIL released.
+// Row i of every result is bit-for-bit what the single-state call gives for row i.
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <limits>
+
+#include "core/equations.hpp"
+#include "python/parallel.hpp"
+#include "python/py_model.hpp"
+
+namespace femdyn::python {
+namespace {
+
+using OptArray = std::optional<Array>;
+
+// The k states of a batch, row i of each a state: q sets k; q̇ and the third argument (τ or
+// q̈) default to zero rows. The arrays are read in place (numpy's memory).
+struct Batch {
+  Eigen::Index k = 0, n = 0;
+  const double *q = nullptr, *qd = nullptr, *third = nullptr;
+  VecX zeros;  // one zero row for an absent argument
+  Batch(const Model& m, const Array& q_in, const OptArray& qd_in, const OptArray& third_in,
+        const char* third_name)
+      : n(m.n()), zeros(VecX::Zero(m.n())) {
+    q = batch_arg(q_in, "q", m, -1).data();
+    k = q_in.shape(0);
+    if (qd_in) qd = batch_arg(*qd_in, "qd", m, k).data();
+    if (third_in) third = batch_arg(*third_in, third_name, m, k).data();
+  }
+  Eigen::Map<const VecX> row(const double* x, Eigen::Index i) const {
+    return {x ? x + i * n : zeros.data(), n};
+  }
+};
+
+// One row's buffers (the core takes VecX).
+struct RowState {
+  VecX q, qd, x;
+  void load(const Batch& b, Eigen::Index i) {
+    q = b.row(b.q, i);
+    qd = b.row(b.qd, i);
+    x = b.row(b.third, i);
+  }
+};
+
+py::dict equations_batch(const PyModel& self, const Array& q, const OptArray& qd,
+                         const OptArray& tau, int threads) {
+  const Model& m = *self.model;
+  const Batch b(m, q, qd, tau, "tau");
+  const py::ssize_t k = b.k, n = b.n;
+  py::array_t<double> M = new_array({k, n, n}), h = new_array({k, n}), Q = new_array({k, n}),
+                      qdd = new_array({k, n});
+  py::array_t<bool> ok(std::vector<py::ssize_t>{k});
+  double *pM = M.mutable_data(), *ph = h.mutable_data(), *pQ = Q.mutable_data(),
+         *pqdd = qdd.mutable_data();
+  bool* pok = ok.mutable_data();
+  std::vector<std::string> failures(k);
+  const int nthreads = batch_threads(k, threads);
+  {
+    py::gil_scoped_release release;
+    for_each_row(m, k, nthreads, [&](Workspace& ws, Eigen::Index i) {
+      thread_local RowState s;
+      s.load(b, i);
+      Status st;
+      try {
+        equations_at(m, ws, s.q, s.qd, s.x, st);
+      } catch (const NumericalError& e) {
+        throw NumericalError("row " + std::to_string(i) + ": " + e.what());
+      }
+      Eigen::Map<RowMatX>(pM + i * n * n, n, n) = ws.Ms;
+      Eigen::Map<VecX>(ph + i * n, n) = ws.h;
+      Eigen::Map<VecX>(pQ + i * n, n) = ws.Q;
+      if (st.ok)
+        Eigen::Map<VecX>(pqdd + i * n, n) = ws.qdd;
+      else
+        Eigen::Map<VecX>(pqdd + i * n, n).setConstant(std::numeric_limits<double>::quiet_NaN());
+      pok[i] = st.ok;
+      failures[i] = st.message;
+    });
+  }
+  py::dict d;
+  d["M"] = M;
+  d["h"] = h;
+  d["Q"] = Q;
+  d["qdd"] = qdd;
+  d["ok"] = ok;
+  d["failures"] = failures;
+  return d;
+}
+
+// forward (q̈ from τ) or inverse (τ from q̈) dynamics of every row into a (k, n) array.
+template <bool Forward>
+py::array_t<double> dynamics_batch(const PyModel& self, const Array& q, const OptArray& qd,
+                                   const OptArray& third, int threads) {
+  const Model& m = *self.model;
+  const Batch b(m, q, qd, third, Forward ? "tau" : "qdd");
+  const py::ssize_t k = b.k, n = b.n;
+  py::array_t<double> out = new_array({k, n});
+  double* po = out.mutable_data();
+  const int nthreads = batch_threads(k, threads);
+  {
+    py::gil_scoped_release release;
+    for_each_row(m, k, nthreads, [&](Workspace& ws, Eigen::Index i) {
+      thread_local RowState s;
+      s.load(b, i);
+      const VecX* result = &ws.tau;
+      if constexpr (Forward) {
+        const Status st = forward_dynamics(m, ws, s.q, s.qd, s.x);
+        if (!st.ok)
+          throw NumericalError("row " + std::to_string(i) + ": at this state " + st.message);
+        result = &ws.qdd;
+      } else {
+        inverse_dynamics(m, ws, s.q, s.qd, s.x);
+      }
+      for (Eigen::Index a = 0; a < n; ++a)
+        if (!std::isfinite((*result)[a]))
+          throw NumericalError("row " + std::to_string(i) + ": " + (Forward ? "q̈" : "τ") + " of '" +
+                               m.coordinate_names[a] + "' is NaN or Inf");
+      Eigen::Map<VecX>(po + i * n, n) = *result;
+    });
+  }
+  return out;
+}
+
+}  // namespace
+
+void bind_batch(py::module_& m) {
+  py::class_<PyModel> model = py::reinterpret_borrow<py::class_<PyModel>>(m.attr("Model"));
+  model
+      .def("equations_batch", &equations_batch, py::arg("q"), py::arg("qd") = py::none(),
+           py::arg("tau") = py::none(), py::arg("threads") = 0,
+           "equations at k states, (k, n) each: dict of M (k, n, n), h, Q, qdd (k, n; NaN rows "
+           "where M^s is singular), ok (k,), failures; threads 0 = all cores; GIL released")
+      .def("forward_dynamics_batch", &dynamics_batch<true>, py::arg("q"),
+           py::arg("qd") = py::none(), py::arg("tau") = py::none(), py::arg("threads") = 0,
+           "q̈ at k states, (k, n); NumericalError naming the first failed row")
+      .def("inverse_dynamics_batch", &dynamics_batch<false>, py::arg("q"),
+           py::arg("qd") = py::none(), py::arg("qdd") = py::none(), py::arg("threads") = 0,
+           "τ at k states, (k, n)");
+}
+
+}  // namespace femdyn::python

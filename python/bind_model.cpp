@@ -1,0 +1,215 @@
+// femdyn.load and femdyn.Model: the equations at one state (docs/python.md).
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+
+#include "core/equations.hpp"
+#include "core/limits.hpp"
+#include "io/model_loader.hpp"
+#include "io/output.hpp"
+#include "python/py_model.hpp"
+
+namespace femdyn::python {
+namespace {
+
+using OptArray = std::optional<Array>;
+
+// The first non-finite entry of x (a result), as the CLI refuses it.
+void require_finite(const Model& model, const double* x, Eigen::Index size, Eigen::Index rows,
+                    const char* what) {
+  for (Eigen::Index i = 0; i < size; ++i)
+    if (!std::isfinite(x[i]))
+      throw NumericalError(std::string("at this state ") + what + " of '" +
+                           model.coordinate_names[i % rows] +
+                           "' is NaN or Inf (the forces or the state overflow double precision)");
+}
+
+std::unique_ptr<PyModel> load(const std::string& path, const OptArray& gravity) {
+  LoadOptions options;
+  std::vector<std::string> warnings;
+  options.warn = [&warnings](const std::string& w) { warnings.push_back(w); };
+  if (gravity) {
+    if (gravity->ndim() != 1 || gravity->shape(0) != 3)
+      throw py::value_error("gravity: expected shape (3,), got " + shape_text(*gravity));
+    const double* g = gravity->data();
+    if (!std::isfinite(g[0]) || !std::isfinite(g[1]) || !std::isfinite(g[2]))
+      throw py::value_error("gravity: NaN or Inf");
+    options.gravity = Vec3(g[0], g[1], g[2]);
+    options.gravity_source = "gravity";
+  }
+  std::unique_ptr<PyModel> model;
+  {
+    py::gil_scoped_release release;
+    model = std::make_unique<PyModel>(load_model(path, options));
+  }
+  for (const std::string& w : warnings)
+    if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw py::error_already_set();
+  return model;
+}
+
+EquationsResult equations(PyModel& self, const Array& q_in, const OptArray& qd_in,
+                          const OptArray& tau_in) {
+  const Model& m = *self.model;
+  const VecX q = vector_arg(q_in, "q", m), qd = vector_arg(qd_in, "qd", m),
+             tau = vector_arg(tau_in, "tau", m);
+  Status st;
+  equations_at(m, self.ws, q, qd, tau, st);
+  EquationsResult r{self.ws.Ms, self.ws.h, self.ws.Q, std::nullopt, st.message};
+  if (st.ok) r.qdd = self.ws.qdd;
+  return r;
+}
+
+VecX forward(PyModel& self, const Array& q, const OptArray& qd, const OptArray& tau) {
+  const Model& m = *self.model;
+  const Status st = forward_dynamics(m, self.ws, vector_arg(q, "q", m), vector_arg(qd, "qd", m),
+                                     vector_arg(tau, "tau", m));
+  if (!st.ok) throw NumericalError("at this state " + st.message);
+  require_finite(m, self.ws.qdd.data(), m.n(), m.n(), "q̈");
+  return self.ws.qdd;
+}
+
+VecX inverse(PyModel& self, const Array& q, const OptArray& qd, const OptArray& qdd) {
+  const Model& m = *self.model;
+  inverse_dynamics(m, self.ws, vector_arg(q, "q", m), vector_arg(qd, "qd", m),
+                   vector_arg(qdd, "qdd", m));
+  require_finite(m, self.ws.tau.data(), m.n(), m.n(), "τ");
+  return self.ws.tau;
+}
+
+// D as an (n, n, n) array, D[a, b, c] = D_abc, h_a = Σ_bc D_abc q̇_b q̇_c.
+py::array_t<double> tensor(PyModel& self, const Array& q_in) {
+  const Model& m = *self.model;
+  const VecX q = vector_arg(q_in, "q", m);
+  const double n = m.n(), entries = std::max(n * n * n, m.n_u() * n * n);
+  if (entries > kMaxTensorEntries)
+    throw py::value_error("tensor: D needs " + std::to_string(static_cast<long>(entries)) +
+                          " numbers for n = " + std::to_string(m.n()) + "; the limit is " +
+                          std::to_string(static_cast<long>(kMaxTensorEntries)));
+  const std::vector<MatX> D = third_order_tensor(m, self.ws, q);
+  const py::ssize_t k = m.n();
+  py::array_t<double> out = new_array({k, k, k});
+  auto d = out.mutable_unchecked<3>();
+  for (py::ssize_t a = 0; a < k; ++a)
+    for (py::ssize_t b = 0; b < k; ++b)
+      for (py::ssize_t c = 0; c < k; ++c) d(a, b, c) = D[a](b, c);
+  return out;
+}
+
+py::dict energy_of(PyModel& self, const Array& q, const OptArray& qd) {
+  const Model& m = *self.model;
+  const Energy e = energy(m, self.ws, vector_arg(q, "q", m), vector_arg(qd, "qd", m));
+  py::dict d;
+  d["kinetic"] = e.kinetic;
+  d["potential"] = e.potential;
+  d["total"] = e.total();
+  return d;
+}
+
+// Per element: its type, body, node labels and N_m row (6 per node: x y z rx ry rz; 1-based
+// transition-coordinate numbers, 0 = left out).
+py::list correlation_table(const PyModel& self) {
+  const Model& m = *self.model;
+  py::list rows;
+  for (const ElementEntry& e : m.elements) {
+    py::dict d;
+    d["element"] = std::string(e.element->type_name());
+    d["body"] = e.body >= 0 ? m.bodies[e.body].name : std::string("world");
+    d["nodes"] = e.node_labels;
+    d["row"] = e.table_row;
+    rows.append(d);
+  }
+  return rows;
+}
+
+py::object json_to_python(const Json& j) {
+  return py::module_::import("json").attr("loads")(j.dump());
+}
+
+}  // namespace
+
+void equations_at(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau,
+                  Status& status) {
+  status = forward_dynamics(model, ws, q, qd, tau);
+  evaluate(model, ws, q, qd, tau);
+  const Eigen::Index n = model.n();
+  require_finite(model, ws.Ms.data(), ws.Ms.size(), n, "M^s");
+  require_finite(model, ws.h.data(), n, n, "h");
+  require_finite(model, ws.Q.data(), n, n, "Q");
+  if (status.ok) require_finite(model, ws.qdd.data(), n, n, "q̈");
+}
+
+void bind_model(py::module_& m) {
+  py::class_<EquationsResult>(m, "Equations",
+                              "M^s q̈ + h = Q at one state: M (n, n), h, Q, qdd (n,); qdd is "
+                              "None when M^s is singular there (failure says why)")
+      .def_readonly("M", &EquationsResult::M)
+      .def_readonly("h", &EquationsResult::h)
+      .def_readonly("Q", &EquationsResult::Q)
+      .def_readonly("qdd", &EquationsResult::qdd)
+      .def_readonly("failure", &EquationsResult::failure)
+      .def("__getitem__",
+           [](const EquationsResult& r, const std::string& key) -> py::object {
+             if (key == "M") return py::cast(r.M);
+             if (key == "h") return py::cast(r.h);
+             if (key == "Q") return py::cast(r.Q);
+             if (key == "qdd") return py::cast(r.qdd);
+             throw py::key_error(key);
+           })
+      .def("keys",
+           [](const EquationsResult&) {
+             return std::vector<std::string>{"M", "h", "Q", "qdd"};
+           })
+      .def("__repr__", [](const EquationsResult& r) {
+        return "<femdyn.Equations n=" + std::to_string(r.h.size()) +
+               (r.qdd ? "" : " (no qdd: " + r.failure + ")") + ">";
+      });
+
+  py::class_<PyModel>(m, "Model", "A compiled mechanism (immutable); femdyn.load makes one")
+      .def_property_readonly("n", [](const PyModel& s) { return s.model->n(); })
+      .def_property_readonly("n_u", [](const PyModel& s) { return s.model->n_u(); })
+      .def_property_readonly("name", [](const PyModel& s) { return s.model->name; })
+      .def_property_readonly("coordinates",
+                             [](const PyModel& s) { return s.model->coordinate_names; })
+      .def_property_readonly("gravity", [](const PyModel& s) { return Vec3(s.model->gravity); })
+      .def("equations", &equations, py::arg("q"), py::arg("qd") = py::none(),
+           py::arg("tau") = py::none(),
+           "M^s, h, Q and q̈ at (q, q̇, τ) (omitted: zero), as `femdyn equations` computes them")
+      .def("forward_dynamics", &forward, py::arg("q"), py::arg("qd") = py::none(),
+           py::arg("tau") = py::none(), "q̈ = (M^s)⁻¹ (Q − h); NumericalError if M^s is singular")
+      .def("inverse_dynamics", &inverse, py::arg("q"), py::arg("qd") = py::none(),
+           py::arg("qdd") = py::none(), "τ such that M^s q̈ + h = Q(τ)")
+      .def(
+          "mass_matrix",
+          [](PyModel& s, const Array& q) {
+            mass_matrix(*s.model, s.ws, vector_arg(q, "q", *s.model));
+            return MatX(s.ws.Ms);
+          },
+          py::arg("q"), "M^s(q), (n, n)")
+      .def(
+          "bias",
+          [](PyModel& s, const Array& q, const Array& qd) {
+            evaluate_bias(*s.model, s.ws, vector_arg(q, "q", *s.model),
+                          vector_arg(qd, "qd", *s.model));
+            return VecX(s.ws.h);
+          },
+          py::arg("q"), py::arg("qd"), "h(q, q̇) = D[q̇, q̇], (n,)")
+      .def("tensor", &tensor, py::arg("q"),
+           "D (n, n, n) with h_a = Σ_bc D[a, b, c] q̇_b q̇_c (numpy: einsum('abc,b,c', D, qd, qd))")
+      .def("energy", &energy_of, py::arg("q"), py::arg("qd") = py::none(),
+           "{'kinetic', 'potential', 'total'} in J")
+      .def("correlation_table", &correlation_table,
+           "per element: {'element', 'body', 'nodes', 'row'} (row: N_m, 6 per node)")
+      .def(
+          "info", [](const PyModel& s) { return json_to_python(info_json(*s.model)); },
+          "what `femdyn info --json` prints, as a dict")
+      .def("__repr__", [](const PyModel& s) {
+        return "<femdyn.Model '" + s.model->name + "' n=" + std::to_string(s.model->n()) + ">";
+      });
+
+  m.def("load", &load, py::arg("path"), py::arg("gravity") = py::none(),
+        "A femdyn JSON model or a URDF file (*.urdf) as a Model; gravity (3,) overrides the "
+        "model's. Raises femdyn.ModelError (a ValueError) naming the file, place and problem.");
+}
+
+}  // namespace femdyn::python

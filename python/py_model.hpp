@@ -1,0 +1,38 @@
+// The Python module's model: an immutable compiled Model, shared (by shared_ptr) with batch
+// threads and integrators, plus one Workspace for the single-state calls. Those keep the GIL,
+// so two Python threads never use that Workspace at once; the batch calls, simulate and
+// validate release the GIL and use Workspaces of their own.
+#pragma once
+#include <memory>
+
+#include "core/workspace.hpp"
+#include "python/arrays.hpp"
+
+namespace femdyn::python {
+
+struct PyModel {
+  explicit PyModel(Model m) : model(std::make_shared<const Model>(std::move(m))), ws(*model) {}
+  std::shared_ptr<const Model> model;
+  Workspace ws;
+};
+
+// M, h, Q and q̈ at one state; qdd is absent when forward dynamics failed (then `failure`
+// says why), as `femdyn equations` prints null.
+struct EquationsResult {
+  MatX M;
+  VecX h, Q;
+  std::optional<VecX> qdd;
+  std::string failure;
+};
+
+// The part of `femdyn equations` after parsing: forward dynamics, then evaluate (the same order,
+// so the same numbers). Throws NumericalError if M^s, h, Q or q̈ is not finite.
+void equations_at(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau,
+                  Status& status);
+
+void bind_model(py::module_& m);
+void bind_batch(py::module_& m);
+void bind_simulate(py::module_& m);
+void bind_validate(py::module_& m);
+
+}  // namespace femdyn::python

@@ -1,0 +1,111 @@
+"""Bad input gets the documented messages and exceptions and never crashes the interpreter
+(docs/python.md, "Errors")."""
+import json
+
+import numpy as np
+import pytest
+
+import femdyn
+from conftest import model_path
+
+
+@pytest.fixture(scope="module")
+def finger():
+    return femdyn.load(model_path("models/finger.json"))
+
+
+def test_exception_classes():
+    assert issubclass(femdyn.ModelError, ValueError)
+    assert issubclass(femdyn.NumericalError, ArithmeticError)
+
+
+@pytest.mark.parametrize("call,message", [
+    (lambda m: m.equations([1, 2, 3]), "q: expected shape (4,), got (3,)"),
+    (lambda m: m.equations(np.zeros(4), np.zeros(5)), "qd: expected shape (4,), got (5,)"),
+    (lambda m: m.equations(np.zeros(4), None, np.zeros((4, 1))),
+     "tau: expected shape (4,), got (4, 1)"),
+    (lambda m: m.forward_dynamics(np.zeros((2, 4))), "q: expected shape (4,), got (2, 4)"),
+    (lambda m: m.inverse_dynamics(np.zeros(4), np.zeros(4), np.zeros(2)),
+     "qdd: expected shape (4,), got (2,)"),
+    (lambda m: m.mass_matrix(np.zeros(())), "q: expected shape (4,), got ()"),
+    (lambda m: m.tensor(np.zeros(3)), "q: expected shape (4,), got (3,)"),
+    (lambda m: m.energy(np.zeros(4), np.zeros(3)), "qd: expected shape (4,), got (3,)"),
+    (lambda m: m.equations_batch(np.zeros(4)), "q: expected shape (k, 4), got (4,)"),
+    (lambda m: m.equations_batch(np.zeros((3, 4)), np.zeros((2, 4))),
+     "qd: expected shape (3, 4), got (2, 4)"),
+    (lambda m: m.forward_dynamics_batch(np.zeros((3, 4)), None, np.zeros((3, 5))),
+     "tau: expected shape (3, 4), got (3, 5)"),
+    (lambda m: m.inverse_dynamics_batch(np.zeros((3, 4)), None, np.zeros(3)),
+     "qdd: expected shape (3, 4), got (3,)"),
+    (lambda m: m.equations_batch(np.zeros((3, 4)), threads=-1),
+     "threads: expected an integer in [0, 256], got -1"),
+    (lambda m: m.equations([0, 0, np.nan, 0]), "q: entry 2 ('pip') is NaN or Inf"),
+    (lambda m: m.forward_dynamics(np.zeros(4), [0, np.inf, 0, 0]),
+     "qd: entry 1 ('mcp') is NaN or Inf"),
+    (lambda m: m.equations_batch(np.array([[0, 0, 0, 0], [0, 0, 0, -np.inf]])),
+     "q: row 1, entry 3 ('dip') is NaN or Inf"),
+    (lambda m: femdyn.simulate(m, 0.1, q0=np.zeros(3)), "q0: expected shape (4,), got (3,)"),
+    (lambda m: femdyn.simulate(m, 0.1, integrator="rk5"),
+     "integrator: 'rk5' is not one of rk4, euler, dopri, bdf"),
+    (lambda m: femdyn.simulate(m, 0.1, dt=1e-3),
+     "dt sets the step of rk4 and euler; dopri is adaptive: use rtol and atol"),
+    (lambda m: femdyn.simulate(m, 0.1, integrator="rk4", rtol=1e-6),
+     "rtol/atol apply to dopri and bdf; rk4 has a fixed step: use dt"),
+    (lambda m: femdyn.simulate(m, -1), "t_end: expected a time in (0, 1e9] s"),
+    (lambda m: femdyn.simulate(m, 1, t_eval=[0.5, 0.2]),
+     "t_eval: expected nondecreasing times in [0, t_end]; entry 1 is not"),
+    (lambda m: femdyn.load(model_path("models/finger.json"), gravity=[0, 0]),
+     "gravity: expected shape (3,), got (2,)"),
+])
+def test_value_errors(finger, call, message):
+    with pytest.raises(ValueError) as e:
+        call(finger)
+    assert str(e.value) == message
+    assert not isinstance(e.value, femdyn.ModelError)
+
+
+def test_bad_integrator_option(finger):
+    with pytest.raises(ValueError, match="^dt"):
+        femdyn.simulate(finger, 0.1, integrator="rk4", dt=-1)
+
+
+def test_types_are_type_errors(finger):
+    with pytest.raises(TypeError):
+        finger.equations("abc")
+    with pytest.raises(ValueError, match=r"^q: expected shape \(4,\), got \(\)$"):
+        finger.equations(None)  # a 0-d array to numpy: q has no default
+    with pytest.raises(TypeError):
+        femdyn.load(42)
+
+
+def test_model_errors_name_the_file_and_place(tmp_path):
+    with pytest.raises(femdyn.ModelError, match="nope.json: cannot open file"):
+        femdyn.load(str(tmp_path / "nope.json"))
+    bad = tmp_path / "bad.json"
+    bad.write_text("{ not json")
+    with pytest.raises(femdyn.ModelError, match="bad.json"):
+        femdyn.load(str(bad))
+    doc = json.loads(open(model_path("models/pendulum.json")).read())
+    doc["bodies"][0]["joint"]["type"] = "screw"
+    bad.write_text(json.dumps(doc))
+    with pytest.raises(femdyn.ModelError, match=r"bad.json: /bodies/0/joint"):
+        femdyn.load(str(bad))
+    with pytest.raises(femdyn.ModelError, match="is a directory"):
+        femdyn.load(str(tmp_path))
+
+
+def test_overflow_is_a_numerical_error(finger):
+    with pytest.raises(femdyn.NumericalError, match="NaN or Inf"):
+        finger.equations(np.zeros(4), np.full(4, 1e200))
+    with pytest.raises(femdyn.NumericalError, match="^row 1: .*NaN or Inf"):
+        finger.forward_dynamics_batch(np.zeros((3, 4)), np.array([[0.0] * 4, [1e200] * 4,
+                                                                 [0.0] * 4]))
+
+
+def test_failed_simulation(finger):
+    with pytest.raises(femdyn.NumericalError):
+        femdyn.simulate(finger, 1.0, integrator="euler", dt=0.5, qd0=np.full(4, 1e150))
+    r = femdyn.simulate(finger, 1.0, integrator="euler", dt=0.5, qd0=np.full(4, 1e150),
+                        check=False)
+    assert not r["stats"]["ok"] and r["stats"]["failure"]
+    assert len(r["t"]) >= 1 and np.isfinite(r["q"]).all()
