@@ -18,4 +18,5 @@ PYBIND11_MODULE(_femdyn, m) {
   bind_batch(m);
   bind_simulate(m);
   bind_validate(m);
+  bind_builder(m);
 }

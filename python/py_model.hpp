@@ -34,5 +34,6 @@ void bind_model(py::module_& m);
 void bind_batch(py::module_& m);
 void bind_simulate(py::module_& m);
 void bind_validate(py::module_& m);
+void bind_builder(py::module_& m);
 
 }  // namespace femdyn::python

@@ -9,6 +9,7 @@ file, femdyn.NumericalError (an ArithmeticError) for a singular mass matrix or a
 state, ValueError for a bad argument ("q: expected shape (4,), got (3,)", NaN or Inf entries).
 """
 from ._femdyn import (  # noqa: F401
+    Builder,
     Equations,
     Model,
     ModelError,
@@ -23,9 +24,9 @@ from ._sweep import grid, sweep  # noqa: F401,E402  (pandas and dask are importe
 if with_simbody:
     from ._femdyn import validate  # noqa: F401
 
-__all__ = ["Equations", "Model", "ModelError", "NumericalError", "grid", "load", "simulate",
+__all__ = ["Builder", "Equations", "Model", "ModelError", "NumericalError", "grid", "load", "simulate",
            "sweep", "with_simbody"] + (["validate"] if with_simbody else [])
 
-for _cls in (Equations, Model, ModelError, NumericalError):
+for _cls in (Builder, Equations, Model, ModelError, NumericalError):
     _cls.__module__ = "femdyn"
 del _cls

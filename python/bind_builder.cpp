@@ -1,0 +1,204 @@
+// femdyn.Builder: a mechanism described in Python without JSON (models/builder.hpp), compiled to
+// a femdyn.Model. Couplings are given in the JSON format's words (ratio, offset, polynomial,
+// spline, four_bar) and read by the loader's own reader (io parse_coupling).
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <variant>
+
+#include "io/model_loader.hpp"
+#include "models/builder.hpp"
+#include "python/py_model.hpp"
+
+namespace femdyn::python {
+namespace {
+
+// A Python value (dict, list, tuple, str, bool, int, float, None) as JSON, for a coupling.
+Json to_json(const py::handle& v, const std::string& name) {
+  if (v.is_none()) return nullptr;
+  if (py::isinstance<py::bool_>(v)) return v.cast<bool>();
+  if (py::isinstance<py::int_>(v)) return v.cast<long long>();
+  if (py::isinstance<py::float_>(v)) return v.cast<double>();
+  if (py::isinstance<py::str>(v)) return v.cast<std::string>();
+  if (py::isinstance<py::dict>(v)) {
+    Json out = Json::object();
+    for (const auto& [key, value] : v.cast<py::dict>()) {
+      if (!py::isinstance<py::str>(key)) throw py::type_error(name + ": keys must be strings");
+      out[key.cast<std::string>()] = to_json(value, name);
+    }
+    return out;
+  }
+  if (py::isinstance<py::sequence>(v) || py::isinstance<py::array>(v)) {
+    Json out = Json::array();
+    for (const py::handle item : py::iter(v)) out.push_back(to_json(item, name));
+    return out;
+  }
+  try {  // a numpy scalar or anything float() accepts
+    return py::float_(py::reinterpret_borrow<py::object>(v)).cast<double>();
+  } catch (const py::error_already_set&) {
+    throw py::type_error(name + ": cannot use a " +
+                         std::string(py::str(v.get_type().attr("__name__"))) + " here");
+  }
+}
+
+// (3,) finite, as Vec3.
+Vec3 vec3_arg(const Array& a, const char* name) {
+  if (a.ndim() != 1 || a.shape(0) != 3)
+    throw py::value_error(std::string(name) + ": expected shape (3,), got " + shape_text(a));
+  const Vec3 v(a.data()[0], a.data()[1], a.data()[2]);
+  if (!v.allFinite()) throw py::value_error(std::string(name) + ": NaN or Inf");
+  return v;
+}
+
+// (3, 3) finite, as Mat3.
+Mat3 mat3_arg(const Array& a, const char* name) {
+  if (a.ndim() != 2 || a.shape(0) != 3 || a.shape(1) != 3)
+    throw py::value_error(std::string(name) + ": expected shape (3, 3), got " + shape_text(a));
+  Mat3 m;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) m(i, j) = a.data()[3 * i + j];
+  if (!m.allFinite()) throw py::value_error(std::string(name) + ": NaN or Inf");
+  return m;
+}
+
+// A node: its name (str) or a position (3,).
+NodeDescription node_arg(const py::object& node, const char* name) {
+  if (py::isinstance<py::str>(node)) return node.cast<std::string>();
+  return vec3_arg(node.cast<Array>(), name);
+}
+
+JointSpec joint_arg(const std::string& type, const std::optional<std::string>& name,
+                    const Array& axis, const Array& xyz, const Array& rpy,
+                    const std::optional<std::pair<double, double>>& limits, double stiffness,
+                    double rest, double damping) {
+  JointSpec j;
+  if (type == "revolute" || type == "continuous")
+    j.type = JointType::Revolute;
+  else if (type == "prismatic")
+    j.type = JointType::Prismatic;
+  else if (type == "fixed")
+    j.type = JointType::Fixed;
+  else
+    throw py::value_error("joint type: unknown '" + type +
+                          "' (expected revolute, continuous, prismatic or fixed)");
+  if (name) j.name = *name;
+  j.axis = vec3_arg(axis, "axis");
+  j.xyz = vec3_arg(xyz, "xyz");
+  j.rpy = vec3_arg(rpy, "rpy");
+  if (limits) {
+    if (j.type == JointType::Fixed) throw py::value_error("limits: a fixed joint has none");
+    if (std::isnan(limits->first) || std::isnan(limits->second))
+      throw py::value_error("limits: NaN");
+    j.lower = limits->first, j.upper = limits->second;
+  }
+  j.stiffness = stiffness, j.rest = rest, j.damping = damping;
+  return j;
+}
+
+}  // namespace
+
+void bind_builder(py::module_& m) {
+  py::class_<MechanismBuilder>(m, "Builder",
+                               "A mechanism described in code: bodies, nodes, elements, "
+                               "couplings, loads; build() compiles it (docs/python.md)")
+      .def(py::init([](const std::string& name, const std::optional<Array>& gravity) {
+             auto b = std::make_unique<MechanismBuilder>(name);
+             if (gravity) b->gravity(vec3_arg(*gravity, "gravity"));
+             return b;
+           }),
+           py::arg("name"), py::arg("gravity") = py::none())
+      .def(
+          "body",
+          [](MechanismBuilder& b, const std::string& name, const std::string& parent,
+             const std::string& type, const std::optional<std::string>& joint, const Array& axis,
+             const Array& xyz, const Array& rpy,
+             const std::optional<std::pair<double, double>>& limits, double stiffness, double rest,
+             double damping) {
+            b.body(name, parent,
+                   joint_arg(type, joint, axis, xyz, rpy, limits, stiffness, rest, damping));
+          },
+          py::arg("name"), py::arg("parent") = "world", py::arg("type") = "fixed",
+          py::arg("joint") = py::none(), py::arg("axis") = Vec3(0, 0, 1),
+          py::arg("xyz") = Vec3(0, 0, 0), py::arg("rpy") = Vec3(0, 0, 0),
+          py::arg("limits") = py::none(), py::arg("stiffness") = 0.0, py::arg("rest") = 0.0,
+          py::arg("damping") = 0.0,
+          "A body on `parent` ('world': the ground) by a joint of `type` (revolute, prismatic, "
+          "fixed) named `joint` (default: the body's name)")
+      .def(
+          "node",
+          [](MechanismBuilder& b, const std::string& body, const std::string& name,
+             const Array& position) { b.node(body, name, vec3_arg(position, "position")); },
+          py::arg("body"), py::arg("name"), py::arg("position"))
+      .def(
+          "lumped_point",
+          [](MechanismBuilder& b, const std::string& body, const py::object& node, double mass) {
+            b.lumped_point(body, node_arg(node, "node"), mass);
+          },
+          py::arg("body"), py::arg("node"), py::arg("mass"))
+      .def(
+          "rotary_node",
+          [](MechanismBuilder& b, const std::string& body, const py::object& node,
+             const Array& inertia) {
+            b.rotary_node(body, node_arg(node, "node"), mat3_arg(inertia, "inertia"));
+          },
+          py::arg("body"), py::arg("node"), py::arg("inertia"))
+      .def(
+          "rigid_body",
+          [](MechanismBuilder& b, const std::string& body, double mass, const Array& com,
+             const Array& inertia) {
+            b.rigid_body(body, mass, vec3_arg(com, "com"), mat3_arg(inertia, "inertia"));
+          },
+          py::arg("body"), py::arg("mass"), py::arg("com"), py::arg("inertia"),
+          "mass, centre of mass and inertia about it (body axes)")
+      .def(
+          "space_bar",
+          [](MechanismBuilder& b, const std::string& body, const py::object& a,
+             const py::object& b_node, double mass, const Array& inertia) {
+            b.space_bar(body, node_arg(a, "a"), node_arg(b_node, "b"), mass,
+                        mat3_arg(inertia, "inertia"));
+          },
+          py::arg("body"), py::arg("a"), py::arg("b"), py::arg("mass"), py::arg("inertia"),
+          "a rigid bar from a to b of this mass and centroidal inertia")
+      .def(
+          "rod",
+          [](MechanismBuilder& b, const std::string& body, const py::object& a,
+             const py::object& b_node,
+             double mass) { b.rod(body, node_arg(a, "a"), node_arg(b_node, "b"), mass); },
+          py::arg("body"), py::arg("a"), py::arg("b"), py::arg("mass"),
+          "a slender rod; a node 'other_body/name' lies on another body")
+      .def(
+          "coupling",
+          [](MechanismBuilder& b, const std::string& joint, const py::object& follows,
+             const py::kwargs& law) {
+            Json c = to_json(law, "coupling");
+            c["joint"] = joint;
+            c["follows"] = to_json(follows, "follows");
+            b.coupling(parse_coupling(c, b.next_coupling()));
+          },
+          py::arg("joint"), py::arg("follows"),
+          "θ_joint from the joint(s) it follows, in the JSON format's words: ratio=, offset=, "
+          "or polynomial=, spline=, four_bar= (docs/model-format.md#couplings)")
+      .def(
+          "load",
+          [](MechanismBuilder& b, const std::string& body, const Array& point, const Array& force,
+             const Array& torque) {
+            b.load(body, vec3_arg(point, "point"), vec3_arg(force, "force"),
+                   vec3_arg(torque, "torque"));
+          },
+          py::arg("body"), py::arg("point") = Vec3(0, 0, 0), py::arg("force") = Vec3(0, 0, 0),
+          py::arg("torque") = Vec3(0, 0, 0))
+      .def(
+          "build",
+          [](const MechanismBuilder& b) {
+            Model model;
+            {
+              py::gil_scoped_release release;
+              model = b.build();
+            }
+            return std::make_unique<PyModel>(std::move(model));
+          },
+          "compile the mechanism (the checks of a JSON file's compile) into a femdyn.Model");
+}
+
+}  // namespace femdyn::python

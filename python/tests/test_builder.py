@@ -1,0 +1,158 @@
+"""femdyn.Builder: a mechanism described in Python without JSON is the model its JSON file
+loads (to the bit), and bad arguments get the loader's messages (docs/python.md, "Builder")."""
+import json
+
+import numpy as np
+import pytest
+
+import femdyn
+from conftest import model_path, state
+
+# Every element form, a four-bar law closed by a rod, a polynomial of two joints, a linear
+# coupling, a spring, a damper, limits and a load (the model of tests/test_builder.cpp).
+DOCUMENT = {
+    "name": "everything", "gravity": [0.3, -9.81, -1.0],
+    "bodies": [
+        {"name": "crank", "parent": "world",
+         "joint": {"name": "j1", "type": "revolute", "axis": [0, 0, 1]},
+         "nodes": {"tip": [0.1, 0, 0]},
+         "elements": [{"type": "lumped_point", "node": "tip", "mass": 0.2},
+                      {"type": "rod", "nodes": ["tip", "rocker/tip"], "mass": 0.05}]},
+        {"name": "rocker", "parent": "world",
+         "joint": {"name": "j2", "type": "revolute", "axis": [0, 0, 1],
+                   "origin": {"xyz": [0.3, 0, 0]}},
+         "nodes": {"tip": [0.2, 0, 0]},
+         "elements": [{"type": "lumped_point", "node": "tip", "mass": 0.3},
+                      {"type": "rotary_node", "node": [0.1, 0, 0],
+                       "inertia": [[0.001, 0.0001, 0], [0.0001, 0.002, 0], [0, 0, 0.0025]]}]},
+        {"name": "arm", "parent": "rocker",
+         "joint": {"name": "j3", "type": "revolute", "axis": [0, 1, 0.2],
+                   "origin": {"xyz": [0.2, 0, 0], "rpy": [0.1, 0.2, 0.3]},
+                   "spring": {"stiffness": 2, "rest": 0.3}, "damping": 0.05},
+         "elements": [{"type": "rigid_body", "mass": 0.5, "com": [0.1, 0, 0.01],
+                       "inertia": [[0.002, 0.0002, 0], [0.0002, 0.003, 0.0001],
+                                   [0, 0.0001, 0.004]]}]},
+        {"name": "slider", "parent": "arm",
+         "joint": {"name": "j4", "type": "prismatic", "axis": [1, 0.2, 0],
+                   "origin": {"xyz": [0.25, 0, 0]}, "limits": [-0.2, 0.3]},
+         "elements": [{"type": "space_bar", "nodes": [[0, 0, 0], [0.2, 0.02, 0]], "mass": 0.4,
+                       "inertia": [[0.0001, 0, 0], [0, 0.0014, 0], [0, 0, 0.0014]]}]},
+        {"name": "hand", "parent": "slider",
+         "joint": {"name": "j5", "type": "revolute", "axis": [1, 0, 0],
+                   "origin": {"xyz": [0.2, 0.02, 0]}},
+         "elements": [{"type": "lumped_point", "node": [0, 0.05, 0], "mass": 0.1}]},
+        {"name": "finger", "parent": "hand",
+         "joint": {"name": "j6", "type": "revolute", "axis": [0, 0, 1],
+                   "origin": {"xyz": [0, 0.05, 0]}},
+         "elements": [{"type": "lumped_point", "node": [0.04, 0, 0], "mass": 0.05}]}],
+    "couplings": [
+        {"joint": "j2", "follows": "j1",
+         "four_bar": {"ground": 0.3, "input": 0.1, "coupler": 0.35, "output": 0.2,
+                      "output_offset": 0}},
+        {"joint": "j5", "follows": ["j3", "j4"], "polynomial": [[0.5, 1, 0], [0.2, 1, 1]]},
+        {"joint": "j6", "follows": [{"joint": "j3", "ratio": -0.7}], "offset": 0.1}],
+    "loads": [{"body": "arm", "point": [0.1, 0, 0.05], "force": [1, -2, 0.5],
+               "torque": [0.1, 0, -0.2]}]}
+
+
+def built():
+    b = femdyn.Builder("everything", gravity=[0.3, -9.81, -1.0])
+    b.body("crank", "world", type="revolute", joint="j1", axis=[0, 0, 1])
+    b.node("crank", "tip", [0.1, 0, 0])
+    b.body("rocker", "world", type="revolute", joint="j2", axis=[0, 0, 1], xyz=[0.3, 0, 0])
+    b.node("rocker", "tip", [0.2, 0, 0])
+    b.lumped_point("crank", "tip", 0.2)
+    b.rod("crank", "tip", "rocker/tip", 0.05)
+    b.lumped_point("rocker", "tip", 0.3)
+    b.rotary_node("rocker", [0.1, 0, 0], [[0.001, 0.0001, 0], [0.0001, 0.002, 0], [0, 0, 0.0025]])
+    b.body("arm", "rocker", type="revolute", joint="j3", axis=[0, 1, 0.2], xyz=[0.2, 0, 0],
+           rpy=[0.1, 0.2, 0.3], stiffness=2, rest=0.3, damping=0.05)
+    b.rigid_body("arm", 0.5, [0.1, 0, 0.01],
+                 np.array([[0.002, 0.0002, 0], [0.0002, 0.003, 0.0001], [0, 0.0001, 0.004]]))
+    b.body("slider", "arm", type="prismatic", joint="j4", axis=[1, 0.2, 0], xyz=[0.25, 0, 0],
+           limits=(-0.2, 0.3))
+    b.space_bar("slider", [0, 0, 0], [0.2, 0.02, 0], 0.4, np.diag([0.0001, 0.0014, 0.0014]))
+    b.body("hand", "slider", type="revolute", joint="j5", axis=[1, 0, 0], xyz=[0.2, 0.02, 0])
+    b.lumped_point("hand", [0, 0.05, 0], 0.1)
+    b.body("finger", "hand", type="revolute", joint="j6", axis=[0, 0, 1], xyz=[0, 0.05, 0])
+    b.lumped_point("finger", [0.04, 0, 0], 0.05)
+    b.coupling("j2", "j1", four_bar={"ground": 0.3, "input": 0.1, "coupler": 0.35,
+                                     "output": 0.2, "output_offset": 0})
+    b.coupling("j5", ["j3", "j4"], polynomial=[[0.5, 1, 0], [0.2, 1, 1]])
+    b.coupling("j6", [{"joint": "j3", "ratio": -0.7}], offset=0.1)
+    b.load("arm", point=[0.1, 0, 0.05], force=[1, -2, 0.5], torque=[0.1, 0, -0.2])
+    return b.build()
+
+
+@pytest.fixture(scope="module")
+def pair(tmp_path_factory):
+    path = tmp_path_factory.mktemp("builder") / "everything.json"
+    path.write_text(json.dumps(DOCUMENT))
+    return built(), femdyn.load(str(path))
+
+
+def test_builder_equals_json(pair):
+    a, b = pair
+    assert a.coordinates == b.coordinates == ["j1", "j3", "j4"]
+    assert a.n_u == b.n_u
+    assert a.correlation_table() == b.correlation_table()
+    assert a.info() == b.info()
+    for seed in range(8):
+        q, qd, tau = state(a.n, seed)
+        ea, eb = a.equations(q, qd, tau), b.equations(q, qd, tau)
+        for key in ("M", "h", "Q", "qdd"):
+            assert np.array_equal(ea[key], eb[key]), key  # the same arithmetic: to the bit
+        assert np.array_equal(a.tensor(q), b.tensor(q))
+        assert a.energy(q, qd) == b.energy(q, qd)
+
+
+def test_builder_model_validates_against_simbody(pair):
+    if not femdyn.with_simbody:
+        pytest.skip("built without Simbody")
+    report = femdyn.validate(pair[0], states=5, t_end=0.05)
+    assert report["pass"], report
+
+
+@pytest.mark.parametrize("call,error,message", [
+    (lambda b: b.lumped_point("link", [0, 0, -1], -1), femdyn.ModelError,
+     "arm (builder): /bodies/0/elements/0/mass: must be positive, got -1"),
+    (lambda b: b.lumped_point("link", "tip", 1), femdyn.ModelError,
+     "arm (builder): /bodies/0/elements/0/node: unknown node 'tip' (not in the body's nodes)"),
+    (lambda b: b.lumped_point("nope", [0, 0, 0], 1), femdyn.ModelError,
+     "unknown body 'nope'"),
+    (lambda b: b.rotary_node("link", [0, 0, 0], np.diag([1, 1, 3])), femdyn.ModelError,
+     "arm (builder): /bodies/0/elements/0/inertia: inertia violates the triangle inequality"),
+    (lambda b: b.rigid_body("link", 1, [0, 0], np.eye(3)), ValueError,
+     "com: expected shape (3,), got (2,)"),
+    (lambda b: b.rigid_body("link", 1, [0, np.nan, 0], np.eye(3)), ValueError, "com: NaN or Inf"),
+    (lambda b: b.rod("link", [0, 0, 0], [1, 0, 0], 1e300), femdyn.ModelError,
+     "is out of range"),
+    (lambda b: b.body("x", "world", type="hinge"), ValueError, "joint type: unknown 'hinge'"),
+    (lambda b: b.coupling("j", "k", four_bar={"ground": -1}), femdyn.ModelError,
+     "arm (builder): /couplings/0/four_bar/ground: must be positive, got -1"),
+    (lambda b: b.coupling("j", "k", ratio="x"), femdyn.ModelError, "/couplings/0/ratio"),
+    (lambda b: b.coupling("j", object()), TypeError, "follows: cannot use a object here"),
+    (lambda b: b.load("link", force=[1, 2]), ValueError, "force: expected shape (3,), got (2,)"),
+])
+def test_builder_bad_arguments(call, error, message):
+    b = femdyn.Builder("arm")
+    b.body("link", "world", type="revolute", joint="j")
+    with pytest.raises(error) as e:
+        call(b)
+    assert message in str(e.value)
+
+
+def test_builder_compile_errors_name_the_place():
+    b = femdyn.Builder("arm")
+    b.body("link", "world", type="revolute", joint="j")
+    b.lumped_point("link", [0, 0, -1], 1)
+    b.body("other", "missing", type="revolute")
+    with pytest.raises(femdyn.ModelError, match=r"^arm \(builder\): /bodies/1"):
+        b.build()
+    # A failed call leaves the builder as it was: the model still builds without it.
+    b2 = femdyn.Builder("ok")
+    b2.body("link", "world", type="revolute")
+    with pytest.raises(femdyn.ModelError):
+        b2.lumped_point("link", [1, 0, 0], -2)
+    b2.lumped_point("link", [1, 0, 0], 2)  # 1 m from the z axis: M = m l² = 2
+    assert b2.build().mass_matrix([0.0])[0, 0] == pytest.approx(2.0)
