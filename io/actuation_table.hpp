@@ -14,6 +14,10 @@ class ActuationTable {
  public:
   // Throws ModelError ("FILE:LINE: …") on a malformed file.
   ActuationTable(const std::string& path, const Model& model);
+  // From samples already checked by the caller: t strictly increasing (at least 2), tau n × |t|
+  // (column r at t[r]); `path` names the source in reports.
+  ActuationTable(std::vector<double> t, MatX tau, std::string path)
+      : path_(std::move(path)), t_(std::move(t)), tau_(std::move(tau)) {}
 
   void operator()(double t, VecX& tau) const;  // no allocation
   double t_first() const { return t_.front(); }

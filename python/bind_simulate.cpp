@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/integrator.hpp"
+#include "io/actuation_table.hpp"
 #include "python/py_model.hpp"
 
 namespace femdyn::python {
@@ -67,18 +68,8 @@ Actuation tau_table(const Model& m, const Array& times, const Array& values, dou
                           std::to_string(t.back()) + "] s; it must cover [0, t_end]");
   MatX tau = Eigen::Map<const RowMatX>(values.data(), rows, m.n()).transpose();  // n x samples
   if (!tau.allFinite()) throw py::value_error("tau: NaN or Inf");
-  return [t = std::move(t), tau = std::move(tau)](double time, VecX& out) {
-    if (time <= t.front()) {
-      out = tau.col(0);
-      return;
-    }
-    if (time >= t.back()) {
-      out = tau.col(tau.cols() - 1);
-      return;
-    }
-    const auto r = std::upper_bound(t.begin(), t.end(), time) - t.begin() - 1;
-    const double s = (time - t[r]) / (t[r + 1] - t[r]);
-    out = (1 - s) * tau.col(r) + s * tau.col(r + 1);
+  return [table = ActuationTable(std::move(t), std::move(tau), "tau_t")](double time, VecX& out) {
+    table(time, out);
   };
 }
 
