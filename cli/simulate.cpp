@@ -10,6 +10,7 @@
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
 #include "core/integrator.hpp"
+#include "core/recorded_run.hpp"
 #include "io/actuation_table.hpp"
 #include "io/atomic_file.hpp"
 #include "io/trajectory_csv.hpp"
@@ -125,8 +126,7 @@ int cmd_simulate(int argc, char** argv) {
     tau = [&table](double t, VecX& out) { (*table)(t, out); };
     driven = true;
   }
-  bool conservative = !driven && m.torques.empty();
-  for (const Body& b : m.bodies) conservative = conservative && b.joint.damping == 0;
+  const bool is_conservative = conservative(m, driven);
 
   // Output: refused before any work if it would clobber a file.
   std::optional<AtomicFile> out;
@@ -147,40 +147,31 @@ int cmd_simulate(int argc, char** argv) {
   integ->reset(0, q0, qd0, t_end);
   InterruptGuard guard;
   Progress progress(t_end, "s");
-  const Energy E0 = integ->motion().energy_at(integ->y().data());
-  double max_balance = 0, scale = std::max(std::abs(E0.total()), std::abs(E0.kinetic));
-  long rows = 0, step = 0;
-  const auto output = [&] {
-    const Energy E = integ->motion().energy_at(integ->y().data());
-    max_balance = std::max(max_balance, std::abs(E.total() - E0.total() - integ->work()));
-    scale = std::max({scale, std::abs(E.total()), E.kinetic});
-    if (out) write_trajectory_row(out->stream(), integ->t(), integ->y(), E);
-    ++rows;
-  };
-  const auto begin = std::chrono::steady_clock::now();
-  Status st;
-  output();
-  while (integ->t() < t_end) {
-    st = integ->step();
-    if (!st.ok) break;
-    if (++step % every == 0 || integ->t() >= t_end) output();
-    progress.update(integ->t());
-    if (g_interrupted) {
-      progress.finish();
-      std::cerr << "femdyn simulate: interrupted at t = " << integ->t() << " s"
-                << (out ? "; " + out->path() + " was not written" : std::string()) << "\n";
-      return 130;  // `out` discards its temporary file
-    }
-  }
+  const RecordedRun run = run_recorded(
+      *integ, t_end, every, nullptr,
+      [&](const Integrator& i, const Energy& E) {
+        if (out) write_trajectory_row(out->stream(), i.t(), i.y(), E);
+      },
+      [&](double t) {
+        progress.update(t);
+        return g_interrupted != 0;
+      });
   progress.finish();
-  const double wall =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  if (run.interrupted) {
+    std::cerr << "femdyn simulate: interrupted at t = " << integ->t() << " s"
+              << (out ? "; " + out->path() + " was not written" : std::string()) << "\n";
+    return 130;  // `out` discards its temporary file
+  }
+  const Status& st = run.status;
+  const Energy& E0 = run.initial;
+  const double max_balance = run.max_balance, scale = run.scale, wall = run.wall_time;
+  const long rows = run.rows;
   if (out) out->commit();
 
   const IntegratorStats& s = integ->stats();
   const double simulated = integ->t();
   const double rtf = s.wall_time > 0 ? simulated / s.wall_time : 0;
-  const std::string balance_name = conservative ? "energy drift" : "energy-balance error";
+  const std::string balance_name = is_conservative ? "energy drift" : "energy-balance error";
   if (a.has("json")) {
     Json j = {{"model", m.name},
               {"coordinates", m.n()},
@@ -194,7 +185,7 @@ int cmd_simulate(int argc, char** argv) {
               {"wall_time", wall},
               {"integration_time", s.wall_time},
               {"real_time_factor", rtf},
-              {"conservative", conservative},
+              {"conservative", is_conservative},
               {"energy_initial", E0.total()},
               {"energy_balance_error", max_balance},
               {"energy_balance_relative", scale > 0 ? max_balance / scale : 0.0},

@@ -168,19 +168,20 @@ Model compile_with_coupling_level(MechanismSpec spec) {
   return m;
 }
 
+double span_length(const ElementEntry& e, const Workspace& ws) {
+  const auto nodes = e.element->nodes();
+  const auto world = [&](int l) {
+    const BodyState& B = ws.body[e.node_body[l]];
+    return Vec3(B.p + B.R * nodes[l].position);
+  };
+  return (world(0) - world(1)).norm();
+}
+
 void check_rigid_spans(const Model& m) {
   const bool any = std::any_of(m.elements.begin(), m.elements.end(),
                                [](const ElementEntry& e) { return e.spans; });
   if (!any) return;
   Workspace ws(m);
-  const auto length = [&](const ElementEntry& e) {
-    const auto nodes = e.element->nodes();
-    const auto world = [&](int l) {
-      const BodyState& B = ws.body[e.node_body[l]];
-      return Vec3(B.p + B.R * nodes[l].position);
-    };
-    return (world(0) - world(1)).norm();
-  };
   VecX q(m.n());
   std::mt19937 rng(12345);
   const VecX zero = VecX::Zero(m.n());
@@ -191,7 +192,7 @@ void check_rigid_spans(const Model& m) {
     std::size_t s = 0;
     for (const ElementEntry& e : m.elements) {
       if (!e.spans || e.node_body.size() != 2) continue;
-      const double L = length(e);
+      const double L = span_length(e, ws);
       if (k == 0) {
         L0.push_back(L);
         continue;

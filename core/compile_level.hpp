@@ -3,6 +3,7 @@
 // itself), and the model's coordinates become the joints that no coupling sets.
 #pragma once
 #include "core/model.hpp"
+#include "core/workspace.hpp"
 
 namespace femdyn {
 
@@ -14,5 +15,8 @@ Model compile_tree(MechanismSpec spec);
 // kinematics: checked at the reference posture and 64 seeded postures within the limits;
 // otherwise ModelError naming the element, the posture and the change in length.
 void check_rigid_spans(const Model& m);
+// The distance between the two nodes of an element that spans two bodies, at the body poses
+// in ws (after propagate).
+double span_length(const ElementEntry& e, const Workspace& ws);
 
 }  // namespace femdyn

@@ -3,10 +3,10 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include "core/integrator.hpp"
+#include "core/recorded_run.hpp"
 #include "io/actuation_table.hpp"
 #include "python/py_model.hpp"
 
@@ -110,54 +110,30 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
     driven = !u.isZero(0);
     if (driven) tau = [u](double, VecX& out) { out = u; };
   }
-  bool conservative = !driven && m.torques.empty();
-  for (const Body& b : m.bodies) conservative = conservative && b.joint.damping == 0;
+  const bool is_conservative = conservative(m, driven);
 
   std::unique_ptr<Integrator> integ = make_integrator(m, o, tau);
   Rows rows;
-  Status st;
-  double max_balance = 0, wall = 0;
-  Energy E0;
+  RecordedRun run;
   {
     py::gil_scoped_release release;
     integ->reset(0, q0, qd0, t_end);
-    E0 = integ->motion().energy_at(integ->y().data());
-    const auto output = [&] {
-      const Energy E = integ->motion().energy_at(integ->y().data());
-      max_balance = std::max(max_balance, std::abs(E.total() - E0.total() - integ->work()));
-      rows.add(integ->t(), integ->y(), E, integ->work());
-    };
     // Ctrl-C reaches the run: Python's signal check every 256 steps (the GIL taken briefly).
-    const auto interrupted = [](long step) {
-      if (step % 256 != 0) return false;
-      py::gil_scoped_acquire acquire;
-      return PyErr_CheckSignals() != 0;
-    };
-    const auto begin = std::chrono::steady_clock::now();
     long step = 0;
-    bool stop = false;
-    if (t_eval_in) {
-      for (double te : t_eval) {
-        if (te > integ->t()) st = integ->advance_to(te);
-        if (!st.ok) break;
-        output();
-        if ((stop = interrupted(++step))) break;
-      }
-    } else {
-      output();
-      while (integ->t() < t_end) {
-        st = integ->step();
-        if (!st.ok) break;
-        if (++step % every == 0 || integ->t() >= t_end) output();
-        if ((stop = interrupted(step))) break;
-      }
-    }
-    wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-    if (stop) {
+    run = run_recorded(
+        *integ, t_end, every, t_eval_in ? &t_eval : nullptr,
+        [&rows](const Integrator& i, const Energy& E) { rows.add(i.t(), i.y(), E, i.work()); },
+        [&step](double) {
+          if (++step % 256 != 0) return false;
+          py::gil_scoped_acquire acquire;
+          return PyErr_CheckSignals() != 0;
+        });
+    if (run.interrupted) {
       py::gil_scoped_acquire acquire;
       throw py::error_already_set();
     }
   }
+  const Status& st = run.status;
   if (!st.ok && check) throw NumericalError(st.message);
 
   const py::ssize_t k = static_cast<py::ssize_t>(rows.t.size()), n = m.n();
@@ -178,12 +154,12 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
   stats["rejected"] = s.rejected;
   stats["rhs_evals"] = s.rhs_evals;
   stats["jac_evals"] = s.jac_evals;
-  stats["wall_time"] = wall;
+  stats["wall_time"] = run.wall_time;
   stats["integration_time"] = s.wall_time;
   stats["real_time_factor"] = s.wall_time > 0 ? integ->t() / s.wall_time : 0.0;
-  stats["conservative"] = conservative;
-  stats["energy_initial"] = E0.total();
-  stats["energy_balance_error"] = max_balance;
+  stats["conservative"] = is_conservative;
+  stats["energy_initial"] = run.initial.total();
+  stats["energy_balance_error"] = run.max_balance;
   stats["ok"] = st.ok;
   stats["failure"] = st.message;
   py::dict d;

@@ -202,17 +202,25 @@ struct SimbodyTwin::Impl {
       if (!l.torque.isZero(0)) Force::ConstantTorque(forces, mobod[l.body], to_simtk(l.torque));
     }
 
-    independent.resize(m.n());
     if (m.closed_loop()) {  // the laws and rods as constraints, pointwise and for trajectories
-      for (int k = 0; k < m.n(); ++k) independent[k] = m.coordinate_theta[k];
+      independent = m.coordinate_theta;
       loops::add_constraints(matter, m, mobod, rods);
+    } else {
+      add_linear_couplers();
     }
-    // Couplings θ_j = Σ_k C_jk q_k + θ0_j as constraints among the mobilities, for trajectories.
-    for (int k = 0; k < m.n() && !m.closed_loop(); ++k) {
+    finish_state();
+  }
+
+  // Couplings θ_j = Σ_k C_jk q_k + θ0_j as constraints among the mobilities, for trajectories.
+  void add_linear_couplers() {
+    using namespace SimTK;
+    const TwinModel& m = model;
+    independent.resize(m.n());
+    for (int k = 0; k < m.n(); ++k) {
       independent[k] = independent_theta(m, k);
       if (independent[k] < 0) couplers = false;
     }
-    if (couplers && !m.closed_loop()) {
+    if (couplers) {
       for (int j = 0; j < m.n_theta(); ++j) {
         bool is_independent = false;
         for (int k = 0; k < m.n(); ++k) is_independent |= independent[k] == j;
@@ -234,7 +242,12 @@ struct SimbodyTwin::Impl {
         Constraint::CoordinateCoupler(matter, f.release(), bodies, which);  // Simbody owns f
       }
     }
+  }
 
+  // The realized state and the index maps.
+  void finish_state() {
+    using namespace SimTK;
+    const TwinModel& m = model;
     state = system.realizeTopology();
     system.realizeModel(state);
     theta_q.resize(m.n_theta());

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "core/body_inertia.hpp"
+#include "core/compile_level.hpp"
 #include "core/equations.hpp"
 #include "core/errors.hpp"
 #include "core/fixed_step.hpp"
@@ -61,19 +62,15 @@ TwinRod twin_rod(const Model& m, const ElementEntry& e, const TwinModel& t) {
   r.point_a = nodes[0].position, r.point_b = nodes[1].position;
   Workspace ws(m);  // its length, kept by every posture (compile checks it)
   propagate(m, ws, reference_posture(m), VecX::Zero(m.n()), {.jacobian = false, .bias = false});
-  const auto world = [&](int l) {
-    const BodyState& B = ws.body[e.node_body[l]];
-    return Vec3(B.p + B.R * nodes[l].position);
-  };
-  r.length = (world(1) - world(0)).norm();
+  r.length = span_length(e, ws);
+  std::string closes;  // the coupled joint(s) on its path, for the message
   for (int theta : path_joints(m, r.body_a, r.body_b))
     for (const TwinLaw& law : t.laws)
       if (law.theta == theta) {
+        closes += (closes.empty() ? "'" : ", '") + law.name + "'";
         if (r.closes >= 0)
-          throw ModelError(e.where, "the rod spans more than one coupled joint ('" +
-                                        t.laws[0].name +
-                                        "' …): the Simbody twin cannot tell "
-                                        "which loop it closes");
+          throw ModelError(e.where, "the rod spans more than one coupled joint (" + closes +
+                                        "): the Simbody twin cannot tell which loop it closes");
         r.closes = theta;
       }
   if (r.closes < 0)
@@ -86,18 +83,22 @@ TwinRod twin_rod(const Model& m, const ElementEntry& e, const TwinModel& t) {
   return r;
 }
 
+// A core law as the twin's callable (twin.hpp reads no C++20: no std::span in its interface).
+std::function<bool(const double*, double&, double*, double*)> callable(
+    std::shared_ptr<const CouplingFunction> law) {
+  return [law = std::move(law)](const double* x, double& f, double* df, double* d2f) {
+    const std::size_t k = law->arity();
+    return law->evaluate({x, k}, f, {df, k}, {d2f, k * k});
+  };
+}
+
 // The closed-loop form of the twin (twin.hpp): every coupled joint a law of the joints it
 // follows, every element that spans bodies a rod.
 void add_loops(const Model& m, TwinModel& t) {
   if (m.coupling_level) {
     t.coordinate_theta = m.coupling_level->coordinate_theta;
     for (const CoupledJoint& j : m.coupling_level->coupled)
-      t.laws.push_back({j.theta, j.sources,
-                        [law = j.law](const double* x, double& f, double* df, double* d2f) {
-                          const std::size_t k = law->arity();
-                          return law->evaluate({x, k}, f, {df, k}, {d2f, k * k});
-                        },
-                        j.name});
+      t.laws.push_back({j.theta, j.sources, callable(j.law), j.name});
   } else {  // linear couplings, each coordinate a joint of its own
     for (int k = 0; k < m.n(); ++k) {
       const int j = independent_theta(t, k);
@@ -116,11 +117,7 @@ void add_loops(const Model& m, TwinModel& t) {
       for (int k = 0; k < m.n(); ++k)
         if (t.C(j, k) != 0)
           law.sources.push_back(t.coordinate_theta[k]), ratios.push_back(t.C(j, k));
-      auto linear = std::make_shared<LinearCoupling>(std::move(ratios), t.theta0[j]);
-      law.law = [linear](const double* x, double& f, double* df, double* d2f) {
-        const std::size_t k = linear->arity();
-        return linear->evaluate({x, k}, f, {df, k}, {d2f, k * k});
-      };
+      law.law = callable(std::make_shared<LinearCoupling>(std::move(ratios), t.theta0[j]));
       t.laws.push_back(std::move(law));
     }
   }

@@ -1,0 +1,36 @@
+// A run recorded row by row, as `femdyn simulate` (cli/simulate.cpp) and femdyn.simulate
+// (python/bind_simulate.cpp) make it: from the integrator's reset state to t_end, a row at the
+// start, then after every `every`-th step and at the last one — or, given `times`, a row at each
+// of those times (advance_to, dense output) — and the energy balance over the rows,
+//   max |E(t) − E(0) − W(t)|,  W the work of the non-conservative forces (τ, dampers, torques).
+#pragma once
+#include <functional>
+#include <vector>
+
+#include "core/equations.hpp"
+#include "core/integrator.hpp"
+
+namespace femdyn {
+
+struct RecordedRun {
+  Status status;             // the integrator's, where it failed (the rows end at its last step)
+  bool interrupted = false;  // `stop` ended the run
+  Energy initial;            // E(0)
+  double max_balance = 0;    // max over the rows of |E − E(0) − W|
+  double scale = 0;          // max over the rows of |E| and the kinetic energy (for a ratio)
+  long rows = 0;
+  double wall_time = 0;  // s, the whole loop (rows included)
+};
+
+// `times` null: rows every `every` steps; else a row at each of *times (none if it is empty).
+// `row(integ, E)` at each row; `stop(t)` after each step (or time): true ends the run.
+RecordedRun run_recorded(Integrator& integ, double t_end, long every,
+                         const std::vector<double>* times,
+                         const std::function<void(const Integrator&, const Energy&)>& row,
+                         const std::function<bool(double t)>& stop);
+
+// True when nothing but conservative forces acts: no τ (`driven` false), no damper, no body
+// torque. The energy balance is then the energy drift.
+bool conservative(const Model& model, bool driven);
+
+}  // namespace femdyn
