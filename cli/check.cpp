@@ -1,14 +1,17 @@
 // femdyn check MODEL: the numerical diagnosis of a user's model (core/stability.hpp) over
-// sampled states: conditioning of M^s, the stiffest mode and the largest stable step of each
-// explicit integrator, suspicious bodies, and a recommended integrator and step.
+// sampled states: conditioning of M^s, the modes of the linearised dynamics (the stiffest one
+// and the fastest motion, each labelled by kind), the largest stable step of each explicit
+// integrator, suspicious bodies, and advice on accuracy and stability: a recommended
+// integrator and step, with the error to expect (docs/stability.md).
+#include <chrono>
 #include <cmath>
 #include <complex>
 #include <iostream>
 #include <limits>
 #include <random>
-#include <sstream>
 
 #include "cli/commands.hpp"
+#include "cli/progress.hpp"
 #include "core/sampling.hpp"
 #include "core/stability.hpp"
 #include "io/output.hpp"
@@ -17,36 +20,177 @@ namespace femdyn::cli {
 namespace {
 
 constexpr const char* kHelp =
-    R"(usage: femdyn check MODEL [--states K] [--seed S] [--json] [--gravity gx,gy,gz]
+    R"(usage: femdyn check MODEL [--states K] [--seed S] [--tol r] [--budget SECONDS] [--json]
+                    [--gravity gx,gy,gz]
 
 Diagnoses the model at K seeded states (default 10: q = 0 at rest, then q within the joint
 limits and q̇ in ±1):
   - cond(M^s) = λ_max/λ_min over the states (q̈ loses about log10 cond digits), symmetry and
     positive definiteness;
-  - the stiffest mode: the eigenvalue of largest modulus of the linearised dynamics
-    A = ∂(q̇, q̈)/∂(q, q̇) (central differences of forward dynamics), and from A the largest
-    stable step of rk4, euler (symplectic) and dopri, the smallest over the states;
+  - the modes of the linearised dynamics A = ∂(q̇, q̈)/∂(q, q̇) (central differences of
+    forward dynamics), each labelled: oscillatory (with a damping ratio only where the model
+    has dampers), saddle (an unstable equilibrium), decaying (overdamped), growing; the
+    stiffest mode (largest |λ|) with the joint and body it moves most, and the fastest motion
+    (the fastest mode but the stiff dissipative ones: dissipative and 100x faster than the
+    slowest mode);
+  - from A the largest stable step of rk4, euler and dopri, the smallest over the states;
   - bodies with suspicious mass properties, by name: near-zero mass or a mass ratio beyond 1e6
-    to a neighbour, a near-zero principal inertia, an inertia that nearly violates the triangle
-    inequality;
-  - a recommended integrator and step (docs/stability.md).
-Exit 1 when M^s is singular at a sampled state or a body is flagged.
+    to a neighbour, a near-zero principal inertia, an inertia that violates the triangle
+    inequality; a flat body (a disc or plate, on the inequality's boundary) is a note;
+  - a recommended integrator and step with the error to expect: rk4 at the step that resolves
+    the fastest motion to a relative error --tol per period (default 1e-3; rule in
+    docs/stability.md), at most half its stability limit; bdf only where the stiffest mode is
+    dissipative and limits rk4 10x below what the motion needs; an undamped fast mode is named
+    (remove, damp or resolve it: bdf does not cure it).
+Work is bounded: the time of the whole check is estimated first (4n evaluations and a dense
+eigenproblem of 2n per state); beyond --budget seconds (default 120) it is refused with the
+estimate. A progress line shows on a terminal.
+Exit 0: no fault (notes may be printed); 1: M^s is singular at a sampled state, a body is
+flagged, or the check would exceed its budget; 2: a bad command line.
 )";
 
-// What an eigenvalue of the linearised dynamics is, in words.
-std::string mode_text(std::complex<double> l) {
-  const double r = std::abs(l);
-  if (r == 0) return "no dynamics";
-  if (std::abs(l.imag()) <= 1e-9 * r)
-    return l.real() > 0 ? "real, growing: a fall or an unstable equilibrium"
-                        : "real, decaying: overdamped";
-  return "oscillatory, damping ratio " + format_short(-l.real() / r);
+const IntegratorKind kExplicit[] = {IntegratorKind::Rk4, IntegratorKind::Euler,
+                                    IntegratorKind::Dopri};
+
+// The joint and body a coordinate belongs to, for naming a mode: "joint 'j2' (body 'link2')",
+// or the coordinate's name where it is not a joint's (a coupled coordinate).
+std::string where(const Model& m, int a) {
+  if (a < 0) return "?";
+  const std::string& name = m.coordinate_names[a];
+  for (const Body& b : m.bodies)
+    if (b.joint.name == name) return "joint '" + name + "' (body '" + b.name + "')";
+  return "coordinate '" + name + "'";
+}
+
+// Seconds a state costs: 4n evaluations of forward dynamics, the eigenproblems of A (2n, with
+// vectors: about 4e-9 (2n)³ s measured on this kind of machine) and of M^s (1e-9 n³).
+double seconds_per_state(const Model& m) {
+  Workspace ws(m);
+  const VecX z = VecX::Zero(m.n());
+  const auto begin = std::chrono::steady_clock::now();
+  constexpr int kProbe = 4;
+  for (int i = 0; i < kProbe; ++i) (void)forward_dynamics(m, ws, z, z, z);
+  const double eval =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count() / kProbe;
+  const double n = m.n();
+  return 4 * n * eval + 4e-9 * std::pow(2 * n, 3) + 1e-9 * std::pow(n, 3);
+}
+
+struct Diagnosis {
+  double cond_lo = std::numeric_limits<double>::infinity(), cond_hi = 0, asym = 0;
+  int singular_states = 0;
+  std::string singular_message;
+  Mode stiffest;  // largest |λ| over the states
+  Mode fastest;   // the fastest mode but the stiff dissipative ones (the motion to resolve)
+  double h_max[3] = {INFINITY, INFINITY, INFINITY};
+};
+
+void diagnose_state(const Model& m, Workspace& ws, const VecX& q, const VecX& qd, bool dampers,
+                    Diagnosis& d) {
+  const VecX tau = VecX::Zero(m.n());
+  evaluate(m, ws, q, qd, tau);
+  const MassMatrixHealth h = mass_matrix_health(ws.Ms);
+  d.asym = std::max(d.asym, h.asymmetry);
+  d.cond_lo = std::min(d.cond_lo, h.condition);
+  d.cond_hi = std::max(d.cond_hi, h.condition);
+  if (!h.positive_definite) {
+    ++d.singular_states;
+    const Status st = ws.solver.factorize(ws.Ms);
+    if (d.singular_message.empty()) d.singular_message = st.ok ? "λ_min ≤ 0" : st.message;
+    return;
+  }
+  const Linearization lin = linearize(m, ws, q, qd, tau);
+  if (!lin.status.ok) return;
+  // Stiff and dissipative: a dissipative mode more than 100x faster than the slowest mode,
+  // which decays long before the motion around it has moved. The fastest of the others is the
+  // motion a step must resolve.
+  const std::vector<Mode> md = modes(lin, dampers);
+  double slowest = std::numeric_limits<double>::infinity();
+  for (const Mode& x : md)
+    if (x.kind != ModeKind::None) slowest = std::min(slowest, x.omega);
+  for (const Mode& x : md) {
+    if (x.omega > d.stiffest.omega) d.stiffest = x;
+    const bool stiff_dissipative = x.dissipative() && x.omega > 100 * slowest;
+    if (!stiff_dissipative && x.kind != ModeKind::None && x.omega > d.fastest.omega) d.fastest = x;
+  }
+  for (int i = 0; i < 3; ++i)
+    if (const auto hs = largest_stable_step(lin, kExplicit[i]))
+      d.h_max[i] = std::min(d.h_max[i], *hs);
+}
+
+// The advice, as text and as numbers (dt 0 where no step is recommended).
+struct Advice {
+  std::string text, integrator;
+  double dt_rk4 = 0, dt_euler = 0, error_per_period = 0, period = 0;
+  bool stability_limited = false;
+};
+
+Advice advise(const Model& m, const Diagnosis& d, double tol) {
+  Advice a;
+  if (d.singular_states > 0) {
+    a.text = "none: M^s is singular at " + std::to_string(d.singular_states) +
+             " of the states; repair the model first";
+    return a;
+  }
+  const double limit = d.h_max[0];
+  if (d.fastest.omega == 0 && !std::isfinite(limit)) {
+    a.integrator = "dopri";
+    a.text = "dopri --rtol " + format_short(tol) + ": no mode was found (nothing moves by itself)";
+    return a;
+  }
+  // The step that resolves the fastest motion, and at most half the stability limit.
+  const double resolve = resolving_step(IntegratorKind::Rk4, d.fastest.omega, tol);
+  a.dt_rk4 = std::min(resolve, 0.5 * limit);
+  a.stability_limited = 0.5 * limit < resolve;
+  a.dt_euler =
+      std::min(resolving_step(IntegratorKind::Euler, d.fastest.omega, tol), 0.5 * d.h_max[1]);
+  a.period = d.fastest.omega > 0 ? 2 * std::numbers::pi / d.fastest.omega : 0;
+  a.error_per_period =
+      d.fastest.omega > 0 ? error_per_period(IntegratorKind::Rk4, d.fastest.omega, a.dt_rk4) : 0;
+
+  const std::string stiff = d.stiffest.text() + ", in " + where(m, d.stiffest.coordinate);
+  // Stiffness BDF cures: a dissipative stiffest mode that limits rk4 10x below what the motion
+  // needs (it decays, so nothing is lost by stepping over it implicitly).
+  if (d.stiffest.dissipative() && 0.5 * limit * 10 < resolve) {
+    a.integrator = "bdf";
+    a.text = "bdf --rtol " + format_short(tol) + ": the stiffest mode (" + stiff +
+             ") is dissipative and limits rk4 to dt < " + format_short(limit) + " s, " +
+             format_short(resolve / limit) + "x below the " + format_short(resolve) +
+             " s that the motion needs";
+    return a;
+  }
+  a.integrator = "rk4";
+  std::string text = "rk4 --dt " + format_short(a.dt_rk4) + " (";
+  if (a.stability_limited)
+    text += "half its stability limit " + format_short(limit) + " s";
+  else
+    text += format_short(a.period / a.dt_rk4) + " steps a period of the fastest motion, " +
+            d.fastest.text() + ", period " + format_short(a.period) + " s";
+  text += "): expect a relative error of about " + format_short(a.error_per_period) +
+          " per period (" + format_short(a.error_per_period) + " x t / " + format_short(a.period) +
+          " s over a run of t); or dopri --rtol " + format_short(tol);
+  if (!d.stiffest.dissipative() && d.stiffest.kind == ModeKind::Oscillatory && limit < 1e-4)
+    text += ". The stiffest mode (" + stiff + ", limit " + format_short(limit) +
+            " s) is an undamped fast oscillation: remove it (merge a tiny body into its "
+            "neighbour, or fix the joint), damp it, or resolve it; bdf does not cure it (it "
+            "must still follow or damp the oscillation)";
+  a.text = text;
+  return a;
+}
+
+Json mode_json(const Model& m, const Mode& md) {
+  return {{"lambda", {md.lambda.real(), md.lambda.imag()}},
+          {"omega", md.omega},
+          {"kind", md.text()},
+          {"damping_ratio", std::isnan(md.zeta) ? Json(nullptr) : Json(md.zeta)},
+          {"where", where(m, md.coordinate)}};
 }
 
 }  // namespace
 
 int cmd_check(int argc, char** argv) {
-  const Args a = parse_args(argc, argv, 2, {"help", "json"}, {"states", "seed", "gravity"});
+  const Args a =
+      parse_args(argc, argv, 2, {"help", "json"}, {"states", "seed", "tol", "budget", "gravity"});
   if (a.has("help")) {
     std::cout << kHelp;
     return 0;
@@ -54,111 +198,101 @@ int cmd_check(int argc, char** argv) {
   const Model m = load(a);
   const int K = static_cast<int>(integer_option(a, "states", 10, 1, 10000));
   std::mt19937 rng(static_cast<unsigned>(integer_option(a, "seed", 1, 0, 4294967295.0)));
+  const double tol = number_option(a, "tol", 1e-3);
+  if (!(tol > 0 && tol < 1)) throw CliError("--tol expects a relative error in (0, 1)");
+  const double budget = number_option(a, "budget", 120);
+  if (!(budget > 0)) throw CliError("--budget expects a positive number of seconds");
   const int n = m.n();
-  Workspace ws(m);
-  const VecX tau = VecX::Zero(n);
 
-  double cond_lo = std::numeric_limits<double>::infinity(), cond_hi = 0, asym = 0;
-  int singular_states = 0;
-  std::string singular_message;
-  double stiffest = 0;
-  std::complex<double> stiffest_lambda;
-  const IntegratorKind explicit_kinds[] = {IntegratorKind::Rk4, IntegratorKind::Euler,
-                                           IntegratorKind::Dopri};
-  double h_max[3] = {INFINITY, INFINITY, INFINITY};
-  bool h_known[3] = {true, true, true};
-  for (int k = 0; k < K; ++k) {
-    const VecX q = k == 0 ? VecX::Zero(n) : random_posture(m, rng);
-    const VecX qd = k == 0 ? VecX::Zero(n) : random_uniform(n, 1.0, rng);
-    evaluate(m, ws, q, qd, tau);
-    const MassMatrixHealth h = mass_matrix_health(ws.Ms);
-    asym = std::max(asym, h.asymmetry);
-    cond_lo = std::min(cond_lo, h.condition);
-    cond_hi = std::max(cond_hi, h.condition);
-    if (!h.positive_definite) {
-      ++singular_states;
-      const Status st = ws.solver.factorize(ws.Ms);
-      if (singular_message.empty()) singular_message = st.ok ? "λ_min ≤ 0" : st.message;
-      continue;
-    }
-    const Linearization lin = linearize(m, ws, q, qd, tau);
-    if (!lin.status.ok) continue;
-    if (std::abs(lin.stiffest) > stiffest) {
-      stiffest = std::abs(lin.stiffest);
-      stiffest_lambda = lin.stiffest;
-    }
-    for (int i = 0; i < 3; ++i) {
-      const auto hs = largest_stable_step(lin, explicit_kinds[i]);
-      if (!hs)
-        h_known[i] = false;
-      else
-        h_max[i] = std::min(h_max[i], *hs);
+  // Bounded work: estimated up front, refused beyond the budget.
+  const double per_state = seconds_per_state(m);
+  if (per_state * K > budget) {
+    std::cerr << "femdyn check: " << a.positional[0] << ": checking " << K << " states of " << n
+              << " coordinates would take about " << format_duration(per_state * K) << " ("
+              << format_duration(per_state)
+              << " a state: 4n evaluations and a dense eigenproblem of 2n = " << 2 * n
+              << "), beyond the budget of " << format_duration(budget) << ": use --states "
+              << std::max(1, static_cast<int>(budget / per_state)) << " or raise --budget\n";
+    return 1;
+  }
+
+  Workspace ws(m);
+  Diagnosis d;
+  const bool dampers = has_dampers(m);
+  {
+    Progress progress(K, "states");
+    for (int k = 0; k < K; ++k) {
+      const VecX q = k == 0 ? VecX::Zero(n) : random_posture(m, rng);
+      const VecX qd = k == 0 ? VecX::Zero(n) : random_uniform(n, 1.0, rng);
+      diagnose_state(m, ws, q, qd, dampers, d);
+      progress.update(k + 1);
     }
   }
   const std::vector<SuspiciousBody> bodies = suspicious_bodies(m);
-
-  // Recommendation: explicit methods while their stable step is not the binding constraint.
-  std::string recommendation;
-  if (singular_states > 0)
-    recommendation = "none: M^s is singular at " + std::to_string(singular_states) +
-                     " of the states; repair the model first";
-  else if (h_max[0] < 1e-4)
-    recommendation = "bdf (e.g. --rtol 1e-6): the stiffest mode limits rk4 to dt < " +
-                     format_short(h_max[0]) + " s and dopri to steps < " + format_short(h_max[2]) +
-                     " s";
-  else if (std::isfinite(h_max[0]))
-    recommendation = "dopri (--rtol 1e-6) for accuracy; for a fixed-rate loop rk4 with dt <= " +
-                     format_short(h_max[0] / 2) + " s (half its stability limit)";
-  else
-    recommendation = "dopri (--rtol 1e-6); no stiff mode was found";
+  bool flagged = false;
+  for (const auto& b : bodies) flagged = flagged || !b.note;
+  const Advice advice = advise(m, d, tol);
 
   if (a.has("json")) {
     Json j = {{"model", m.name},
-              {"coordinates", n},
+              {"n", n},
+              {"coordinates", m.coordinate_names},
               {"states", K},
-              {"condition", {{"min", cond_lo}, {"max", cond_hi}}},
-              {"digits_lost", std::log10(cond_hi)},
-              {"asymmetry", asym},
-              {"singular_states", singular_states},
-              {"stiffest_mode", stiffest},
-              {"stiffest_kind", mode_text(stiffest_lambda)},
-              {"recommendation", recommendation}};
+              {"condition", {{"min", d.cond_lo}, {"max", d.cond_hi}}},
+              {"digits_lost", std::log10(d.cond_hi)},
+              {"asymmetry", d.asym},
+              {"singular_states", d.singular_states},
+              {"stiffest_mode", mode_json(m, d.stiffest)},
+              {"fastest_motion", mode_json(m, d.fastest)},
+              {"recommendation", advice.text},
+              {"recommended",
+               {{"integrator", advice.integrator},
+                {"tol", tol},
+                {"rk4_dt", advice.dt_rk4},
+                {"euler_dt", advice.dt_euler},
+                {"rk4_error_per_period", advice.error_per_period},
+                {"period", advice.period},
+                {"stability_limited", advice.stability_limited}}}};
     Json steps = Json::object();
     for (int i = 0; i < 3; ++i)
-      steps[integrator_name(explicit_kinds[i])] =
-          h_known[i] && std::isfinite(h_max[i]) ? Json(h_max[i]) : Json(nullptr);
+      steps[integrator_name(kExplicit[i])] =
+          std::isfinite(d.h_max[i]) ? Json(d.h_max[i]) : Json(nullptr);
     j["largest_stable_step"] = steps;
-    Json flagged = Json::array();
-    for (const auto& b : bodies) flagged.push_back({{"body", b.name}, {"why", b.why}});
-    j["suspicious_bodies"] = flagged;
-    if (!singular_message.empty()) j["singular"] = singular_message;
+    Json flags = Json::array(), notes = Json::array();
+    for (const auto& b : bodies)
+      (b.note ? notes : flags).push_back({{"body", b.name}, {"why", b.why}});
+    j["suspicious_bodies"] = flags;
+    j["notes"] = notes;
+    if (!d.singular_message.empty()) j["singular"] = d.singular_message;
     std::cout << j.dump(2) << "\n";
   } else {
     std::cout << "model: " << m.name << " (" << n << " coordinates, " << m.bodies.size()
               << " bodies), " << K << " states\n";
-    if (singular_states)
-      std::cout << "M^s: singular at " << singular_states << " of " << K
-                << " states: " << singular_message << "\n";
-    if (singular_states < K)
-      std::cout << "M^s: cond from " << format_short(cond_lo) << " to " << format_short(cond_hi)
-                << " (q̈ loses up to " << format_short(std::log10(cond_hi))
-                << " digits of 16), symmetric to " << format_short(asym)
-                << (singular_states ? "" : ", positive definite at every state") << "\n";
-    std::cout << "stiffest mode: |λ| = " << format_short(stiffest) << " rad/s ("
-              << mode_text(stiffest_lambda) << ")\nlargest stable step:";
+    if (d.singular_states)
+      std::cout << "M^s: singular at " << d.singular_states << " of " << K
+                << " states: " << d.singular_message << "\n";
+    if (d.singular_states < K)
+      std::cout << "M^s: cond from " << format_short(d.cond_lo) << " to " << format_short(d.cond_hi)
+                << " (q̈ loses up to " << format_short(std::log10(d.cond_hi))
+                << " digits of 16), symmetric to " << format_short(d.asym)
+                << (d.singular_states ? "" : ", positive definite at every state") << "\n";
+    std::cout << "stiffest mode: |λ| = " << format_short(d.stiffest.omega) << " 1/s, "
+              << d.stiffest.text() << ", in " << where(m, d.stiffest.coordinate) << "\n"
+              << "fastest motion: " << d.fastest.text() << ", in " << where(m, d.fastest.coordinate)
+              << "\nlargest stable step:";
     for (int i = 0; i < 3; ++i)
-      std::cout << " " << integrator_name(explicit_kinds[i]) << " "
-                << (!h_known[i]               ? std::string("n/a (n > 200)")
-                    : std::isfinite(h_max[i]) ? format_short(h_max[i]) + " s"
+      std::cout << " " << integrator_name(kExplicit[i]) << " "
+                << (std::isfinite(d.h_max[i]) ? format_short(d.h_max[i]) + " s"
                                               : std::string("unlimited"))
                 << (i < 2 ? "," : "");
     std::cout << " (bdf: unlimited)\n";
     if (bodies.empty()) std::cout << "suspicious bodies: none\n";
     for (const auto& b : bodies)
-      std::cout << "suspicious body '" << b.name << "': " << b.why << "\n";
-    std::cout << "recommended: " << recommendation << "\n";
+      std::cout << (b.note ? "note: body '" : "suspicious body '") << b.name << "': " << b.why
+                << "\n";
+    std::cout << "recommended: " << advice.text << "\n";
   }
-  return singular_states > 0 || !bodies.empty() ? 1 : 0;
+  return d.singular_states > 0 || flagged ? 1 : 0;
 }
 
 }  // namespace femdyn::cli

@@ -21,13 +21,15 @@ namespace {
 constexpr const char* kHelp =
     R"(usage: femdyn simulate MODEL --t-end T [--integrator rk4|euler|dopri|bdf]
                         [--dt h | --rtol r --atol a] [--q0 …] [--qd0 …] [--tau … | --tau-csv FILE]
-                        [--out traj.csv] [--every k] [--force] [--json] [--gravity gx,gy,gz]
+                        [--out traj.csv] [--every k | --sample-dt s] [--max-steps N] [--force]
+                        [--json] [--gravity gx,gy,gz]
 
 Integrates M^s q̈ + h = Q from (q0, q̇0) (default 0) over [0, T] and prints a summary:
 integrator, steps, rejected steps, evaluations of forward dynamics, Jacobians, wall time,
 real-time factor (simulated time / integration wall time), and the energy balance: the largest
 |E(t) − E(0) − W(t)| over the output rows, W the work of the non-conservative forces (τ,
-dampers, body torques); for a conservative model that is the energy drift.
+dampers, body torques); for a conservative model that is the energy drift. It is given
+relative to the energy the motion started with plus the work done (docs/simulation.md).
 
 integrators (docs/simulation.md):
   rk4    classical Runge–Kutta 4, fixed step --dt (default 1e-3 s)
@@ -37,14 +39,54 @@ integrators (docs/simulation.md):
 --tau a,b,… is a constant actuation on the coordinates; --tau-csv FILE a time table with the
 header t,<coordinate>,… (or tau_<coordinate>), interpolated linearly; it must cover [0, T].
 --out writes t, q_*, qd_*, kinetic, potential, total, work every k-th step (--every, default 1;
-the first and last rows always). The file appears whole when the run ends: an existing file is
+the first and last rows always, the last at T exactly), or at the times 0, s, 2s, …, T
+(--sample-dt s; adaptive methods interpolate there, fixed-step ones land there with a
+shortened step and return to their grid t = k dt). The file appears whole when the run ends:
+an existing file is
 kept unless --force, and a failed or interrupted run never leaves half a file (a run stopped by
 a numerical fault writes the rows up to the last good step and says so). --json prints the
-summary as one object. Exit 1 on a numerical fault (the message names the time, the quantity
-and the likely cause), 130 when interrupted.
+summary as one object.
+Before it starts, a fixed-step run that needs more than --max-steps steps (default 1e7) or a
+dt below the time's resolution is refused with its step count and estimated time, and an
+output larger than the free disk space is refused with its size. A solution that diverges
+(its energy grows far beyond what it started with and was given) stops as a failure that names
+the stiffest mode and the step it allows. A joint that leaves its declared limits gets one
+warning (the joint, the time, the value). Exit 1 on a numerical fault or a divergence (the
+message names the time, the quantity and the likely cause), 130 when interrupted.
 )";
 
 std::string num(double x) { return format_number(x, "%.4g"); }
+
+// The row times 0, s, 2s, …, t_end (the last one exactly t_end).
+std::vector<double> output_times(double t_end, double s) {
+  std::vector<double> times;
+  for (long k = 0; static_cast<double>(k) * s < t_end - 1e-9 * s; ++k)
+    times.push_back(static_cast<double>(k) * s);
+  times.push_back(t_end);
+  return times;
+}
+
+// Whether the trajectory file fits on its disk: rows × (2n + 5) numbers of at most 24 bytes
+// (a fixed-step run's rows are known up front; an adaptive run's, without --sample-dt, are not).
+Status output_fits(const AtomicFile& out, const Model& m, const IntegratorOptions& o, double t_end,
+                   long every, const std::optional<std::vector<double>>& times) {
+  double rows = 0;
+  if (times)
+    rows = static_cast<double>(times->size());
+  else if (!is_adaptive(o.kind))
+    rows = std::ceil(t_end / o.fixed.dt) / static_cast<double>(every) + 2;
+  else
+    return {};
+  const double bytes = rows * (2.0 * m.n() + 5) * 24;
+  std::error_code ec;
+  const auto space =
+      std::filesystem::space(std::filesystem::absolute(out.temporary(), ec).parent_path(), ec);
+  if (ec || bytes <= static_cast<double>(space.available)) return {};
+  return {false, "the trajectory would take up to " + format_short(bytes / 1e9) + " GB (" +
+                     format_short(rows) + " rows) and the disk has " +
+                     format_short(static_cast<double>(space.available) / 1e9) +
+                     " GB free: write fewer rows (--every k or --sample-dt s)"};
+}
 
 volatile std::sig_atomic_t g_interrupted = 0;
 extern "C" void on_interrupt(int) { g_interrupted = 1; }
@@ -89,6 +131,9 @@ IntegratorOptions integrator_options(const Args& a) {
                      integrator_name(o.kind) + " has a fixed step: use --dt");
     o.fixed.dt = number_option(a, "dt", o.fixed.dt);
   }
+  const long max_steps = static_cast<long>(integer_option(a, "max-steps", 1e7, 1, 1e15));
+  o.fixed.max_steps = max_steps;
+  if (a.has("max-steps")) o.adaptive.max_steps = max_steps;
   if (const std::string why = o.check(); !why.empty()) throw CliError("--" + why);
   return o;
 }
@@ -96,7 +141,7 @@ IntegratorOptions integrator_options(const Args& a) {
 int cmd_simulate(int argc, char** argv) {
   const Args a = parse_args(argc, argv, 2, {"help", "json", "force"},
                             {"gravity", "t-end", "integrator", "dt", "rtol", "atol", "q0", "qd0",
-                             "tau", "tau-csv", "out", "every"});
+                             "tau", "tau-csv", "out", "every", "sample-dt", "max-steps"});
   if (a.has("help")) {
     std::cout << kHelp;
     return 0;
@@ -108,6 +153,15 @@ int cmd_simulate(int argc, char** argv) {
   const IntegratorOptions o = integrator_options(a);
   const VecX q0 = state_vector(a, "q0", m), qd0 = state_vector(a, "qd0", m);
   const long every = static_cast<long>(integer_option(a, "every", 1, 1));
+  if (a.has("every") && a.has("sample-dt"))
+    throw CliError("--every and --sample-dt exclude each other");
+  std::optional<std::vector<double>> sample_times;
+  if (a.has("sample-dt")) {
+    const double s = number_option(a, "sample-dt", 0);
+    if (!(s > 0) || t_end / s > 1e9)
+      throw CliError("--sample-dt expects a positive interval, at most 1e9 rows over --t-end");
+    sample_times = output_times(t_end, s);
+  }
 
   // τ: constant, a table, or none (passive).
   if (a.has("tau") && a.has("tau-csv")) throw CliError("--tau and --tau-csv exclude each other");
@@ -140,15 +194,19 @@ int cmd_simulate(int argc, char** argv) {
     } catch (const std::runtime_error& e) {
       throw CliError(std::string("--out ") + e.what());
     }
-    write_trajectory_header(out->stream(), m);
   }
 
   std::unique_ptr<Integrator> integ = make_integrator(m, o, tau);
   integ->reset(0, q0, qd0, t_end);
+  if (out) {
+    const Status fits = output_fits(*out, m, o, t_end, every, sample_times);
+    if (!fits.ok) throw CliError("--out " + out->path() + ": " + fits.message);
+    write_trajectory_header(out->stream(), m);
+  }
   InterruptGuard guard;
   Progress progress(t_end, "s");
   const RecordedRun run = run_recorded(
-      *integ, t_end, every, nullptr,
+      *integ, t_end, every, sample_times ? &*sample_times : nullptr,
       [&](const Integrator& i, const Energy& E) {
         if (out) write_trajectory_row(out->stream(), i.t(), i.y(), E);
       },
@@ -163,10 +221,17 @@ int cmd_simulate(int argc, char** argv) {
     return 130;  // `out` discards its temporary file
   }
   const Status& st = run.status;
+  if (run.rows == 0 && !st.ok)  // refused by the plan: nothing was run
+    throw CliError(std::string(a.positional[0]) + ": " + st.message);
   const Energy& E0 = run.initial;
   const double max_balance = run.max_balance, scale = run.scale, wall = run.wall_time;
   const long rows = run.rows;
   if (out) out->commit();
+  if (!a.has("json"))  // (with --json they are the object's "limit_crossings")
+    for (const LimitCrossing& c : run.limit_crossings)
+      std::cerr << "femdyn simulate: warning: joint '" << c.name << "' left its limits ["
+                << num(c.lower) << ", " << num(c.upper) << "] at t = " << num(c.t) << " s (value "
+                << num(c.value) << "); limits are not enforced\n";
 
   const IntegratorStats& s = integ->stats();
   const double simulated = integ->t();
@@ -188,9 +253,19 @@ int cmd_simulate(int argc, char** argv) {
               {"conservative", is_conservative},
               {"energy_initial", E0.total()},
               {"energy_balance_error", max_balance},
-              {"energy_balance_relative", scale > 0 ? max_balance / scale : 0.0},
+              {"energy_scale", scale},
+              {"energy_balance_relative", run.relative_balance()},
               {"rows", rows},
-              {"ok", st.ok}};
+              {"ok", st.ok},
+              {"diverged", st.diverged}};
+    Json crossings = Json::array();
+    for (const LimitCrossing& c : run.limit_crossings)
+      crossings.push_back({{"joint", c.name},
+                           {"t", c.t},
+                           {"value", c.value},
+                           {"lower", c.lower},
+                           {"upper", c.upper}});
+    j["limit_crossings"] = crossings;
     if (is_adaptive(o.kind))
       j["options"] = {{"rtol", o.adaptive.rtol}, {"atol", o.adaptive.atol}};
     else
@@ -211,8 +286,8 @@ int cmd_simulate(int argc, char** argv) {
               << "wall time " << num(wall) << " s (integration " << num(s.wall_time)
               << " s), real-time factor " << num(rtf) << "\n"
               << balance_name << ": max |E(t) - E(0) - W(t)| = " << num(max_balance) << " J ("
-              << num(scale > 0 ? max_balance / scale : 0) << " of the energy scale) over " << rows
-              << " rows\n";
+              << num(run.relative_balance()) << " of the " << num(scale)
+              << " J the motion started with and was given) over " << rows << " rows\n";
     if (out) std::cout << "wrote " << out->path() << " (" << rows << " rows)\n";
   }
   if (!st.ok) {

@@ -72,11 +72,13 @@ int cmd_stress(int argc, char** argv) {
   Json results = Json::array();
   std::ostringstream md, csv;
   md << "| class | case | n | cond(M^s) along the motion | SPD | stiffest mode (rad/s) | "
-        "largest stable step rk4 / euler (s) | relative error: rk4 / euler at the fixed step, "
+        "largest stable step rk4 / euler (s), measured (linear theory) | relative error: rk4 / "
+        "euler at the fixed step, "
         "dopri / bdf at rtol 1e-6 | energy balance | Simbody (relative) | verdict "
         "|\n|---|---|---|---|---|---|---|---|---|---|---|\n";
   csv << "class,case,n,cond_min,cond_max,positive_definite,stiffest,rk4_stable_step,"
-         "euler_stable_step,dt,rk4_error,euler_error,dopri_error,bdf_error,energy_error,"
+         "euler_stable_step,rk4_theory_step,euler_theory_step,dt,rk4_error,euler_error,dopri_error,"
+         "bdf_error,energy_error,"
          "simbody_error,verdict\n";
   for (const StressCase& c : cases) {
     const auto begin = std::chrono::steady_clock::now();
@@ -108,6 +110,9 @@ int cmd_stress(int argc, char** argv) {
     const auto step = [&](std::size_t i) {
       return i < r.integrators.size() ? r.integrators[i].largest_stable_step : -1.0;
     };
+    const auto theory = [&](std::size_t i) {
+      return i < r.integrators.size() ? r.integrators[i].theory_step : -1.0;
+    };
     Json j = {{"class", c.klass},     {"case", c.name},       {"description", c.description},
               {"expected", c.expect}, {"verdict", r.verdict}, {"n", r.n},
               {"seconds", seconds}};
@@ -121,11 +126,13 @@ int cmd_stress(int argc, char** argv) {
                 {"energy_error", r.energy_error},
                 {"simbody_error", r.simbody_error},
                 {"simbody_note", r.simbody_note},
+                {"search_note", r.search_note},
                 {"dt", c.dt}});
       Json its = Json::array();
       for (const auto& it : r.integrators)
         its.push_back({{"integrator", it.name},
                        {"largest_stable_step", it.largest_stable_step},
+                       {"theory_step", it.theory_step},
                        {"error", it.error},
                        {"steps", it.steps},
                        {"failure", it.failure}});
@@ -135,9 +142,12 @@ int cmd_stress(int argc, char** argv) {
     md << "| " << c.klass << " | " << c.name << " | " << r.n << " | ";
     if (r.refused.empty())
       md << g(r.cond_min) << " … " << g(r.cond_max) << " | " << (r.positive_definite ? "yes" : "no")
-         << " | " << (r.stiffest > 0 ? g(r.stiffest) : "—") << " | " << g(step(0)) << " / "
-         << g(step(1)) << " | at " << g(c.dt) << " s: " << (err(0) < 0 ? "unstable" : g(err(0)))
-         << " / " << (err(1) < 0 ? "unstable" : g(err(1))) << "; rtol 1e-6: " << g(err(2)) << " / "
+         << " | " << (r.stiffest > 0 ? g(r.stiffest) : "—") << " | "
+         << (r.search_note.empty() ? g(step(0)) + " (" + g(theory(0)) + ") / " + g(step(1)) + " (" +
+                                         g(theory(1)) + ")"
+                                   : r.search_note)
+         << " | at " << g(c.dt) << " s: " << (err(0) < 0 ? "unstable" : g(err(0))) << " / "
+         << (err(1) < 0 ? "unstable" : g(err(1))) << "; rtol 1e-6: " << g(err(2)) << " / "
          << g(err(3)) << " | " << g(r.energy_error) << " | "
          << (r.simbody_error >= 0     ? g(r.simbody_error)
              : r.simbody_note.empty() ? "—"
@@ -149,8 +159,9 @@ int cmd_stress(int argc, char** argv) {
     std::replace(verdict.begin(), verdict.end(), ',', ';');
     csv << c.klass << "," << c.name << "," << r.n << "," << r.cond_min << "," << r.cond_max << ","
         << r.positive_definite << "," << r.stiffest << "," << step(0) << "," << step(1) << ","
-        << c.dt << "," << err(0) << "," << err(1) << "," << err(2) << "," << err(3) << ","
-        << r.energy_error << "," << r.simbody_error << ",\"" << verdict << "\"\n";
+        << theory(0) << "," << theory(1) << "," << c.dt << "," << err(0) << "," << err(1) << ","
+        << err(2) << "," << err(3) << "," << r.energy_error << "," << r.simbody_error << ",\""
+        << verdict << "\"\n";
   }
   if (write) {
     for (const auto& [name, text] : {std::pair{"stress.md", md.str()}, {"stress.csv", csv.str()}}) {

@@ -250,7 +250,7 @@ Energy energy(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) 
   if (model.coupling_level) return chain::energy(model, ws, q, qd);
   evaluate(model, ws, q, qd, VecX());
   Energy E;
-  E.kinetic = 0.5 * qd.dot(ws.Ms * qd);
+  E.kinetic = 0.5 * qd.dot(ws.Ms.lazyProduct(qd));  // (no temporary: energy is looked at mid-run)
   // Potential of constant nodal forces: −F_i x_i over translation DOFs (positions in world).
   for (int i = 0; i < model.n_u(); ++i) {
     const SystemDof& d = model.dofs[i];

@@ -1,25 +1,21 @@
 #include "core/fixed_step.hpp"
 
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 
 namespace femdyn {
-namespace {
-
-// The likely cause of a NaN that a fixed step produced.
-Status unstable(Status st, double dt) {
-  char buf[200];
-  std::snprintf(buf, sizeof buf,
-                "; likely cause: the step dt = %g s is beyond the stability limit of the "
-                "stiffest mode (use a smaller step, or the bdf integrator)",
-                dt);
-  st.message += buf;
-  return st;
-}
-
-}  // namespace
 
 FixedStep::FixedStep(const Model& model, const FixedStepOptions& options, Actuation tau)
     : Integrator(model, std::move(tau)), options_(options), y_next_(y_.size()) {}
+
+std::string FixedStep::setting() const { return "dt = " + format_short(options_.dt) + " s"; }
+
+Status FixedStep::one_step() {
+  // The next grid time, or t_stop when it is nearer (or within round-off of the grid time).
+  const double next = grid(k_ + 1);
+  return advance(next >= t_stop_ - 1e-9 * options_.dt ? t_stop_ : next);
+}
 
 Status FixedStep::advance(double t_out) {
   const double dt = options_.dt;
@@ -27,23 +23,54 @@ Status FixedStep::advance(double t_out) {
     if (stats_.steps >= options_.max_steps)
       return {false, at_time(t_) + "more than " + std::to_string(options_.max_steps) +
                          " steps (max_steps); likely cause: dt too small for the time span"};
-    // Land on t_out: the last step is shortened (or stretched by round-off, at most 1e-9 dt).
-    const bool last = t_out - t_ <= dt * (1 + 1e-9);
-    const double h = last ? t_out - t_ : dt;
-    Status st = take_step(h);
-    stats_.rhs_evals = motion_.evaluations();
-    if (!st.ok) {
-      // A NaN met inside the step came from the step itself: say so.
-      if (st.non_finite) st = unstable(std::move(st), dt);
-      return st;
+    // The next grid time, unless t_out comes first; a grid time within 1e-9 dt of t_out (by
+    // round-off) is t_out itself.
+    double t_next = grid(k_ + 1);
+    bool on_grid = true;
+    if (t_next > t_out - 1e-9 * dt) {
+      on_grid = t_next <= t_out + 1e-9 * dt;
+      t_next = t_out;
     }
-    if (Status bad = motion_.check_state(t_ + h, y_next_.data()); !bad.ok)
-      return unstable(std::move(bad), dt);
+    Status st = take_step(t_next - t_);
+    stats_.rhs_evals = motion_.evaluations();
+    // An overflow inside the step or in the state it made (y_ itself is finite): the step
+    // blew the state up, whatever the last good state shows.
+    if (!st.ok) return st.non_finite ? diverged() : explain(std::move(st));
+    if (!motion_.check_state(t_next, y_next_.data()).ok) return diverged();
     y_.swap(y_next_);
-    t_ = last ? t_out : t_ + dt;
+    t_ = t_next;
+    if (on_grid) ++k_;
     ++stats_.steps;
+    if (Status w = watch(); !w.ok) return w;
   }
   return {};
+}
+
+Status FixedStep::plan(double t_end) {
+  const double dt = options_.dt, span = t_end - t_;
+  if (!(span > 0)) return {};
+  // t + dt must differ from t at every time of the run.
+  const double t_max = std::max(std::abs(t_), std::abs(t_end));
+  if (t_max + dt == t_max || t_max - dt == t_max)
+    return {false, "dt = " + format_short(dt) + " s is below the resolution of the time at t = " +
+                       format_short(t_max) + " s (t + dt == t in double precision)"};
+  const double steps = std::ceil(span / dt - 1e-9);
+  if (steps <= static_cast<double>(options_.max_steps)) return {};
+  // The time it would take, from a few evaluations at the start.
+  VecX f(y_.size());
+  const auto begin = std::chrono::steady_clock::now();
+  constexpr int kProbe = 8;
+  for (int i = 0; i < kProbe; ++i) (void)motion_.rhs(t_, y_.data(), f.data());
+  const double per_eval =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count() / kProbe;
+  const double evals = steps * evaluations_per_step();
+  return {false, "the run needs " + format_short(steps) + " steps of dt = " + format_short(dt) +
+                     " s over " + format_short(span) + " s (" + format_short(evals) +
+                     " evaluations of forward dynamics, about " +
+                     format_duration(evals * per_eval) + "), more than the limit of " +
+                     std::to_string(options_.max_steps) +
+                     " steps: use a larger dt, or an adaptive integrator (dopri), or raise the "
+                     "limit (--max-steps, max_steps=)"};
 }
 
 Rk4::Rk4(const Model& model, const FixedStepOptions& options, Actuation tau)

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/fixed_step.hpp"
+#include "core/stability.hpp"
 #include "core/sundials_integrators.hpp"
 
 namespace femdyn {
@@ -86,15 +87,20 @@ void Integrator::reset(double t0, const VecX& q0, const VecX& qd0, double t_stop
   if (q0.size() != n || qd0.size() != n)
     throw std::invalid_argument("Integrator::reset: expected q0, qd0 of size " + std::to_string(n));
   y_ << q0, qd0, 0.0;
-  t_ = t0;
+  y0_ = y_;
+  t_ = t0_ = t0;
   t_stop_ = t_stop;
   stats_ = {};
+  const Energy E0 = motion_.energy_at(y_.data());
+  watch_.start(E0, potential_reach(motion_.model(), motion_.workspace()),
+               qd0.size() ? qd0.cwiseAbs().maxCoeff() : 0.0);
   start();
 }
 
 Status Integrator::advance_to(double t_out) {
   const auto begin = std::chrono::steady_clock::now();
   Status st = t_out > t_ ? advance(t_out) : Status{};
+  st = st.ok ? watch() : explain(std::move(st));
   stats_.wall_time +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   return st;
@@ -104,8 +110,42 @@ Status Integrator::step() {
   if (t_ >= t_stop_) return {};
   const auto begin = std::chrono::steady_clock::now();
   Status st = one_step();
+  st = st.ok ? watch() : explain(std::move(st));
   stats_.wall_time +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  return st;
+}
+
+Status Integrator::plan(double) { return {}; }
+
+Status Integrator::watch() {
+  const int n = motion_.n();
+  const double qd_norm = n ? qd().cwiseAbs().maxCoeff() : 0.0;
+  if (!watch_.due(qd_norm)) return {};
+  if (watch_.look(motion_.energy_at(y_.data()), work(), qd_norm)) return diverged();
+  return {};
+}
+
+Status Integrator::explain(Status failure) {
+  if (failure.diverged) return failure;
+  const int n = motion_.n();
+  const double qd_norm = n ? qd().cwiseAbs().maxCoeff() : 0.0;
+  if (watch_.look(motion_.energy_at(y_.data()), work(), qd_norm)) return diverged();
+  return failure;
+}
+
+Status Integrator::diverged() {
+  const int n = motion_.n();
+  VecX tau0(n);
+  motion_.actuation(t0_, tau0);
+  Status st{false,
+            at_time(t_) + "the solution diverges (the state holds " + format_short(watch_.gain()) +
+                " J more energy than the " + format_short(watch_.supplied()) +
+                " J it started with and was given): " +
+                divergence_cause(motion_.model(), kind(), fixed_dt(), setting(), y0_.head(n),
+                                 y0_.segment(n, n), tau0),
+            -1};
+  st.diverged = true;
   return st;
 }
 

@@ -12,13 +12,16 @@
 // The state is y = (q, q̇, W), W the work of the non-conservative forces. A failure (step-size
 // underflow, NaN in the state, M^s losing definiteness, a Newton solver that does not converge)
 // is a failed Status naming the time, the quantity and the likely cause; the integrator keeps
-// its last good state.
+// its last good state. Divergence is looked for first (core/divergence.hpp): a run whose state
+// blows up fails as "the solution diverges" with the stiffest mode and the step it allows, even
+// where the blown-up state then makes M^s singular or overflows.
 #pragma once
 #include <limits>
 #include <memory>
 #include <string>
 #include <string_view>
 
+#include "core/divergence.hpp"
 #include "core/motion.hpp"
 
 namespace femdyn {
@@ -32,9 +35,9 @@ bool parse_integrator(std::string_view name, IntegratorKind& kind);
 bool is_adaptive(IntegratorKind kind);
 
 struct FixedStepOptions {
-  double dt = 1e-3;                // s
-  long max_steps = 1'000'000'000;  // a run of more steps stops with a message
-  std::string check() const;       // "" if valid, else "dt: …" naming the field
+  double dt = 1e-3;             // s
+  long max_steps = 10'000'000;  // a run that needs more steps is refused before it starts
+  std::string check() const;    // "" if valid, else "dt: …" naming the field
 };
 
 struct AdaptiveOptions {
@@ -75,6 +78,12 @@ class Integrator {
   // One step: dt for a fixed-step method, one internal (error-controlled) step for an adaptive
   // one; never past t_stop.
   Status step();
+  // Whether a run to t_end can be made: a fixed-step run of more than max_steps steps, or with
+  // a dt below the time's resolution (t + dt == t), is refused here, before any work, with the
+  // step count, an estimate of its time and how to raise the limit.
+  virtual Status plan(double t_end);
+  // "dt = 0.001 s" or "rtol 1e-06, atol 1e-08": the setting a message quotes.
+  virtual std::string setting() const = 0;
 
   double t() const { return t_; }
   auto q() const { return y_.head(motion_.n()); }
@@ -83,16 +92,26 @@ class Integrator {
   const VecX& y() const { return y_; }
   const IntegratorStats& stats() const { return stats_; }
   Motion& motion() { return motion_; }
+  const DivergenceWatch& divergence() const { return watch_; }
 
  protected:
   Integrator(const Model& model, Actuation tau);
   virtual void start() = 0;  // after reset: (re)initialise the method at (t_, y_, t_stop_)
   virtual Status advance(double t_out) = 0;  // the method's own advance_to
   virtual Status one_step() = 0;             // the method's own step
+  // After an accepted step: the divergence test when the rates have grown (core/divergence.hpp).
+  Status watch();
+  // A failure, unless the last good state shows the solution diverging: then that, first.
+  Status explain(Status failure);
+  // The failed Status "at t = …: the solution diverges …: <cause>".
+  Status diverged();
+  // The fixed step, or 0 for an adaptive method (for the divergence's cause).
+  virtual double fixed_dt() const { return 0; }
   Motion motion_;
-  VecX y_;
-  double t_ = 0, t_stop_ = 0;
+  VecX y_, y0_;
+  double t_ = 0, t0_ = 0, t_stop_ = 0;
   IntegratorStats stats_;
+  DivergenceWatch watch_;
 };
 
 struct IntegratorOptions {  // what make_integrator reads: the one that applies to `kind`

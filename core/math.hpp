@@ -75,4 +75,14 @@ inline std::string format_number(double x, const char* spec = "%.6g") {
 // Three significant digits, for reports and diagnoses.
 inline std::string format_short(double x) { return format_number(x, "%.3g"); }
 
+// A duration for a person: "0.4 s", "12 min", "3.1 h", "2.5 days".
+inline std::string format_duration(double seconds) {
+  if (!(seconds < 120)) {
+    if (seconds < 7200) return format_number(seconds / 60, "%.3g") + " min";
+    if (seconds < 172800) return format_number(seconds / 3600, "%.3g") + " h";
+    return format_number(seconds / 86400, "%.3g") + " days";
+  }
+  return format_number(seconds, "%.2g") + " s";
+}
+
 }  // namespace femdyn

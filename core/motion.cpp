@@ -46,12 +46,10 @@ Status Motion::rhs(double t, const double* y, double* ydot) {
   const int n = model_.n();
   q_ = Eigen::Map<const VecX>(y, n);
   qd_ = Eigen::Map<const VecX>(y + n, n);
-  if (tau_)
-    tau_(t, u_);
-  else
-    u_.setZero();
+  actuation(t, u_);
   if (Status st = check_state(t, y); !st.ok) return st;
-  if (!u_.allFinite()) return {false, at_time(t) + "the actuation tau(t) is NaN or Inf", -1, true};
+  // (an input's fault, not an overflow of the motion: non_finite stays false)
+  if (!u_.allFinite()) return {false, at_time(t) + "the actuation tau(t) is NaN or Inf", -1};
   Status st = forward_dynamics(model_, ws_, q_, qd_, u_);
   if (!st.ok) {
     st.message = at_time(t) + st.message;
@@ -61,6 +59,13 @@ Status Motion::rhs(double t, const double* y, double* ydot) {
   Eigen::Map<VecX>(ydot + n, n) = ws_.qdd;
   ydot[2 * n] = nonconservative_power(model_, ws_, qd_, u_);
   return {};
+}
+
+void Motion::actuation(double t, VecX& tau) const {
+  if (tau_)
+    tau_(t, tau);
+  else
+    tau.setZero(n());
 }
 
 Energy Motion::energy_at(const double* y) {

@@ -35,6 +35,10 @@ class Motion {
 
   // Mechanical energy at y (kinetic, potential; the work W is y's last entry).
   Energy energy_at(const double* y);
+  // τ(t) (zero when passive).
+  void actuation(double t, VecX& tau) const;
+  // The workspace of the last evaluation (rhs or energy_at).
+  const Workspace& workspace() const { return ws_; }
 
  private:
   const Model& model_;

@@ -3,8 +3,49 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 
 namespace femdyn {
+
+namespace {
+
+// Joints with finite limits, checked after every step; each reported once.
+class LimitWatch {
+ public:
+  explicit LimitWatch(const Model& m) : model_(m), ws_(m) {
+    for (int j = 0; j < m.n_theta(); ++j) {
+      const Joint& J = m.bodies[m.theta_joint[j]].joint;
+      if (std::isfinite(J.lower) || std::isfinite(J.upper)) limited_.push_back(j);
+    }
+  }
+  template <class Q, class Qd>
+  void look(double t, const Q& q, const Qd& qd, std::vector<LimitCrossing>& out) {
+    if (limited_.empty()) return;
+    q_ = q;
+    qd_ = qd;
+    try {
+      joint_state(model_, ws_, q_, qd_);
+    } catch (const std::exception&) {
+      return;  // a law undefined here: the integrator's next evaluation says so
+    }
+    for (int& j : limited_) {
+      if (j < 0) continue;
+      const Joint& J = model_.bodies[model_.theta_joint[j]].joint;
+      const double x = ws_.theta[j];
+      if (x >= J.lower && x <= J.upper) continue;
+      out.push_back({j, J.name, t, x, J.lower, J.upper});
+      j = -1;  // once per joint
+    }
+  }
+
+ private:
+  const Model& model_;
+  Workspace ws_;
+  VecX q_, qd_;
+  std::vector<int> limited_;
+};
+
+}  // namespace
 
 RecordedRun run_recorded(Integrator& integ, double t_end, long every,
                          const std::vector<double>* times,
@@ -12,11 +53,20 @@ RecordedRun run_recorded(Integrator& integ, double t_end, long every,
                          const std::function<bool(double t)>& stop) {
   RecordedRun r;
   r.initial = integ.motion().energy_at(integ.y().data());
-  r.scale = std::max(std::abs(r.initial.total()), std::abs(r.initial.kinetic));
+  const double S0 = integ.divergence().initial_scale();
+  r.scale = S0;
+  if (Status plan = integ.plan(times ? (times->empty() ? integ.t() : times->back()) : t_end);
+      !plan.ok) {
+    r.status = plan;
+    return r;
+  }
+  const Model& model = integ.motion().model();
+  LimitWatch limits(model);
+  limits.look(integ.t(), integ.q(), integ.qd(), r.limit_crossings);
   const auto output = [&] {
     const Energy E = integ.motion().energy_at(integ.y().data());
     r.max_balance = std::max(r.max_balance, std::abs(E.total() - r.initial.total() - integ.work()));
-    r.scale = std::max({r.scale, std::abs(E.total()), E.kinetic});
+    r.scale = std::max(r.scale, S0 + std::abs(integ.work()));
     row(integ, E);
     ++r.rows;
   };
@@ -25,6 +75,7 @@ RecordedRun run_recorded(Integrator& integ, double t_end, long every,
     for (double t : *times) {
       if (t > integ.t()) r.status = integ.advance_to(t);
       if (!r.status.ok) break;
+      limits.look(integ.t(), integ.q(), integ.qd(), r.limit_crossings);
       output();
       if ((r.interrupted = stop(integ.t()))) break;
     }
@@ -33,6 +84,7 @@ RecordedRun run_recorded(Integrator& integ, double t_end, long every,
     for (long step = 1; integ.t() < t_end; ++step) {
       r.status = integ.step();
       if (!r.status.ok) break;
+      limits.look(integ.t(), integ.q(), integ.qd(), r.limit_crossings);
       if (step % every == 0 || integ.t() >= t_end) output();
       if ((r.interrupted = stop(integ.t()))) break;
     }

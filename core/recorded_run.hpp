@@ -2,7 +2,12 @@
 // (python/bind_simulate.cpp) make it: from the integrator's reset state to t_end, a row at the
 // start, then after every `every`-th step and at the last one — or, given `times`, a row at each
 // of those times (advance_to, dense output) — and the energy balance over the rows,
-//   max |E(t) − E(0) − W(t)|,  W the work of the non-conservative forces (τ, dampers, torques).
+//   max |E(t) − E(0) − W(t)|,  W the work of the non-conservative forces (τ, dampers, torques),
+// relative to the fixed scale S₀ + max |W| (core/divergence.hpp): the energy the motion started
+// with plus the work done, which does not grow with the error. The run is planned first
+// (Integrator::plan: a fixed-step run beyond max_steps is refused before any work), and a
+// solution that diverges fails as such (core/integrator.hpp). Joints that leave their declared
+// limits are recorded, once per joint, at the first step that finds them outside.
 #pragma once
 #include <functional>
 #include <vector>
@@ -12,17 +17,27 @@
 
 namespace femdyn {
 
+// A joint outside its limits [lower, upper] (the first step found it there).
+struct LimitCrossing {
+  int joint = -1;  // θ index
+  std::string name;
+  double t = 0, value = 0, lower = 0, upper = 0;
+};
+
 struct RecordedRun {
-  Status status;             // the integrator's, where it failed (the rows end at its last step)
+  Status status;             // the plan's or the integrator's failure (rows end at its last step)
   bool interrupted = false;  // `stop` ended the run
   Energy initial;            // E(0)
   double max_balance = 0;    // max over the rows of |E − E(0) − W|
-  double scale = 0;          // max over the rows of |E| and the kinetic energy (for a ratio)
+  double scale = 0;          // S₀ + max over the rows of |W| (J): the fixed scale of the balance
+  double relative_balance() const { return scale > 0 ? max_balance / scale : max_balance; }
+  std::vector<LimitCrossing> limit_crossings;
   long rows = 0;
   double wall_time = 0;  // s, the whole loop (rows included)
 };
 
-// `times` null: rows every `every` steps; else a row at each of *times (none if it is empty).
+// `times` null: rows every `every` steps, the last one at t_end exactly; else a row at each of
+// *times (none if it is empty).
 // `row(integ, E)` at each row; `stop(t)` after each step (or time): true ends the run.
 RecordedRun run_recorded(Integrator& integ, double t_end, long every,
                          const std::vector<double>* times,

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 
 namespace femdyn {
 namespace {
@@ -84,6 +85,13 @@ Linearization linearize(const Model& m, Workspace& ws, const VecX& q, const VecX
     }
     x[i] = x0;
   }
+  if (!lin.A.allFinite()) {  // (an eigensolver given NaN may never return)
+    lin.status = {false,
+                  "the linearised dynamics are NaN or Inf at this state (the state or the "
+                  "forces overflow double precision)",
+                  -1, true};
+    return lin;
+  }
   lin.eigenvalues = Eigen::EigenSolver<MatX>(lin.A, false).eigenvalues();
   for (Eigen::Index i = 0; i < lin.eigenvalues.size(); ++i) {
     if (std::abs(lin.eigenvalues[i]) > std::abs(lin.stiffest)) lin.stiffest = lin.eigenvalues[i];
@@ -95,16 +103,149 @@ Linearization linearize(const Model& m, Workspace& ws, const VecX& q, const VecX
 std::optional<double> largest_stable_step(const Linearization& lin, IntegratorKind kind) {
   if (kind == IntegratorKind::Bdf) return std::numeric_limits<double>::infinity();
   const double rate = std::abs(lin.stiffest);
+  if (!std::isfinite(rate) || !lin.status.ok) return std::nullopt;
   if (rate == 0) return std::numeric_limits<double>::infinity();
   // Every explicit method here is unstable beyond h |λ| = 10; bisect on log h below that.
   double lo = 1e-6 / rate, hi = 10 / rate;
   if (!stable(lin, kind, lo)) return 0.0;
   if (stable(lin, kind, hi)) return hi;
-  while (hi / lo > 1 + 1e-6) {
-    const double mid = std::sqrt(lo * hi);
+  // (lo √(hi/lo), not √(lo hi): the product underflows for rates beyond 1e150; at most 60
+  // halvings of log(hi/lo) = log 1e7 reach 1e-6)
+  for (int i = 0; i < 60 && hi / lo > 1 + 1e-6; ++i) {
+    const double mid = lo * std::sqrt(hi / lo);
     (stable(lin, kind, mid) ? lo : hi) = mid;
   }
   return lo;
+}
+
+bool has_dampers(const Model& m) {
+  for (const Body& b : m.bodies)
+    if (b.joint.damping != 0) return true;
+  return false;
+}
+
+std::string Mode::text() const {
+  const std::string w = format_short(omega) + " rad/s";
+  switch (kind) {
+    case ModeKind::None:
+      return "no dynamics";
+    case ModeKind::Oscillatory:
+      if (!std::isnan(zeta)) return "oscillatory at " + w + ", damping ratio " + format_short(zeta);
+      if (std::abs(lambda.real()) > 1e-6 * omega)
+        return "oscillatory at " + w + "; its real part " + format_short(lambda.real()) +
+               " 1/s comes from linearising at this state (not an equilibrium), not from damping";
+      return "oscillatory at " + w + ", undamped";
+    case ModeKind::Saddle:
+      return "saddle: an unstable equilibrium, falling away at " + format_short(omega) + " 1/s";
+    case ModeKind::Decaying:
+      return "real, decaying: overdamped, time constant " + format_short(1 / omega) + " s";
+    case ModeKind::Growing:
+      return "real, growing at " + format_short(omega) + " 1/s: a fall, or the motion pulling away";
+  }
+  return "?";
+}
+
+std::vector<Mode> modes(const Linearization& lin, bool dissipative_model) {
+  if (!lin.status.ok || lin.A.size() == 0 || !lin.A.allFinite()) return {};
+  const Eigen::EigenSolver<MatX> eig(lin.A, true);
+  const Eigen::VectorXcd& ev = eig.eigenvalues();
+  const int n = static_cast<int>(lin.A.rows()) / 2;
+  double largest = 0;
+  for (Eigen::Index i = 0; i < ev.size(); ++i) largest = std::max(largest, std::abs(ev[i]));
+  std::vector<Mode> out;
+  for (Eigen::Index i = 0; i < ev.size(); ++i) {
+    Mode md;
+    md.lambda = ev[i];
+    md.omega = std::abs(ev[i]);
+    const double tiny = 1e-9 * std::max(largest, 1e-300);
+    if (md.omega <= tiny) {
+      md.kind = ModeKind::None;
+    } else if (std::abs(ev[i].imag()) > 1e-9 * md.omega) {
+      md.kind = ModeKind::Oscillatory;
+      if (dissipative_model && ev[i].real() <= 0) md.zeta = -ev[i].real() / md.omega;
+    } else {
+      // A real eigenvalue with its mirror −λ among the others: a saddle.
+      bool mirrored = false;
+      for (Eigen::Index j = 0; j < ev.size(); ++j)
+        mirrored = mirrored || (j != i && std::abs(ev[j] + ev[i]) <= 1e-3 * md.omega);
+      md.kind = mirrored           ? ModeKind::Saddle
+                : ev[i].real() < 0 ? ModeKind::Decaying
+                                   : ModeKind::Growing;
+    }
+    // The coordinate that moves most: the largest entry of the eigenvector's q part.
+    double best = -1;
+    for (int a = 0; a < n; ++a)
+      if (std::abs(eig.eigenvectors()(a, i)) > best) {
+        best = std::abs(eig.eigenvectors()(a, i));
+        md.coordinate = a;
+      }
+    out.push_back(md);
+  }
+  std::stable_sort(out.begin(), out.end(),
+                   [](const Mode& a, const Mode& b) { return a.omega > b.omega; });
+  return out;
+}
+
+double resolving_step(IntegratorKind kind, double omega, double tol) {
+  constexpr double two_pi = 2 * std::numbers::pi;
+  if (!(omega > 0) || !(tol > 0)) return std::numeric_limits<double>::infinity();
+  double N = 0;
+  if (kind == IntegratorKind::Rk4)
+    N = std::pow(std::pow(two_pi, 5) / (120 * tol), 0.25);
+  else if (kind == IntegratorKind::Euler)
+    N = std::max(std::numbers::pi / tol, std::sqrt(std::pow(two_pi, 3) / (24 * tol)));
+  else
+    return 0;
+  return two_pi / (N * omega);
+}
+
+double error_per_period(IntegratorKind kind, double omega, double dt) {
+  constexpr double two_pi = 2 * std::numbers::pi;
+  const double N = two_pi / (omega * dt);
+  if (kind == IntegratorKind::Rk4) return std::pow(two_pi, 5) / (120 * std::pow(N, 4));
+  if (kind == IntegratorKind::Euler)
+    return std::max(std::numbers::pi / N, std::pow(two_pi, 3) / (24 * N * N));
+  return NAN;
+}
+
+std::string divergence_cause(const Model& m, IntegratorKind kind, double dt,
+                             const std::string& setting, const VecX& q0, const VecX& qd0,
+                             const VecX& tau0) {
+  const std::string method = std::string(integrator_name(kind)) + " at " + setting;
+  if (dt <= 0)
+    return method + ": the error control did not hold the solution; tighten rtol and atol" +
+           (kind == IntegratorKind::Dopri ? std::string(", or use bdf for a stiff model")
+                                          : std::string());
+  constexpr int kLargest = 400;  // a dense eigenproblem of 2n beyond it takes seconds
+  if (m.n() > kLargest)
+    return method + " is likely beyond the stability limit of the model's stiffest mode (n = " +
+           std::to_string(m.n()) + " is too large to find it here; femdyn check --states 1 " +
+           "estimates it); use a smaller dt or dopri";
+  Workspace ws(m);
+  const Linearization lin = linearize(m, ws, q0, qd0, tau0);
+  if (!lin.status.ok)
+    return method + " diverged from a start state whose dynamics cannot be linearised (" +
+           lin.status.message + "); use a smaller dt or dopri";
+  const std::optional<double> limit = largest_stable_step(lin, kind);
+  const std::vector<Mode> md = modes(lin, has_dampers(m));
+  const std::string mode = md.empty() ? std::string("no mode") : md.front().text();
+  // A step that is stable with margin and resolves the stiffest oscillation to 1e-3 a period.
+  double advice = limit && std::isfinite(*limit) ? 0.5 * *limit : dt / 4;
+  if (!md.empty() && md.front().kind == ModeKind::Oscillatory)
+    advice = std::min(advice, resolving_step(kind, md.front().omega, 1e-3));
+  // A dissipative stiffest mode is BDF's case; an undamped one must be resolved (dopri does).
+  const bool dissipative = !md.empty() && md.front().dissipative();
+  const std::string use =
+      "; use dt ≤ " + format_short(advice) + " s or " + (dissipative ? "bdf" : "dopri");
+  if (limit && std::isfinite(*limit) && dt > *limit)
+    return method + " is beyond the stability limit of the stiffest mode at the start (" + mode +
+           "; limit ≈ " + format_short(*limit) + " s)" + use;
+  return method + " is within the linear stability limit of the start state (" +
+         (limit && std::isfinite(*limit) ? format_short(*limit) + " s" : std::string("none")) +
+         ", stiffest mode " + mode +
+         "), so the motion left the region where that holds (faster speeds, a stiffer posture) "
+         "or the method's error accumulated" +
+         use;
 }
 
 std::vector<SuspiciousBody> suspicious_bodies(const Model& m) {
@@ -143,10 +284,18 @@ std::vector<SuspiciousBody> suspicious_bodies(const Model& m) {
       flag(b, "near-zero principal inertia: " + format_short(I[0]) + " kg·m² against " +
                   format_short(I[2]) +
                   " (a thin rod or a point): rotations about that axis are ill-conditioned");
-    else if (I[0] + I[1] - I[2] < 1e-6 * I[2])
-      flag(b, "inertia nearly violates the triangle inequality (I1 + I2 − I3 = " +
+    else if (std::abs(I[0] + I[1] - I[2]) <= 1e-6 * I[2]) {
+      // I1 + I2 = I3 is a lamina (a thin disc or plate): physically valid, worth a look.
+      flag(b,
+           "a flat body: its principal inertias meet the triangle inequality's boundary "
+           "(I1 + I2 − I3 = " +
+               format_short(I[0] + I[1] - I[2]) + " kg·m², I3 = " + format_short(I[2]) +
+               "), as a thin disc or plate does; if the body is not flat, check the tensor");
+      out.back().note = true;
+    } else if (I[0] + I[1] - I[2] < 0)
+      flag(b, "inertia violates the triangle inequality (I1 + I2 − I3 = " +
                   format_short(I[0] + I[1] - I[2]) + " kg·m², I3 = " + format_short(I[2]) +
-                  "): a flat body at best, or a mistyped tensor");
+                  "): no rigid body has it; a mistyped tensor");
   }
   return out;
 }

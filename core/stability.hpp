@@ -15,6 +15,8 @@
 //   its step on the mode taken as an oscillator (ω = |λ|, ζ = |Re λ|/|λ|). Undamped modes give
 //   the classical limits h ω ≤ 2.83 (RK4), ≈ 3.3 (dopri), < 2 (symplectic Euler).
 #pragma once
+#include <cmath>
+#include <complex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,10 +50,56 @@ Linearization linearize(const Model& model, Workspace& ws, const VecX& q, const 
 // by bisection (relative precision 1e-6); +inf when every step is stable (no dynamics).
 std::optional<double> largest_stable_step(const Linearization& lin, IntegratorKind kind);
 
+// What a mode (an eigenvalue λ of A) is (docs/stability.md#modes):
+//   oscillatory   a complex pair: natural frequency ω = |λ|; a damping ratio ζ = −Re λ / |λ| ≥ 0
+//                 only where the model dissipates (joint dampers). In a conservative model the
+//                 mode is undamped, and a real part at a moving state comes from the velocity
+//                 terms of the linearisation there, not from damping (ζ is then NaN).
+//   saddle        a real pair ±λ: an unstable equilibrium (the mechanism falls away from it at
+//                 the rate |λ|);
+//   decaying      real, negative, alone: an overdamped (dissipative) mode, time constant 1/|λ|;
+//   growing       real, positive, alone: a fall, or the motion at that state pulling away;
+//   none          λ = 0: no restoring force on that coordinate.
+enum class ModeKind { None, Oscillatory, Saddle, Decaying, Growing };
+struct Mode {
+  std::complex<double> lambda;
+  ModeKind kind = ModeKind::None;
+  double omega = 0;     // |λ| (rad/s)
+  double zeta = NAN;    // damping ratio, where it is one (oscillatory, dissipative model)
+  int coordinate = -1;  // the coordinate that moves most in the mode (its eigenvector's q part)
+  bool dissipative() const { return kind == ModeKind::Decaying || (zeta >= 0.5); }
+  std::string text() const;  // e.g. "oscillatory, undamped (a conservative model)"
+};
+// The modes of a linearisation, stiffest first; `dissipative_model`: the model has dampers.
+std::vector<Mode> modes(const Linearization& lin, bool dissipative_model);
+bool has_dampers(const Model& model);
+
+// The largest step that resolves an oscillation of ω (rad/s) to a relative error `tol` per
+// period (docs/stability.md#accuracy), from the method's error on x″ = −ω² x with N steps a
+// period (hω = 2π/N):
+//   rk4    phase error per period (2π)⁵ / (120 N⁴)      → N = ((2π)⁵ / (120 tol))^¼
+//   euler  orbit distortion hω/2 = π/N per step (its phase error (2π)³/(24 N²) is smaller)
+//                                                        → N = max(π/tol, √((2π)³/(24 tol)))
+// dt = 2π / (N ω). dopri and bdf: 0 (their steps follow their tolerance).
+double resolving_step(IntegratorKind kind, double omega, double tol);
+// The relative error per period that step dt gives on an oscillation of ω (the inverse of the
+// rule above, the larger of its terms).
+double error_per_period(IntegratorKind kind, double omega, double dt);
+
+// The cause of a diverged run of `kind` (at fixed step dt, or adaptive with dt = 0 and its
+// `setting`), for its one-line message: the stiffest mode of the linearisation at the start
+// state and the step limit and step it gives, e.g. "rk4 at dt = 1.5 s is beyond the stability
+// limit of the stiffest mode (10 rad/s, oscillatory, undamped; limit ≈ 0.283 s); use dt ≤
+// 0.037 s or dopri".
+std::string divergence_cause(const Model& model, IntegratorKind kind, double dt,
+                             const std::string& setting, const VecX& q0, const VecX& qd0,
+                             const VecX& tau0);
+
 // A body whose mass properties make the equations ill-conditioned or unphysical-looking.
 struct SuspiciousBody {
   int body = -1;
   std::string name, why;
+  bool note = false;  // a physically valid edge case worth knowing (a flat body), not a fault
 };
 std::vector<SuspiciousBody> suspicious_bodies(const Model& model);
 

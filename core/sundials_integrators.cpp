@@ -103,6 +103,10 @@ Status Adaptive::failure(int flag) {
   }
 }
 
+std::string Adaptive::setting() const {
+  return "rtol " + format_short(options_.rtol) + ", atol " + format_short(options_.atol);
+}
+
 Status Adaptive::advance(double t_out) {
   double t_reached = t_;
   const int flag = evolve(t_out, t_reached, false);

@@ -27,6 +27,7 @@ class Adaptive : public Integrator {
   Adaptive(const Model& model, const AdaptiveOptions& options, Actuation tau);
   Status advance(double t_out) override;
   Status one_step() override;
+  std::string setting() const override;
   Status finish(int flag, double t_reached, double t_target);
   // What SUNDIALS' return code means for the user, with the step size where it failed.
   Status failure(int flag);

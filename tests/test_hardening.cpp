@@ -311,10 +311,10 @@ TEST_CASE("an interrupted simulate leaves the old output file intact", "[hardeni
   const fs::path out = dir / "traj.csv";
   std::ofstream(out.string()) << "old\n";
   // A run of a simulated hour at a 1 µs step takes far longer than the 1 s before SIGINT.
-  const Run r =
-      run_shell("sh -c '" + std::string(FEMDYN_BINARY) + " simulate " + model_path("finger.json") +
-                " --t-end 3600 --integrator rk4 --dt 1e-6 --out " + out.string() +
-                " --force & pid=$!; sleep 1; kill -INT $pid; wait $pid; echo exit=$?'");
+  const Run r = run_shell(
+      "sh -c '" + std::string(FEMDYN_BINARY) + " simulate " + model_path("finger.json") +
+      " --t-end 3600 --integrator rk4 --dt 1e-6 --max-steps 1e10 --every 1000000 --out " +
+      out.string() + " --force & pid=$!; sleep 1; kill -INT $pid; wait $pid; echo exit=$?'");
   INFO(r.out);
   CHECK(r.out.find("exit=130") != std::string::npos);  // stopped by the signal, as documented
   std::ifstream in(out.string());

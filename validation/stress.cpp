@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <stdexcept>
 
 #include "core/integrator.hpp"
@@ -67,8 +68,9 @@ StressResult run_stress(const Model& m, const StressScenario& s) {
   Workspace ws(m);
   if (const Status st = forward_dynamics(m, ws, s.q0, s.qd0, VecX::Zero(m.n())); !st.ok)
     return refused_case("at the initial state: " + st.message);
+  Linearization lin;
   if (!s.large) {
-    const Linearization lin = linearize(m, ws, s.q0, s.qd0, VecX::Zero(m.n()));
+    lin = linearize(m, ws, s.q0, s.qd0, VecX::Zero(m.n()));
     r.stiffest = std::abs(lin.stiffest);
   }
 
@@ -103,11 +105,15 @@ StressResult run_stress(const Model& m, const StressScenario& s) {
   }
 
   // Every integrator at the scenario's step or tolerance; the fixed-step ones' stable limit.
+  // A trial run covers at least kMinSteps steps and kPeriods periods of the stiffest mode, however
+  // long or short the scenario is, and is stable when it neither diverges nor fails.
+  const double period = r.stiffest > 0 ? 2 * std::numbers::pi / r.stiffest : 0;
   const auto stable = [&](IntegratorKind kind, double dt) {
-    if (s.t_end / dt > 2e6) return true;  // too many steps to try: assume the small step holds
-    const Run run = integrate(m, {.kind = kind, .fixed = {.dt = dt}}, s, times, false);
-    const double e = max_error(run.x, ref.x);
-    return run.status.ok && e >= 0 && e <= 10 * state_scale;
+    const double span = std::max(kPeriods * period, kMinSteps * dt);
+    auto integ =
+        make_integrator(m, {.kind = kind, .fixed = {.dt = dt, .max_steps = 1'000'000'000}});
+    integ->reset(0, s.q0, s.qd0, span);
+    return integ->advance_to(span).ok;
   };
   for (IntegratorKind kind : kIntegrators) {
     StressIntegrator it{.name = integrator_name(kind)};
@@ -127,20 +133,29 @@ StressResult run_stress(const Model& m, const StressScenario& s) {
       it.error = max_error(run.x, ref.x) / state_scale;
     else
       it.failure = run.status.message;
-    if (!is_adaptive(kind) && !s.large && r.stiffest > 0) {
-      // Bracket around the linearised estimate by factors of 2, then bisect (8 halvings).
-      double lo = 0.5 * 2.0 / r.stiffest, hi = lo;
-      while (!stable(kind, lo) && lo > 1e-9) lo /= 2;
-      hi = 2 * lo;
-      while (stable(kind, hi) && hi < s.t_end) hi *= 2;
-      for (int i = 0; i < 8; ++i) {
-        const double mid = std::sqrt(lo * hi);
+    if (!is_adaptive(kind) && r.stiffest > 0) {
+      if (const auto h = largest_stable_step(lin, kind); h && std::isfinite(*h))
+        it.theory_step = *h;
+      // Bracket from the linear estimate by factors of 2 (every explicit method here is
+      // unstable beyond h |λ| = 10), then bisect on log h to 1 %.
+      double lo = 1 / r.stiffest;
+      while (!stable(kind, lo) && lo * r.stiffest > 1e-6) lo /= 2;
+      double hi = 2 * lo;
+      while (stable(kind, hi) && hi * r.stiffest < 100) hi *= 2;
+      while (hi / lo > 1.01) {
+        const double mid = lo * std::sqrt(hi / lo);
         (stable(kind, mid) ? lo : hi) = mid;
       }
       it.largest_stable_step = lo;
     }
     r.integrators.push_back(std::move(it));
   }
+  if (s.large)
+    r.search_note =
+        "no step search: the linearisation (4n evaluations and a dense eigenproblem of 2n = " +
+        std::to_string(2 * m.n()) + ") takes too long at this size";
+  else if (r.stiffest == 0)
+    r.search_note = "no step search: no mode at the initial state (every step is stable)";
 
   // Simbody.
   if (s.large) {

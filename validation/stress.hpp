@@ -3,10 +3,12 @@
 //   - cond(M^s) over the reference trajectory, symmetry, positive definiteness;
 //   - the reference motion: Dormand–Prince at rtol 1e-10, or BDF at 1e-10 when Dormand–Prince
 //     gives up (a stiff case), and its energy balance |E − E0 − W| relative to the energy;
-//   - for rk4 and euler the largest stable step, by bisection of real runs (a run is stable
-//     when it ends without a fault within 10x the state's size of the reference), started
-//     from the linearised estimate (core/stability.hpp); for every integrator the error at
-//     the scenario's step (rk4, euler) or at rtol 1e-6 (dopri, bdf);
+//   - for rk4 and euler the largest stable step, by bisection of real runs from the initial
+//     state: a step is stable when a run of at least kMinSteps steps and kPeriods periods of
+//     the stiffest mode (2π/|λ|) ends without diverging or failing (core/divergence.hpp), so
+//     a step longer than the scenario still gets its steps; beside it the linear theory's
+//     limit at the initial state (core/stability.hpp); for every integrator the error at the
+//     scenario's step (rk4, euler) or at rtol 1e-6 (dopri, bdf);
 //   - agreement with Simbody's twin (RungeKuttaMerson at 1e-10) where Simbody can hold it;
 // and a verdict: stable; stable only with the implicit integrator; ill-conditioned (cond >
 // 1e12); or refused, with the reason.
@@ -27,9 +29,13 @@ struct StressScenario {
   bool large = false;
 };
 
+inline constexpr int kMinSteps = 200;   // steps of a stability trial run, at least
+inline constexpr double kPeriods = 20;  // periods of the stiffest mode it covers, at least
+
 struct StressIntegrator {
   std::string name;
   double largest_stable_step = -1;  // s; −1: not searched (adaptive, or not asked)
+  double theory_step = -1;          // s: the linearisation's limit at the initial state
   double error = -1;  // at the scenario's step or tolerance, relative to the state's size
                       // max(1, max |x_ref|); −1: the run failed or was not made
   long steps = 0;
@@ -48,6 +54,7 @@ struct StressResult {
   double simbody_error = -1;  // max ‖(θ, θ̇) − Simbody‖∞ over the samples, relative to the
                               // state's size; −1: not compared
   std::string simbody_note;
+  std::string search_note;  // why no step search was made, where none was
   std::string verdict;
 };
 

@@ -1,0 +1,67 @@
+// A numerical solution that diverges (docs/simulation.md#divergence), told from the energy
+// balance E(t) − E(0) = W(t) that the exact motion keeps (core/motion.hpp). Dampers only take
+// energy out, so the energy the state holds beyond what the forces supplied,
+//
+//   gain(t) = E(t) − E(0) − max(0, max_{s≤t} W(s)),
+//
+// is at most the integration error for a motion that is being followed. The solution diverges
+// when that gain dwarfs every energy the motion was given and is most of what the state holds:
+//
+//   gain > 10 S   and   gain > ½ T(t),        S = S₀ + max_{s≤t} max(0, W(s)),
+//   S₀ = max(|E(0)|, T(0), |V(0)|, Σ_i |F_i| |x_i(0)|),
+//
+// F_i the constant nodal forces (gravity, loads) and x_i their nodes' positions at the start
+// (the potential they can exchange about the world origin). An unstable explicit step grows the
+// state geometrically, so gain overtakes 10 S within a few steps of the growth becoming
+// visible, long before an overflow or a matrix that the blown-up state makes singular; and a
+// run that merely loses accuracy (gain a fraction of S) is not called diverged.
+//
+// The fixed scale of the reported energy balance is S₀ + max_{s≤t} |W(s)| (`scale()`): the
+// energy the motion started with plus the work done, which does not grow with the error.
+#pragma once
+#include <algorithm>
+#include <cmath>
+
+#include "core/equations.hpp"
+
+namespace femdyn {
+
+class DivergenceWatch {
+ public:
+  // At the start of a run: E(0) and Σ_i |F_i| |x_i(0)|.
+  void start(const Energy& E0, double potential_reach, double qd_norm) {
+    E0_ = E0;
+    S0_ = std::max({std::abs(E0.total()), E0.kinetic, std::abs(E0.potential), potential_reach});
+    max_work_ = max_abs_work_ = 0;
+    qd_looked_ = std::max(qd_norm, kQdFloor);
+    gain_ = 0;
+  }
+  // The energy needs a look when ‖q̇‖∞ has doubled since the last look: a diverging explicit
+  // step grows the rates geometrically, and a look costs one evaluation of M^s.
+  bool due(double qd_norm) const { return !(qd_norm <= 2 * qd_looked_); }
+  // Looks at the energy E and the work W at a state; true when the solution diverges there.
+  bool look(const Energy& E, double W, double qd_norm) {
+    qd_looked_ = std::max(qd_norm, kQdFloor);
+    max_work_ = std::max(max_work_, W);
+    max_abs_work_ = std::max(max_abs_work_, std::abs(W));
+    gain_ = E.total() - E0_.total() - max_work_;
+    if (!std::isfinite(E.total()) || !std::isfinite(W)) return true;
+    return gain_ > 10 * (S0_ + max_work_) && gain_ > 0.5 * E.kinetic;
+  }
+  double initial_scale() const { return S0_; }          // S₀ (J)
+  double scale() const { return S0_ + max_abs_work_; }  // S₀ + max |W| (J)
+  double gain() const { return gain_; }                 // at the last look (J)
+  double supplied() const { return S0_ + max_work_; }   // S (J)
+  const Energy& initial() const { return E0_; }
+
+ private:
+  static constexpr double kQdFloor = 1e-6;  // rad/s or m/s: rates below it never trigger
+  Energy E0_;
+  double S0_ = 0, max_work_ = 0, max_abs_work_ = 0, qd_looked_ = kQdFloor, gain_ = 0;
+};
+
+// Σ_i |F_i| |x_i|: the constant nodal forces (gravity and loads, per node) times their nodes'
+// distances from the world origin, at the state of the last evaluation in ws.
+double potential_reach(const Model& model, const Workspace& ws);
+
+}  // namespace femdyn
