@@ -114,7 +114,8 @@ int cmd_check(int argc, char** argv) {
 
   if (a.has("json")) {
     Json j = {{"model", m.name},
-              {"coordinates", n},
+              {"n", n},
+              {"coordinates", m.coordinate_names},
               {"states", K},
               {"condition", {{"min", cond_lo}, {"max", cond_hi}}},
               {"digits_lost", std::log10(cond_hi)},
