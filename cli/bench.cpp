@@ -59,8 +59,9 @@ q̈ in ±5), cycled; per engine and quantity a warm-up, then 15 batches of about
 per call, the report is the median, min and max over the batches. Both engines are first
 checked to agree on M^s, h and q̈ at the first state (relative 1e-8; a warning if not).
 A Debug build refuses to time anything.
---json: {"model", "n", "build", "results": [{"engine": "femdyn" | "simbody", "quantity",
-"median_ns", "min_ns", "max_ns"}]}.
+--json: {"model", "n", "coordinates", "build", "results": [{"engine": "femdyn" | "simbody",
+"quantity", "median_ns", "min_ns", "max_ns"}]} (n the number of coordinates, "coordinates"
+their names).
 )";
 
 constexpr int kTensorMaxN = 40;  // D above this many coordinates takes too long to time
@@ -212,7 +213,8 @@ void print_table(const std::string& path, int n, int K, const Method& method,
   if (!skipped.empty()) std::cout << "D        skipped (" << skipped << ")\n";
 }
 
-nlohmann::ordered_json report_json(const std::string& path, int n, const std::vector<Row>& rows) {
+nlohmann::ordered_json report_json(const std::string& path, const Model& m,
+                                   const std::vector<Row>& rows) {
   nlohmann::ordered_json results = nlohmann::ordered_json::array();
   auto add = [&](const char* engine, const std::string& quantity, const Timing& t) {
     results.push_back({{"engine", engine},
@@ -225,7 +227,11 @@ nlohmann::ordered_json report_json(const std::string& path, int n, const std::ve
     add("femdyn", r.quantity, r.femdyn);
     add("simbody", r.quantity, r.simbody);
   }
-  return {{"model", path}, {"n", n}, {"build", FEMDYN_BUILD_TYPE}, {"results", results}};
+  return {{"model", path},
+          {"n", m.n()},
+          {"coordinates", m.coordinate_names},
+          {"build", FEMDYN_BUILD_TYPE},
+          {"results", results}};
 }
 
 }  // namespace
@@ -320,7 +326,7 @@ int cmd_bench(int argc, char** argv) {
 
   if (a.has("json")) {
     if (!skipped.empty()) std::cerr << "femdyn bench: D not timed (" << skipped << ")\n";
-    std::cout << report_json(path, n, rows).dump(2) << "\n";
+    std::cout << report_json(path, m, rows).dump(2) << "\n";
   } else {
     print_table(path, n, K, method, rows, skipped);
   }

@@ -29,7 +29,8 @@ constexpr const char* kEquationsHelp =
 Prints the system equations M^s(q) q̈ + h(q, q̇) = Q(q, q̇, τ) at the state, and
 q̈ = (M^s)⁻¹(Q − h). Omitted q, q̇, τ are zero; τ is the actuation force on each generalized
 coordinate. --tensor adds D (n x n x n) with h_a = Σ_bc D_abc q̇_b q̇_c.
---json prints one object: {"coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd"[, "D"]}.
+--json prints one object: {"n", "coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd"[, "D"]}
+(n the number of coordinates, "coordinates" their names).
 )";
 
 }  // namespace
@@ -57,9 +58,7 @@ std::vector<double> parse_numbers(const std::string& opt, const std::string& tex
       used = 0;
     }
     if (out_of_range || (std::isfinite(x) && std::abs(x) > kMaxMagnitude))
-      throw CliError("--" + opt + ": " + quoted_text(item) +
-                     " is out of range (|x| ≤ 1e100: beyond it the equations' products overflow "
-                     "double precision)");
+      throw CliError("--" + opt + ": " + quoted_text(item) + kOutOfRange);
     if (item.empty() || used != item.size())
       throw CliError("--" + opt + ": " + quoted_text(item) + " is not a number");
     if (!std::isfinite(x)) throw CliError("--" + opt + ": " + quoted_text(item) + " is NaN or Inf");

@@ -19,13 +19,17 @@ namespace {
 
 constexpr const char* kHelp =
     R"(usage: femdyn compare MODEL_A MODEL_B [--states K] [--seed S] [--qd-scale V]
-                       [--q a,b,… [--qd …]] [--tau …] [--json] [--gravity gx,gy,gz]
+                       [--q a,b,… [--qd …]] [--tau …] [--rtol R] [--json] [--gravity gx,gy,gz]
 
 Relative error of A against B, ‖A − B‖ / ‖B‖ (max-norm), for M^s, h and q̈ (under the actuation
 --tau, default 0), at K seeded
 random states (q uniform within joint limits, or ±π / ±0.5 m without; q̇ uniform in ±V rad/s,
 default V = 2), or at the one state given by --q/--qd. Both models must have the same number of
 generalized coordinates. Prints max and median over the states.
+--rtol R (a number > 0) makes it a test: exit 1 if the max relative error of M^s, h or q̈ is
+above R (each one above is named on stderr), exit 0 if none is. Without it the exit is 0.
+--json prints {"a", "b", "n", "coordinates" (A's), "states", "seed", "max_rel_error",
+"median_rel_error"}, with "rtol" and "pass" under --rtol.
 )";
 
 double rel(const MatX& a, const MatX& b) { return relative_error(a, b, 0.0); }
@@ -34,7 +38,7 @@ double rel(const MatX& a, const MatX& b) { return relative_error(a, b, 0.0); }
 
 int cmd_compare(int argc, char** argv) {
   const Args a = parse_args(argc, argv, 2, {"help", "json"},
-                            {"states", "seed", "qd-scale", "q", "qd", "tau", "gravity"});
+                            {"states", "seed", "qd-scale", "q", "qd", "tau", "rtol", "gravity"});
   if (a.has("help")) {
     std::cout << kHelp;
     return 0;
@@ -49,6 +53,13 @@ int cmd_compare(int argc, char** argv) {
   const auto seed = static_cast<unsigned>(integer_option(a, "seed", 1, 0, 4294967295.0));
   const double vscale = number_option(a, "qd-scale", 2.0);
   if (vscale < 0) throw CliError("--qd-scale expects one number >= 0");
+  // --rtol makes compare a test. A tolerance of 0 or below would fail every real comparison:
+  // refused, as parse_numbers refuses NaN, Inf and |R| > 1e100.
+  const bool test = a.has("rtol");
+  const double rtol = number_option(a, "rtol", 0);
+  if (test && !(rtol > 0))
+    throw CliError("--rtol: " + format_number(rtol) +
+                   " is not a tolerance (expected a number > 0)");
   Workspace wa(A), wb(B);
   std::mt19937 rng(seed);
   std::vector<double> eM, eh, eqdd;
@@ -78,15 +89,31 @@ int cmd_compare(int argc, char** argv) {
   const auto [mM, dM] = stats(eM);
   const auto [mh, dh] = stats(eh);
   const auto [mq, dq] = stats(eqdd);
+  // Under --rtol: the quantities whose max error is above it (NaN counts as above).
+  std::string above;
+  if (test)
+    for (auto [name, mx] : {std::pair{"M^s", mM}, {"h", mh}, {"qdd", mq}})
+      if (!(mx <= rtol))
+        above += (above.empty() ? "" : ", ") + std::string(name) + " " + format_number(mx, "%.3e");
+  const int code = above.empty() ? 0 : 1;
+  if (!above.empty())
+    std::cerr << "femdyn compare: max relative error above --rtol " << format_number(rtol) << ": "
+              << above << "\n";
   if (a.has("json")) {
     Json j = {{"a", a.positional[0]},
               {"b", a.positional[1]},
+              {"n", A.n()},
+              {"coordinates", A.coordinate_names},
               {"states", K},
               {"seed", seed},
               {"max_rel_error", {{"M", mM}, {"h", mh}, {"qdd", mq}}},
               {"median_rel_error", {{"M", dM}, {"h", dh}, {"qdd", dq}}}};
+    if (test) {
+      j["rtol"] = rtol;
+      j["pass"] = code == 0;
+    }
     std::cout << j.dump(2) << "\n";
-    return 0;
+    return code;
   }
   std::cout << "A: " << a.positional[0] << "\nB: " << B.where << "\n"
             << K
@@ -97,7 +124,8 @@ int cmd_compare(int argc, char** argv) {
             << std::scientific << std::setprecision(3);
   for (auto [name, mx, md] : {std::tuple{"M^s", mM, dM}, {"h", mh, dh}, {"qdd", mq, dq}})
     std::cout << std::left << std::setw(10) << name << " " << mx << "   " << md << "\n";
-  return 0;
+  if (test) std::cout << (code ? "FAIL" : "PASS") << " (--rtol " << format_number(rtol) << ")\n";
+  return code;
 }
 
 }  // namespace femdyn::cli

@@ -10,6 +10,7 @@ constexpr const char* kUsage =
     R"(femdyn — equations of motion of mechanisms by the equivalent-element method
 
 usage: femdyn COMMAND MODEL [options]
+       femdyn --version
 
 commands:
   info        coordinates, bodies, elements, DOFs kept and left out, the correlation table
@@ -37,6 +38,15 @@ int main(int argc, char** argv) {
       !std::strcmp(argv[1], "help")) {
     std::cout << kUsage;
     return argc < 2 ? 2 : 0;
+  }
+  // The version is CMake's project(VERSION) (CMakeLists.txt); femdyn.__version__ is the same.
+  if (!std::strcmp(argv[1], "--version")) {
+    if (argc > 2) {
+      std::cerr << "femdyn --version: takes no arguments\n";
+      return 2;
+    }
+    std::cout << "femdyn " << FEMDYN_VERSION << "\n";
+    return 0;
   }
   const std::string cmd = argv[1];
   try {

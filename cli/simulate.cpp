@@ -239,7 +239,8 @@ int cmd_simulate(int argc, char** argv) {
   const std::string balance_name = is_conservative ? "energy drift" : "energy-balance error";
   if (a.has("json")) {
     Json j = {{"model", m.name},
-              {"coordinates", m.n()},
+              {"n", m.n()},
+              {"coordinates", m.coordinate_names},
               {"integrator", integ->name()},
               {"t_end", t_end},
               {"t_reached", simulated},

@@ -21,7 +21,8 @@ Plans the quintic (minimum-jerk) motion q_ref(t) from --from (default 0) to --to
 (default 1), computes the joint torques τ(t) = M^s q̈_ref + h − Q(τ = 0) by inverse dynamics,
 then simulates the model under τ(t) alone (RK4, N steps, default 1000) and reports how closely
 the simulated motion follows q_ref. --csv writes t, q_ref, τ and q_sim per step (atomically; an
-existing FILE is replaced only with --force, and never when it is MODEL).
+existing FILE is replaced only with --force, and never when it is MODEL). --json prints
+{"model", "n", "coordinates", "duration", "steps", "max_tracking_error", "max_abs_tau"}.
 )";
 
 }  // namespace
@@ -90,10 +91,8 @@ int cmd_track(int argc, char** argv) {
     }
   }
   if (a.has("json")) {
-    std::cout << Json{{"model", m.name},
-                      {"duration", T},
-                      {"steps", N},
-                      {"max_tracking_error", max_err},
+    std::cout << Json{{"model", m.name},       {"n", m.n()}, {"coordinates", m.coordinate_names},
+                      {"duration", T},         {"steps", N}, {"max_tracking_error", max_err},
                       {"max_abs_tau", max_tau}}
                      .dump(2)
               << "\n";

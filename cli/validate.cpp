@@ -39,7 +39,7 @@ trajectory's sample times "t", "state_error" and the energy of both runs.
 
 std::string sci(double x) { return format_number(x, "%.2e"); }
 
-Json report_json(const std::string& path, const validation::ValidationReport& r) {
+Json report_json(const std::string& path, const Model& m, const validation::ValidationReport& r) {
   Json rel = Json::object(), abs = Json::object();
   for (const auto& q : r.quantities) {
     rel[q.name] = q.max_rel;
@@ -61,12 +61,17 @@ Json report_json(const std::string& path, const validation::ValidationReport& r)
       {"state_error", t.error},
       {"energy", {{"femdyn", t.energy_femdyn}, {"simbody", t.energy_simbody}}}};
   if (!t.run) traj["skipped"] = t.skipped;
-  return {
-      {"model", path},        {"states", r.states},
-      {"coordinates", r.n},   {"tolerance", r.quantities.empty() ? 0.0 : r.quantities[0].tolerance},
-      {"max_rel_error", rel}, {"max_abs_error", abs},
-      {"trajectory", traj},   {"notes", r.notes},
-      {"failure", r.failure}, {"pass", r.pass()}};
+  return {{"model", path},
+          {"states", r.states},
+          {"n", r.n},
+          {"coordinates", m.coordinate_names},
+          {"tolerance", r.quantities.empty() ? 0.0 : r.quantities[0].tolerance},
+          {"max_rel_error", rel},
+          {"max_abs_error", abs},
+          {"trajectory", traj},
+          {"notes", r.notes},
+          {"failure", r.failure},
+          {"pass", r.pass()}};
 }
 
 void print_text(const std::string& path, const validation::ValidationReport& r) {
@@ -157,7 +162,9 @@ int cmd_validate(int argc, char** argv) {
   o.t_end = nonnegative(a, "t-end", o.t_end);
   o.tolerance = nonnegative(a, "tol", o.tolerance);
   o.qd_scale = nonnegative(a, "qd-scale", o.qd_scale);
-  if (o.t_end > 100) throw CliError("--t-end expects at most 100 s");
+  if (o.t_end > validation::kMaxTrajectoryTime)
+    throw CliError("--t-end expects at most " + format_number(validation::kMaxTrajectoryTime) +
+                   " s");
 
   // Load every model first: a bad file fails before any work.
   std::deque<Model> models;  // (Model is move-only and its move may throw: no vector)
@@ -179,7 +186,7 @@ int cmd_validate(int argc, char** argv) {
     }
     all_pass = all_pass && r.pass();
     if (a.has("json"))
-      reports.push_back(report_json(a.positional[i], r));
+      reports.push_back(report_json(a.positional[i], models[i], r));
     else if (a.has("markdown"))
       print_markdown_row(a.positional[i], r);
     else

@@ -29,13 +29,16 @@ inline std::string magnitude_text(double x) {
   return buf;
 }
 
+// How every refusal of a number past kMaxMagnitude ends, wherever the number was read (a model,
+// the command line, a τ table, a Python argument): "1e+308 is out of range (|x| ≤ 1e100: …)".
+inline constexpr const char* kOutOfRange =
+    " is out of range (|x| ≤ 1e100: beyond it the equations' products overflow double precision)";
+inline std::string out_of_range_text(double x) { return magnitude_text(x) + kOutOfRange; }
+
 // "<what> is NaN or Inf", or "<what> 1e+308 is out of range (|x| ≤ 1e100: …)".
 inline void check_magnitude(double x, const std::string& where, const std::string& what) {
   if (!std::isfinite(x)) throw ModelError(where, what + " is NaN or Inf");
-  if (std::abs(x) > kMaxMagnitude)
-    throw ModelError(where, what + " " + magnitude_text(x) +
-                                " is out of range (|x| ≤ 1e100: beyond it the equations' "
-                                "products overflow double precision)");
+  if (std::abs(x) > kMaxMagnitude) throw ModelError(where, what + " " + out_of_range_text(x));
 }
 
 inline void check_magnitude(const Vec3& v, const std::string& where, const std::string& what) {

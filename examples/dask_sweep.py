@@ -2,8 +2,8 @@
 """A parameter study on dask.distributed (docs/python.md#sweeps): the finger's error against
 run time across proximal link lengths and integrators.
 
-    PYTHONPATH=build/python python3 examples/dask_sweep.py [--scheduler ADDRESS] [--out DIR]
-                                                           [--quick] [--check-serial]
+    PYTHONPATH=build/python /usr/bin/python3 examples/dask_sweep.py [--scheduler ADDRESS]
+                                                [--out DIR] [--quick] [--check-serial]
 
 Each case builds the paper's finger with one proximal length, integrates its free motion for
 0.5 s with one integrator and setting (rk4, euler: dt; dopri, bdf: rtol), and measures the error
@@ -87,14 +87,27 @@ def plot(table, path):
     fig.savefig(path, dpi=100)
 
 
-def main():
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--scheduler", help="address of an existing dask scheduler")
-    p.add_argument("--out", default=".", help="directory for finger_sweep.csv and .png")
-    p.add_argument("--quick", action="store_true", help="fewer cases (the tests)")
+def parser():
+    """The command line; --help shows the docstring's first paragraph (the whole sentence, not
+    its first line) and, after the options, its explanation."""
+    paragraphs = [" ".join(p.split()) for p in __doc__.split("\n\n")]
+    p = argparse.ArgumentParser(description=paragraphs[0], epilog=paragraphs[2])
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="The address of an existing dask scheduler (tcp://host:8786); without "
+                        "it, a LocalCluster of 2 worker processes on 127.0.0.1.")
+    p.add_argument("--out", metavar="DIR", default=".",
+                   help="The directory for finger_sweep.csv and finger_sweep.png (default: the "
+                        "current directory).")
+    p.add_argument("--quick", action="store_true",
+                   help="Fewer cases: one length and two settings per integrator (the tests).")
     p.add_argument("--check-serial", action="store_true",
-                   help="also run the cases serially and compare")
-    a = p.parse_args()
+                   help="Also run the cases serially and exit 1 unless every number but the "
+                        "timings is equal.")
+    return p
+
+
+def main():
+    a = parser().parse_args()
     from dask.distributed import Client, LocalCluster
 
     if a.scheduler:

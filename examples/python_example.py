@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """femdyn from Python: the worked example of docs/python.md (run by the tests).
 
-    PYTHONPATH=build/python python3 examples/python_example.py [MODEL]
+    PYTHONPATH=build/python /usr/bin/python3 examples/python_example.py [MODEL]
 
 Loads the paper's robot finger, prints its equations M q'' + h = Q at one state, checks
 h = D[q', q'] and inverse dynamics, evaluates a batch of states on every core, and simulates

@@ -6,6 +6,8 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/limits.hpp"
+#include "core/names.hpp"
 #include "io/input_file.hpp"
 
 namespace femdyn {
@@ -63,17 +65,28 @@ ActuationTable::ActuationTable(const std::string& path, const Model& m) : path_(
                                   std::to_string(head.size()));
     std::vector<double> v(cells.size());
     for (std::size_t c = 0; c < cells.size(); ++c) {
+      const std::string column = "column " + std::to_string(c + 1);
       std::size_t used = 0;
+      bool overflow = false;
       try {
         v[c] = std::stod(cells[c], &used);
+      } catch (const std::out_of_range&) {
+        // As the command line reads numbers (cli parse_numbers): an overflow (1e400) is out of
+        // range, an underflow (1e-400) is its nearest double (0 or a subnormal).
+        char* end = nullptr;
+        v[c] = std::strtod(cells[c].c_str(), &end);
+        used = static_cast<std::size_t>(end - cells[c].c_str());
+        overflow = !(std::abs(v[c]) < 1);
       } catch (const std::exception&) {
         used = 0;
       }
       if (cells[c].empty() || used != cells[c].size())
-        throw ModelError(
-            where, "column " + std::to_string(c + 1) + ": '" + cells[c] + "' is not a number");
-      if (!std::isfinite(v[c]))
-        throw ModelError(where, "column " + std::to_string(c + 1) + " is NaN or Inf");
+        throw ModelError(where, column + ": " + quoted_text(cells[c]) + " is not a number");
+      // t and τ are physical numbers like the model's and --tau's: finite, |x| ≤ 1e100.
+      if (overflow) throw ModelError(where, column + ": " + quoted_text(cells[c]) + kOutOfRange);
+      if (!std::isfinite(v[c])) throw ModelError(where, column + " is NaN or Inf");
+      if (std::abs(v[c]) > kMaxMagnitude)
+        throw ModelError(where, column + ": " + out_of_range_text(v[c]));
     }
     if (!rows.empty() && !(v[0] > rows.back()[0]))
       throw ModelError(where, "t must increase strictly from row to row");

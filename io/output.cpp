@@ -53,6 +53,7 @@ void print_mat(std::ostringstream& out, const MatX& m) {
 Json equations_json(const Model& model, const Workspace& ws, const VecX& q, const VecX& qd,
                     const VecX& tau, bool have_qdd, const std::vector<MatX>& D) {
   Json j;
+  j["n"] = model.n();
   j["coordinates"] = model.coordinate_names;
   j["q"] = vec_json(q);
   j["qd"] = vec_json(qd);
@@ -168,6 +169,7 @@ std::string info_text(const Model& model) {
 Json info_json(const Model& model) {
   Json j;
   j["model"] = model.name;
+  j["n"] = model.n();
   j["coordinates"] = model.coordinate_names;
   Json u = Json::array();
   for (int i = 0; i < model.n_u(); ++i) u.push_back(model.dof_name(i));
@@ -212,7 +214,7 @@ int key_rank(const std::string& k) {
                                 "spring", "damping", "nodes", "elements", "mass", "com", "inertia",
                                 "bodies", "couplings", "loads", "correlation_table",
                                 // equations --json
-                                "coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd", "D"};
+                                "n", "coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd", "D"};
   for (std::size_t i = 0; i < std::size(order); ++i)
     if (k == order[i]) return static_cast<int>(i);
   return static_cast<int>(std::size(order));

@@ -9,7 +9,8 @@
 
 namespace femdyn {
 
-// {"coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd"} (+ "D" when D is non-empty).
+// {"n", "coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd"} (+ "D" when D is non-empty):
+// n the number of coordinates, "coordinates" their names (as in every JSON output of femdyn).
 // qdd is null when M^s is singular at the state.
 Json equations_json(const Model& model, const Workspace& ws, const VecX& q, const VecX& qd,
                     const VecX& tau, bool have_qdd, const std::vector<MatX>& D);
@@ -24,7 +25,7 @@ Json info_json(const Model& model);
 std::string correlation_table_text(const Model& model);
 
 // JSON as people write it: keys in the order of the formats (a model: name, gravity, bodies, …;
-// the equations: coordinates, q, qd, tau, M, h, Q, qdd, D), arrays of numbers (vectors, matrix
+// the equations: n, coordinates, q, qd, tau, M, h, Q, qdd, D), arrays of numbers (vectors, matrix
 // rows) on one line, two-space indent. Numbers keep full (round-trip) precision.
 std::string readable_json(const Json& doc);
 

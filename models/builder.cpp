@@ -26,6 +26,24 @@ void check_inertia(const Mat3& I, const std::string& where) {
   if (const auto problem = inertia_problem(I)) throw ModelError(where, *problem);
 }
 
+// A fixed joint has no motion, so an axis, limits, a spring or a damper on it would be ignored:
+// refused, as the JSON loader refuses those keys on a fixed joint. JointSpec's type defaults to
+// fixed, so this is also what catches a moving joint whose type was forgotten (the body would
+// be welded to its parent without a word). The axis counts as given when it is not the default.
+void check_fixed_joint(const JointSpec& j) {
+  if (j.type != JointType::Fixed) return;
+  const JointSpec defaults;
+  const char* given = j.axis != defaults.axis                                        ? "axis"
+                      : j.lower != defaults.lower || j.upper != defaults.upper       ? "limits"
+                      : j.stiffness != defaults.stiffness || j.rest != defaults.rest ? "spring"
+                      : j.damping != defaults.damping                                ? "damping"
+                                                                                     : nullptr;
+  if (given)
+    throw ModelError(j.where + "/" + given,
+                     "a fixed joint has no motion: no axis, limits, spring or damping (is the "
+                     "joint's type missing? JointSpec's type defaults to fixed)");
+}
+
 }  // namespace
 
 MechanismBuilder::MechanismBuilder(std::string name) {
@@ -51,6 +69,7 @@ void MechanismBuilder::body(const std::string& name, const std::string& parent, 
     check_magnitude(x, joint.where, "joint spring or damper");
   if (joint.stiffness < 0 || joint.damping < 0)
     throw ModelError(joint.where, "stiffness and damping must not be negative");
+  check_fixed_joint(joint);
   b.joint = std::move(joint);
   spec_.bodies.push_back(std::move(b));
 }

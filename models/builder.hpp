@@ -29,7 +29,9 @@ class MechanismBuilder {
 
   void gravity(const Vec3& g);
   // A body hanging from `parent` ("world" for the ground) by `joint` (its name defaults to the
-  // body's; `where` is set here).
+  // body's; `where` is set here). A fixed joint (JointSpec's default type) with an axis other
+  // than the default, limits, a spring or a damper is refused, as in a JSON file: that is a
+  // moving joint whose type was left out.
   void body(const std::string& name, const std::string& parent, JointSpec joint);
   // A named node of a body (its frame).
   void node(const std::string& body, const std::string& name, const Vec3& position);

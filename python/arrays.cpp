@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/limits.hpp"
+
 namespace femdyn::python {
 
 std::string shape_text(const py::array& a) {
@@ -12,41 +14,47 @@ std::string shape_text(const py::array& a) {
 
 namespace {
 
-// The first non-finite entry of `data` (n per row) named, or nothing.
-void check_finite(const double* data, Eigen::Index rows, const char* name, const Model& model,
-                  bool batch) {
+// The first entry of `data` (n per row) that is not finite (or, bounded, of magnitude above
+// kMaxMagnitude) named with its value, or nothing.
+void check_entries(const double* data, Eigen::Index rows, const char* name, const Model& model,
+                   bool batch, Entries entries) {
   const Eigen::Index n = model.n();
   for (Eigen::Index i = 0; i < rows; ++i)
-    for (Eigen::Index a = 0; a < n; ++a)
-      if (!std::isfinite(data[i * n + a]))
-        throw py::value_error(
-            std::string(name) + ": " + (batch ? "row " + std::to_string(i) + ", " : std::string()) +
-            "entry " + std::to_string(a) + " ('" + model.coordinate_names[a] + "') is NaN or Inf");
+    for (Eigen::Index a = 0; a < n; ++a) {
+      const double x = data[i * n + a];
+      const bool finite = std::isfinite(x);
+      if (finite && (entries == Entries::Finite || std::abs(x) <= kMaxMagnitude)) continue;
+      throw py::value_error(std::string(name) + ": " +
+                            (batch ? "row " + std::to_string(i) + ", " : std::string()) + "entry " +
+                            std::to_string(a) + " ('" + model.coordinate_names[a] + "') " +
+                            (finite ? out_of_range_text(x) : std::string("is NaN or Inf")));
+    }
 }
 
 }  // namespace
 
-VecX vector_arg(const Array& a, const char* name, const Model& model) {
+VecX vector_arg(const Array& a, const char* name, const Model& model, Entries entries) {
   const Eigen::Index n = model.n();
   if (a.ndim() != 1 || a.shape(0) != n)
     throw py::value_error(std::string(name) + ": expected shape (" + std::to_string(n) +
                           ",), got " + shape_text(a));
-  check_finite(a.data(), 1, name, model, false);
+  check_entries(a.data(), 1, name, model, false, entries);
   return Eigen::Map<const VecX>(a.data(), n);
 }
 
-VecX vector_arg(const std::optional<Array>& a, const char* name, const Model& model) {
-  return a ? vector_arg(*a, name, model) : VecX::Zero(model.n());
+VecX vector_arg(const std::optional<Array>& a, const char* name, const Model& model,
+                Entries entries) {
+  return a ? vector_arg(*a, name, model, entries) : VecX::Zero(model.n());
 }
 
 Eigen::Map<const RowMatX> batch_arg(const Array& a, const char* name, const Model& model,
-                                    Eigen::Index k) {
+                                    Eigen::Index k, Entries entries) {
   const Eigen::Index n = model.n();
   if (a.ndim() != 2 || a.shape(1) != n || (k >= 0 && a.shape(0) != k))
     throw py::value_error(std::string(name) + ": expected shape (" +
                           (k >= 0 ? std::to_string(k) : std::string("k")) + ", " +
                           std::to_string(n) + "), got " + shape_text(a));
-  check_finite(a.data(), a.shape(0), name, model, true);
+  check_entries(a.data(), a.shape(0), name, model, true, entries);
   return {a.data(), a.shape(0), n};
 }
 

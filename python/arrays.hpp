@@ -28,14 +28,22 @@ class NumericalError : public std::runtime_error {
 // "(3,)", "(5, 4)".
 std::string shape_text(const py::array& a);
 
-// A state vector: shape (n,), every entry finite. Absent (None, where allowed) is zero.
-VecX vector_arg(const Array& a, const char* name, const Model& model);
-VecX vector_arg(const std::optional<Array>& a, const char* name, const Model& model);
+// What the entries of an argument may be. Finite: a state (q, q̇, q̈), where an overflow is a
+// NumericalError at that state. Bounded: an actuation τ, a physical input like the model's
+// numbers and the CLI's --tau and --tau-csv, finite and |x| ≤ kMaxMagnitude (core/limits.hpp).
+enum class Entries { Finite, Bounded };
 
-// A batch of states: shape (k, n) with finite entries, seen in place (row i = state i). `k` is
-// the number of rows required, or -1 for the first batch argument (which sets k).
+// A state vector: shape (n,), every entry finite (and bounded if asked). Absent (None, where
+// allowed) is zero.
+VecX vector_arg(const Array& a, const char* name, const Model& model,
+                Entries entries = Entries::Finite);
+VecX vector_arg(const std::optional<Array>& a, const char* name, const Model& model,
+                Entries entries = Entries::Finite);
+
+// A batch of states: shape (k, n) with finite (bounded) entries, seen in place (row i = state
+// i). `k` is the number of rows required, or -1 for the first batch argument (which sets k).
 Eigen::Map<const RowMatX> batch_arg(const Array& a, const char* name, const Model& model,
-                                    Eigen::Index k);
+                                    Eigen::Index k, Entries entries = Entries::Finite);
 
 // A fresh C-ordered float64 array of the given shape.
 py::array_t<double> new_array(std::initializer_list<py::ssize_t> shape);

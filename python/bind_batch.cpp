@@ -15,18 +15,19 @@ namespace {
 using OptArray = std::optional<Array>;
 
 // The k states of a batch, row i of each a state: q sets k; q̇ and the third argument (τ or
-// q̈) default to zero rows. The arrays are read in place (numpy's memory).
+// q̈) default to zero rows. The arrays are read in place (numpy's memory). τ is bounded as a
+// physical input (|x| ≤ 1e100), the states only finite (arrays.hpp).
 struct Batch {
   Eigen::Index k = 0, n = 0;
   const double *q = nullptr, *qd = nullptr, *third = nullptr;
   VecX zeros;  // one zero row for an absent argument
   Batch(const Model& m, const Array& q_in, const OptArray& qd_in, const OptArray& third_in,
-        const char* third_name)
+        const char* third_name, Entries third_entries)
       : n(m.n()), zeros(VecX::Zero(m.n())) {
     q = batch_arg(q_in, "q", m, -1).data();
     k = q_in.shape(0);
     if (qd_in) qd = batch_arg(*qd_in, "qd", m, k).data();
-    if (third_in) third = batch_arg(*third_in, third_name, m, k).data();
+    if (third_in) third = batch_arg(*third_in, third_name, m, k, third_entries).data();
   }
   Eigen::Map<const VecX> row(const double* x, Eigen::Index i) const {
     return {x ? x + i * n : zeros.data(), n};
@@ -46,7 +47,7 @@ struct RowState {
 py::dict equations_batch(const PyModel& self, const Array& q, const OptArray& qd,
                          const OptArray& tau, int threads) {
   const Model& m = *self.model;
-  const Batch b(m, q, qd, tau, "tau");
+  const Batch b(m, q, qd, tau, "tau", Entries::Bounded);
   const py::ssize_t k = b.k, n = b.n;
   py::array_t<double> M = new_array({k, n, n}), h = new_array({k, n}), Q = new_array({k, n}),
                       qdd = new_array({k, n});
@@ -93,7 +94,8 @@ template <bool Forward>
 py::array_t<double> dynamics_batch(const PyModel& self, const Array& q, const OptArray& qd,
                                    const OptArray& third, int threads) {
   const Model& m = *self.model;
-  const Batch b(m, q, qd, third, Forward ? "tau" : "qdd");
+  const Batch b(m, q, qd, third, Forward ? "tau" : "qdd",
+                Forward ? Entries::Bounded : Entries::Finite);
   const py::ssize_t k = b.k, n = b.n;
   py::array_t<double> out = new_array({k, n});
   double* po = out.mutable_data();

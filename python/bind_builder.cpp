@@ -68,10 +68,39 @@ NodeDescription node_arg(const py::object& node, const char* name) {
   return vec3_arg(node.cast<Array>(), name);
 }
 
-JointSpec joint_arg(const std::string& type, const std::optional<std::string>& name,
-                    const Array& axis, const Array& xyz, const Array& rpy,
-                    const std::optional<std::pair<double, double>>& limits, double stiffness,
-                    double rest, double damping) {
+using OptArray = std::optional<Array>;
+using OptNumber = std::optional<double>;
+
+// Builder.body's joint: `type` and the arguments that describe the joint, each None when not
+// given. Without a type the body is welded to its parent (a fixed joint at its origin), so a
+// joint argument without one is refused: it would be ignored, or (xyz, rpy) weld a body that
+// was meant to move. With type='fixed', the motion's arguments (axis, limits, spring, damper)
+// are refused as the JSON loader refuses them on a fixed joint.
+JointSpec joint_arg(const std::optional<std::string>& type_in,
+                    const std::optional<std::string>& name, const OptArray& axis,
+                    const OptArray& xyz, const OptArray& rpy,
+                    const std::optional<std::pair<double, double>>& limits, OptNumber stiffness,
+                    OptNumber rest, OptNumber damping) {
+  const std::pair<const char*, bool> motion[] = {{"axis", axis.has_value()},
+                                                 {"limits", limits.has_value()},
+                                                 {"stiffness", stiffness.has_value()},
+                                                 {"rest", rest.has_value()},
+                                                 {"damping", damping.has_value()}};
+  if (!type_in) {
+    for (const auto& [arg, given] :
+         {std::pair{"joint", name.has_value()}, {"xyz", xyz.has_value()}, {"rpy", rpy.has_value()}})
+      if (given)
+        throw py::value_error(std::string(arg) +
+                              ": given without a joint type; a body without type= is welded to "
+                              "its parent (say type='revolute', 'prismatic', or 'fixed' to weld "
+                              "it)");
+    for (const auto& [arg, given] : motion)
+      if (given)
+        throw py::value_error(std::string(arg) +
+                              ": given without a joint type; a body without type= is welded to "
+                              "its parent (say type='revolute' or 'prismatic')");
+  }
+  const std::string type = type_in.value_or("fixed");
   JointSpec j;
   if (type == "revolute" || type == "continuous")
     j.type = JointType::Revolute;
@@ -82,17 +111,21 @@ JointSpec joint_arg(const std::string& type, const std::optional<std::string>& n
   else
     throw py::value_error("joint type: unknown '" + type +
                           "' (expected revolute, continuous, prismatic or fixed)");
+  if (j.type == JointType::Fixed)
+    for (const auto& [arg, given] : motion)
+      if (given)
+        throw py::value_error(std::string(arg) +
+                              ": a fixed joint has no motion: no axis, limits, spring or damping");
   if (name) j.name = *name;
-  j.axis = vec3_arg(axis, "axis");
-  j.xyz = vec3_arg(xyz, "xyz");
-  j.rpy = vec3_arg(rpy, "rpy");
+  if (axis) j.axis = vec3_arg(*axis, "axis");
+  if (xyz) j.xyz = vec3_arg(*xyz, "xyz");
+  if (rpy) j.rpy = vec3_arg(*rpy, "rpy");
   if (limits) {
-    if (j.type == JointType::Fixed) throw py::value_error("limits: a fixed joint has none");
     if (std::isnan(limits->first) || std::isnan(limits->second))
       throw py::value_error("limits: NaN");
     j.lower = limits->first, j.upper = limits->second;
   }
-  j.stiffness = stiffness, j.rest = rest, j.damping = damping;
+  j.stiffness = stiffness.value_or(0), j.rest = rest.value_or(0), j.damping = damping.value_or(0);
   return j;
 }
 
@@ -111,20 +144,24 @@ void bind_builder(py::module_& m) {
       .def(
           "body",
           [](MechanismBuilder& b, const std::string& name, const std::string& parent,
-             const std::string& type, const std::optional<std::string>& joint, const Array& axis,
-             const Array& xyz, const Array& rpy,
-             const std::optional<std::pair<double, double>>& limits, double stiffness, double rest,
-             double damping) {
+             const std::optional<std::string>& type, const std::optional<std::string>& joint,
+             const OptArray& axis, const OptArray& xyz, const OptArray& rpy,
+             const std::optional<std::pair<double, double>>& limits, OptNumber stiffness,
+             OptNumber rest, OptNumber damping) {
             b.body(name, parent,
                    joint_arg(type, joint, axis, xyz, rpy, limits, stiffness, rest, damping));
           },
-          py::arg("name"), py::arg("parent") = "world", py::arg("type") = "fixed",
-          py::arg("joint") = py::none(), py::arg("axis") = Vec3(0, 0, 1),
-          py::arg("xyz") = Vec3(0, 0, 0), py::arg("rpy") = Vec3(0, 0, 0),
-          py::arg("limits") = py::none(), py::arg("stiffness") = 0.0, py::arg("rest") = 0.0,
-          py::arg("damping") = 0.0,
+          py::arg("name"), py::arg("parent") = "world", py::arg("type") = py::none(),
+          py::arg("joint") = py::none(), py::arg("axis") = py::none(), py::arg("xyz") = py::none(),
+          py::arg("rpy") = py::none(), py::arg("limits") = py::none(),
+          py::arg("stiffness") = py::none(), py::arg("rest") = py::none(),
+          py::arg("damping") = py::none(),
           "A body on `parent` ('world': the ground) by a joint of `type` (revolute, prismatic, "
-          "fixed) named `joint` (default: the body's name)")
+          "fixed) named `joint` (default: the body's name), at xyz, rpy (default 0), about axis "
+          "(default (0, 0, 1)), with limits (lower, upper), a spring (stiffness, rest) and a "
+          "damper. Without type the body is welded to its parent's origin and no other joint "
+          "argument may be given (ValueError naming it); a fixed joint takes no axis, limits, "
+          "spring or damper.")
       .def(
           "node",
           [](MechanismBuilder& b, const std::string& body, const std::string& name,

@@ -52,7 +52,7 @@ EquationsResult equations(PyModel& self, const Array& q_in, const OptArray& qd_i
                           const OptArray& tau_in) {
   const Model& m = *self.model;
   const VecX q = vector_arg(q_in, "q", m), qd = vector_arg(qd_in, "qd", m),
-             tau = vector_arg(tau_in, "tau", m);
+             tau = vector_arg(tau_in, "tau", m, Entries::Bounded);
   Status st;
   equations_at(m, self.ws, q, qd, tau, st);
   EquationsResult r{self.ws.Ms, self.ws.h, self.ws.Q, std::nullopt, st.message};
@@ -63,7 +63,7 @@ EquationsResult equations(PyModel& self, const Array& q_in, const OptArray& qd_i
 VecX forward(PyModel& self, const Array& q, const OptArray& qd, const OptArray& tau) {
   const Model& m = *self.model;
   const Status st = forward_dynamics(m, self.ws, vector_arg(q, "q", m), vector_arg(qd, "qd", m),
-                                     vector_arg(tau, "tau", m));
+                                     vector_arg(tau, "tau", m, Entries::Bounded));
   if (!st.ok) throw NumericalError("at this state " + st.message);
   require_finite(m, self.ws.qdd.data(), m.n(), m.n(), "q̈");
   return self.ws.qdd;

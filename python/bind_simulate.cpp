@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/integrator.hpp"
+#include "core/limits.hpp"
 #include "core/recorded_run.hpp"
 #include "io/actuation_table.hpp"
 #include "python/py_model.hpp"
@@ -59,15 +60,18 @@ Actuation tau_table(const Model& m, const Array& times, const Array& values, dou
     throw py::value_error("tau: expected shape (" + std::to_string(rows) + ", " +
                           std::to_string(m.n()) + ") with tau_t, got " + shape_text(values));
   std::vector<double> t(times.data(), times.data() + rows);
-  for (py::ssize_t r = 0; r < rows; ++r)
+  for (py::ssize_t r = 0; r < rows; ++r) {
+    if (std::isfinite(t[r]) && std::abs(t[r]) > kMaxMagnitude)  // as --tau-csv's t column
+      throw py::value_error("tau_t: entry " + std::to_string(r) + " " + out_of_range_text(t[r]));
     if (!std::isfinite(t[r]) || (r > 0 && !(t[r] > t[r - 1])))
       throw py::value_error("tau_t: expected finite, strictly increasing times; entry " +
                             std::to_string(r) + " is not");
+  }
   if (t.front() > 0 || t.back() < t_end)
     throw py::value_error("tau_t: covers t in [" + std::to_string(t.front()) + ", " +
                           std::to_string(t.back()) + "] s; it must cover [0, t_end]");
-  MatX tau = Eigen::Map<const RowMatX>(values.data(), rows, m.n()).transpose();  // n x samples
-  if (!tau.allFinite()) throw py::value_error("tau: NaN or Inf");
+  // Row r is τ at t[r]: finite and bounded, as --tau-csv's rows are.
+  MatX tau = batch_arg(values, "tau", m, rows, Entries::Bounded).transpose();  // n x samples
   return [table = ActuationTable(std::move(t), std::move(tau), "tau_t")](double time, VecX& out) {
     table(time, out);
   };
@@ -106,7 +110,7 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
     tau = tau_table(m, *tau_t_in, *tau_in, t_end);
     driven = true;
   } else {
-    const VecX u = vector_arg(tau_in, "tau", m);
+    const VecX u = vector_arg(tau_in, "tau", m, Entries::Bounded);
     driven = !u.isZero(0);
     if (driven) tau = [u](double, VecX& out) { out = u; };
   }

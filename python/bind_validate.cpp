@@ -14,7 +14,11 @@ namespace {
 py::dict validate(const PyModel& self, int states, unsigned seed, double tolerance, double t_end,
                   int samples) {
   if (states < 1) throw py::value_error("states: expected an integer >= 1");
-  if (!(t_end >= 0)) throw py::value_error("t_end: expected a time >= 0 (0: no trajectory)");
+  // The CLI's limit on --t-end (validation::kMaxTrajectoryTime), shared, not copied.
+  if (!(t_end >= 0 && t_end <= validation::kMaxTrajectoryTime))
+    throw py::value_error("t_end: " + format_number(t_end, "%.15g") + " is not a time in [0, " +
+                          format_number(validation::kMaxTrajectoryTime) +
+                          "] s (0: no trajectory; the limit of femdyn validate --t-end)");
   if (samples < 1) throw py::value_error("samples: expected an integer >= 1");
   if (!(tolerance > 0)) throw py::value_error("tolerance: expected a number > 0");
   validation::ValidationOptions o;
@@ -58,6 +62,7 @@ py::dict validate(const PyModel& self, int states, unsigned seed, double toleran
   py::dict d;
   d["model"] = r.model;
   d["n"] = r.n;
+  d["coordinates"] = self.model->coordinate_names;
   d["states"] = r.states;
   d["quantities"] = quantities;
   d["trajectory"] = traj;

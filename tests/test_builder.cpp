@@ -158,3 +158,45 @@ TEST_CASE("the builder refuses bad arguments with the loader's paths", "[builder
   b.body("other", "missing", revolute("k", Vec3::UnitZ()));
   CHECK_THROWS_WITH(b.build(), Catch::StartsWith("arm (builder): /bodies/1"));
 }
+
+TEST_CASE("a joint whose type was left out is refused, not welded", "[builder][errors]") {
+  // JointSpec's type defaults to fixed: a joint given an axis, limits, a spring or a damper but
+  // no type would weld its body to the parent and ignore them. The builder refuses it, naming
+  // the joint's path, as the JSON loader refuses the same joint written in a file.
+  const std::string loader_says = "a fixed joint has no motion: no axis, limits, spring or damping";
+  JointSpec axis;
+  axis.axis = Vec3::UnitY();
+  JointSpec limits;
+  limits.lower = -1, limits.upper = 1;
+  JointSpec spring;
+  spring.stiffness = 2;
+  JointSpec rest;
+  rest.rest = 0.3;
+  JointSpec damper;
+  damper.damping = 0.1;
+  for (const auto& [joint, key] : {std::pair{axis, "axis"},
+                                   {limits, "limits"},
+                                   {spring, "spring"},
+                                   {rest, "spring"},
+                                   {damper, "damping"}}) {
+    INFO(key);
+    MechanismBuilder b("arm");
+    CHECK_THROWS_WITH(b.body("link", "world", joint),
+                      Catch::StartsWith("arm (builder): /bodies/0/joint/" + std::string(key) +
+                                        ": " + loader_says));
+    CHECK(b.spec().bodies.empty());  // nothing added
+  }
+  CHECK_THROWS_WITH(load_text(R"({"name": "arm", "bodies": [{"name": "link", "parent": "world",
+                    "joint": {"type": "fixed", "damping": 0.1}}]})"),
+                    Catch::Contains("/bodies/0/joint/damping: " + loader_says));
+  // A fixed joint with an origin only, and the same joint with its type, are accepted.
+  MechanismBuilder b("arm");
+  JointSpec weld;
+  weld.xyz = {0.1, 0, 0};
+  b.body("base", "world", weld);
+  damper.type = JointType::Revolute;
+  b.body("link", "base", damper);
+  b.lumped_point("link", Vec3(0.2, 0, 0), 1);
+  const Model m = b.build();
+  CHECK(m.coordinate_names == std::vector<std::string>{"link"});
+}

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <set>
 
 #include "tests/helpers.hpp"
@@ -276,4 +277,95 @@ TEST_CASE("import writes JSON that loads back, atomically, or nothing at all", "
   CHECK_THAT(no.out, Catch::Contains("more than one root link"));
   CHECK_FALSE(std::filesystem::exists(bad_out));
   CHECK(run("import " + model_path("urdf/arm7.urdf")).code == 2);  // no -o
+}
+
+TEST_CASE("femdyn --version prints the version of CMakeLists.txt's project()", "[cli]") {
+  std::ifstream f(std::string(FEMDYN_SOURCE_DIR) + "/CMakeLists.txt");
+  const std::string cmake((std::istreambuf_iterator<char>(f)), {});
+  std::smatch version;
+  REQUIRE(std::regex_search(cmake, version, std::regex(R"(project\(femdyn VERSION ([0-9.]+))")));
+  const Run r = run("--version");
+  CHECK(r.code == 0);
+  CHECK(r.out == "femdyn " + version[1].str() + "\n");
+  const Run extra = run("--version now");
+  CHECK(extra.code == 2);
+  CHECK(extra.out == "femdyn --version: takes no arguments\n");
+  CHECK_THAT(run("--help").out, Catch::Contains("femdyn --version"));
+}
+
+TEST_CASE("compare --rtol: exit 1 above the tolerance, 0 within it, 2 for a bad tolerance",
+          "[cli]") {
+  const std::string pair = " compare " + model_path("finger_paper.json") + " " +
+                           model_path("finger.json") + " --states 5";
+  const Run report = run(pair + " --json");
+  REQUIRE(report.code == 0);  // without --rtol only a report
+  const auto errors = nlohmann::json::parse(report.out).at("max_rel_error");
+  double worst = 0;
+  std::string worst_name;
+  for (const auto& [key, shown] : {std::pair{"M", "M^s"}, {"h", "h"}, {"qdd", "qdd"}})
+    if (errors.at(key).get<double>() > worst) worst = errors.at(key), worst_name = shown;
+  REQUIRE(worst > 0.01);  // the paper's discretisation is not the exact finger
+  char within[32], above[32];
+  std::snprintf(within, sizeof within, "%.17g", worst * 1.01);
+  std::snprintf(above, sizeof above, "%.17g", worst * 0.99);
+  // Just above the largest error: exit 0. Just below it: exit 1, the quantity named on stderr
+  // (one line) and "pass": false in the JSON on stdout.
+  const Run pass = run(pair + " --rtol " + within);
+  CHECK(pass.code == 0);
+  CHECK_THAT(pass.out, Catch::EndsWith("PASS (--rtol " + format_number(worst * 1.01) + ")\n"));
+  const std::string err =
+      (std::filesystem::temp_directory_path() / "femdyn_cli_compare_rtol.err").string();
+  const Run fail = run_shell("{ " + std::string(FEMDYN_BINARY) + pair + " --rtol " + above +
+                             " --json 2>" + err + "; }");
+  CHECK(fail.code == 1);
+  const auto j = nlohmann::json::parse(fail.out);
+  CHECK(j.at("pass") == false);
+  CHECK(j.at("rtol").get<double>() == std::strtod(above, nullptr));
+  std::ifstream e(err);
+  const std::string stderr_text((std::istreambuf_iterator<char>(e)), {});
+  CHECK_THAT(stderr_text, Catch::StartsWith("femdyn compare: max relative error above --rtol ") &&
+                              Catch::Contains(": " + worst_name + " "));
+  CHECK(std::count(stderr_text.begin(), stderr_text.end(), '\n') == 1);
+  std::remove(err.c_str());
+  // A model against itself is exact: it passes any tolerance.
+  const std::string finger = model_path("finger.json");
+  CHECK(run("compare " + finger + " " + finger + " --states 3 --rtol 1e-300").code == 0);
+  // A tolerance must be a number > 0: one line, exit 2.
+  for (const char* bad : {"0", "-1", "nan", "inf", "1e200", "abc", "1,2", "''"}) {
+    INFO(bad);
+    const Run r = run("compare " + finger + " " + finger + " --states 1 --rtol " + bad);
+    CHECK(r.code == 2);
+    CHECK_THAT(r.out, Catch::StartsWith("femdyn compare: --rtol"));
+    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
+  }
+  CHECK(run("compare " + finger + " " + finger + " --rtol 0").out ==
+        "femdyn compare: --rtol: 0 is not a tolerance (expected a number > 0)\n");
+  CHECK_THAT(run("compare --help").out, Catch::Contains("--rtol R"));
+}
+
+TEST_CASE("every --json output: \"coordinates\" the names, \"n\" how many", "[cli]") {
+  const std::string finger = model_path("finger.json");
+  const Model m = load_model(finger);  // the names from the library, not from the CLI
+  std::vector<std::string> commands = {
+      "equations " + finger,
+      "info " + finger,
+      "simulate " + finger + " --t-end 0.01",
+      "check " + finger + " --states 2",
+      "compare " + finger + " " + finger + " --states 2",
+      "track " + finger + " --to 0.1,0.2,0.3,0.4 --duration 0.1 --steps 10"};
+#ifdef FEMDYN_WITH_SIMBODY
+  commands.push_back("validate " + finger + " --states 2 --t-end 0");
+#ifdef NDEBUG  // (bench refuses to time a build with asserts)
+  commands.push_back("bench " + finger + " --quick --states 2");
+#endif
+#endif
+  for (const std::string& command : commands) {
+    INFO(command);
+    const Run r =
+        run_shell("{ " + std::string(FEMDYN_BINARY) + " " + command + " --json 2>/dev/null; }");
+    CHECK(r.code == 0);
+    const auto j = nlohmann::json::parse(r.out);
+    CHECK(j.at("coordinates") == nlohmann::json(m.coordinate_names));
+    CHECK(j.at("n") == m.n());
+  }
 }

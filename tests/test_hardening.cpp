@@ -136,6 +136,35 @@ TEST_CASE("out-of-range numbers are refused naming the field", "[hardening]") {
                     Catch::StartsWith(path + ": --gravity: gravity 1e+200 is out of range"));
 }
 
+TEST_CASE("a τ table (--tau-csv) is held to the 1e100 limit like --tau", "[hardening]") {
+  const fs::path dir = scratch();
+  const std::string pend = model_path("pendulum.json"), csv = (dir / "tau.csv").string();
+  const auto simulate = [&](const std::string& rows) {
+    std::ofstream(csv) << "t,theta\n" << rows;
+    return run("simulate " + pend + " --t-end 1 --tau-csv " + csv);
+  };
+  const std::string limit =
+      " is out of range (|x| ≤ 1e100: beyond it the equations' products overflow double "
+      "precision)\n";
+  Run r = simulate("0,1\n1,1e200\n");  // τ: file, line, column and the value
+  CHECK(r.code == 1);
+  CHECK(r.out == "femdyn simulate: " + csv + ":3: column 2: 1e+200" + limit);
+  r = simulate("0,1\n1,-1e400\n");  // beyond double: the text as written
+  CHECK(r.code == 1);
+  CHECK(r.out == "femdyn simulate: " + csv + ":3: column 2: '-1e400'" + limit);
+  r = simulate("0,1\n1e200,1\n");  // the time column too
+  CHECK(r.code == 1);
+  CHECK(r.out == "femdyn simulate: " + csv + ":3: column 1: 1e+200" + limit);
+  // The same limit as --tau's, and nothing stricter: 1e100 itself and an underflow are read.
+  CHECK_THAT(run("simulate " + pend + " --t-end 1 --tau 1e101").out,
+             Catch::Contains("--tau: '1e101'" + limit.substr(0, limit.size() - 1)));
+  r = simulate("0,1e-400\n1,-1e100\n");
+  CHECK_THAT(r.out, !Catch::Contains(csv + ":"));  // (the run may overflow; the table is read)
+  r = simulate("0,1e-400\n1,-0.5\n");
+  CHECK(r.code == 0);
+  fs::remove_all(dir);
+}
+
 TEST_CASE("names with control characters are refused and user text is echoed escaped",
           "[hardening]") {
   json j = pendulum();

@@ -9,6 +9,12 @@
 
 namespace femdyn::validation {
 
+// The longest trajectory compared (s), for `femdyn validate --t-end` and femdyn.validate's
+// t_end alike: a bound on the check's run time. femdyn's RK4 run starts at a 1 ms step
+// (rk4_step) and is refined only within a budget of max_rk4_steps (1e5) steps, which a
+// trajectory of 100 s spends at its first halving.
+inline constexpr double kMaxTrajectoryTime = 100;
+
 struct ValidationOptions {
   int states = 20;  // K seeded random states
   unsigned seed = 1;

@@ -156,3 +156,45 @@ def test_builder_compile_errors_name_the_place():
         b2.lumped_point("link", [1, 0, 0], -2)
     b2.lumped_point("link", [1, 0, 0], 2)  # 1 m from the z axis: M = m l² = 2
     assert b2.build().mass_matrix([0.0])[0, 0] == pytest.approx(2.0)
+
+
+@pytest.mark.parametrize("argument,value", [
+    ("axis", [0, 1, 0]), ("damping", 0.1), ("stiffness", 2.0), ("rest", 0.3),
+    ("limits", (-1, 1)), ("xyz", [0.1, 0, 0]), ("rpy", [0, 0, 0.5]), ("joint", "elbow"),
+    ("damping", 0.0),  # given is given, whatever its value
+])
+def test_joint_arguments_without_a_type_are_refused(argument, value):
+    """A body without type= is welded to its parent: a joint argument given with it would be
+    ignored (or weld a body meant to move), so it is a ValueError naming the argument, and the
+    builder is left as it was."""
+    b = femdyn.Builder("arm")
+    with pytest.raises(ValueError, match=rf"^{argument}: given without a joint type"):
+        b.body("link", "world", **{argument: value})
+    b.body("link", "world", type="revolute", **{argument: value})  # with a type it is a joint
+    b.lumped_point("link", [0.5, 0, 0], 1.0)
+    assert b.build().n == 1
+
+
+@pytest.mark.parametrize("argument,value", [
+    ("axis", [0, 0, 1]), ("damping", 0.1), ("stiffness", 2.0), ("rest", 0.3), ("limits", (-1, 1)),
+])
+def test_a_fixed_joint_takes_no_motion_arguments(argument, value):
+    """As the JSON loader refuses them on a fixed joint (docs/model-format.md)."""
+    b = femdyn.Builder("arm")
+    with pytest.raises(ValueError, match=rf"^{argument}: a fixed joint has no motion"):
+        b.body("link", "world", type="fixed", **{argument: value})
+
+
+def test_a_weld_is_said_with_type_fixed():
+    """A welded body: without type= (at the parent's origin), or with type='fixed' and its
+    origin and name. Neither adds a coordinate; the link below keeps M = m l² = 1 * 0.5²."""
+    masses = []
+    for weld in ({}, {"type": "fixed", "xyz": [0.2, 0, 0], "joint": "weld"}):
+        b = femdyn.Builder("arm")
+        b.body("base", "world", **weld)
+        b.body("link", "base", type="revolute", axis=[0, 0, 1])
+        b.lumped_point("link", [0.5, 0, 0], 1.0)
+        model = b.build()
+        assert model.coordinates == ["link"]
+        masses.append(model.mass_matrix([0.0])[0, 0])
+    assert masses[0] == pytest.approx(0.25) and masses[1] == pytest.approx(0.25)

@@ -109,3 +109,63 @@ def test_failed_simulation(finger):
                         check=False)
     assert not r["stats"]["ok"] and r["stats"]["failure"]
     assert len(r["t"]) >= 1 and np.isfinite(r["q"]).all()
+
+
+LIMIT = ("is out of range (|x| ≤ 1e100: beyond it the equations' products overflow double "
+         "precision)")
+
+
+@pytest.mark.parametrize("call,message", [
+    (lambda m: m.equations(np.zeros(4), None, [0, 0, 1e200, 0]),
+     f"tau: entry 2 ('pip') 1e+200 {LIMIT}"),
+    (lambda m: m.forward_dynamics(np.zeros(4), None, [-1e101, 0, 0, 0]),
+     f"tau: entry 0 ('abduction') -1e+101 {LIMIT}"),
+    (lambda m: m.equations_batch(np.zeros((2, 4)), None, [[0, 0, 0, 0], [0, 1e300, 0, 0]]),
+     f"tau: row 1, entry 1 ('mcp') 1e+300 {LIMIT}"),
+    (lambda m: m.forward_dynamics_batch(np.zeros((2, 4)), None, [[0, 0, 0, 1e200], [0] * 4]),
+     f"tau: row 0, entry 3 ('dip') 1e+200 {LIMIT}"),
+    (lambda m: femdyn.simulate(m, 0.1, tau=[0, 0, 0, 1e200]),
+     f"tau: entry 3 ('dip') 1e+200 {LIMIT}"),
+    (lambda m: femdyn.simulate(m, 0.1, tau_t=[0, 1], tau=[[0] * 4, [0, 2e100, 0, 0]]),
+     f"tau: row 1, entry 1 ('mcp') 2e+100 {LIMIT}"),
+    (lambda m: femdyn.simulate(m, 0.1, tau_t=[0, 1e200], tau=[[0] * 4, [0] * 4]),
+     f"tau_t: entry 1 1e+200 {LIMIT}"),
+    (lambda m: femdyn.simulate(m, 0.1, tau_t=[0, 1], tau=[[0] * 4, [0, np.nan, 0, 0]]),
+     "tau: row 1, entry 1 ('mcp') is NaN or Inf"),
+])
+def test_tau_is_held_to_the_physical_limit(finger, call, message):
+    """τ is a physical input like the model's numbers and the CLI's --tau and --tau-csv: finite
+    and |x| ≤ 1e100 (docs/robustness.md), with the argument, row, entry and value named."""
+    with pytest.raises(ValueError) as e:
+        call(finger)
+    assert str(e.value) == message
+
+
+def test_tau_at_the_limit_is_accepted(finger):
+    """1e100 itself is within the limit; the states are only required to be finite (an overflow
+    at a state is a NumericalError, test_overflow_is_a_numerical_error)."""
+    tau = np.array([1e100, 0, 0, 0])
+    assert np.isfinite(finger.equations(np.zeros(4), None, tau).Q).all()
+    assert finger.forward_dynamics_batch(np.zeros((1, 4)), None, tau[None, :]).shape == (1, 4)
+
+
+@pytest.mark.skipif(not femdyn.with_simbody, reason="built without Simbody")
+def test_validate_caps_t_end_as_the_cli_does(finger):
+    """The trajectory limit is the CLI's --t-end limit (validation::kMaxTrajectoryTime), which
+    `femdyn validate --t-end` reports in its own error; both refuse just above it."""
+    import subprocess
+
+    from conftest import BINARY
+
+    cli = subprocess.run([str(BINARY), "validate", model_path("models/finger.json"),
+                          "--t-end", "1000"], capture_output=True, text=True)
+    assert cli.returncode == 2
+    limit = cli.stderr.strip().rsplit("at most ", 1)[1].split(" s")[0]
+    assert float(limit) == 100
+    with pytest.raises(ValueError) as e:
+        femdyn.validate(finger, states=1, t_end=float(limit) + 0.5)
+    assert str(e.value).startswith(f"t_end: 100.5 is not a time in [0, {limit}] s")
+    assert "femdyn validate --t-end" in str(e.value)
+    for bad in (-1, np.inf, np.nan):
+        with pytest.raises(ValueError, match=r"^t_end: .* is not a time in \[0, 100\] s"):
+            femdyn.validate(finger, states=1, t_end=bad)

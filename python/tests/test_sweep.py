@@ -42,3 +42,28 @@ def test_dask_example_equals_serial(tmp_path):
     euler = table[table.integrator == "euler"]["error"].to_numpy()
     assert 10 < rk4[0] / rk4[1] < 20 and 1.8 < euler[0] / euler[1] < 2.2
     assert (tmp_path / "finger_sweep.png").stat().st_size > 10000
+
+
+def test_dask_example_help_is_whole():
+    """--help exits 0 with the docstring's whole first sentence (it used to stop at the end of
+    the docstring's first line, mid-sentence), and every help text is a full sentence."""
+    script = ROOT / "examples" / "dask_sweep.py"
+    env = dict(subprocess_env(), COLUMNS="1000")  # argparse wraps at the width: no wrapping
+    out = subprocess.run([sys.executable, str(script), "--help"], env=env, capture_output=True,
+                         text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    text = " ".join(out.stdout.split())
+    assert ("A parameter study on dask.distributed (docs/python.md#sweeps): the finger's error "
+            "against run time across proximal link lengths and integrators.") in text
+    assert "exits 1 unless every number but the timings is equal." in text  # the epilog, whole
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("dask_sweep", script)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)  # (main() runs only as a script)
+    parser = module.parser()
+    helps = [a.help for a in parser._actions if a.help and a.dest != "help"]
+    assert len(helps) == 4
+    for h in [parser.description, parser.epilog] + helps:
+        assert h[0].isupper() and h.endswith("."), h
+        assert " ".join(h.split()) in text  # shown whole
