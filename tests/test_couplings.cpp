@@ -246,12 +246,24 @@ TEST_CASE("the four-bar finger runs in info, equations, simulate and check, and 
   CHECK(v.code == 0);
   CHECK_THAT(v.out, Catch::Contains("loop ") && Catch::Contains("1 rod(s)"));
 #ifdef NDEBUG  // (a build with asserts, tools/sanitize.sh: study refuses to time it)
-  // study sweeps femdyn's and Simbody's integrators on the closed loop.
+  // study sweeps femdyn's and Simbody's integrators on the closed loop, and says that the two
+  // do not integrate the same formulation (femdyn the reduced law, Simbody a constrained loop):
+  // on the formulation line and in every ratio.
   const std::string out = "/tmp/femdyn_fourbar_study_" + std::to_string(getpid());
   const Run st = run_shell(std::string(FEMDYN_BINARY) + " study " + model + " --quick --out " +
                            out + " 2>&1; code=$?; rm -rf " + out + "; exit $code");
   CHECK(st.code == 0);
   CHECK_THAT(st.out, Catch::Contains("fastest Simbody") && !Catch::Contains("not built"));
+  const std::string differ =
+      "femdyn: reduced law; Simbody: constrained loop — not the same "
+      "formulation";
+  CHECK_THAT(st.out, Catch::Contains("formulation: " + differ));
+  std::istringstream lines(st.out);
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("| 1e-", 0) == 0 && line.find(" | —") == std::string::npos) {
+      INFO(line);
+      CHECK_THAT(line, Catch::EndsWith("(" + differ + ") |"));
+    }
 #endif
 }
 

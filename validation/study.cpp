@@ -1,10 +1,13 @@
 #include "validation/study.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <stdexcept>
+#include <thread>
 
 #include "core/integrator.hpp"
 #include "validation/twin.hpp"
@@ -59,17 +62,64 @@ Sampled femdyn_run(const Model& m, const IntegratorOptions& o, const StudyOption
   return s;
 }
 
-void score(StudyRun& r, const States& x, const std::vector<double>& energy, const States& ref) {
+// The error measure (study.hpp): each component of x = (θ, θ̇) in a group — angle, angular
+// rate, position, speed — whose size S_g is the reference's largest magnitude in that group.
+struct Measure {
+  std::vector<int> group;        // per component of x
+  std::array<double, 4> size{};  // S_g; 1 where a group is identically zero
+  std::array<bool, 4> present{};
+  static constexpr const char* kName[4] = {"angle", "angular rate", "position", "speed"};
+  static constexpr const char* kUnit[4] = {"rad", "rad/s", "m", "m/s"};
+
+  Measure(const Model& m, const States& ref) {
+    const int nt = m.n_theta();
+    for (int half = 0; half < 2; ++half)
+      for (int j = 0; j < nt; ++j) {
+        const bool prismatic = m.bodies[m.theta_joint[j]].joint.type == JointType::Prismatic;
+        group.push_back((prismatic ? 2 : 0) + half);
+      }
+    for (const VecX& x : ref)
+      for (std::size_t i = 0; i < group.size(); ++i) {
+        size[group[i]] = std::max(size[group[i]], std::abs(x[static_cast<Eigen::Index>(i)]));
+        present[group[i]] = true;
+      }
+    for (double& s : size)
+      if (!(s > 0)) s = 1;
+  }
+  // The relative error of one sample, and the absolute errors of its positions and rates.
+  double relative(const VecX& x, const VecX& ref, double* position = nullptr,
+                  double* rate = nullptr) const {
+    double e = 0;
+    const std::size_t half = group.size() / 2;
+    for (std::size_t i = 0; i < group.size(); ++i) {
+      const double d =
+          std::abs(x[static_cast<Eigen::Index>(i)] - ref[static_cast<Eigen::Index>(i)]);
+      if (!std::isfinite(d)) return d;
+      e = std::max(e, d / size[group[i]]);
+      double* abs = i < half ? position : rate;
+      if (abs) *abs = std::max(*abs, d);
+    }
+    return e;
+  }
+};
+
+void score(StudyRun& r, const States& x, const std::vector<double>& energy, const States& ref,
+           const Measure& measure) {
   if (x.size() != ref.size()) {
     r.ok = false;
     return;
   }
   for (std::size_t k = 0; k < ref.size(); ++k) {
-    r.error = std::max(r.error, max_abs(x[k] - ref[k]));
+    const double e = measure.relative(x[k], ref[k], &r.position_error, &r.rate_error);
+    if (!std::isfinite(e)) {  // (std::max would drop a NaN)
+      r.ok = false;
+      r.failure = "NaN or Inf in the state at sample " + std::to_string(k);
+      return;
+    }
+    r.error = std::max(r.error, e);
     r.energy_drift = std::max(r.energy_drift, std::abs(energy[k] - energy[0]));
   }
-  r.final_error = max_abs(x.back() - ref.back());
-  if (!std::isfinite(r.error)) r.ok = false;
+  r.final_error = measure.relative(x.back(), ref.back());
 }
 
 std::vector<double> decades(int from, int to) {  // 10^-from … 10^-to
@@ -78,22 +128,67 @@ std::vector<double> decades(int from, int to) {  // 10^-from … 10^-to
   return v;
 }
 
+double median(std::vector<double> t) {
+  if (t.empty()) return 0;
+  std::sort(t.begin(), t.end());
+  const std::size_t h = t.size() / 2;
+  return t.size() % 2 ? t[h] : 0.5 * (t[h - 1] + t[h]);
+}
+
 }  // namespace
+
+std::vector<double> load_average() {
+  std::ifstream f("/proc/loadavg");
+  std::vector<double> out(3);
+  for (double& v : out)
+    if (!(f >> v)) return {};
+  return out;
+}
+
+StudyMachine study_machine() {
+  StudyMachine m;
+  std::ifstream cpu("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(cpu, line))
+    if (line.rfind("model name", 0) == 0 && line.find(':') != std::string::npos) {
+      m.cpu = line.substr(line.find(':') + 1);
+      m.cpu.erase(0, m.cpu.find_first_not_of(" \t"));
+      break;
+    }
+  m.cores = static_cast<int>(std::thread::hardware_concurrency());
+  return m;
+}
 
 StudyReport run_study(const Model& m, const StudyOptions& o,
                       const std::function<void(const std::string&)>& log) {
   StudyReport rep;
+  rep.machine = study_machine();
+  rep.machine.load_start = load_average();
   rep.model = m.name;
   rep.n = m.n();
   rep.t_end = o.t_end;
+  rep.samples = o.samples;
   rep.q0 = o.q0;
   rep.qd0 = o.qd0;
+  rep.interpolate = o.interpolate;
   rep.conservative = m.torques.empty();
   for (const Body& b : m.bodies) rep.conservative = rep.conservative && b.joint.damping == 0;
   std::vector<double> times;
   for (int k = 1; k <= o.samples; ++k) times.push_back(o.t_end * k / o.samples);
   std::vector<double> with_zero = times;  // Simbody samples t = 0 too
   with_zero.insert(with_zero.begin(), 0.0);
+  const TwinSampling twin_sampling =
+      o.interpolate ? TwinSampling::Interpolate : TwinSampling::StepToEach;
+  rep.sampling =
+      o.interpolate
+          ? "both engines step freely and interpolate at the samples: femdyn's dopri and bdf by "
+            "their dense output, Simbody's integrators by Integrator::stepTo with no scheduled "
+            "event (cubic Hermite; CPodes its own), neither stepping past the last sample; "
+            "femdyn's rk4 and euler land on the samples, their steps dividing the sample spacing"
+          : "both engines land on every sample: femdyn's dopri and bdf shorten a step to end on "
+            "it (stop_at_outputs), Simbody's integrators through TimeStepper (each sample a "
+            "scheduled event; CPodes still interpolates inside CPODES); femdyn's rk4 and euler "
+            "land on the samples, their steps dividing the sample spacing";
 
   // Reference: Dormand–Prince landing on every sample, at rtol 1e-14 and 1e-13.
   const auto reference = [&](double rtol) {
@@ -111,8 +206,12 @@ StudyReport run_study(const Model& m, const StudyOptions& o,
       "femdyn dopri (Dormand-Prince 5(4), SUNDIALS ARKODE) landing on each "
       "sample, rtol = atol = 1e-14";
   const Sampled ref = reference(rep.reference_rtol), coarse = reference(10 * rep.reference_rtol);
+  const Measure measure(m, ref.x);
+  for (int g = 0; g < 4; ++g)
+    if (measure.present[g])
+      rep.scales.push_back({Measure::kName[g], measure.size[g], Measure::kUnit[g]});
   for (std::size_t k = 0; k < ref.x.size(); ++k)
-    rep.reference_error = std::max(rep.reference_error, max_abs(ref.x[k] - coarse.x[k]));
+    rep.reference_error = std::max(rep.reference_error, measure.relative(coarse.x[k], ref.x[k]));
   rep.resolution = 100 * rep.reference_error;
 
   // femdyn sweeps. Fixed steps: N = samples·2^k steps, so the samples lie on the grid.
@@ -130,7 +229,10 @@ StudyReport run_study(const Model& m, const StudyOptions& o,
     s.run = [&, kind](double value) {
       IntegratorOptions io{.kind = kind};
       if (is_adaptive(kind))
-        io.adaptive = {.rtol = value, .atol = value, .max_steps = 100'000'000};
+        io.adaptive = {.rtol = value,
+                       .atol = value,
+                       .max_steps = 100'000'000,
+                       .stop_at_outputs = !o.interpolate};
       else
         io.fixed = {.dt = value};
       const Sampled r = femdyn_run(m, io, o, times);
@@ -143,14 +245,40 @@ StudyReport run_study(const Model& m, const StudyOptions& o,
       run.rhs_evals = r.stats.rhs_evals;
       run.ok = r.status.ok;
       run.failure = r.status.message;
-      if (run.ok) score(run, r.x, r.energy, ref.x);
+      if (run.ok) score(run, r.x, r.energy, ref.x, measure);
       return run;
     };
     femdyn.push_back(std::move(s));
   }
 
   // Simbody sweeps over accuracies, when the twin can integrate the model.
-  SimbodyTwin twin(twin_model(m));
+  const TwinModel tm = twin_model(m);
+  if (tm.closed_loop()) {
+    rep.same_formulation = false;
+    rep.femdyn_formulation = "reduced law";
+    rep.simbody_formulation = "constrained loop";
+    rep.notes.push_back(
+        "not the same formulation: femdyn integrates the reduced law (" + std::to_string(m.n()) +
+        " coordinates; the coupled joints follow θ = g(q)), Simbody's twin a constrained loop (" +
+        std::to_string(tm.n_theta()) + " joints, " + std::to_string(tm.laws.size()) +
+        " coupled joint(s) and " + std::to_string(tm.rods.size()) +
+        " rod(s) as CoordinateCoupler and Ball constraints, kept on them by projection). "
+        "The times compare the two formulations, not the two engines on the same equations.");
+  } else if (tm.n_theta() > tm.n()) {
+    rep.same_formulation = false;
+    rep.femdyn_formulation = "reduced coordinates";
+    rep.simbody_formulation = "coordinate couplers";
+    rep.notes.push_back(
+        "not the same formulation: femdyn integrates the reduced coordinates (" +
+        std::to_string(m.n()) + " of them, θ = C q + θ0), Simbody's twin all " +
+        std::to_string(tm.n_theta()) +
+        " joints with the coupling as CoordinateCoupler constraints, kept on them by "
+        "projection. The times compare the two formulations, not the two engines on the same "
+        "equations.");
+  } else {
+    rep.femdyn_formulation = rep.simbody_formulation = "tree coordinates";
+  }
+  SimbodyTwin twin(tm);
   std::string why_not;
   if (twin.can_simulate(&why_not)) {
     for (SimbodyIntegrator which : simbody_integrators()) {
@@ -160,7 +288,7 @@ StudyReport run_study(const Model& m, const StudyOptions& o,
               o.quick ? decades(2, 8) : decades(2, 10),
               {}};
       s.run = [&, which](double accuracy) {
-        const TwinRun r = twin.simulate(o.q0, o.qd0, with_zero, accuracy, which);
+        const TwinRun r = twin.simulate(o.q0, o.qd0, with_zero, accuracy, which, twin_sampling);
         StudyRun run{.engine = "Simbody",
                      .integrator = simbody_integrator_name(which),
                      .setting = "accuracy",
@@ -179,7 +307,7 @@ StudyReport run_study(const Model& m, const StudyOptions& o,
             x.push_back(std::move(v));
             energy.push_back(t.energy);
           }
-          score(run, x, energy, ref.x);
+          score(run, x, energy, ref.x, measure);
         }
         return run;
       };
@@ -189,14 +317,16 @@ StudyReport run_study(const Model& m, const StudyOptions& o,
     rep.notes.push_back("Simbody's integrators were not run: " + why_not);
   }
 
-  // Round-robin, the engines alternating; a sweep stops after a run over budget or an error
-  // below the reference's resolution (a failed run, e.g. a step beyond the stability limit,
-  // does not stop it: a finer setting may succeed).
+  // Round-robin, the engines alternating: each run once, as the warm-up of its setting, whose
+  // error and time decide whether the sweep goes on. A sweep stops after a run over budget or
+  // an error below the reference's resolution (a failed run, e.g. a step beyond the stability
+  // limit, does not stop it: a finer setting may succeed).
   std::vector<Sweep*> order;
   for (std::size_t i = 0; i < std::max(femdyn.size(), simbody.size()); ++i) {
     if (i < femdyn.size()) order.push_back(&femdyn[i]);
     if (i < simbody.size()) order.push_back(&simbody[i]);
   }
+  std::vector<std::pair<Sweep*, std::size_t>> made;  // each run's sweep and index in rep.runs
   const double budget = o.quick ? 0.2 : o.run_budget;
   for (bool any = true; any;) {
     any = false;
@@ -204,32 +334,44 @@ StudyReport run_study(const Model& m, const StudyOptions& o,
       if (!s->active || s->next >= s->values.size()) continue;
       any = true;
       StudyRun r = s->run(s->values[s->next++]);
-      r.times = {r.wall_time};
+      r.warm_up_time = r.wall_time;
       r.resolved = r.ok && r.error >= rep.resolution;
       if (log)
         log(r.engine + " " + r.integrator + " " + r.setting + " " + format_number(r.value, "%.3g") +
-            (r.ok ? ": error " + format_number(r.error, "%.2e") + ", " +
+            (r.ok ? ": error " + format_number(r.error, "%.2e") + ", warm-up " +
                         format_number(r.wall_time, "%.3g s")
                   : ": failed: " + r.failure));
       s->active = r.wall_time < budget && (!r.ok || r.error >= rep.resolution);
+      made.emplace_back(s, rep.runs.size());
       rep.runs.push_back(std::move(r));
     }
   }
 
-  // Repeats of the short runs, in rounds, in the same alternating order.
-  const int repeats = o.quick ? 1 : o.repeats;
-  for (int round = 1; round < repeats; ++round) {
+  // The timed runs, in rounds, in the same alternating order; a failed run keeps its one time.
+  rep.timed_repeats = o.quick ? 3 : std::max(1, o.repeats);
+  rep.timed_repeats_long = o.quick ? 3 : std::max(1, o.long_repeats);
+  const auto wanted = [&](const StudyRun& r) {
+    return !r.ok ? 0
+                 : (r.warm_up_time < o.repeat_below ? rep.timed_repeats : rep.timed_repeats_long);
+  };
+  for (int round = 0; round < std::max(rep.timed_repeats, rep.timed_repeats_long); ++round)
     for (Sweep* s : order)
-      for (StudyRun& r : rep.runs)
-        if (r.ok && r.engine == s->engine && r.integrator == s->integrator &&
-            r.wall_time < o.repeat_below)
-          r.times.push_back(s->run(r.value).wall_time);
-  }
+      for (const auto& [sweep, i] : made) {
+        StudyRun& r = rep.runs[i];
+        if (sweep != s || round >= wanted(r)) continue;
+        const StudyRun again = s->run(r.value);
+        r.times.push_back(again.wall_time);
+        if (again.steps != r.steps)  // a run is deterministic: the same steps every time
+          rep.notes.push_back(r.engine + " " + r.integrator + " " + r.setting + " " +
+                              format_number(r.value, "%.3g") + " took " +
+                              std::to_string(again.steps) + " steps in a timed run, " +
+                              std::to_string(r.steps) + " in its warm-up");
+      }
   for (StudyRun& r : rep.runs) {
-    std::vector<double> t = r.times;
-    std::sort(t.begin(), t.end());
-    r.wall_time = t.empty() ? 0 : t[t.size() / 2];
+    if (r.times.empty()) r.times = {r.warm_up_time};
+    r.wall_time = median(r.times);
   }
+  rep.machine.load_end = load_average();
   return rep;
 }
 

@@ -650,13 +650,13 @@ void count(const SimTK::Integrator& integ, TwinRunStats& stats) {
 }  // namespace
 
 // Settings: setAccuracy and setConstraintTolerance at `accuracy`; Simbody's defaults otherwise,
-// set explicitly: setReturnEveryInternalStep(false) and setAllowInterpolation(true). The
-// interpolation is never used here, though: TimeStepper::stepTo(t) passes t to the integrator
-// as a scheduled event time too, so a step ends exactly at every sample time and each sample
-// is an integrator step's own state (the samples cap the step at their spacing). Only
+// set explicitly: setReturnEveryInternalStep(false) and setAllowInterpolation(true). StepToEach
+// drives a TimeStepper, whose stepTo(t) makes t a scheduled event time too, so a step ends at
+// every sample; Interpolate calls the integrator's own stepTo(t) (no scheduled event), with the
+// final time at the last sample, and samples its interpolated states (twin.hpp). Only
 // initialize() and stepTo() are timed.
 TwinRun SimbodyTwin::simulate(const VecX& q0, const VecX& qd0, const std::vector<double>& times,
-                              double accuracy, SimbodyIntegrator which) {
+                              double accuracy, SimbodyIntegrator which, TwinSampling sampling) {
   Impl& s = *impl_;
   TwinRun run;
   TwinRunStats& stats = run.stats;
@@ -675,15 +675,26 @@ TwinRun SimbodyTwin::simulate(const VecX& q0, const VecX& qd0, const std::vector
     integ->setConstraintTolerance(accuracy);
     integ->setReturnEveryInternalStep(false);
     integ->setAllowInterpolation(true);
+    const bool interpolate = sampling == TwinSampling::Interpolate;
+    if (interpolate && !times.empty() && times.back() > 0) integ->setFinalTime(times.back());
     SimTK::TimeStepper stepper(s.system, *integ);
     {
       Stopwatch timed{stats.wall_time};
-      stepper.initialize(s.state);
+      if (interpolate)
+        integ->initialize(s.state);
+      else
+        stepper.initialize(s.state);
     }
     for (double t : times) {
       if (t > 0) {
         Stopwatch timed{stats.wall_time};
-        stepper.stepTo(t);
+        if (interpolate) {
+          // Returns at t, or earlier at the start of the continuous interval or a step limit.
+          while (integ->getTime() < t && !integ->isSimulationOver())
+            if (integ->stepTo(t) == SimTK::Integrator::EndOfSimulation) break;
+        } else {
+          stepper.stepTo(t);
+        }
       }
       if (std::abs(integ->getTime() - t) > 1e-12 * std::max(1.0, t)) {
         stats.ok = false;

@@ -112,7 +112,7 @@ struct TwinSample {
 
 // Simbody's error-controlled integrators, for trajectories (SimbodyTwin::simulate) and the
 // work-precision study. Each is used in its default error-controlled (variable-step) mode at
-// the accuracy asked for, never with a fixed step; a step ends exactly at every sample time.
+// the accuracy asked for, never with a fixed step; how the samples are taken is TwinSampling.
 enum class SimbodyIntegrator {
   RungeKuttaMerson,    // 4th order, embedded error estimate (the twin's default)
   RungeKutta3,         // 3rd order, embedded 2nd-order estimate
@@ -131,6 +131,18 @@ const char* simbody_integrator_name(SimbodyIntegrator which);
 // there.
 std::vector<SimbodyIntegrator> simbody_integrators();
 
+// How a trajectory is sampled:
+//   StepToEach: by TimeStepper::stepTo(t), which passes t to the integrator as a scheduled event
+//     time too, so a step ends exactly at every sample time (the samples cap the step at their
+//     spacing) and each sample is a step's own state.
+//   Interpolate: by Integrator::stepTo(t) with no scheduled event and the final time set to the
+//     last sample (as femdyn's adaptive integrators, which never step past t_stop), so the
+//     integrator steps freely and a sample inside a step is interpolated: a cubic Hermite
+//     interpolant of the step's ends for the Runge–Kutta and Verlet integrators (projected back
+//     onto the constraints), CPODES' own Nordsieck interpolation for CPodes (which interpolates
+//     in either mode: CPODES in its normal mode steps past the time asked and interpolates back).
+enum class TwinSampling { StepToEach, Interpolate };
+
 // What one SimbodyTwin::simulate run cost, from Simbody's own counters.
 struct TwinRunStats {
   long steps = 0;                 // Integrator::getNumStepsTaken()
@@ -138,7 +150,7 @@ struct TwinRunStats {
   long realizations = 0;          // getNumRealizations(): Simbody's right-hand-side evaluations
   long error_test_failures = 0;   // getNumErrorTestFailures()
   long convergence_failures = 0;  // getNumConvergenceTestFailures() (iterative methods; else 0)
-  double wall_time = 0;  // s in TimeStepper::initialize and stepTo only (not samples, energy)
+  double wall_time = 0;           // s in initialize and stepTo only (not samples, energy)
   bool ok = true;
   std::string failure;  // one line: why the run stopped early, if it did (then ok = false)
 };
@@ -165,11 +177,13 @@ class SimbodyTwin {
   bool can_simulate(std::string* why_not = nullptr) const;
   std::vector<TwinSample> simulate(const VecX& q0, const VecX& qd0,
                                    const std::vector<double>& times, double accuracy);
-  // The same by `which`, with its statistics and wall time. Never throws for a failed
-  // integration: stats.ok = false, stats.failure says why and `samples` holds those reached
-  // (none, with the reason, if the coupling cannot be posed as coordinate couplers).
+  // The same by `which`, sampled as `sampling` says, with its statistics and wall time. Never
+  // throws for a failed integration: stats.ok = false, stats.failure says why and `samples`
+  // holds those reached (none, with the reason, if the coupling cannot be posed as coordinate
+  // couplers).
   TwinRun simulate(const VecX& q0, const VecX& qd0, const std::vector<double>& times,
-                   double accuracy, SimbodyIntegrator which);
+                   double accuracy, SimbodyIntegrator which,
+                   TwinSampling sampling = TwinSampling::StepToEach);
 
   // Timing entry points (validation/benchmark.cpp, femdyn bench): Simbody's own work only,
   // on buffers allocated by the first call. Each sets θ = C q + θ0, θ̇ = C q̇ (a plain loop)

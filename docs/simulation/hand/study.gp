@@ -1,132 +1,135 @@
 # femdyn study: dexterous hand (generated; gnuplot study.gp)
-set terminal pngcairo size 1000,650 font 'sans,11'
+set terminal pngcairo size 1100,700 font 'sans,11'
 if (!exists('out')) out = 'study.png'
 set output out
 set logscale xy
 set format x '10^{%L}'
 set format y '10^{%L}'
-set xlabel 'wall time (s)'
-set ylabel 'max state error ‖(θ, θ̇) − reference‖∞'
-set title 'Work-precision: dexterous hand, t = 0…0.25 s'
+set xlabel "wall time (s): median of 5 timed runs after a warm-up (3 for runs of 50 ms or longer)" noenhanced
+set ylabel "relative state error: max(|Δθ| / max|θ|, |Δθ̇| / max|θ̇|)   (θ in rad, θ̇ in rad/s)" noenhanced
+set title "Work-precision: dexterous hand, t = 0…0.25 s\nboth engines interpolate at the 20 samples (dense output; rk4, euler land on them)" noenhanced
 set grid
 set key outside right top
 $d0 << EOD
-0.000692575 578.794
-0.00140286 8.52637
-0.00275059 0.224427
-0.00549995 0.0128368
-0.0107261 0.000926042
-0.0224306 6.91196e-05
-0.044504 4.68175e-06
-0.0889548 3.0399e-07
-0.181469 1.99891e-08
+0.000305436 2.68166
+0.000541155 0.0395043
+0.00109392 0.00103981
+0.00215587 5.94753e-05
+0.0042755 4.29053e-06
+0.00859769 3.20245e-07
+0.0172647 2.16919e-08
+0.0373099 1.40889e-09
 EOD
 $d1 << EOD
-0.00640677 1.42959
-0.00992403 1.05507
-0.0165165 0.133272
-0.028606 0.0196003
-0.0443699 0.00232175
-0.107474 0.000289974
-0.135954 2.63774e-05
-0.251023 3.41798e-06
-0.473502 2.38028e-07
+0.000326475 1.45373
+0.000559231 0.400687
+0.00118387 0.192188
+0.00261181 0.145298
+0.00451393 0.0751868
+0.00938776 0.0367531
+0.018847 0.0180114
+0.038773 0.0088978
+0.0942149 0.00442004
+0.17292 0.00220258
+0.298309 0.0010994
+0.637036 0.000549226
+1.18451 0.000274494
+2.26448 0.000137217
 EOD
 $d2 << EOD
-0.000697294 313.765
-0.00140026 86.4818
-0.00274059 41.4806
-0.00536069 31.3603
-0.0107276 16.2279
-0.021582 7.93256
-0.043196 3.88748
-0.0892005 1.92045
-0.223696 0.953994
-0.455741 0.475391
-0.764519 0.237288
-1.58962 0.118542
-3.06001 0.0592451
+0.00119084 0.0370038
+0.00144665 0.00186963
+0.00208319 0.000287571
+0.00331677 7.65526e-06
+0.00460937 5.02148e-07
+0.00701927 4.76917e-08
+0.0107888 4.86707e-09
+0.0171544 4.87082e-10
 EOD
 $d3 << EOD
-0.00941869 5.81139
-0.0185682 0.58796
-0.0361755 0.0351474
-0.0727013 0.00262541
-0.173606 0.000190591
-0.429728 3.28824e-05
-0.685953 3.21147e-06
-1.4179 3.28618e-07
-3.22923 3.23723e-08
+0.00287818 0.0415986
+0.00428836 0.0180762
+0.00521722 0.00173091
+0.00693365 0.000439813
+0.0101389 3.16347e-05
+0.0143692 7.59951e-06
+0.019685 6.3189e-07
+0.0286503 2.28555e-07
+0.0410306 3.49685e-08
 EOD
 $d4 << EOD
-0.00246542 7.98648
-0.0031941 0.403585
-0.00459812 0.0620681
-0.00703556 0.00165276
-0.0100478 0.000108378
-0.0153548 1.03692e-05
-0.0245654 4.4783e-07
-0.0390396 1.05826e-07
+0.00796897 0.042707
+0.0106971 0.00892503
+0.0165944 0.000944218
+0.0277171 0.000113009
+0.053419 1.32092e-05
+0.074907 1.54261e-06
+0.127973 1.53051e-07
+0.236635 1.61537e-08
+0.438776 1.24309e-09
 EOD
 $d5 << EOD
-0.00655708 25.9439
-0.00923598 25.0972
-0.01299 0.741778
-0.0187673 0.139034
-0.0261114 0.00836799
-0.0516237 0.00295205
-0.0619322 0.000415963
-0.0852727 6.64589e-05
-0.136016 8.1977e-06
+0.0104462 0.034576
+0.0191877 0.00209604
+0.0372315 0.000161893
+0.0772556 1.05925e-05
+0.152226 8.94495e-07
+0.315279 1.54692e-07
+0.671429 1.49695e-08
+1.4478 1.36031e-09
+3.25423 1.50583e-10
 EOD
 $d6 << EOD
-0.0044495 8.97838
-0.00643095 3.90146
-0.00806468 0.373591
-0.0107065 0.0949266
-0.0155669 0.00682784
-0.0246563 0.00164023
-0.0308355 0.000136382
-0.0469793 4.93299e-05
-0.0648509 7.55196e-06
+0.0074063 0.240009
+0.0119919 0.0726855
+0.0131151 0.00709669
+0.0188274 0.000257463
+0.0267112 0.000125106
+0.0385096 1.61209e-05
+0.0574398 1.99886e-06
+0.101679 2.78136e-07
+0.149763 4.54186e-08
 EOD
 $d7 << EOD
-0.00717616 124.732
-0.00905158 14.6828
-0.0163039 3.50046
-0.0325189 0.413155
-0.0654487 0.0785914
-0.182391 0.0131872
-0.297011 0.00303337
-0.671107 0.00082269
-1.39966 0.000176457
+0.00700712 0.375649
+0.00981576 0.0728741
+0.0168828 0.00777684
+0.0321496 0.00169302
+0.0688932 0.00029962
+0.136852 7.27313e-05
+0.28505 1.37521e-05
+0.6392 3.81344e-06
+1.4732 8.1378e-07
 EOD
 $d8 << EOD
-0.0160824 87.1088
-0.0460322 40.687
-0.128672 12.5061
-0.386244 3.93048
-1.3036 1.19839
-4.25245 0.403247
+0.0168044 0.417636
+0.060346 0.190743
+0.166172 0.0581215
+0.461808 0.0182363
+1.40534 0.00556604
+4.5037 0.00186561
 EOD
 $d9 << EOD
-0.0117032 35.0656
-0.0171306 14.5489
-0.026179 1.71973
-0.0340764 0.365797
-0.0508266 0.0907152
-0.0679629 0.00937323
-0.111567 0.00103381
-0.158659 0.00017343
-0.20474 1.98684e-05
+0.0136188 0.162466
+0.0180667 0.0674078
+0.0264386 0.00796782
+0.0373391 0.00169481
+0.0499867 0.000420301
+0.089939 4.3428e-05
+0.106232 4.78985e-06
+0.137746 8.03535e-07
+0.198704 9.20547e-08
 EOD
-plot $d0 using 1:2 with linespoints lw 2 pt 7 dt 1 lc rgb '#d62728' title 'femdyn rk4', \
-     $d1 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#1f77b4' title 'Simbody RungeKuttaMerson', \
-     $d2 using 1:2 with linespoints lw 2 pt 7 dt 1 lc rgb '#ff7f0e' title 'femdyn euler', \
-     $d3 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#2ca02c' title 'Simbody RungeKutta3', \
-     $d4 using 1:2 with linespoints lw 2 pt 7 dt 1 lc rgb '#8c564b' title 'femdyn dopri', \
-     $d5 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#17becf' title 'Simbody RungeKuttaFeldberg', \
-     $d6 using 1:2 with linespoints lw 2 pt 7 dt 1 lc rgb '#e377c2' title 'femdyn bdf', \
-     $d7 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#9467bd' title 'Simbody Verlet', \
-     $d8 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#7f7f7f' title 'Simbody SemiExplicitEuler2', \
-     $d9 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#393b79' title 'Simbody CPodes'
+plot keyentry with lines lt nodraw title '{/:Bold femdyn} (solid)', \
+     $d0 using 1:2 with linespoints lw 2 pt 7 dt 1 lc rgb '#d62728' title 'rk4' noenhanced, \
+     $d1 using 1:2 with linespoints lw 2 pt 7 dt 1 lc rgb '#ff7f0e' title 'euler' noenhanced, \
+     $d2 using 1:2 with linespoints lw 2 pt 7 dt 1 lc rgb '#8c564b' title 'dopri' noenhanced, \
+     $d3 using 1:2 with linespoints lw 2 pt 7 dt 1 lc rgb '#e377c2' title 'bdf' noenhanced, \
+     keyentry with lines lt nodraw title ' ', \
+     keyentry with lines lt nodraw title '{/:Bold Simbody} (dashed)', \
+     $d4 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#1f77b4' title 'RungeKuttaMerson' noenhanced, \
+     $d5 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#2ca02c' title 'RungeKutta3' noenhanced, \
+     $d6 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#17becf' title 'RungeKuttaFeldberg' noenhanced, \
+     $d7 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#9467bd' title 'Verlet' noenhanced, \
+     $d8 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#7f7f7f' title 'SemiExplicitEuler2' noenhanced, \
+     $d9 using 1:2 with linespoints lw 1.5 pt 6 dt 2 lc rgb '#393b79' title 'CPodes' noenhanced
