@@ -221,7 +221,7 @@ int cmd_simulate(int argc, char** argv) {
     return 130;  // `out` discards its temporary file
   }
   const Status& st = run.status;
-  if (run.rows == 0 && !st.ok)  // refused by the plan: nothing was run
+  if (run.refused)  // by the plan, before any work
     throw CliError(std::string(a.positional[0]) + ": " + st.message);
   const Energy& E0 = run.initial;
   const double max_balance = run.max_balance, scale = run.scale, wall = run.wall_time;

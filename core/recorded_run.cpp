@@ -58,6 +58,7 @@ RecordedRun run_recorded(Integrator& integ, double t_end, long every,
   if (Status plan = integ.plan(times ? (times->empty() ? integ.t() : times->back()) : t_end);
       !plan.ok) {
     r.status = plan;
+    r.refused = true;
     return r;
   }
   const Model& model = integ.motion().model();

@@ -27,6 +27,7 @@ struct LimitCrossing {
 struct RecordedRun {
   Status status;             // the plan's or the integrator's failure (rows end at its last step)
   bool interrupted = false;  // `stop` ended the run
+  bool refused = false;      // the plan refused the run before any work (status says why)
   Energy initial;            // E(0)
   double max_balance = 0;    // max over the rows of |E − E(0) − W|
   double scale = 0;          // S₀ + max over the rows of |W| (J): the fixed scale of the balance

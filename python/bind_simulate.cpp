@@ -86,11 +86,17 @@ py::array_t<double> vector_array(const std::vector<double>& x) {
 py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, const OptArray& qd0_in,
                   const std::string& integrator, std::optional<double> dt,
                   std::optional<double> rtol, std::optional<double> atol, const OptArray& tau_in,
-                  const OptArray& tau_t_in, const OptArray& t_eval_in, long every, bool check) {
+                  const OptArray& tau_t_in, const OptArray& t_eval_in, long every, bool check,
+                  std::optional<double> max_steps) {
   const Model& m = *self.model;
   if (!(t_end > 0) || t_end > 1e9) throw py::value_error("t_end: expected a time in (0, 1e9] s");
   if (every < 1) throw py::value_error("every: expected an integer >= 1");
-  const IntegratorOptions o = options_of(integrator, dt, rtol, atol);
+  IntegratorOptions o = options_of(integrator, dt, rtol, atol);
+  if (max_steps) {  // as the CLI's --max-steps: the fixed-step plan's limit, and adaptive's
+    if (!(*max_steps >= 1 && *max_steps <= 1e15) || *max_steps != std::floor(*max_steps))
+      throw py::value_error("max_steps: expected an integer in [1, 1e15]");
+    o.fixed.max_steps = o.adaptive.max_steps = static_cast<long>(*max_steps);
+  }
   const VecX q0 = vector_arg(q0_in, "q0", m), qd0 = vector_arg(qd0_in, "qd0", m);
   std::vector<double> t_eval;
   if (t_eval_in) {
@@ -138,6 +144,7 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
     }
   }
   const Status& st = run.status;
+  if (run.refused) throw py::value_error(st.message);  // before any work: the arguments' fault
   if (!st.ok && check) throw NumericalError(st.message);
 
   const py::ssize_t k = static_cast<py::ssize_t>(rows.t.size()), n = m.n();
@@ -164,7 +171,21 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
   stats["conservative"] = is_conservative;
   stats["energy_initial"] = run.initial.total();
   stats["energy_balance_error"] = run.max_balance;
+  stats["energy_scale"] = run.scale;
+  stats["energy_balance_relative"] = run.relative_balance();
   stats["ok"] = st.ok;
+  stats["diverged"] = st.diverged;
+  py::list crossings;
+  for (const LimitCrossing& c : run.limit_crossings) {
+    py::dict x;
+    x["joint"] = c.name;
+    x["t"] = c.t;
+    x["value"] = c.value;
+    x["lower"] = c.lower;
+    x["upper"] = c.upper;
+    crossings.append(x);
+  }
+  stats["limit_crossings"] = crossings;
   stats["failure"] = st.message;
   py::dict d;
   d["t"] = vector_array(rows.t);
@@ -185,14 +206,16 @@ void bind_simulate(py::module_& m) {
         py::arg("qd0") = py::none(), py::arg("integrator") = "dopri", py::arg("dt") = py::none(),
         py::arg("rtol") = py::none(), py::arg("atol") = py::none(), py::arg("tau") = py::none(),
         py::arg("tau_t") = py::none(), py::arg("t_eval") = py::none(), py::arg("every") = 1,
-        py::arg("check") = true,
+        py::arg("check") = true, py::arg("max_steps") = py::none(),
         "Integrates M^s q̈ + h = Q over [0, t_end] from (q0, qd0) under tau: constant (n,), or "
         "sampled, tau (m, n) at the times tau_t (m,) covering [0, t_end], interpolated "
         "linearly as --tau-csv; by rk4, "
         "euler (dt) or dopri, bdf (rtol, atol). Rows every `every` steps (first and last "
         "always), or at the times t_eval. Returns a dict: t, q, qd, kinetic, potential, total, "
         "work, stats. A numerical failure raises NumericalError, or with check=False returns the "
-        "rows up to the last good step with stats['ok'] False. The GIL is released.");
+        "rows up to the last good step with stats['ok'] False (a solution that diverges is "
+        "such a failure, stats['diverged'] True). A fixed-step run of more than max_steps "
+        "steps (default 1e7) is refused before it starts with ValueError. The GIL is released.");
 }
 
 }  // namespace femdyn::python

@@ -169,3 +169,48 @@ def test_validate_caps_t_end_as_the_cli_does(finger):
     for bad in (-1, np.inf, np.nan):
         with pytest.raises(ValueError, match=r"^t_end: .* is not a time in \[0, 100\] s"):
             femdyn.validate(finger, states=1, t_end=bad)
+
+
+def test_divergence_is_a_failure_with_its_cause(tmp_path):
+    """The issue's spring (omega = 10 rad/s) at rk4 dt = 1.5 s: never ok, the cause named."""
+    spring = tmp_path / "spring10.json"
+    spring.write_text(json.dumps({
+        "name": "spring", "gravity": [0, 0, 0],
+        "bodies": [{"name": "arm", "parent": "world",
+                    "joint": {"name": "theta", "type": "revolute", "axis": [0, 1, 0],
+                              "spring": {"stiffness": 100}},
+                    "elements": [{"type": "lumped_point", "node": [1, 0, 0], "mass": 1.0}]}]}))
+    m = femdyn.load(str(spring))
+    with pytest.raises(femdyn.NumericalError, match="the solution diverges.*stability limit"):
+        femdyn.simulate(m, 20.0, q0=[0.1], integrator="rk4", dt=1.5)
+    r = femdyn.simulate(m, 20.0, q0=[0.1], integrator="rk4", dt=1.5, check=False)
+    assert not r["stats"]["ok"] and r["stats"]["diverged"]
+    assert np.isfinite(r["q"]).all() and r["stats"]["t_reached"] < 20
+    # The same spring at a resolving step is ok, with its balance relative to the 0.5 J it holds.
+    r = femdyn.simulate(m, 2.0, q0=[0.1], integrator="rk4", dt=0.01)
+    assert r["stats"]["ok"] and not r["stats"]["diverged"]
+    assert r["stats"]["energy_scale"] == pytest.approx(0.5)
+    # RK4 shrinks |R(i h w)|^2 = 1 - (h w)^6/72 a step: 200 steps at h w = 0.1 lose that much.
+    assert r["stats"]["energy_balance_relative"] == pytest.approx(200 * 0.1**6 / 72, rel=0.05)
+
+
+def test_unbounded_work_is_refused_up_front(finger):
+    with pytest.raises(ValueError, match="below the resolution of the time"):
+        femdyn.simulate(finger, 1.0, integrator="rk4", dt=1e-300)
+    with pytest.raises(ValueError, match=r"1e\+09 steps.*max_steps"):
+        femdyn.simulate(finger, 1e6, integrator="euler", dt=1e-3)
+    r = femdyn.simulate(finger, 0.01, integrator="rk4", dt=1e-6, max_steps=20000, every=1000)
+    assert r["stats"]["ok"] and r["stats"]["steps"] == 10000
+    with pytest.raises(ValueError, match="max_steps"):
+        femdyn.simulate(finger, 0.01, integrator="rk4", dt=1e-3, max_steps=0)
+
+
+def test_limit_crossings_are_reported(finger):
+    # The finger's joints have limits; started beyond the flexion range's end at speed.
+    r = femdyn.simulate(finger, 0.5, q0=[0, 0, 0, 0], qd0=[0, 20, 20, 20])
+    crossings = r["stats"]["limit_crossings"]
+    assert crossings, "the finger flexed at 20 rad/s leaves its limits"
+    names = [c["joint"] for c in crossings]
+    assert len(names) == len(set(names))  # once per joint
+    for c in crossings:
+        assert not (c["lower"] <= c["value"] <= c["upper"])
