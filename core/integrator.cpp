@@ -122,7 +122,8 @@ Status Integrator::watch() {
   const int n = motion_.n();
   const double qd_norm = n ? qd().cwiseAbs().maxCoeff() : 0.0;
   if (!watch_.due(qd_norm)) return {};
-  if (watch_.look(motion_.energy_at(y_.data()), work(), qd_norm)) return diverged();
+  if (watch_.look(motion_.energy_at(y_.data()), work(), qd_norm) && watch_.confirmed())
+    return diverged();
   return {};
 }
 

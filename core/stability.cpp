@@ -20,25 +20,80 @@ std::complex<double> stability_function(IntegratorKind kind, std::complex<double
   return r;
 }
 
+// The oscillators x″ = k x + d ẋ that semi-implicit Euler sees (its step is not a map of the
+// first-order modes one by one): one per pair of modes of A, k = −λ1 λ2 and d = λ1 + λ2 —
+// a complex pair λ, λ̄, or two real modes of the same shape (the q parts of their eigenvectors
+// parallel: the overdamped pair of a spring with ζ > 1, a saddle ±a). Mirrored as the modes
+// are: k = −|λ1 λ2|, d = −|Re(λ1 + λ2)|. A real mode with no partner is first order: k = 0,
+// d = −|λ|.
+struct Oscillator {
+  double k = 0, d = 0;
+};
+
+std::vector<Oscillator> euler_oscillators(const Linearization& lin) {
+  const Eigen::EigenSolver<MatX> eig(lin.A, true);
+  const Eigen::VectorXcd& ev = eig.eigenvalues();
+  const Eigen::Index m = ev.size(), n = m / 2;
+  std::vector<bool> used(m, false);
+  std::vector<Oscillator> out;
+  const auto add = [&](std::complex<double> a, std::complex<double> b) {
+    out.push_back({-std::abs((a * b).real()), -std::abs((a + b).real())});
+  };
+  for (Eigen::Index i = 0; i < m; ++i) {
+    if (used[i]) continue;
+    used[i] = true;
+    const double r = std::abs(ev[i]);
+    if (std::abs(ev[i].imag()) > 1e-9 * r) {  // complex: its conjugate is its partner
+      Eigen::Index j = -1;
+      for (Eigen::Index c = 0; c < m; ++c)
+        if (!used[c] &&
+            (j < 0 || std::abs(ev[c] - std::conj(ev[i])) < std::abs(ev[j] - std::conj(ev[i]))))
+          j = c;
+      if (j >= 0) used[j] = true;
+      add(ev[i], std::conj(ev[i]));
+      continue;
+    }
+    // Real: the unused real mode whose shape is most nearly the same.
+    const auto shape = [&](Eigen::Index c) { return eig.eigenvectors().col(c).head(n); };
+    Eigen::Index j = -1;
+    double best = 0.999;
+    for (Eigen::Index c = 0; c < m; ++c) {
+      if (used[c] || std::abs(ev[c].imag()) > 1e-9 * std::abs(ev[c])) continue;
+      const double nc = shape(c).norm() * shape(i).norm();
+      const double cos = nc > 0 ? std::abs(shape(c).dot(shape(i))) / nc : 0;
+      if (cos > best) best = cos, j = c;
+    }
+    if (j >= 0) {
+      used[j] = true;
+      add(ev[i], ev[j]);
+    } else {
+      out.push_back({0, -r});
+    }
+  }
+  return out;
+}
+
 // Each mode λ of A, mirrored into the left half-plane (a physically growing mode, such as a
 // fall, sets the same step limit as its decaying mirror), must not be amplified:
 //   RK4, dopri:  |R(h λ̃)| ≤ 1,  λ̃ = −|Re λ| + i Im λ;
-//   symplectic Euler on the mode as an oscillator x'' + 2ζω x' + ω² x = 0 (ω = |λ|,
-//   ζ = |Re λ|/|λ|): spectral radius of [[1 − h²ω², h(1 − 2hζω)], [−hω², 1 − 2hζω]] ≤ 1.
-bool stable(const Linearization& lin, IntegratorKind kind, double h) {
+//   semi-implicit Euler on each oscillator x″ = k x + d ẋ above: the spectral radius of its
+//   step [[1 + h²k, h(1 + hd)], [hk, 1 + hd]] ≤ 1.
+bool stable(const Linearization& lin, const std::vector<Oscillator>& oscillators,
+            IntegratorKind kind, double h) {
   constexpr double slack = 1 + 1e-12;
+  if (kind == IntegratorKind::Euler) {
+    for (const Oscillator& o : oscillators) {
+      Eigen::Matrix2d G;
+      G << 1 + h * h * o.k, h * (1 + h * o.d), h * o.k, 1 + h * o.d;
+      if (Eigen::EigenSolver<Eigen::Matrix2d>(G, false).eigenvalues().cwiseAbs().maxCoeff() > slack)
+        return false;
+    }
+    return true;
+  }
   for (Eigen::Index i = 0; i < lin.eigenvalues.size(); ++i) {
     const std::complex<double> lambda(-std::abs(lin.eigenvalues[i].real()),
                                       lin.eigenvalues[i].imag());
-    if (kind != IntegratorKind::Euler) {
-      if (std::abs(stability_function(kind, h * lambda)) > slack) return false;
-      continue;
-    }
-    const double w = std::abs(lambda), zeta = w > 0 ? -lambda.real() / w : 0;
-    Eigen::Matrix2d G;
-    G << 1 - h * h * w * w, h * (1 - 2 * h * zeta * w), -h * w * w, 1 - 2 * h * zeta * w;
-    if (Eigen::EigenSolver<Eigen::Matrix2d>(G, false).eigenvalues().cwiseAbs().maxCoeff() > slack)
-      return false;
+    if (std::abs(stability_function(kind, h * lambda)) > slack) return false;
   }
   return true;
 }
@@ -107,13 +162,15 @@ std::optional<double> largest_stable_step(const Linearization& lin, IntegratorKi
   if (rate == 0) return std::numeric_limits<double>::infinity();
   // Every explicit method here is unstable beyond h |λ| = 10; bisect on log h below that.
   double lo = 1e-6 / rate, hi = 10 / rate;
-  if (!stable(lin, kind, lo)) return 0.0;
-  if (stable(lin, kind, hi)) return hi;
+  const std::vector<Oscillator> oscillators =
+      kind == IntegratorKind::Euler ? euler_oscillators(lin) : std::vector<Oscillator>{};
+  if (!stable(lin, oscillators, kind, lo)) return 0.0;
+  if (stable(lin, oscillators, kind, hi)) return hi;
   // (lo √(hi/lo), not √(lo hi): the product underflows for rates beyond 1e150; at most 60
   // halvings of log(hi/lo) = log 1e7 reach 1e-6)
   for (int i = 0; i < 60 && hi / lo > 1 + 1e-6; ++i) {
     const double mid = lo * std::sqrt(hi / lo);
-    (stable(lin, kind, mid) ? lo : hi) = mid;
+    (stable(lin, oscillators, kind, mid) ? lo : hi) = mid;
   }
   return lo;
 }

@@ -11,9 +11,11 @@
 //   does), is amplified: |R(hλ̃)| ≤ 1 with
 //     RK4     R(z) = Σ_{k≤4} z^k/k!
 //     dopri   R(z) = Σ_{k≤5} z^k/k! + z^6/600  (Dormand–Prince 5(4), the 5th-order solution)
-//   and for symplectic Euler, which is not a Runge–Kutta map in y, the spectral radius ≤ 1 of
-//   its step on the mode taken as an oscillator (ω = |λ|, ζ = |Re λ|/|λ|). Undamped modes give
-//   the classical limits h ω ≤ 2.83 (RK4), ≈ 3.3 (dopri), < 2 (symplectic Euler).
+//   and for semi-implicit Euler, which is not a Runge–Kutta map in y, the spectral radius ≤ 1
+//   of its step on each oscillator x″ = k x + d ẋ that a pair of modes makes (k = −λ1 λ2,
+//   d = λ1 + λ2: a complex pair, or two real modes of one shape). Undamped modes give the
+//   classical limits h ω ≤ 2.83 (RK4), ≈ 3.3 (dopri), < 2 (semi-implicit Euler); an overdamped
+//   spring's fast mode λ gives |λ| h ≤ 2.785 (RK4) and about 2 (Euler).
 #pragma once
 #include <cmath>
 #include <complex>

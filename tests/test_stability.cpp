@@ -153,6 +153,41 @@ TEST_CASE("stress springs: 1e1 to 1e5 rad/s, RK4 unstable and BDF stable at 1e5"
     CHECK(c["integrators"][3]["error"].get<double>() < 1e-2);
   }
 }
+TEST_CASE("stress springs: measured stable steps within 5 % of the closed forms", "[stress]") {
+  // Undamped: RK4 ω h ≤ 2√2, semi-implicit Euler ω h < 2. Damped (ζ = 100): the fast real mode
+  // λ = −ω(ζ + √(ζ² − 1)) limits RK4 to |λ| h ≤ 2.785 and Euler to the spectral radius of its
+  // step, which the linear theory column holds (core/stability.cpp); both within 5 %.
+  for (const auto& c : stress_class("springs")) {
+    INFO(c["case"]);
+    const std::string name = c["case"];
+    const double w = std::stod(name.substr(name.find("w=") + 2)),
+                 zeta = std::stod(name.substr(name.find("zeta=") + 5));
+    const auto& rk4 = c["integrators"][0];
+    const auto& euler = c["integrators"][1];
+    const double h_rk4 = rk4["largest_stable_step"], h_euler = euler["largest_stable_step"];
+    CHECK(h_rk4 == Approx(rk4["theory_step"].get<double>()).epsilon(0.05));
+    CHECK(h_euler == Approx(euler["theory_step"].get<double>()).epsilon(0.05));
+    if (zeta == 0) {
+      CHECK(h_rk4 * w == Approx(2 * std::sqrt(2.0)).epsilon(0.05));
+      CHECK(h_euler * w == Approx(2).epsilon(0.05));
+    } else {
+      const double lambda = w * (zeta + std::sqrt(zeta * zeta - 1));
+      CHECK(h_rk4 * lambda == Approx(2.785).epsilon(0.05));
+    }
+  }
+}
+TEST_CASE("stress postures: the slider moves, and every case but the long chain is searched",
+          "[stress]") {
+  for (const auto& c : stress_class("postures")) {
+    INFO(c["case"]);
+    CHECK(c["search_note"] == "");
+    CHECK(c["integrators"][0]["largest_stable_step"].get<double>() > 0);
+    // M^s changes along every motion (the slider is flung out: cond falls by orders).
+    CHECK(c["cond_max"].get<double>() > 1.01 * c["cond_min"].get<double>());
+  }
+  const auto chain = stress_class("size");
+  CHECK_THAT(chain[0]["search_note"].get<std::string>(), Catch::Contains("no step search"));
+}
 TEST_CASE("stress ratios: a mass ratio of 1e6 is ill-conditioned", "[stress]") {
   const auto cases = stress_class("ratios");
   CHECK_THAT(cases[0]["verdict"].get<std::string>(), Catch::Contains("digits"));
