@@ -1,5 +1,7 @@
 // Test helpers: loading models, seeded random mechanisms, finite differences, matrix checks.
 #pragma once
+#include <filesystem>
+#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
@@ -40,5 +42,23 @@ struct Run {
 };
 Run run(const std::string& args);
 Run run_shell(const std::string& command);  // any shell command
+
+// A scratch directory for one test case (in the system's temporary directory, named after the
+// case), emptied at the start and removed afterwards.
+struct Scratch {
+  std::filesystem::path dir;
+  explicit Scratch(const std::string& name)
+      : dir(std::filesystem::temp_directory_path() / ("femdyn_" + name)) {
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+  }
+  ~Scratch() { std::filesystem::remove_all(dir); }
+  Scratch(const Scratch&) = delete;
+  Scratch& operator=(const Scratch&) = delete;
+  std::string operator/(const std::string& f) const { return (dir / f).string(); }
+  std::size_t files() const {
+    return static_cast<std::size_t>(std::distance(std::filesystem::directory_iterator(dir), {}));
+  }
+};
 
 }  // namespace femdyn::test

@@ -20,16 +20,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Scratch {
-  fs::path dir;
-  explicit Scratch(const std::string& name) : dir(fs::temp_directory_path() / ("femdyn_" + name)) {
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-  }
-  ~Scratch() { fs::remove_all(dir); }
-  std::string operator/(const std::string& f) const { return (dir / f).string(); }
-};
-
 // One joint, a spring k and a damper c on a 1 kg point 1 m out (1 kg·m²), gravity g along −z.
 std::string arm_json(double k, double c, double g) {
   std::ostringstream s;

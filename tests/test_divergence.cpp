@@ -20,16 +20,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Scratch {
-  fs::path dir;
-  explicit Scratch(const std::string& name) : dir(fs::temp_directory_path() / ("femdyn_" + name)) {
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-  }
-  ~Scratch() { fs::remove_all(dir); }
-  std::string operator/(const std::string& f) const { return (dir / f).string(); }
-};
-
 // One joint with a spring k on a 1 kg·m² point arm (ω = √k), damper c, gravity g along −z.
 std::string spring_json(double k, double c = 0, double g = 0) {
   std::ostringstream s;

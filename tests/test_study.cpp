@@ -25,16 +25,6 @@ std::string slurp(const fs::path& p) {
   return {std::istreambuf_iterator<char>(in), {}};
 }
 
-struct Scratch {  // a directory for one test case, removed afterwards
-  fs::path dir;
-  explicit Scratch(const std::string& name) : dir(fs::temp_directory_path() / ("femdyn_" + name)) {
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-  }
-  ~Scratch() { fs::remove_all(dir); }
-  std::string operator/(const std::string& f) const { return (dir / f).string(); }
-};
-
 // study's stdout alone (stderr dropped): the JSON report with --json.
 Run study(const std::string& args) {
   return run_shell("{ " + std::string(FEMDYN_BINARY) + " study " + args + " 2>/dev/null; }");
