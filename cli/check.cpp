@@ -3,6 +3,7 @@
 // and the fastest motion, each labelled by kind), the largest stable step of each explicit
 // integrator, suspicious bodies, and advice on accuracy and stability: a recommended
 // integrator and step, with the error to expect (docs/stability.md).
+#include <Eigen/Eigenvalues>
 #include <chrono>
 #include <cmath>
 #include <complex>
@@ -62,18 +63,27 @@ std::string where(const Model& m, int a) {
   return "coordinate '" + name + "'";
 }
 
-// Seconds a state costs: 4n evaluations of forward dynamics, the eigenproblems of A (2n, with
-// vectors: about 4e-9 (2n)³ s measured on this kind of machine) and of M^s (1e-9 n³).
+// Seconds a state costs: 4n evaluations of forward dynamics (timed here) and the dense
+// eigenproblems of A (2n, with vectors, then eigenvalues) and of M^s (n), O(N³) each, scaled
+// from one timed on a random matrix of up to 200 (eigenvalues and vectors: about 2.5x).
 double seconds_per_state(const Model& m) {
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
   Workspace ws(m);
   const VecX z = VecX::Zero(m.n());
-  const auto begin = std::chrono::steady_clock::now();
+  auto begin = Clock::now();
   constexpr int kProbe = 4;
   for (int i = 0; i < kProbe; ++i) (void)forward_dynamics(m, ws, z, z, z);
-  const double eval =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count() / kProbe;
-  const double n = m.n();
-  return 4 * n * eval + 4e-9 * std::pow(2 * n, 3) + 1e-9 * std::pow(n, 3);
+  const double eval = since(begin) / kProbe;
+  const double n = m.n(), N0 = std::min(2 * n, 200.0);
+  std::mt19937 rng(7);
+  MatX probe = random_uniform(static_cast<int>(N0 * N0), 1.0, rng).reshaped(N0, N0);
+  begin = Clock::now();
+  (void)Eigen::EigenSolver<MatX>(probe, true);
+  const double per_cube = since(begin) / (N0 * N0 * N0);  // s per N³, with vectors
+  return 4 * n * eval + per_cube * (1.4 * std::pow(2 * n, 3) + 0.2 * std::pow(n, 3));
 }
 
 struct Diagnosis {
@@ -207,12 +217,17 @@ int cmd_check(int argc, char** argv) {
   // Bounded work: estimated up front, refused beyond the budget.
   const double per_state = seconds_per_state(m);
   if (per_state * K > budget) {
+    const int fit = static_cast<int>(budget / per_state);
     std::cerr << "femdyn check: " << a.positional[0] << ": checking " << K << " states of " << n
               << " coordinates would take about " << format_duration(per_state * K) << " ("
               << format_duration(per_state)
-              << " a state: 4n evaluations and a dense eigenproblem of 2n = " << 2 * n
-              << "), beyond the budget of " << format_duration(budget) << ": use --states "
-              << std::max(1, static_cast<int>(budget / per_state)) << " or raise --budget\n";
+              << " a state: 4n evaluations and dense eigenproblems of 2n = " << 2 * n
+              << "), beyond the budget of " << format_duration(budget) << ": "
+              << (fit >= 1 ? "use --states " + std::to_string(fit) + " or raise --budget"
+                           : "even one state exceeds it; raise --budget to at least " +
+                                 format_number(std::ceil(per_state), "%.0f") +
+                                 " (seconds) with --states 1")
+              << "\n";
     return 1;
   }
 

@@ -33,6 +33,7 @@ struct Oscillator {
 std::vector<Oscillator> euler_oscillators(const Linearization& lin) {
   const Eigen::EigenSolver<MatX> eig(lin.A, true);
   const Eigen::VectorXcd& ev = eig.eigenvalues();
+  const Eigen::MatrixXcd V = eig.eigenvectors();  // (built anew by every call: once here)
   const Eigen::Index m = ev.size(), n = m / 2;
   std::vector<bool> used(m, false);
   std::vector<Oscillator> out;
@@ -54,7 +55,7 @@ std::vector<Oscillator> euler_oscillators(const Linearization& lin) {
       continue;
     }
     // Real: the unused real mode whose shape is most nearly the same.
-    const auto shape = [&](Eigen::Index c) { return eig.eigenvectors().col(c).head(n); };
+    const auto shape = [&](Eigen::Index c) { return V.col(c).head(n); };
     Eigen::Index j = -1;
     double best = 0.999;
     for (Eigen::Index c = 0; c < m; ++c) {
@@ -206,6 +207,7 @@ std::vector<Mode> modes(const Linearization& lin, bool dissipative_model) {
   if (!lin.status.ok || lin.A.size() == 0 || !lin.A.allFinite()) return {};
   const Eigen::EigenSolver<MatX> eig(lin.A, true);
   const Eigen::VectorXcd& ev = eig.eigenvalues();
+  const Eigen::MatrixXcd V = eig.eigenvectors();  // (built anew by every call: once here)
   const int n = static_cast<int>(lin.A.rows()) / 2;
   double largest = 0;
   for (Eigen::Index i = 0; i < ev.size(); ++i) largest = std::max(largest, std::abs(ev[i]));
@@ -232,8 +234,8 @@ std::vector<Mode> modes(const Linearization& lin, bool dissipative_model) {
     // The coordinate that moves most: the largest entry of the eigenvector's q part.
     double best = -1;
     for (int a = 0; a < n; ++a)
-      if (std::abs(eig.eigenvectors()(a, i)) > best) {
-        best = std::abs(eig.eigenvectors()(a, i));
+      if (std::abs(V(a, i)) > best) {
+        best = std::abs(V(a, i));
         md.coordinate = a;
       }
     out.push_back(md);
