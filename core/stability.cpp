@@ -55,13 +55,15 @@ std::vector<Oscillator> euler_oscillators(const Linearization& lin) {
       continue;
     }
     // Real: the unused real mode whose shape is most nearly the same.
-    const auto shape = [&](Eigen::Index c) { return V.col(c).head(n); };
+    // (copied: an `auto` Block of the temporary Block V.col(i) would dangle)
+    const Eigen::VectorXcd shape_i = V.col(i).head(n);
     Eigen::Index j = -1;
     double best = 0.999;
     for (Eigen::Index c = 0; c < m; ++c) {
       if (used[c] || std::abs(ev[c].imag()) > 1e-9 * std::abs(ev[c])) continue;
-      const double nc = shape(c).norm() * shape(i).norm();
-      const double cos = nc > 0 ? std::abs(shape(c).dot(shape(i))) / nc : 0;
+      const Eigen::VectorXcd shape_c = V.col(c).head(n);
+      const double nc = shape_c.norm() * shape_i.norm();
+      const double cos = nc > 0 ? std::abs(shape_c.dot(shape_i)) / nc : 0;
       if (cos > best) best = cos, j = c;
     }
     if (j >= 0) {
