@@ -52,7 +52,7 @@ RecordedRun run_recorded(Integrator& integ, double t_end, long every,
                          const std::function<void(const Integrator&, const Energy&)>& row,
                          const std::function<bool(double t)>& stop) {
   RecordedRun r;
-  r.initial = integ.motion().energy_at(integ.y().data());
+  r.initial = integ.divergence().initial();  // E(0), as reset() evaluated it
   const double S0 = integ.divergence().initial_scale();
   r.scale = S0;
   if (Status plan = integ.plan(times ? (times->empty() ? integ.t() : times->back()) : t_end);

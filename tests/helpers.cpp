@@ -28,6 +28,17 @@ std::vector<std::string> bundled_models() {
 
 Model load_text(const std::string& json_text) { return compile(parse_spec(json_text, "test")); }
 
+std::string arm_json(double k, double c, double g) {
+  std::ostringstream s;
+  s.precision(17);
+  s << R"({"name": "arm", "gravity": [0, 0, )" << -g << R"(], "bodies": [{"name": "arm",
+    "parent": "world", "joint": {"name": "theta", "type": "revolute", "axis": [0, 1, 0],
+    "spring": {"stiffness": )"
+    << k << R"(}, "damping": )" << c << R"(}, "elements": [{"type": "lumped_point",
+    "node": [1, 0, 0], "mass": 1.0}]}]})";
+  return s.str();
+}
+
 std::string random_tree_json(unsigned seed, int bodies, double branching, bool prismatic,
                              double gravity) {
   // The random_tree model plugin (models/random_tree.hpp), with a gravity off the axes.

@@ -17,6 +17,11 @@ std::string model_path(const std::string& name);  // FEMDYN_SOURCE_DIR/models/na
 std::vector<std::string> bundled_models();        // file names of models/*.json, sorted
 Model load_text(const std::string& json_text);
 
+// One revolute joint 'theta' about y carrying a 1 kg point 1 m out along x (1 kg·m² about the
+// joint; body 'arm'), with a joint spring k and damper c (ω = √k, ζ = c / 2ω), under gravity g
+// along −z (θ > 0 turns the arm down).
+std::string arm_json(double k, double c = 0, double g = 0);
+
 // A seeded random tree as JSON text: random axes, offsets and rpy, full physical inertia
 // tensors (rigid_body), revolute and prismatic joints; `branching` in [0, 1]: the chance a
 // body hangs from an earlier body instead of the last one.

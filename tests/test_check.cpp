@@ -20,17 +20,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// One joint, a spring k and a damper c on a 1 kg point 1 m out (1 kg·m²), gravity g along −z.
-std::string arm_json(double k, double c, double g) {
-  std::ostringstream s;
-  s << R"({"name": "arm", "gravity": [0, 0, )" << -g << R"(], "bodies": [{"name": "arm",
-    "parent": "world", "joint": {"name": "theta", "type": "revolute", "axis": [0, 1, 0],
-    "spring": {"stiffness": )"
-    << k << R"(}, "damping": )" << c << R"(}, "elements": [{"type": "lumped_point",
-    "node": [1, 0, 0], "mass": 1.0}]}]})";
-  return s.str();
-}
-
 nlohmann::json check_json(const std::string& path, const std::string& extra = "") {
   const Run r = run("check " + path + " --json " + extra);
   INFO(r.out);

@@ -20,17 +20,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// One joint with a spring k on a 1 kg·m² point arm (ω = √k), damper c, gravity g along −z.
-std::string spring_json(double k, double c = 0, double g = 0) {
-  std::ostringstream s;
-  s << R"({"name": "spring", "gravity": [0, 0, )" << -g << R"(], "bodies": [{"name": "arm",
-    "parent": "world", "joint": {"name": "theta", "type": "revolute", "axis": [0, 1, 0],
-    "spring": {"stiffness": )"
-    << k << R"(}, "damping": )" << c << R"(}, "elements": [{"type": "lumped_point",
-    "node": [1, 0, 0], "mass": 1.0}]}]})";
-  return s.str();
-}
-
 // An arm on a rail: a prismatic carriage, two 0.4 m links and a light tip link (its fast mode
 // sets the step limit) under gravity.
 constexpr const char* kRailArm = R"({"name": "rail arm", "gravity": [0, 0, -9.81], "bodies": [
@@ -59,7 +48,7 @@ nlohmann::json json_of(const std::string& out) {
 TEST_CASE("divergence: the issue's spring at dt = 1.5 s fails as diverging, with its limit",
           "[divergence]") {
   Scratch s("div_spring");
-  std::ofstream(s / "spring10.json") << spring_json(100);
+  std::ofstream(s / "spring10.json") << arm_json(100);
   const Run r = run("simulate " + (s / "spring10.json") +
                     " --t-end 20 --integrator rk4 --dt 1.5 --q0 0.1 --json");
   INFO(r.out);
@@ -124,9 +113,9 @@ TEST_CASE("divergence: falling, driven, damped and inaccurate runs are not calle
      "mass": 1.0}]}]})");
   // A pendulum released horizontally about the origin (E(0) = 0 again), with coarse euler
   // steps: inaccurate (its energy drifts) but not diverging.
-  const Model pendulum = load_text(spring_json(0, 0, 9.81));
+  const Model pendulum = load_text(arm_json(0, 0, 9.81));
   // A damped arm driven by a large constant torque (W grows, dampers take energy out).
-  const Model driven = load_text(spring_json(100, 5));
+  const Model driven = load_text(arm_json(100, 5));
   struct Case {
     const Model* m;
     IntegratorOptions o;
@@ -155,7 +144,7 @@ TEST_CASE("divergence: falling, driven, damped and inaccurate runs are not calle
 }
 
 TEST_CASE("fixed steps lie on the grid t0 + k dt and the last row lands on t_end", "[divergence]") {
-  const Model m = load_text(spring_json(100));
+  const Model m = load_text(arm_json(100));
   for (IntegratorKind kind : {IntegratorKind::Rk4, IntegratorKind::Euler}) {
     auto integ = make_integrator(m, {.kind = kind, .fixed = {.dt = 1e-3}});
     integ->reset(0, VecX::Constant(1, 0.1), VecX::Zero(1), 2.0);
@@ -207,7 +196,7 @@ TEST_CASE("runs that cannot finish are refused before they start", "[divergence]
 TEST_CASE("simulate --sample-dt: rows at uniform times from dense output, the last at t_end",
           "[divergence]") {
   Scratch s("div_sample");
-  std::ofstream(s / "spring.json") << spring_json(100);
+  std::ofstream(s / "spring.json") << arm_json(100);
   const Run r =
       run("simulate " + (s / "spring.json") +
           " --t-end 1 --sample-dt 0.3 --q0 0.1 --rtol 1e-10 --atol 1e-12 --out " + (s / "t.csv"));
@@ -232,7 +221,7 @@ TEST_CASE("simulate --sample-dt: rows at uniform times from dense output, the la
 TEST_CASE("joint limits left are reported once per joint with the time and the value",
           "[divergence]") {
   Scratch s("div_limits");
-  nlohmann::json m = nlohmann::json::parse(spring_json(0, 0, 9.81));
+  nlohmann::json m = nlohmann::json::parse(arm_json(0, 0, 9.81));
   m["bodies"][0]["joint"]["limits"] = {-0.5, 0.5};
   std::ofstream(s / "limited.json") << m.dump();
   // Falling from horizontal (θ = 0) about y under gravity along −z: θ̈ = g cos θ > 0.

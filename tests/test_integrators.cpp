@@ -43,14 +43,6 @@ IntegratorOptions adaptive(IntegratorKind kind, double rtol, double atol) {
 }
 
 // A 1 kg point mass on a 1 m arm about y with a joint spring k: ω = √k rad/s, no gravity.
-std::string spring_json(double k, double damping = 0) {
-  return R"({"name": "stiff spring", "gravity": [0, 0, 0], "bodies": [{"name": "arm",
-    "parent": "world", "joint": {"name": "theta", "type": "revolute", "axis": [0, 1, 0],
-    "spring": {"stiffness": )" +
-         std::to_string(k) + R"(}, "damping": )" + std::to_string(damping) + R"(},
-    "elements": [{"type": "lumped_point", "node": [1, 0, 0], "mass": 1.0}]}]})";
-}
-
 struct Case {
   Model m;
   VecX q0, qd0;
@@ -242,7 +234,7 @@ TEST_CASE("energy: conservative finger, symplectic Euler over 1e5 steps, damped 
 
 TEST_CASE("a 1e4 rad/s joint spring: RK4 at 1e-3 s fails cleanly, BDF follows the closed form",
           "[integrators]") {
-  const Model m = load_text(spring_json(1e8));  // ω = 1e4 rad/s
+  const Model m = load_text(arm_json(1e8));  // ω = 1e4 rad/s
   const VecX q0 = VecX::Constant(1, 0.1), qd0 = VecX::Zero(1);
   auto rk4 = make_integrator(m, fixed(IntegratorKind::Rk4, 1e-3));
   rk4->reset(0, q0, qd0);
@@ -269,7 +261,7 @@ TEST_CASE("a 1e4 rad/s joint spring: RK4 at 1e-3 s fails cleanly, BDF follows th
   CHECK(err < 1e-5);
 
   // Stiff and damped (ζ = 5): BDF takes steps far beyond RK4's stability limit 2.8/ω.
-  const Model damped = load_text(spring_json(1e8, 1e5));
+  const Model damped = load_text(arm_json(1e8, 1e5));
   auto stiff = make_integrator(damped, adaptive(IntegratorKind::Bdf, 1e-6, 1e-9));
   stiff->reset(0, q0, qd0);
   REQUIRE(stiff->advance_to(1.0).ok);

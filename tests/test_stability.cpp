@@ -15,16 +15,6 @@ using namespace femdyn::test;
 
 namespace {
 
-// A 1 kg point on a 1 m arm about y: undamped spring of ω = √k, or a pendulum under gravity.
-Model arm(double k, double damping, double gravity) {
-  return load_text(R"({"name": "arm", "gravity": [0, 0, )" + std::to_string(-gravity) +
-                   R"(], "bodies": [{"name": "arm", "parent": "world", "joint": {"name": "theta",
-    "type": "revolute", "axis": [0, 1, 0], "spring": {"stiffness": )" +
-                   std::to_string(k) + R"(}, "damping": )" + std::to_string(damping) +
-                   R"(}, "elements": [
-    {"type": "lumped_point", "node": [1, 0, 0], "mass": 1.0}]}]})");
-}
-
 std::string number(double x) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.17g", x);
@@ -35,7 +25,7 @@ std::string number(double x) {
 
 TEST_CASE("linearisation and stable steps match the closed forms of an oscillator", "[stability]") {
   const double w = 1e3;
-  const Model m = arm(w * w, 0, 0);
+  const Model m = load_text(arm_json(w * w, 0, 0));
   Workspace ws(m);
   const Linearization lin = linearize(m, ws, VecX::Constant(1, 0.1), VecX::Zero(1), VecX::Zero(1));
   REQUIRE(lin.status.ok);
@@ -48,14 +38,14 @@ TEST_CASE("linearisation and stable steps match the closed forms of an oscillato
   CHECK(*largest_stable_step(lin, IntegratorKind::Euler) * w == Approx(2).epsilon(1e-4));
   CHECK(std::isinf(*largest_stable_step(lin, IntegratorKind::Bdf)));
   // Overdamped (ζ = 100): the fast real mode λ ≈ −2ζω limits RK4 to h |λ| ≤ 2.785.
-  const Model damped = arm(w * w, 2 * 100 * w, 0);
+  const Model damped = load_text(arm_json(w * w, 2 * 100 * w, 0));
   Workspace wd(damped);
   const Linearization fast =
       linearize(damped, wd, VecX::Constant(1, 0.1), VecX::Zero(1), VecX::Zero(1));
   CHECK(*largest_stable_step(fast, IntegratorKind::Rk4) * std::abs(fast.stiffest) ==
         Approx(2.785).epsilon(1e-3));
   // The arm under gravity, horizontal at θ = 0 (θ̈ = g cos θ): A = [[0, 1], [−g sin θ, 0]].
-  const Model pendulum = arm(0, 0, 9.81);
+  const Model pendulum = load_text(arm_json(0, 0, 9.81));
   Workspace wp(pendulum);
   const Linearization p =
       linearize(pendulum, wp, VecX::Constant(1, 0.4), VecX::Zero(1), VecX::Zero(1));
