@@ -6,12 +6,18 @@
 
 namespace femdyn::cli {
 
-Progress::Progress(double total, std::string unit)
+Progress::Progress(double total, std::string unit, std::string label)
     : total_(total),
       unit_(std::move(unit)),
+      label_(std::move(label)),
       tty_(::isatty(STDERR_FILENO) == 1),
       start_(Clock::now()),
       last_(start_) {}
+
+void Progress::update(double done, double total) {
+  total_ = total;
+  update(done);
+}
 
 void Progress::update(double done) {
   if (!tty_) return;
@@ -25,8 +31,8 @@ void Progress::update(double done) {
   bar.resize(width, ' ');
   const double rate = done / elapsed;  // simulated units per wall second
   const double eta = rate > 0 ? (total_ - done) / rate : 0;
-  std::fprintf(stderr, "\r[%s] %5.1f%%  t = %.4g/%.4g %s  %.3g %s/s  ETA %.0f s ", bar.c_str(),
-               100 * f, done, total_, unit_.c_str(), rate, unit_.c_str(), eta);
+  std::fprintf(stderr, "\r[%s] %5.1f%%  %s %.4g/%.4g %s  %.3g %s/s  ETA %.0f s ", bar.c_str(),
+               100 * f, label_.c_str(), done, total_, unit_.c_str(), rate, unit_.c_str(), eta);
   std::fflush(stderr);
   drawn_ = true;
 }

@@ -8,15 +8,17 @@ namespace femdyn::cli {
 
 class Progress {
  public:
-  Progress(double total, std::string unit);  // e.g. t_end, "s"
+  // e.g. (t_end, "s"): "t = 0.1/0.5 s"; with a label, "<label> 0.1/0.5 s" instead.
+  Progress(double total, std::string unit, std::string label = "t =");
   ~Progress() { finish(); }
   void update(double done);
-  void finish();  // clears the bar
+  void update(double done, double total);  // the total revised (an estimate)
+  void finish();                           // clears the bar
 
  private:
   using Clock = std::chrono::steady_clock;
   double total_;
-  std::string unit_;
+  std::string unit_, label_;
   bool tty_;
   bool drawn_ = false;
   Clock::time_point start_, last_;

@@ -2,12 +2,15 @@
 #include "validation/validate.hpp"
 
 #include <climits>
+#include <cmath>
 #include <deque>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <sstream>
 
 #include "cli/commands.hpp"
+#include "cli/progress.hpp"
 #include "io/output.hpp"
 #include "io/urdf_loader.hpp"
 
@@ -16,7 +19,8 @@ namespace {
 
 constexpr const char* kHelp =
     R"(usage: femdyn validate MODEL… [--states K] [--seed S] [--t-end T] [--tol X]
-                        [--qd-scale V] [--json | --markdown] [--gravity gx,gy,gz]
+                        [--qd-scale V] [--budget SECONDS] [--max-memory GB]
+                        [--json | --markdown] [--gravity gx,gy,gz]
 
 Builds each model's Simbody twin (same tree, each body's mass properties from its equivalent
 elements, same forces) and compares, at K seeded random states (default 20; q within joint
@@ -32,6 +36,14 @@ to the longest rod). Then integrates the passive motion (τ = 0) from the first
 state for T seconds (default 0.25; 0 skips): femdyn by RK4 (step 1 ms, halved until its own
 error estimate is below 1e-9), Simbody by RungeKuttaMerson at accuracy 1e-10 and 1e-12, and
 compares the joint states (θ, θ̇) over time against 10x the sum of both error estimates.
+Beyond 1000 coordinates M^s is compared by its products with 4 seeded random vectors (M^s V,
+Simbody's O(n) multiplyByM) rather than entry by entry.
+Bounded work: before any state is compared, each model's time and memory are estimated (a model
+of the costs, from n and a timed probe of each engine); beyond --budget seconds (default 120)
+or --max-memory GB (default: half the available memory, MemAvailable in /proc/meminfo) the
+command refuses with one line on stderr (the estimate and how to proceed) and exits 1. During
+the trajectory, femdyn's step halving and Simbody's runs stop where the budget ends. On a
+terminal a progress line shows the work done against the estimate.
 Exit 1 if any check fails. --json: one object per model (an array for several models);
 --markdown: one table row per model (docs/validation.md). The JSON has the whole series: the
 trajectory's sample times "t", "state_error" and the energy of both runs.
@@ -61,6 +73,19 @@ Json report_json(const std::string& path, const Model& m, const validation::Vali
       {"state_error", t.error},
       {"energy", {{"femdyn", t.energy_femdyn}, {"simbody", t.energy_simbody}}}};
   if (!t.run) traj["skipped"] = t.skipped;
+  if (!t.stopped.empty()) traj["stopped"] = t.stopped;
+  if (!t.refinement.empty()) traj["refinement"] = t.refinement;
+  const auto& e = r.estimate;
+  const Json work = {
+      {"estimated_s", e.seconds()},
+      {"estimated_pointwise_s", e.pointwise},
+      {"estimated_trajectory_s", e.trajectory},
+      {"setup_s", e.setup},
+      {"wall_time_s", r.wall_time},
+      {"estimated_memory_bytes", e.bytes},
+      {"budget_s", e.budget},
+      {"memory_limit_bytes", std::isfinite(e.memory_limit) ? Json(e.memory_limit) : Json(nullptr)},
+      {"mass_comparison", r.dense_mass ? "entries" : "products"}};
   return {{"model", path},
           {"states", r.states},
           {"n", r.n},
@@ -70,6 +95,7 @@ Json report_json(const std::string& path, const Model& m, const validation::Vali
           {"max_abs_error", abs},
           {"trajectory", traj},
           {"notes", r.notes},
+          {"work", work},
           {"failure", r.failure},
           {"pass", r.pass()}};
 }
@@ -98,8 +124,12 @@ void print_text(const std::string& path, const validation::ValidationReport& r) 
               << sci(t.simbody_error_estimate) << "; energy change femdyn "
               << sci(t.energy_change_femdyn) << " J, Simbody " << sci(t.energy_change_simbody)
               << " J)\n";
+  else if (!t.stopped.empty())
+    std::cout << "trajectory   FAIL: not compared within the budget: " << t.stopped
+              << " (shorten --t-end, or raise --budget)\n";
   else
     std::cout << "trajectory not compared: " << t.skipped << "\n";
+  if (t.run && !t.refinement.empty()) std::cout << "femdyn's RK4 step " << t.refinement << "\n";
   if (t.run && !t.error.empty()) {  // the state error over time, at five of the samples
     std::cout << "  state error over time:";
     for (std::size_t k = 0; k < 5; ++k) {
@@ -109,9 +139,10 @@ void print_text(const std::string& path, const validation::ValidationReport& r) 
     std::cout << "\n";
   }
   if (t.run && !t.resolved)
-    std::cout
-        << "trajectory unresolved: the integrators' own error estimates exceed 1e-6 of the "
-           "state; the motion is too fast or chaotic over this time (try a shorter --t-end)\n";
+    std::cout << "trajectory unresolved: the integrators' own error estimates exceed 1e-6 of the "
+                 "state; the motion is too fast or chaotic over this time (try a shorter --t-end"
+              << (t.refinement.find("budget") != std::string::npos ? ", or raise --budget" : "")
+              << ")\n";
   for (const auto& n : r.notes) std::cout << "note: " << n << "\n";
   std::cout << (r.pass() ? "PASS" : "FAIL") << "\n";
 }
@@ -130,7 +161,10 @@ void print_markdown_row(const std::string& path, const validation::ValidationRep
     if (q.name == "loop") std::cout << " | " << sci(q.max_rel), loop = true;
   if (!loop) std::cout << " | —";
   const auto& t = r.trajectory;
-  std::cout << " | " << (t.run ? sci(t.max_state_error) + " (tol " + sci(t.tolerance) + ")" : "—")
+  std::cout << " | "
+            << (t.run               ? sci(t.max_state_error) + " (tol " + sci(t.tolerance) + ")"
+                : t.stopped.empty() ? "—"
+                                    : "not within the budget")
             << " | " << (r.pass() ? "PASS" : "FAIL") << " |\n";
 }
 
@@ -147,8 +181,9 @@ double nonnegative(const Args& a, const std::string& opt, double fallback) {
 }  // namespace
 
 int cmd_validate(int argc, char** argv) {
-  const Args a = parse_args(argc, argv, 2, {"help", "json", "markdown"},
-                            {"states", "seed", "t-end", "tol", "qd-scale", "gravity"});
+  const Args a =
+      parse_args(argc, argv, 2, {"help", "json", "markdown"},
+                 {"states", "seed", "t-end", "tol", "qd-scale", "gravity", "budget", "max-memory"});
   if (a.has("help")) {
     std::cout << kHelp;
     return 0;
@@ -165,10 +200,30 @@ int cmd_validate(int argc, char** argv) {
   if (o.t_end > validation::kMaxTrajectoryTime)
     throw CliError("--t-end expects at most " + format_number(validation::kMaxTrajectoryTime) +
                    " s");
+  o.budget = number_option(a, "budget", o.budget);
+  if (!(o.budget > 0 && o.budget < 1e9))
+    throw CliError("--budget expects a positive number of seconds (below 1e9)");
+  if (a.has("max-memory")) {
+    const double gb = number_option(a, "max-memory", 0);
+    if (!(gb > 0 && gb < 1e9)) throw CliError("--max-memory expects a positive number of GB");
+    o.memory_limit = gb * 1e9;
+  }
 
   // Load every model first: a bad file fails before any work.
   std::deque<Model> models;  // (Model is move-only and its move may throw: no vector)
   for (const std::string& path : a.positional) models.push_back(load_model(path, load_options(a)));
+
+  // Then every model's twin and estimate: work beyond the budget is refused before any state.
+  std::vector<std::unique_ptr<validation::Validator>> validators;
+  bool refused = false;
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    validators.push_back(std::make_unique<validation::Validator>(models[i], o));
+    if (const std::string why = validators.back()->refusal(a.positional[i]); !why.empty()) {
+      std::cerr << "femdyn validate: " << why << "\n";
+      refused = true;
+    }
+  }
+  if (refused) return 1;
 
   bool all_pass = true;
   Json reports = Json::array();
@@ -176,7 +231,14 @@ int cmd_validate(int argc, char** argv) {
     std::cout << "| model | n | M^s | h | Q | q̈ | τ | loop | trajectory state error | result |\n"
               << "|---|---|---|---|---|---|---|---|---|---|\n";
   for (std::size_t i = 0; i < models.size(); ++i) {
-    validation::ValidationReport r = validation::validate(models[i], o);
+    validation::ValidationReport r;
+    {
+      // The estimated seconds of work done against those planned (revised as it goes).
+      Progress progress(validators[i]->estimate().seconds(), "s", "work");
+      validators[i]->set_progress([&](double done, double total) { progress.update(done, total); });
+      r = validators[i]->run();
+      validators[i].reset();  // its workspace and twin
+    }
     if (is_urdf_path(a.positional[i]) && r.failure.empty()) {
       // The import itself, against a Simbody model read straight from the XML.
       std::string failure;

@@ -248,9 +248,22 @@ void joint_state(const Model& model, Workspace& ws, const VecX& q, const VecX& q
 
 Energy energy(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
   if (model.coupling_level) return chain::energy(model, ws, q, qd);
-  evaluate(model, ws, q, qd, VecX());
   Energy E;
-  E.kinetic = 0.5 * qd.dot(ws.Ms.lazyProduct(qd));  // (no temporary: energy is looked at mid-run)
+  if (model.mass_route == MassRoute::Composite) {
+    // Body by body, ½ Σ_b V_bᵀ Λ_b V_b with V_b = J_b q̇ the body's twist in its own axes: the
+    // same ½ q̇ᵀ M^s q̇ (M^s = Σ_b J_bᵀ Λ_b J_b, core/body_inertia.hpp) in O(bodies), without
+    // forming the n x n M^s.
+    propagate(model, ws, q, qd, {.jacobian = false, .bias = true, .rows = false});
+    for (std::size_t b = 0; b < model.bodies.size(); ++b) {
+      const BodyState& B = ws.body[b];
+      Vec6 V;
+      V << B.R.transpose() * B.w, B.R.transpose() * B.v;
+      E.kinetic += 0.5 * V.dot(model.body_inertia[b] * V);
+    }
+  } else {
+    evaluate(model, ws, q, qd, VecX());
+    E.kinetic = 0.5 * qd.dot(ws.Ms.lazyProduct(qd));  // (no temporary: looked at mid-run)
+  }
   // Potential of constant nodal forces: −F_i x_i over translation DOFs (positions in world).
   for (int i = 0; i < model.n_u(); ++i) {
     const SystemDof& d = model.dofs[i];

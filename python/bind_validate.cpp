@@ -1,6 +1,9 @@
 // femdyn.validate: the model against its Simbody twin (validation/validate.hpp), as numbers.
 #include <pybind11/stl.h>
 
+#include <cmath>
+#include <optional>
+
 #include "python/py_model.hpp"
 #ifdef FEMDYN_WITH_SIMBODY
 #include "validation/validate.hpp"
@@ -12,7 +15,7 @@ namespace femdyn::python {
 namespace {
 
 py::dict validate(const PyModel& self, int states, unsigned seed, double tolerance, double t_end,
-                  int samples) {
+                  int samples, double budget, std::optional<double> max_memory) {
   if (states < 1) throw py::value_error("states: expected an integer >= 1");
   // The CLI's limit on --t-end (validation::kMaxTrajectoryTime), shared, not copied.
   if (!(t_end >= 0 && t_end <= validation::kMaxTrajectoryTime))
@@ -21,17 +24,28 @@ py::dict validate(const PyModel& self, int states, unsigned seed, double toleran
                           "] s (0: no trajectory; the limit of femdyn validate --t-end)");
   if (samples < 1) throw py::value_error("samples: expected an integer >= 1");
   if (!(tolerance > 0)) throw py::value_error("tolerance: expected a number > 0");
+  if (!(budget > 0 && budget < 1e9))
+    throw py::value_error("budget: expected a positive number of seconds (below 1e9)");
+  if (max_memory && !(*max_memory > 0 && *max_memory < 1e9))
+    throw py::value_error("max_memory: expected a positive number of GB");
   validation::ValidationOptions o;
   o.states = states;
   o.seed = seed;
   o.tolerance = tolerance;
   o.t_end = t_end;
   o.samples = samples;
+  o.budget = budget;
+  if (max_memory) o.memory_limit = *max_memory * 1e9;
+  // Estimated before any state, and refused beyond the budget with the CLI's message.
   validation::ValidationReport r;
+  std::string refusal;
   {
     py::gil_scoped_release release;
-    r = validation::validate(*self.model, o);
+    validation::Validator v(*self.model, o);
+    refusal = v.refusal(self.model->where.empty() ? self.model->name : self.model->where);
+    if (refusal.empty()) r = v.run();
   }
+  if (!refusal.empty()) throw py::value_error(refusal);
   py::dict quantities;
   for (const validation::QuantityError& q : r.quantities) {
     py::dict d;
@@ -59,6 +73,20 @@ py::dict validate(const PyModel& self, int states, unsigned seed, double toleran
   traj["energy_femdyn"] = t.energy_femdyn;
   traj["energy_simbody"] = t.energy_simbody;
   traj["pass"] = t.pass();
+  if (!t.stopped.empty()) traj["stopped"] = t.stopped;
+  if (!t.refinement.empty()) traj["refinement"] = t.refinement;
+  const validation::WorkEstimate& e = r.estimate;
+  py::dict work;  // as `femdyn validate --json`'s "work"
+  work["estimated_s"] = e.seconds();
+  work["estimated_pointwise_s"] = e.pointwise;
+  work["estimated_trajectory_s"] = e.trajectory;
+  work["setup_s"] = e.setup;
+  work["wall_time_s"] = r.wall_time;
+  work["estimated_memory_bytes"] = e.bytes;
+  work["budget_s"] = e.budget;
+  work["memory_limit_bytes"] =
+      std::isfinite(e.memory_limit) ? py::object(py::float_(e.memory_limit)) : py::none();
+  work["mass_comparison"] = r.dense_mass ? "entries" : "products";
   py::dict d;
   d["model"] = r.model;
   d["n"] = r.n;
@@ -67,6 +95,7 @@ py::dict validate(const PyModel& self, int states, unsigned seed, double toleran
   d["quantities"] = quantities;
   d["trajectory"] = traj;
   d["notes"] = r.notes;
+  d["work"] = work;
   d["failure"] = r.failure;
   d["pass"] = r.pass();
   return d;
@@ -79,10 +108,13 @@ void bind_validate(py::module_& m) {
 #ifdef FEMDYN_WITH_SIMBODY
   m.def("validate", &validate, py::arg("model"), py::arg("states") = 20, py::arg("seed") = 1,
         py::arg("tolerance") = 1e-10, py::arg("t_end") = 0.25, py::arg("samples") = 50,
+        py::arg("budget") = validation::kDefaultBudget, py::arg("max_memory") = py::none(),
         "The model against its Simbody twin (docs/validation.md): M, h, Q, qdd, tau at `states` "
         "seeded random states and a passive trajectory of t_end s (what `femdyn validate` does, "
-        "less its URDF import check). Returns a dict: quantities {name: {max_abs, max_rel, "
-        "tolerance, pass}}, trajectory {...}, notes, failure, pass. The GIL is released.");
+        "less its URDF import check). Estimated first: beyond `budget` seconds or `max_memory` "
+        "GB (default: half the available memory) a ValueError with `femdyn validate`'s message. "
+        "Returns a dict: quantities {name: {max_abs, max_rel, tolerance, pass}}, trajectory "
+        "{...}, notes, work, failure, pass. The GIL is released.");
   // The Simbody integrators that can run in this process: CPodes is among them only if no other
   // SUNDIALS shadows Simbody's bundled copy (validation/twin.hpp); the tests check it is.
   m.def("_simbody_integrators", [] {

@@ -1,7 +1,9 @@
 // The femdyn command end to end: JSON output equals the library, bad input exits non-zero
 // with one line naming file and path.
+#include <algorithm>
 #include <array>
 #include <catch2/catch.hpp>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -189,6 +191,36 @@ TEST_CASE("validate: table and exit 0 on a good model, JSON, exit 1 when it cann
   const Run wrong_tol = run("validate " + model_path("pendulum.json") + " --states 0");
   CHECK(wrong_tol.code == 2);
   CHECK_THAT(wrong_tol.out, Catch::Contains("--states expects one integer >= 1"));
+}
+
+TEST_CASE("validate: a 10000-body chain is refused up front in seconds, with the way on",
+          "[cli][validation]") {
+  // The issue's case: the random_tree plugin, 10,000 bodies in one chain. Its 20 states take
+  // about 13 s here and its trajectory many minutes: beyond --budget 30 on any machine up to
+  // several times faster. The time is a generous guard, not a speed claim (about 3 s measured).
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "femdyn_cli_chain10000.json").string();
+  std::ofstream(path) << R"({"model": "random_tree", "params": {"seed": 3, "bodies": 10000, )"
+                      << R"("branching": 0}})";
+  const auto t0 = std::chrono::steady_clock::now();
+  const Run r = run("validate " + path + " --budget 30");
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  INFO(r.out << "(" << seconds << " s)");
+  CHECK(r.code == 1);
+  CHECK_THAT(r.out, Catch::StartsWith("femdyn validate: " + path +
+                                      ": validating n = 10000 coordinates would take "));
+  CHECK_THAT(r.out, Catch::Contains(" of memory, beyond the budget of 30 s: use --t-end 0 "));
+  CHECK_THAT(r.out, Catch::Contains("--budget "));
+  CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);  // one line, nothing else
+  CHECK(seconds < 60);
+  // The memory limit, and the options' own checks.
+  const Run memory = run("validate " + model_path("finger.json") + " --max-memory 1e-6");
+  CHECK(memory.code == 1);
+  CHECK_THAT(memory.out, Catch::Contains("beyond the memory limit of 1 kB: use --max-memory "));
+  CHECK(run("validate " + model_path("finger.json") + " --budget 0").code == 2);
+  CHECK(run("validate " + model_path("finger.json") + " --max-memory -1").code == 2);
+  std::filesystem::remove(path);
 }
 
 TEST_CASE("bench: every quantity timed on both engines, D skipped as documented, bad input",

@@ -261,7 +261,7 @@ TEST_CASE("Simbody's refusals reach the user as one line naming the body", "[har
   b.inertia_origin(0, 1) = b.inertia_origin(1, 0) = std::nan("");  // Simbody asserts no NaN
   t.bodies.push_back(b);
   t.theta_body = {0};
-  t.C = MatX::Identity(1, 1);
+  t.C = MatX::Identity(1, 1).sparseView();
   t.theta0 = VecX::Zero(1);
   try {
     validation::SimbodyTwin twin(t);

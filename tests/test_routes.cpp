@@ -245,3 +245,28 @@ TEST_CASE("chains and trees of 10000 bodies compile and run on the O(n) routes",
     CHECK((ws.tau - tau).cwiseAbs().maxCoeff() < 1e-11 * scale);
   }
 }
+
+TEST_CASE("energy on the composite route is ½ q̇ᵀ M^s q̇ body by body, M^s never formed",
+          "[routes]") {
+  for (const bool couplings : {false, true})
+    for (const unsigned seed : {3u, 4u}) {
+      const Model m = load_text(mixed_tree_json(seed, 25, 0.5, couplings));
+      REQUIRE(m.mass_route == MassRoute::Composite);
+      std::mt19937 rng(seed);
+      const VecX q = random_posture(m, rng), qd = random_uniform(m.n(), 2, rng);
+      Workspace ws(m), reference(m);
+      const Energy E = energy(m, ws, q, qd);
+      CHECK(ws.Ms.size() == 0);  // O(bodies): no n x n matrix
+      evaluate(m, reference, q, qd, VecX());
+      const double kinetic = 0.5 * qd.dot(reference.Ms * qd);
+      INFO("seed " << seed << " couplings " << couplings);
+      CHECK(E.kinetic == Approx(kinetic).epsilon(1e-12));
+      // The potential is as before: the same body poses.
+      Model transform = load_text(mixed_tree_json(seed, 25, 0.5, couplings));
+      transform.mass_route = MassRoute::Transform;
+      Workspace wt(transform);
+      const Energy Et = energy(transform, wt, q, qd);
+      CHECK(E.potential == Approx(Et.potential).epsilon(1e-12));
+      CHECK(E.kinetic == Approx(Et.kinetic).epsilon(1e-12));
+    }
+}

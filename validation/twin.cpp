@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 
@@ -105,14 +106,25 @@ SimTK::MassProperties mass_properties(const TwinBody& p) {
 
 }  // namespace
 
-int independent_theta(const TwinModel& model, int k) {
-  for (int j = 0; j < model.n_theta(); ++j) {
-    bool unit = model.theta0[j] == 0;
-    for (int c = 0; c < model.n() && unit; ++c) unit = model.C(j, c) == (c == k ? 1.0 : 0.0);
-    if (unit) return j;
-  }
-  return -1;
+std::vector<int> independent_thetas(const TwinModel& model) {
+  // Row j of C is e_k: its only stored non-zero is a 1 in column k (explicit zeros ignored).
+  const int nt = model.n_theta(), n = model.n();
+  std::vector<int> nonzeros(nt, 0), column(nt, -1);
+  std::vector<double> value(nt, 0);
+  for (int k = 0; k < model.C.outerSize(); ++k)
+    for (SpMatX::InnerIterator it(model.C, k); it; ++it) {
+      if (it.value() == 0) continue;
+      const auto j = static_cast<std::size_t>(it.row());
+      ++nonzeros[j], column[j] = k, value[j] = it.value();
+    }
+  std::vector<int> out(n, -1);
+  for (int j = 0; j < nt; ++j)  // the first such θ_j, as the scan by rows found it
+    if (model.theta0[j] == 0 && nonzeros[j] == 1 && value[j] == 1.0 && out[column[j]] < 0)
+      out[column[j]] = j;
+  return out;
 }
+
+int independent_theta(const TwinModel& model, int k) { return independent_thetas(model).at(k); }
 
 constexpr bool kTiming = false;  // set_state's fit_rods in the timing entry points
 
@@ -127,12 +139,13 @@ struct SimbodyTwin::Impl {
   std::vector<int> theta_q, theta_u;        // θ index -> Simbody q / u index
   std::vector<int> independent;             // q index -> θ index, -1 if none
   bool couplers = true;
+  Eigen::SparseMatrix<double, Eigen::RowMajor> C_rows;  // C by rows: θ_j = Σ C_jk q_k + θ0_j
   SimTK::State state;
   SimTK::Matrix M_theta;
   SimTK::Vector zero_mobility, residual, mobility, udot;
   SimTK::Vector_<SimTK::SpatialVec> zero_body, A_GB;
 
-  explicit Impl(TwinModel tm) : model(std::move(tm)) {
+  explicit Impl(TwinModel tm) : model(std::move(tm)), C_rows(model.C) {
     using namespace SimTK;
     const TwinModel& m = model;
     const int nb = static_cast<int>(m.bodies.size());
@@ -215,25 +228,26 @@ struct SimbodyTwin::Impl {
   void add_linear_couplers() {
     using namespace SimTK;
     const TwinModel& m = model;
-    independent.resize(m.n());
+    independent = independent_thetas(m);
+    std::vector<bool> is_independent(m.n_theta(), false);
     for (int k = 0; k < m.n(); ++k) {
-      independent[k] = independent_theta(m, k);
-      if (independent[k] < 0) couplers = false;
+      if (independent[k] < 0)
+        couplers = false;
+      else
+        is_independent[independent[k]] = true;
     }
     if (couplers) {
       for (int j = 0; j < m.n_theta(); ++j) {
-        bool is_independent = false;
-        for (int k = 0; k < m.n(); ++k) is_independent |= independent[k] == j;
-        if (is_independent) continue;
+        if (is_independent[j]) continue;
         // f(θ_j, θ_ind(k)...) = θ_j − Σ_k C_jk θ_ind(k) − θ0_j = 0
         std::vector<MobilizedBodyIndex> bodies{mobod[m.theta_body[j]].getMobilizedBodyIndex()};
         std::vector<MobilizerQIndex> which{MobilizerQIndex(0)};
         std::vector<double> coeff{1.0};
-        for (int k = 0; k < m.n(); ++k) {
-          if (m.C(j, k) == 0) continue;
-          bodies.push_back(mobod[m.theta_body[independent[k]]].getMobilizedBodyIndex());
+        for (decltype(C_rows)::InnerIterator it(C_rows, j); it; ++it) {
+          if (it.value() == 0) continue;
+          bodies.push_back(mobod[m.theta_body[independent[it.col()]]].getMobilizedBodyIndex());
           which.push_back(MobilizerQIndex(0));
-          coeff.push_back(-m.C(j, k));
+          coeff.push_back(-it.value());
         }
         coeff.push_back(-m.theta0[j]);
         Vector a(static_cast<int>(coeff.size()));
@@ -283,8 +297,10 @@ struct SimbodyTwin::Impl {
   // only, so the realized Position stage stays.
   void set_unit_rates(int b, int c) {
     SimTK::Vector& su = state.updU();
-    for (int j = 0; j < model.n_theta(); ++j)
-      su[theta_u[j]] = model.C(j, b) + (c >= 0 ? model.C(j, c) : 0.0);
+    for (int j = 0; j < model.n_theta(); ++j) su[theta_u[j]] = 0;
+    for (const int col : {b, c})
+      if (col >= 0)
+        for (SpMatX::InnerIterator it(model.C, col); it; ++it) su[theta_u[it.row()]] += it.value();
   }
 
   // Sets θ = C q + θ0, θ̇ = C q̇ (without temporaries: the timing entry points use it too) and
@@ -306,9 +322,9 @@ struct SimbodyTwin::Impl {
     }
     for (int j = 0; j < model.n_theta(); ++j) {
       double theta = model.theta0[j], theta_dot = 0;
-      for (int k = 0; k < model.n(); ++k) {
-        theta += model.C(j, k) * q[k];
-        theta_dot += model.C(j, k) * qd[k];
+      for (decltype(C_rows)::InnerIterator it(C_rows, j); it; ++it) {
+        theta += it.value() * q[it.col()];
+        theta_dot += it.value() * qd[it.col()];
       }
       sq[theta_q[j]] = theta;
       su[theta_u[j]] = theta_dot;
@@ -368,28 +384,46 @@ struct SimbodyTwin::Impl {
 SimbodyTwin::SimbodyTwin(TwinModel model) : impl_(std::make_unique<Impl>(std::move(model))) {}
 SimbodyTwin::~SimbodyTwin() = default;
 
-TwinEquations SimbodyTwin::equations(const VecX& q, const VecX& qd, const VecX& tau) {
+TwinEquations SimbodyTwin::equations(const VecX& q, const VecX& qd, const VecX& tau,
+                                     const MatX* V) {
   try {
-    return equations_unguarded(q, qd, tau);
+    return equations_unguarded(q, qd, tau, V);
   } catch (const std::exception& e) {  // SimTK's multi-line text, as one line
     throw std::runtime_error("Simbody failed at this state: " + one_line(e.what()));
   }
 }
 
-TwinEquations SimbodyTwin::equations_unguarded(const VecX& q, const VecX& qd, const VecX& tau) {
+TwinEquations SimbodyTwin::equations_unguarded(const VecX& q, const VecX& qd, const VecX& tau,
+                                               const MatX* V) {
   Impl& s = *impl_;
   const TwinModel& m = s.model;
   const int n = m.n(), nt = m.n_theta();
   TwinEquations out;
   s.set_state(q, qd, SimTK::Stage::Dynamics);
-  if (m.closed_loop()) return closed_loop_equations(tau);
+  if (m.closed_loop()) {
+    out = closed_loop_equations(tau);
+    if (V) out.MV = out.M * *V;
+    return out;
+  }
 
-  // M = Cᵀ M_θ C
-  s.matter.calcM(s.state, s.M_theta);
-  MatX Mt(nt, nt);
-  for (int a = 0; a < nt; ++a)
-    for (int b = 0; b < nt; ++b) Mt(a, b) = s.M_theta(s.theta_u[a], s.theta_u[b]);
-  out.M = m.C.transpose() * Mt * m.C;
+  bool plain = m.n() == nt;  // C = I, θ0 = 0: Simbody's own O(n) forward dynamics applies
+  for (int k = 0; k < n && plain; ++k) plain = s.independent[k] == k;
+  // Products alone where q̈ needs no M (a coupled tree solves M q̈ = Q − h with it).
+  if (V && plain) {  // M V = Cᵀ M_θ C v, column by column, by Simbody's O(n) multiplyByM
+    out.MV.resize(n, V->cols());
+    SimTK::Vector MV;
+    for (Eigen::Index c = 0; c < V->cols(); ++c) {
+      s.matter.multiplyByM(s.state, s.expand(V->col(c)), MV);
+      out.MV.col(c) = s.reduce(MV);
+    }
+  } else {  // M = Cᵀ M_θ C
+    s.matter.calcM(s.state, s.M_theta);
+    MatX Mt(nt, nt);
+    for (int a = 0; a < nt; ++a)
+      for (int b = 0; b < nt; ++b) Mt(a, b) = s.M_theta(s.theta_u[a], s.theta_u[b]);
+    const MatX MtC = Mt * m.C;
+    out.M = m.C.transpose() * MtC;
+  }
 
   // h: residual with no applied force and θ̈ = 0 is the velocity (Coriolis, gyroscopic) term.
   s.matter.calcResidualForceIgnoringConstraints(s.state, s.zero_mobility, s.zero_body,
@@ -404,8 +438,6 @@ TwinEquations SimbodyTwin::equations_unguarded(const VecX& q, const VecX& qd, co
   s.matter.calcResidualForceIgnoringConstraints(s.state, mob, body, s.zero_mobility, with_forces);
   out.Q = s.reduce(s.residual - with_forces) + tau;
 
-  bool plain = m.n() == nt;  // C = I, θ0 = 0: Simbody's own O(n) forward dynamics applies
-  for (int k = 0; k < n && plain; ++k) plain = s.independent[k] == k;
   if (plain) {
     SimTK::Vector applied = mob;
     for (int j = 0; j < nt; ++j) applied[s.theta_u[j]] += tau[j];
@@ -414,6 +446,7 @@ TwinEquations SimbodyTwin::equations_unguarded(const VecX& q, const VecX& qd, co
     for (int j = 0; j < nt; ++j) out.qdd[j] = s.udot[s.theta_u[j]];
   } else {
     out.qdd = out.M.llt().solve(out.Q - out.h);
+    if (V) out.MV = out.M * *V, out.M = MatX();
   }
   return out;
 }
@@ -505,7 +538,8 @@ void SimbodyTwin::time_inverse(const VecX& q, const VecX& qd, const VecX& qdd) {
   if (s.bench_theta_ddot.size() != nu) s.bench_theta_ddot = SimTK::Vector(nu, 0.0);
   for (int j = 0; j < s.model.n_theta(); ++j) {
     double theta_ddot = 0;
-    for (int k = 0; k < s.model.n(); ++k) theta_ddot += s.model.C(j, k) * qdd[k];
+    for (decltype(s.C_rows)::InnerIterator it(s.C_rows, j); it; ++it)
+      theta_ddot += it.value() * qdd[it.col()];
     s.bench_theta_ddot[s.theta_u[j]] = theta_ddot;
   }
   s.matter.calcResidualForceIgnoringConstraints(
@@ -656,7 +690,8 @@ void count(const SimTK::Integrator& integ, TwinRunStats& stats) {
 // final time at the last sample, and samples its interpolated states (twin.hpp). Only
 // initialize() and stepTo() are timed.
 TwinRun SimbodyTwin::simulate(const VecX& q0, const VecX& qd0, const std::vector<double>& times,
-                              double accuracy, SimbodyIntegrator which, TwinSampling sampling) {
+                              double accuracy, SimbodyIntegrator which, TwinSampling sampling,
+                              const TwinRunLimits& limits) {
   Impl& s = *impl_;
   TwinRun run;
   TwinRunStats& stats = run.stats;
@@ -677,7 +712,19 @@ TwinRun SimbodyTwin::simulate(const VecX& q0, const VecX& qd0, const std::vector
     integ->setAllowInterpolation(true);
     const bool interpolate = sampling == TwinSampling::Interpolate;
     if (interpolate && !times.empty() && times.back() > 0) integ->setFinalTime(times.back());
+    // A time bound: the integrator hands control back every kChunk steps (ReachedStepLimit),
+    // and the stepper every significant state, so the clock can be read between steps.
+    constexpr int kChunk = 16;
+    const bool bounded = limits.wall_time > 0;
+    if (bounded) integ->setInternalStepLimit(kChunk);
     SimTK::TimeStepper stepper(s.system, *integ);
+    if (bounded) stepper.setReportAllSignificantStates(true);
+    const auto start = std::chrono::steady_clock::now();
+    const auto out_of_time = [&] {
+      return bounded &&
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >
+                 limits.wall_time;
+    };
     {
       Stopwatch timed{stats.wall_time};
       if (interpolate)
@@ -685,16 +732,30 @@ TwinRun SimbodyTwin::simulate(const VecX& q0, const VecX& qd0, const std::vector
       else
         stepper.initialize(s.state);
     }
+    bool timed_out = false;
     for (double t : times) {
       if (t > 0) {
         Stopwatch timed{stats.wall_time};
         if (interpolate) {
           // Returns at t, or earlier at the start of the continuous interval or a step limit.
-          while (integ->getTime() < t && !integ->isSimulationOver())
+          while (integ->getTime() < t && !integ->isSimulationOver() && !(timed_out = out_of_time()))
             if (integ->stepTo(t) == SimTK::Integrator::EndOfSimulation) break;
+        } else if (bounded) {  // returns at every significant state, and every kChunk steps
+          while (integ->getTime() < t && !integ->isSimulationOver() && !(timed_out = out_of_time()))
+            stepper.stepTo(t);
         } else {
           stepper.stepTo(t);
         }
+      }
+      if (timed_out) {
+        stats.ok = false;
+        stats.out_of_time = true;
+        char text[160];
+        std::snprintf(text, sizeof text,
+                      " stopped at t = %.3g s of %.3g s: its time bound of %.3g s ran out",
+                      integ->getTime(), times.back(), limits.wall_time);
+        stats.failure = simbody_integrator_name(which) + std::string(text);
+        break;
       }
       if (std::abs(integ->getTime() - t) > 1e-12 * std::max(1.0, t)) {
         stats.ok = false;
@@ -702,6 +763,7 @@ TwinRun SimbodyTwin::simulate(const VecX& q0, const VecX& qd0, const std::vector
         break;
       }
       run.samples.push_back(s.sample(integ->getState()));
+      if (limits.on_sample) limits.on_sample(t);
     }
   } catch (const std::exception& e) {
     stats.ok = false;

@@ -26,6 +26,7 @@
 //   Q = M^s (q̈(Simbody's forces) − q̈(no force)) + τ;   τ(q̈) = M^s (q̈ − q̈(Simbody's forces)).
 #pragma once
 #include <Eigen/Dense>
+#include <Eigen/Sparse>
 #include <functional>
 #include <memory>
 #include <string>
@@ -35,6 +36,7 @@ namespace femdyn::validation {
 
 using MatX = Eigen::MatrixXd;
 using VecX = Eigen::VectorXd;
+using SpMatX = Eigen::SparseMatrix<double>;
 using Mat3 = Eigen::Matrix3d;
 using Vec3 = Eigen::Vector3d;
 
@@ -77,7 +79,7 @@ struct TwinRod {
 struct TwinModel {
   std::vector<TwinBody> bodies;  // parents first
   std::vector<int> theta_body;   // θ index -> body
-  MatX C;                        // θ = C q + θ0
+  SpMatX C;                      // θ = C q + θ0 (sparse: the identity is n entries, not n²)
   VecX theta0;
   Vec3 gravity = Vec3::Zero();
   struct Load {
@@ -97,7 +99,8 @@ struct TwinModel {
 
 // Simbody's equations reduced to q: M = Cᵀ M_θ C, h = Cᵀ h_θ(C q̇), Q = Cᵀ Q_θ + τ.
 struct TwinEquations {
-  MatX M;
+  MatX M;   // n x n; empty when asked for products only (SimbodyTwin::equations with V)
+  MatX MV;  // M V for the V asked for (n x p), else empty
   VecX h, Q, qdd;
   // Closed loop: Simbody's constraint errors at the state set from q, q̇ (max |qerr|, |uerr|:
   // m and m/s for a rod's ball, rad and rad/s for a coupler); 0 otherwise.
@@ -152,12 +155,22 @@ struct TwinRunStats {
   long convergence_failures = 0;  // getNumConvergenceTestFailures() (iterative methods; else 0)
   double wall_time = 0;           // s in initialize and stepTo only (not samples, energy)
   bool ok = true;
-  std::string failure;  // one line: why the run stopped early, if it did (then ok = false)
+  bool out_of_time = false;  // stopped by TwinRunLimits::wall_time (then ok = false)
+  std::string failure;       // one line: why the run stopped early, if it did (then ok = false)
 };
 
 struct TwinRun {
   std::vector<TwinSample> samples;  // those reached (all of `times` when stats.ok)
   TwinRunStats stats;
+};
+
+// Bounds on a run (validate's budget): past `wall_time` seconds it stops (stats.ok = false, the
+// reason in stats.failure), looked at every few steps; `on_sample(t)` is called after each
+// sample. A run with no bound steps exactly as before (the bound only makes Simbody return to
+// the caller between steps, which changes none of them).
+struct TwinRunLimits {
+  double wall_time = 0;  // s; 0: none
+  std::function<void(double t)> on_sample;
 };
 
 class SimbodyTwin {
@@ -167,7 +180,11 @@ class SimbodyTwin {
   SimbodyTwin(const SimbodyTwin&) = delete;
   SimbodyTwin& operator=(const SimbodyTwin&) = delete;
 
-  TwinEquations equations(const VecX& q, const VecX& qd, const VecX& tau);
+  // With V (n x p): MV = M V and M left empty. Without a coupling (C = I, θ0 = 0) M is never
+  // formed: Simbody's O(n) operator multiplyByM on each column; a coupled tree (which solves
+  // M q̈ = Q − h with it) and a closed loop (which has no such operator) form M and multiply.
+  // Without V: M, and MV empty.
+  TwinEquations equations(const VecX& q, const VecX& qd, const VecX& tau, const MatX* V = nullptr);
   VecX inverse_dynamics(const VecX& q, const VecX& qd, const VecX& qdd);
 
   // Passive motion (τ = 0) from (q0, q̇0) by RungeKuttaMersonIntegrator at `accuracy`, sampled
@@ -183,7 +200,8 @@ class SimbodyTwin {
   // couplers).
   TwinRun simulate(const VecX& q0, const VecX& qd0, const std::vector<double>& times,
                    double accuracy, SimbodyIntegrator which,
-                   TwinSampling sampling = TwinSampling::StepToEach);
+                   TwinSampling sampling = TwinSampling::StepToEach,
+                   const TwinRunLimits& limits = {});
 
   // Timing entry points (validation/benchmark.cpp, femdyn bench): Simbody's own work only,
   // on buffers allocated by the first call. Each sets θ = C q + θ0, θ̇ = C q̇ (a plain loop)
@@ -216,7 +234,7 @@ class SimbodyTwin {
 
  private:
   // The same without the guard that turns SimTK's exceptions into one line.
-  TwinEquations equations_unguarded(const VecX& q, const VecX& qd, const VecX& tau);
+  TwinEquations equations_unguarded(const VecX& q, const VecX& qd, const VecX& tau, const MatX* V);
   VecX inverse_dynamics_unguarded(const VecX& q, const VecX& qd, const VecX& qdd);
   TwinEquations closed_loop_equations(const VecX& tau);
   struct Impl;
@@ -225,5 +243,7 @@ class SimbodyTwin {
 
 // θ_j that carries q_k directly (row j of C is e_k and θ0_j = 0), or -1.
 int independent_theta(const TwinModel& model, int k);
+// The same for every k at once, in O(nnz(C) + nθ).
+std::vector<int> independent_thetas(const TwinModel& model);
 
 }  // namespace femdyn::validation

@@ -1,7 +1,11 @@
 #include "validation/validate.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
 #include <memory>
 #include <random>
 #include <stdexcept>
@@ -13,6 +17,7 @@
 #include "core/fixed_step.hpp"
 #include "core/inertia.hpp"
 #include "core/kinematics.hpp"
+#include "core/math.hpp"
 #include "core/model.hpp"
 #include "core/sampling.hpp"
 #include "validation/twin.hpp"
@@ -100,23 +105,25 @@ void add_loops(const Model& m, TwinModel& t) {
     for (const CoupledJoint& j : m.coupling_level->coupled)
       t.laws.push_back({j.theta, j.sources, callable(j.law), j.name});
   } else {  // linear couplings, each coordinate a joint of its own
+    const std::vector<int> independent = independent_thetas(t);
     for (int k = 0; k < m.n(); ++k) {
-      const int j = independent_theta(t, k);
+      const int j = independent[k];
       if (j < 0)
         throw ModelError(m.where, "coordinate '" + m.coordinate_names[k] +
                                       "' drives no joint directly: the closed-loop Simbody twin "
                                       "needs each coordinate to be a joint");
       t.coordinate_theta.push_back(j);
     }
+    std::vector<bool> is_coordinate(m.n_theta(), false);
+    for (int j : t.coordinate_theta) is_coordinate[j] = true;
+    const SpRowMat rows(t.C);
     for (int j = 0; j < m.n_theta(); ++j) {
-      if (std::find(t.coordinate_theta.begin(), t.coordinate_theta.end(), j) !=
-          t.coordinate_theta.end())
-        continue;
+      if (is_coordinate[j]) continue;
       TwinLaw law{j, {}, {}, m.bodies[m.theta_joint[j]].joint.name};
       std::vector<double> ratios;
-      for (int k = 0; k < m.n(); ++k)
-        if (t.C(j, k) != 0)
-          law.sources.push_back(t.coordinate_theta[k]), ratios.push_back(t.C(j, k));
+      for (SpRowMat::InnerIterator it(rows, j); it; ++it)  // columns in increasing order
+        if (it.value() != 0)
+          law.sources.push_back(t.coordinate_theta[it.col()]), ratios.push_back(it.value());
       law.law = callable(std::make_shared<LinearCoupling>(std::move(ratios), t.theta0[j]));
       t.laws.push_back(std::move(law));
     }
@@ -152,7 +159,7 @@ TwinModel twin_model(const Model& m) {
     t.bodies.push_back(tb);
   }
   t.theta_body = m.theta_joint;
-  t.C = MatX(m.C);
+  t.C = m.C;
   t.theta0 = m.theta0;
   t.gravity = m.gravity;
   for (const PointLoad& l : m.point_loads)
@@ -167,6 +174,56 @@ TwinModel twin_model(const Model& m) {
 
 namespace {
 
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// The wall time of one call of f: the first call alone when it is slow (over 20 ms), else the
+// mean of up to five more (the first warms the buffers up).
+template <class F>
+double timed(F&& f) {
+  auto t0 = Clock::now();
+  f();
+  const double first = seconds_since(t0);
+  if (first > 0.02) return first;
+  int calls = 0;
+  t0 = Clock::now();
+  do {
+    f();
+    ++calls;
+  } while (calls < 5 && seconds_since(t0) < 0.02);
+  return seconds_since(t0) / calls;
+}
+
+// Cost model constants, measured on a 2-core x86-64 machine (docs/validation.md, "Bounded
+// work"); everything else is timed on the model itself.
+//   femdyn's M^s beyond kEvaluateProbeLimit coordinates (timed directly below it): per path
+//   entry S_kᵀ I^c S_i formed, and per entry of the n x n matrix (mirrored), measured on chains
+//   and trees of 3000 and 10,000 bodies; the products M^s V (kMassProducts of them), per entry;
+constexpr int kEvaluateProbeLimit = 3000;
+constexpr double kSecondsPerPathEntry = 4e-9;
+constexpr double kSecondsPerMatrixEntry = 1.5e-9;
+constexpr double kSecondsPerProductEntry = 2.5e-9;
+//   the Transform route's Tᵀ (M T), per multiply-add;
+constexpr double kSecondsPerFlop = 1e-9;
+//   Simbody's trajectory, timed over 1/kSimbodyProbeParts of it; its run at 100x the accuracy
+//   takes 100^(1/4) = 3.2 times as many steps of its 4th-order method (measured: 3.0 to 3.1);
+constexpr double kSimbodyProbeParts = 20;
+const double kTightRatio = std::pow(100.0, 0.25);
+//   memory per body of the twin (Simbody's system and state) and of femdyn's workspaces.
+constexpr double kBytesPerBody = 20e3;
+
+double dense_bytes(double rows, double cols) { return 8 * rows * cols; }
+
+std::string format_bytes(double bytes) {
+  if (!std::isfinite(bytes)) return "unlimited";
+  if (bytes >= 1e9) return format_number(bytes / 1e9, "%.3g") + " GB";
+  if (bytes >= 1e6) return format_number(bytes / 1e6, "%.3g") + " MB";
+  return format_number(bytes / 1e3, "%.3g") + " kB";
+}
+
 void accumulate(QuantityError& e, const MatX& femdyn, const MatX& simbody) {
   const double d = max_abs(femdyn - simbody);
   const double scale = max_abs(simbody);
@@ -175,13 +232,20 @@ void accumulate(QuantityError& e, const MatX& femdyn, const MatX& simbody) {
 }
 
 // femdyn's passive motion by RK4 (core/fixed_step.hpp) at step dt, sampled at `times`
-// (multiples of dt). Returns false if the integration failed (M^s singular on the way).
-// An overflow along the trajectory (NaN or Inf) is an error, never a skipped comparison.
-bool integrate(const Model& m, const VecX& q0, const VecX& qd0, const std::vector<double>& times,
-               double dt, std::vector<VecX>& state, std::vector<double>& energy) {
+// (multiples of dt): the joint states (θ, θ̇) and the states (q, q̇) at the samples.
+// Returns false if the integration failed (M^s singular on the way). An overflow along the
+// trajectory (NaN or Inf) is an error, never a skipped comparison.
+struct Run {
+  std::vector<VecX> x, q, qd;
+  double wall_time = 0;
+};
+bool integrate(const Model& m, Workspace& ws, const VecX& q0, const VecX& qd0,
+               const std::vector<double>& times, double dt, Run& run,
+               const std::function<void(double)>& on_sample) {
+  const auto t0 = Clock::now();
+  run = Run();
   Rk4 rk4(m, {.dt = dt});
   rk4.reset(0, q0, qd0);
-  Workspace ws(m);
   for (double target : times) {
     const Status st = rk4.advance_to(target);
     if (st.non_finite) throw std::runtime_error("along the trajectory: " + st.message);
@@ -189,79 +253,13 @@ bool integrate(const Model& m, const VecX& q0, const VecX& qd0, const std::vecto
     joint_state(m, ws, rk4.q(), rk4.qd());
     VecX x(2 * m.n_theta());
     x << ws.theta, ws.theta_dot;
-    state.push_back(std::move(x));
-    energy.push_back(rk4.motion().energy_at(rk4.y().data()).total());
+    run.x.push_back(std::move(x));
+    run.q.push_back(rk4.q());
+    run.qd.push_back(rk4.qd());
+    if (on_sample) on_sample(target);
   }
+  run.wall_time = seconds_since(t0);
   return true;
-}
-
-TrajectoryReport compare_trajectory(const Model& m, SimbodyTwin& twin, const VecX& q0,
-                                    const VecX& qd0, const ValidationOptions& o) {
-  TrajectoryReport r;
-  r.t_end = o.t_end;
-  if (o.t_end <= 0) {
-    r.skipped = "--t-end 0";
-    return r;
-  }
-  if (!twin.can_simulate(&r.skipped)) return r;
-  const int samples = std::max(1, o.samples);
-  // Halve femdyn's RK4 step until its own error estimate (dt against dt/2) is below the target,
-  // within a budget of steps; sample times lie on the grid.
-  std::vector<double> times;
-  std::vector<VecX> x, x_half;
-  std::vector<double> e, e_half;
-  double dt = o.t_end / std::max(1.0, std::round(o.t_end / o.rk4_step));
-  for (int i = 0; i <= samples; ++i) times.push_back(dt * std::round(o.t_end * i / samples / dt));
-  const char* singular = "femdyn's mass matrix turned singular along the trajectory";
-  if (!integrate(m, q0, qd0, times, dt, x, e)) {
-    r.skipped = singular;
-    return r;
-  }
-  for (;; dt /= 2) {
-    x_half.clear(), e_half.clear();
-    if (!integrate(m, q0, qd0, times, dt / 2, x_half, e_half)) {
-      r.skipped = singular;
-      return r;
-    }
-    double estimate = 0, scale = 1;
-    for (std::size_t i = 0; i < times.size(); ++i) {
-      estimate = std::max(estimate, max_abs(x[i] - x_half[i]) / 15);
-      scale = std::max(scale, max_abs(x_half[i]));
-    }
-    r.rk4_step = dt / 2;
-    if (estimate <= o.rk4_target * scale || o.t_end / dt * 2 > o.max_rk4_steps) break;
-    x.swap(x_half), e.swap(e_half);
-  }
-  // Simbody at its accuracy and 100x tighter: the difference estimates its own error.
-  const std::vector<TwinSample> sim = twin.simulate(q0, qd0, times, o.simbody_accuracy);
-  const std::vector<TwinSample> tight = twin.simulate(q0, qd0, times, o.simbody_accuracy / 100);
-  r.run = true;
-  r.rk4_error_estimate = 0;
-  double scale = 1;
-  for (std::size_t i = 0; i < times.size(); ++i) {
-    VecX xs(x[i].size()), xt(x[i].size());
-    xs << sim[i].theta, sim[i].theta_dot;
-    xt << tight[i].theta, tight[i].theta_dot;
-    const double err = max_abs(x_half[i] - xt);  // the finer runs of both
-    r.t.push_back(times[i]);
-    r.error.push_back(err);
-    r.energy_femdyn.push_back(e_half[i]);
-    r.energy_simbody.push_back(tight[i].energy);
-    r.max_state_error = std::max(r.max_state_error, err);
-    // RK4 is 4th order: x_dt − x_exact ≈ 16/15 (x_dt − x_dt/2); the finer run is 16x better.
-    r.rk4_error_estimate = std::max(r.rk4_error_estimate, max_abs(x[i] - x_half[i]) / 15);
-    r.simbody_error_estimate = std::max(r.simbody_error_estimate, max_abs(xs - xt));
-    r.energy_change_femdyn = std::max(r.energy_change_femdyn, std::abs(e_half[i] - e_half[0]));
-    r.energy_change_simbody =
-        std::max(r.energy_change_simbody, std::abs(tight[i].energy - tight[0].energy));
-    scale = std::max(scale, max_abs(xt));
-  }
-  // The two runs may differ by what each integrator gets wrong (with a margin of 10), plus
-  // round-off. A comparison whose integrators are not that accurate proves nothing: the motion
-  // is unresolved (chaotic over this time, or too fast) and fails with that reason.
-  r.tolerance = 10 * (r.rk4_error_estimate + r.simbody_error_estimate) + 1e-12 * scale;
-  r.resolved = r.tolerance <= o.resolved_tolerance * scale;
-  return r;
 }
 
 }  // namespace
@@ -273,99 +271,475 @@ bool ValidationReport::pass() const {
   return trajectory.pass();
 }
 
-ValidationReport validate(const Model& m, const ValidationOptions& o) {
-  ValidationReport r;
-  r.model = m.name;
-  r.n = m.n();
-  r.states = o.states;
-  if (m.explicit_table)
-    r.notes.push_back(
-        "the model gives its correlation table explicitly; DOFs it leaves out or "
-        "joins are approximations of the rigid bodies Simbody simulates");
-  for (const std::string& a : m.approximations) r.notes.push_back("approximation: " + a);
+double default_memory_limit() {
+  std::ifstream in("/proc/meminfo");
+  std::string line;
+  while (std::getline(in, line)) {  // "MemAvailable:   23705392 kB"
+    double kib = 0;
+    if (line.rfind("MemAvailable:", 0) == 0 && std::sscanf(line.c_str() + 13, "%lf", &kib) == 1)
+      return 0.5 * kib * 1024;
+  }
+  return std::numeric_limits<double>::infinity();
+}
 
-  // Each body's elements must sum to a rigid body: nothing else can be built in Simbody.
+struct Validator::Impl {
+  const Model& m;
+  ValidationOptions o;
+  Clock::time_point start = Clock::now();
+  ValidationReport r;  // notes and failures found while building the twin
   TwinModel tm;
-  try {
-    tm = twin_model(m);
-  } catch (const ModelError& e) {
-    r.failure = e.what();
-    return r;
-  }
-  if (tm.closed_loop())
-    r.notes.push_back("closed loop: " + std::to_string(tm.laws.size()) + " coupled joint(s), " +
-                      std::to_string(tm.rods.size()) +
-                      " rod(s); Simbody's equations from its constrained forward dynamics");
-  for (std::size_t b = 0; b < tm.bodies.size(); ++b) {
-    const TwinBody& tb = tm.bodies[b];
-    const Mat3 I_com = tb.inertia_origin - point_inertia(tb.mass, tb.com);  // parallel axis
-    if (tb.mass == 0 && !tb.inertia_origin.isZero(0)) {
-      r.failure += (r.failure.empty() ? "" : "; ") + ("body '" + m.bodies[b].name +
-                                                      "' has a rotary inertia but no mass, which a "
-                                                      "Simbody body cannot have");
-      continue;
-    }
-    if (const auto problem = inertia_problem(I_com, tb.inertia_origin.cwiseAbs().maxCoeff()))
-      r.failure +=
-          (r.failure.empty() ? "" : "; ") +
-          ("body '" + m.bodies[b].name + "': its elements sum to no rigid body (" + *problem + ")");
-  }
-  if (!r.failure.empty()) return r;
-  std::unique_ptr<SimbodyTwin> twin_ptr;
-  try {
-    twin_ptr = std::make_unique<SimbodyTwin>(tm);
-  } catch (const std::exception& e) {
-    r.failure = std::string("Simbody refused the twin: ") + e.what();
-    return r;
-  }
-  SimbodyTwin& twin = *twin_ptr;
-  Workspace ws(m);
-  for (const char* name : {"M", "h", "Q", "qdd", "tau"})
-    r.quantities.push_back({name, 0, 0, o.tolerance});
-  if (tm.closed_loop()) r.quantities.push_back({"loop", 0, 0, o.tolerance});
-  QuantityError &eM = r.quantities[0], &eh = r.quantities[1], &eQ = r.quantities[2],
-                &eqdd = r.quantities[3], &etau = r.quantities[4];
-  // The loop's closure at femdyn's θ = g(q), θ̇ = G q̇: Simbody's constraint errors relative to
-  // the longest rod (m) and its speed, or in rad and rad/s for couplers alone.
-  double length = 1;
-  if (!tm.rods.empty()) {
-    length = 0;
-    for (const TwinRod& rod : tm.rods) length = std::max(length, rod.length);
+  std::unique_ptr<SimbodyTwin> twin;
+  Workspace ws;
+  MatX V;  // products: the seeded random vectors M^s is multiplied by
+  WorkEstimate estimate;
+  // Probes (s): femdyn's forward dynamics and its energy at a state.
+  double t_fd = 0, t_energy = 0;
+  double simbody_cost = 0;  // s: Simbody's two trajectory runs, as estimated
+
+  Impl(const Model& model, ValidationOptions options) : m(model), o(std::move(options)), ws(model) {
+    r.model = m.name;
+    r.n = m.n();
+    r.states = o.states;
+    estimate.n = m.n();
+    estimate.states = o.states;
+    estimate.budget = o.budget;
+    estimate.memory_limit = o.memory_limit > 0 ? o.memory_limit : default_memory_limit();
+    estimate.dense_mass = r.dense_mass = m.n() <= kDenseMassLimit;
+    if (build()) probe();
+    estimate.setup = seconds_since(start);
   }
 
-  std::mt19937 rng(o.seed);
-  VecX q0, qd0;
-  for (int k = 0; k < o.states; ++k) {
-    const VecX q = random_posture(m, rng);
-    const VecX qd = random_uniform(m.n(), o.qd_scale, rng);
-    const VecX tau = random_uniform(m.n(), o.tau_scale, rng);
-    const VecX qdd = random_uniform(m.n(), o.qdd_scale, rng);
-    if (k == 0) q0 = q, qd0 = qd;
+  // The twin, or r.failure saying why there is none.
+  bool build() {
+    if (m.explicit_table)
+      r.notes.push_back(
+          "the model gives its correlation table explicitly; DOFs it leaves out or "
+          "joins are approximations of the rigid bodies Simbody simulates");
+    for (const std::string& a : m.approximations) r.notes.push_back("approximation: " + a);
 
-    const TwinEquations s = twin.equations(q, qd, tau);
-    if (tm.closed_loop()) {
-      QuantityError& loop = r.quantities[5];
-      const double speed = length * std::max(1.0, max_abs(qd));
-      loop.max_abs = std::max({loop.max_abs, s.loop_position_error, s.loop_velocity_error});
-      loop.max_rel =
-          std::max({loop.max_rel, s.loop_position_error / length, s.loop_velocity_error / speed});
+    // Each body's elements must sum to a rigid body: nothing else can be built in Simbody.
+    try {
+      tm = twin_model(m);
+    } catch (const ModelError& e) {
+      r.failure = e.what();
+      return false;
     }
-    const Status st = forward_dynamics(m, ws, q, qd, tau);
-    evaluate(m, ws, q, qd, tau);
-    accumulate(eM, ws.Ms, s.M);
-    accumulate(eh, ws.h, s.h);
-    accumulate(eQ, ws.Q, s.Q);
-    if (st.ok) {
-      accumulate(eqdd, ws.qdd, s.qdd);
+    if (tm.closed_loop())
+      r.notes.push_back("closed loop: " + std::to_string(tm.laws.size()) + " coupled joint(s), " +
+                        std::to_string(tm.rods.size()) +
+                        " rod(s); Simbody's equations from its constrained forward dynamics");
+    for (std::size_t b = 0; b < tm.bodies.size(); ++b) {
+      const TwinBody& tb = tm.bodies[b];
+      const Mat3 I_com = tb.inertia_origin - point_inertia(tb.mass, tb.com);  // parallel axis
+      if (tb.mass == 0 && !tb.inertia_origin.isZero(0)) {
+        r.failure += (r.failure.empty() ? "" : "; ") +
+                     ("body '" + m.bodies[b].name +
+                      "' has a rotary inertia but no mass, which a Simbody body cannot have");
+        continue;
+      }
+      if (const auto problem = inertia_problem(I_com, tb.inertia_origin.cwiseAbs().maxCoeff()))
+        r.failure += (r.failure.empty() ? "" : "; ") +
+                     ("body '" + m.bodies[b].name + "': its elements sum to no rigid body (" +
+                      *problem + ")");
+    }
+    if (!r.failure.empty()) return false;
+    try {
+      twin = std::make_unique<SimbodyTwin>(tm);
+    } catch (const std::exception& e) {
+      r.failure = std::string("Simbody refused the twin: ") + e.what();
+      return false;
+    }
+    if (!r.dense_mass) {
+      std::mt19937 rng(o.seed + 7919);  // apart from the states' sequence
+      V.resize(m.n(), kMassProducts);
+      for (int c = 0; c < kMassProducts; ++c) V.col(c) = random_uniform(m.n(), 1, rng);
+    }
+    return true;
+  }
+
+  // The costs, from one state of each kind of work (a state apart from the compared ones).
+  void probe() {
+    const int n = m.n();
+    std::mt19937 rng(o.seed + 104729);
+    const VecX q = random_posture(m, rng), qd = random_uniform(n, o.qd_scale, rng),
+               tau = random_uniform(n, o.tau_scale, rng), qdd = random_uniform(n, o.qdd_scale, rng);
+    t_fd = timed([&] { (void)forward_dynamics(m, ws, q, qd, tau); });
+    const double t_id = timed([&] { inverse_dynamics(m, ws, q, qd, qdd); });
+    double t_eval = 0;
+    if (n <= kEvaluateProbeLimit) {
+      t_eval = timed([&] { evaluate(m, ws, q, qd, tau); });
+    } else {  // a model of the n x n work, not timed: it would form the matrix to time it
+      double path_entries = 0;
+      const double per_entry =
+          m.identity_coupling ? 1.0
+                              : std::pow(m.C.nonZeros() / std::max(1.0, double(m.n_theta())), 2);
+      for (const Body& b : m.bodies) {
+        if (b.joint.theta < 0) continue;
+        for (int a = &b - m.bodies.data(); a >= 0; a = m.bodies[a].parent)
+          if (m.bodies[a].joint.theta >= 0) path_entries += per_entry;
+      }
+      t_eval =
+          2 * t_id + kSecondsPerPathEntry * path_entries + kSecondsPerMatrixEntry * double(n) * n;
+      if (m.mass_route == MassRoute::Transform) t_eval += kSecondsPerFlop * 2.0 * m.n_u() * n * n;
+    }
+    t_energy =
+        m.mass_route == MassRoute::Composite ? timed([&] { (void)energy(m, ws, q, qd); }) : t_eval;
+    double t_sim = 0;
+    try {
+      t_sim = timed([&] { (void)twin->equations(q, qd, tau, r.dense_mass ? nullptr : &V); }) +
+              timed([&] { (void)twin->inverse_dynamics(q, qd, qdd); });
+    } catch (const std::exception&) {
+      // A state Simbody cannot take is reported by the comparison itself; the estimate goes on.
+    }
+    estimate.per_state = t_fd + t_eval + t_id + t_sim;
+    if (!r.dense_mass) estimate.per_state += kSecondsPerProductEntry * double(n) * n;  // M^s V
+    estimate.pointwise = o.states * estimate.per_state;
+
+    // The trajectory as usually refined: femdyn's RK4 at dt, dt/2 and dt/4 (7 S0 steps of 4
+    // evaluations, S0 = t_end / dt, within max_rk4_steps a run), the energy at each sample, and
+    // Simbody's two runs, timed on the trajectory's first twentieth from its first state (Simbody's
+    // error control sets its step by the motion at hand, which that stretch shows) and scaled to
+    // the whole (its steps at 100x the accuracy: 100^(1/4) = 3.2 times as many).
+    if (o.t_end > 0 && o.states > 0) {
+      const double s0 = std::max(1.0, std::round(o.t_end / o.rk4_step));
+      const double samples = std::max(1, o.samples) + 1;
+      const double steps = 3 * s0 + (2 * s0 <= o.max_rk4_steps ? 4 * s0 : 0);
+      estimate.trajectory = steps * 4 * t_fd + samples * t_energy;
+      if (twin->can_simulate()) {
+        std::mt19937 first(o.seed);  // the first state of run(): the trajectory's start
+        const VecX q0 = random_posture(m, first), qd0 = random_uniform(n, o.qd_scale, first);
+        const double stretch = o.t_end / kSimbodyProbeParts;
+        const double scale = (1 + kTightRatio) * kSimbodyProbeParts;
+        TwinRunLimits limits;  // a probe that runs out of time is over the budget already
+        limits.wall_time = o.budget / scale;
+        const TwinRun probe =
+            twin->simulate(q0, qd0, {0.0, stretch}, o.simbody_accuracy,
+                           SimbodyIntegrator::RungeKuttaMerson, TwinSampling::StepToEach, limits);
+        simbody_cost = scale * probe.stats.wall_time;
+        estimate.at_least = probe.stats.out_of_time;
+        estimate.trajectory += simbody_cost;
+      }
+    }
+
+    // Memory: femdyn's n x n M^s, what its routes form besides, Simbody's matrices, the
+    // samples, and a measured amount per body.
+    const double nt = m.n_theta(), nb = static_cast<double>(m.bodies.size());
+    double bytes = dense_bytes(n, n) + kBytesPerBody * nb;
+    if (m.mass_route == MassRoute::Transform)
+      bytes += 2 * dense_bytes(m.n_u(), n) + 2 * dense_bytes(3 * nb, n);  // T, M T, Jω, Jv
+    if (m.dynamics_route == DynamicsRoute::Cholesky && m.mass_pattern.solver == SolverKind::Dense)
+      bytes += dense_bytes(n, n);                                                 // its factor
+    if (m.coupling_level) bytes += 2 * dense_bytes(nt, nt) + dense_bytes(nt, n);  // the tree's
+    if (tm.closed_loop())
+      bytes += 5 * dense_bytes(n, n);  // q̈'s response, its inverse, M^s, h's and Q's products
+    else if (r.dense_mass || !m.identity_coupling)  // a coupled tree forms M to solve for q̈
+      bytes +=
+          2 * dense_bytes(nt, nt) + 3 * dense_bytes(n, n);  // calcM, M_θ, Cᵀ M_θ C, a difference
+    else
+      bytes += 4 * dense_bytes(n, kMassProducts);
+    if (o.t_end > 0) bytes += 8 * dense_bytes(std::max(1, o.samples) + 1, 2 * (nt + n));
+    estimate.bytes = bytes;
+  }
+
+  // The trajectory from (q0, q̇0), within what is left of the budget at `deadline`.
+  TrajectoryReport trajectory(const VecX& q0, const VecX& qd0, Clock::time_point deadline,
+                              const std::function<void(double)>& progress) {
+    TrajectoryReport tr;
+    tr.t_end = o.t_end;
+    if (o.t_end <= 0) {
+      tr.skipped = "--t-end 0";
+      return tr;
+    }
+    if (!twin->can_simulate(&tr.skipped)) return tr;
+    const auto left = [&] {
+      return std::chrono::duration<double>(deadline - Clock::now()).count();
+    };
+    const int samples = std::max(1, o.samples);
+    // femdyn's RK4 at dt and dt/2; sample times lie on the grid.
+    std::vector<double> times;
+    double dt = o.t_end / std::max(1.0, std::round(o.t_end / o.rk4_step));
+    for (int i = 0; i <= samples; ++i) times.push_back(dt * std::round(o.t_end * i / samples / dt));
+    const char* singular = "femdyn's mass matrix turned singular along the trajectory";
+    Run coarse, fine;
+    double done = 0;  // estimated seconds of trajectory work done, for the progress line
+    const auto femdyn_run = [&](double step, Run& run) {
+      const double cost = std::round(o.t_end / step) * 4 * t_fd;
+      const double before = done;
+      const bool ok = integrate(m, ws, q0, qd0, times, step, run,
+                                [&](double t) { progress(before + cost * t / o.t_end); });
+      done = before + cost;
+      return ok;
+    };
+    if (!femdyn_run(dt, coarse) || !femdyn_run(dt / 2, fine)) {
+      tr.skipped = singular;
+      return tr;
+    }
+    double estimate_rk4 = 0, scale = 1;
+    const auto rk4_estimate = [&] {
+      estimate_rk4 = 0, scale = 1;
+      for (std::size_t i = 0; i < times.size(); ++i) {
+        estimate_rk4 = std::max(estimate_rk4, max_abs(coarse.x[i] - fine.x[i]) / 15);
+        scale = std::max(scale, max_abs(fine.x[i]));
+      }
+    };
+    rk4_estimate();
+
+    // Simbody at its accuracy and 100x tighter (the difference estimates its own error), each
+    // bounded by what is left; the tighter run takes about 100^(1/4) = 3.2 times as long.
+    const double tight_ratio = kTightRatio;
+    std::vector<TwinSample> sim, tight;
+    {
+      TwinRunLimits limits;
+      limits.wall_time = std::max(1e-3, left() / (1 + tight_ratio));
+      double before = done;
+      const double cost = simbody_cost / (1 + tight_ratio);  // the run at its accuracy
+      limits.on_sample = [&](double t) { progress(before + cost * t / o.t_end); };
+      TwinRun a =
+          twin->simulate(q0, qd0, times, o.simbody_accuracy, SimbodyIntegrator::RungeKuttaMerson,
+                         TwinSampling::StepToEach, limits);
+      if (!a.stats.ok) {
+        tr.stopped =
+            "Simbody at accuracy " + format_short(o.simbody_accuracy) + ": " + a.stats.failure;
+        return tr;
+      }
+      if (tight_ratio * a.stats.wall_time > 2 * left()) {
+        tr.stopped = "Simbody at accuracy " + format_short(o.simbody_accuracy / 100) +
+                     " would take about " + format_duration(tight_ratio * a.stats.wall_time) +
+                     " (" + format_duration(a.stats.wall_time) + " at " +
+                     format_short(o.simbody_accuracy) + "), more than the " +
+                     format_duration(std::max(0.0, left())) + " left of the budget";
+        return tr;
+      }
+      limits.wall_time = std::max(1e-3, left());
+      before = done += cost;
+      limits.on_sample = [&](double t) { progress(before + tight_ratio * cost * t / o.t_end); };
+      TwinRun b =
+          twin->simulate(q0, qd0, times, o.simbody_accuracy / 100,
+                         SimbodyIntegrator::RungeKuttaMerson, TwinSampling::StepToEach, limits);
+      if (!b.stats.ok) {
+        tr.stopped = "Simbody at accuracy " + format_short(o.simbody_accuracy / 100) + ": " +
+                     b.stats.failure;
+        return tr;
+      }
+      done += tight_ratio * cost;
+      sim = std::move(a.samples);
+      tight = std::move(b.samples);
+    }
+    double simbody_estimate = 0, tight_scale = 1;
+    for (std::size_t i = 0; i < times.size(); ++i) {
+      VecX xs(fine.x[i].size()), xt(fine.x[i].size());
+      xs << sim[i].theta, sim[i].theta_dot;
+      xt << tight[i].theta, tight[i].theta_dot;
+      simbody_estimate = std::max(simbody_estimate, max_abs(xs - xt));
+      tight_scale = std::max(tight_scale, max_abs(xt));
+    }
+
+    // Halve femdyn's step until its own error estimate (dt against dt/2) is below the target,
+    // within max_rk4_steps steps a run and the budget; not at all when Simbody's own estimate
+    // already leaves the comparison unresolved.
+    tr.rk4_step = dt / 2;
+    if (10 * simbody_estimate + 1e-12 * tight_scale > o.resolved_tolerance * tight_scale) {
+      if (estimate_rk4 > o.rk4_target * scale)
+        tr.refinement =
+            "not halved further: Simbody's own error estimate alone leaves the comparison "
+            "unresolved";
     } else {
-      eqdd.max_abs = eqdd.max_rel = INFINITY;
-      r.notes.push_back("femdyn: " + st.message);
+      while (estimate_rk4 > o.rk4_target * scale) {
+        if (o.t_end / dt * 2 > o.max_rk4_steps) {
+          tr.refinement = "not halved beyond dt = " + format_short(dt / 2) + " s: the limit of " +
+                          format_short(o.max_rk4_steps) + " steps a run";
+          break;
+        }
+        const double next = 2 * fine.wall_time;  // the run at dt/4 against the one at dt/2
+        if (next > left()) {
+          tr.refinement = "not halved beyond dt = " + format_short(dt / 2) +
+                          " s: the run at dt = " + format_short(dt / 4) + " s would take about " +
+                          format_duration(next) + ", more than the " +
+                          format_duration(std::max(0.0, left())) + " left of the budget (--budget)";
+          break;
+        }
+        dt /= 2;
+        std::swap(coarse, fine);
+        if (!femdyn_run(dt / 2, fine)) {
+          tr.skipped = singular;
+          return tr;
+        }
+        tr.rk4_step = dt / 2;
+        rk4_estimate();
+      }
     }
-    inverse_dynamics(m, ws, q, qd, qdd);
-    accumulate(etau, ws.tau, twin.inverse_dynamics(q, qd, qdd));
+
+    tr.run = true;
+    tr.rk4_error_estimate = 0;
+    scale = 1;
+    for (std::size_t i = 0; i < times.size(); ++i) {
+      VecX xs(fine.x[i].size()), xt(fine.x[i].size());
+      xs << sim[i].theta, sim[i].theta_dot;
+      xt << tight[i].theta, tight[i].theta_dot;
+      const double err = max_abs(fine.x[i] - xt);  // the finer runs of both
+      const double e = energy(m, ws, fine.q[i], fine.qd[i]).total();
+      tr.t.push_back(times[i]);
+      tr.error.push_back(err);
+      tr.energy_femdyn.push_back(e);
+      tr.energy_simbody.push_back(tight[i].energy);
+      tr.max_state_error = std::max(tr.max_state_error, err);
+      // RK4 is 4th order: x_dt − x_exact ≈ 16/15 (x_dt − x_dt/2); the finer run is 16x better.
+      tr.rk4_error_estimate =
+          std::max(tr.rk4_error_estimate, max_abs(coarse.x[i] - fine.x[i]) / 15);
+      tr.simbody_error_estimate = std::max(tr.simbody_error_estimate, max_abs(xs - xt));
+      tr.energy_change_femdyn =
+          std::max(tr.energy_change_femdyn, std::abs(e - tr.energy_femdyn[0]));
+      tr.energy_change_simbody =
+          std::max(tr.energy_change_simbody, std::abs(tight[i].energy - tight[0].energy));
+      scale = std::max(scale, max_abs(xt));
+    }
+    // The two runs may differ by what each integrator gets wrong (with a margin of 10), plus
+    // round-off. A comparison whose integrators are not that accurate proves nothing: the motion
+    // is unresolved (chaotic over this time, or too fast) and fails with that reason.
+    tr.tolerance = 10 * (tr.rk4_error_estimate + tr.simbody_error_estimate) + 1e-12 * scale;
+    tr.resolved = tr.tolerance <= o.resolved_tolerance * scale;
+    return tr;
   }
-  if (o.states > 0) r.trajectory = compare_trajectory(m, twin, q0, qd0, o);
-  return r;
+
+  ValidationReport run() {
+    r.estimate = estimate;
+    if (!r.failure.empty()) {
+      r.wall_time = seconds_since(start);
+      return r;
+    }
+    const auto run_start = Clock::now();
+    const auto deadline = run_start + std::chrono::duration_cast<Clock::duration>(
+                                          std::chrono::duration<double>(o.budget));
+    double total = estimate.seconds();
+    const auto progress = [&](double done) {
+      if (!o.progress) return;
+      total = std::max(total, done);
+      o.progress(done, total);
+    };
+    SimbodyTwin& tw = *twin;
+    for (const char* name : {"M", "h", "Q", "qdd", "tau"})
+      r.quantities.push_back({name, 0, 0, o.tolerance});
+    if (tm.closed_loop()) r.quantities.push_back({"loop", 0, 0, o.tolerance});
+    QuantityError &eM = r.quantities[0], &eh = r.quantities[1], &eQ = r.quantities[2],
+                  &eqdd = r.quantities[3], &etau = r.quantities[4];
+    // The loop's closure at femdyn's θ = g(q), θ̇ = G q̇: Simbody's constraint errors relative
+    // to the longest rod (m) and its speed, or in rad and rad/s for couplers alone.
+    double length = 1;
+    if (!tm.rods.empty()) {
+      length = 0;
+      for (const TwinRod& rod : tm.rods) length = std::max(length, rod.length);
+    }
+
+    std::mt19937 rng(o.seed);
+    VecX q0, qd0;
+    for (int k = 0; k < o.states; ++k) {
+      const VecX q = random_posture(m, rng);
+      const VecX qd = random_uniform(m.n(), o.qd_scale, rng);
+      const VecX tau = random_uniform(m.n(), o.tau_scale, rng);
+      const VecX qdd = random_uniform(m.n(), o.qdd_scale, rng);
+      if (k == 0) q0 = q, qd0 = qd;
+
+      const TwinEquations s = tw.equations(q, qd, tau, r.dense_mass ? nullptr : &V);
+      if (tm.closed_loop()) {
+        QuantityError& loop = r.quantities[5];
+        const double speed = length * std::max(1.0, max_abs(qd));
+        loop.max_abs = std::max({loop.max_abs, s.loop_position_error, s.loop_velocity_error});
+        loop.max_rel =
+            std::max({loop.max_rel, s.loop_position_error / length, s.loop_velocity_error / speed});
+      }
+      const Status st = forward_dynamics(m, ws, q, qd, tau);
+      evaluate(m, ws, q, qd, tau);
+      if (r.dense_mass)
+        accumulate(eM, ws.Ms, s.M);
+      else
+        accumulate(eM, ws.Ms * V, s.MV);
+      accumulate(eh, ws.h, s.h);
+      accumulate(eQ, ws.Q, s.Q);
+      if (st.ok) {
+        accumulate(eqdd, ws.qdd, s.qdd);
+      } else {
+        eqdd.max_abs = eqdd.max_rel = INFINITY;
+        r.notes.push_back("femdyn: " + st.message);
+      }
+      inverse_dynamics(m, ws, q, qd, qdd);
+      accumulate(etau, ws.tau, tw.inverse_dynamics(q, qd, qdd));
+      progress((k + 1) * estimate.per_state);
+    }
+    if (!r.dense_mass)
+      r.notes.push_back("M^s compared by its products with " + std::to_string(kMassProducts) +
+                        " seeded random vectors (n > " + std::to_string(kDenseMassLimit) +
+                        "): the error is ‖ΔM^s V‖∞ / ‖M^s V‖∞");
+    if (o.states > 0) {
+      const double pointwise = estimate.pointwise;
+      r.trajectory =
+          trajectory(q0, qd0, deadline, [&](double done) { progress(pointwise + done); });
+    }
+    r.wall_time = seconds_since(start);
+    return r;
+  }
+};
+
+Validator::Validator(const Model& model, ValidationOptions options)
+    : impl_(std::make_unique<Impl>(model, std::move(options))) {}
+Validator::~Validator() = default;
+
+const WorkEstimate& Validator::estimate() const { return impl_->estimate; }
+
+std::string Validator::refusal(const std::string& label) const {
+  const WorkEstimate& e = impl_->estimate;
+  if (!impl_->r.failure.empty() || e.within()) return {};
+  const ValidationOptions& o = impl_->o;
+  const bool time = e.seconds() > e.budget, memory = e.bytes > e.memory_limit;
+  std::string text = label + ": validating n = " + std::to_string(e.n) +
+                     " coordinates would take " + (e.at_least ? "at least " : "about ") +
+                     format_duration(e.seconds()) + " (" + std::to_string(e.states) +
+                     " states of " + format_duration(e.per_state) +
+                     (o.t_end > 0 ? ", the trajectory " + format_duration(e.trajectory) : "") +
+                     ") and " + format_bytes(e.bytes) + " of memory, beyond ";
+  if (time) text += "the budget of " + format_number(e.budget, "%.4g") + " s";
+  if (time && memory) text += " and ";
+  if (memory)
+    text += "the memory limit of " + format_bytes(e.memory_limit) +
+            (o.memory_limit > 0 ? "" : " (half the available memory)");
+  text += ": use ";
+  // How to proceed: no trajectory, fewer states, a larger budget, a larger memory limit.
+  std::vector<std::string> ways;
+  if (time) {
+    const double P = e.pointwise, T = e.trajectory, B = e.budget, s = e.per_state;
+    const auto states = [&](double seconds) {
+      return std::to_string(std::max(1, static_cast<int>(seconds / s)));
+    };
+    if (T > 0 && P <= B)
+      ways.push_back("--t-end 0 (t_end=0: no trajectory, about " + format_duration(P) + ")");
+    // A shorter trajectory: its cost is about proportional to its length (unknown beyond a
+    // lower bound when Simbody's probe ran out of time).
+    if (const double t_end = T > 0 ? 0.8 * o.t_end * (B - P) / T : 0;
+        P < B && t_end >= 1e-3 && !e.at_least)
+      ways.push_back("--t-end " + format_number(t_end, "%.2g") + " (t_end=)");
+    if (P + T > B && T + s <= B) ways.push_back("--states " + states(B - T) + " (states=)");
+    if (T > 0 && P > B && s <= B) ways.push_back("--t-end 0 --states " + states(B));
+    ways.push_back("--budget " + format_number(std::ceil(1.1 * e.seconds()), "%.0f") +
+                   (e.at_least ? " or more" : "") + " (budget=)");
+  }
+  if (memory)
+    ways.push_back("--max-memory " + format_number(std::ceil(1.1 * e.bytes / 1e8) / 10, "%.1f") +
+                   " (max_memory=, GB) if that much memory is free");
+  for (std::size_t i = 0; i < ways.size(); ++i)
+    text += (i == 0 ? "" : i + 1 == ways.size() ? ", or " : ", ") + ways[i];
+  return text;
+}
+
+ValidationReport Validator::run() { return impl_->run(); }
+
+void Validator::set_progress(std::function<void(double, double)> progress) {
+  impl_->o.progress = std::move(progress);
+}
+
+ValidationReport validate(const Model& m, const ValidationOptions& o) {
+  Validator v(m, o);
+  if (std::string why = v.refusal(m.where.empty() ? m.name : m.where); !why.empty())
+    throw OverBudget(why);
+  return v.run();
 }
 
 QuantityError validate_urdf_import(const Model& m, const std::string& path,

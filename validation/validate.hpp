@@ -1,6 +1,9 @@
 // femdyn against its Simbody twin: pointwise at seeded random states, and along a passive
 // trajectory. docs/validation.md describes the method and the tolerance policy.
 #pragma once
+#include <functional>
+#include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -14,6 +17,17 @@ namespace femdyn::validation {
 // (rk4_step) and is refined only within a budget of max_rk4_steps (1e5) steps, which a
 // trajectory of 100 s spends at its first halving.
 inline constexpr double kMaxTrajectoryTime = 100;
+
+// Bounded work (docs/validation.md, "Bounded work"). Each validation is estimated before any
+// state is compared, from n and a timed probe, and refused beyond a budget of time
+// (ValidationOptions::budget, `femdyn validate --budget`) or of memory (half the memory
+// available, /proc/meminfo's MemAvailable, unless ValidationOptions::memory_limit says
+// otherwise). Up to kDenseMassLimit coordinates M^s is compared entry by entry (Simbody's calcM,
+// n² numbers); beyond, by its products M^s V with kMassProducts seeded random vectors
+// (Simbody's O(n) multiplyByM), so that no n x n matrix but femdyn's own M^s is formed.
+inline constexpr double kDefaultBudget = 120;  // s
+inline constexpr int kDenseMassLimit = 1000;
+inline constexpr int kMassProducts = 4;
 
 struct ValidationOptions {
   int states = 20;  // K seeded random states
@@ -29,6 +43,34 @@ struct ValidationOptions {
   double max_rk4_steps = 1e5;        // or the finer run would take more steps than this
   double resolved_tolerance = 1e-6;  // the trajectory check fails as unresolved above this
   double simbody_accuracy = 1e-10;
+  double budget = kDefaultBudget;  // s: estimated beyond it, refused; the trajectory's
+                                   // refinement and Simbody's runs stop at it
+  double memory_limit = 0;         // bytes; 0: half of the available memory
+  // Called now and then with the work done and the work planned, in estimated seconds (for a
+  // progress line); from the calling thread.
+  std::function<void(double done, double total)> progress;
+};
+
+// What a validation will cost, estimated before any state is compared (Validator).
+struct WorkEstimate {
+  int n = 0, states = 0;
+  bool dense_mass = true;   // M^s entry by entry (n <= kDenseMassLimit), else by products
+  double setup = 0;         // s spent building the twin and probing (already spent)
+  double per_state = 0;     // s: one pointwise state, both engines
+  double pointwise = 0;     // s: the K states
+  double trajectory = 0;    // s: the trajectory as usually refined (docs/validation.md)
+  double bytes = 0;         // peak memory of the check beyond the loaded model (B)
+  double budget = 0;        // s
+  double memory_limit = 0;  // B; infinite where the available memory is unknown
+  bool at_least = false;    // Simbody's probe ran out of time: the estimate is a lower bound
+  double seconds() const { return pointwise + trajectory; }
+  bool within() const { return seconds() <= budget && bytes <= memory_limit; }
+};
+
+// Refused up front: what() is the one line Validator::refusal gives.
+class OverBudget : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
 };
 
 // One compared quantity: max over the states of ‖x_femdyn − x_simbody‖∞ and of that divided by
@@ -53,7 +95,15 @@ struct TrajectoryReport {
   std::vector<double> t, error;                                // the state error over time
   std::vector<double> energy_femdyn,
       energy_simbody;  // E(t) of both runs (J; each with its own zero)
-  bool pass() const { return !run || (resolved && max_state_error <= tolerance); }
+  // Why the comparison could not be made within the budget (Simbody's runs stopped): it fails.
+  std::string stopped;
+  // Why femdyn's RK4 step was not halved down to its target, if it was not ("not halved beyond
+  // dt = …": the budget, the step limit; "not halved further": Simbody's own error already too
+  // large for the comparison to resolve the motion).
+  std::string refinement;
+  bool pass() const {
+    return stopped.empty() && (!run || (resolved && max_state_error <= tolerance));
+  }
 };
 
 struct ValidationReport {
@@ -63,10 +113,41 @@ struct ValidationReport {
   TrajectoryReport trajectory;
   std::vector<std::string> notes;  // e.g. approximations the model makes on purpose
   std::string failure;             // why no comparison could be made (then it fails)
+  bool dense_mass = true;          // "M" entry by entry; else ‖ΔM^s V‖∞ / ‖M^s V‖∞
+  WorkEstimate estimate;
+  double wall_time = 0;  // s: the whole validation, the twin and the probes included
   bool pass() const;
 };
 
+// One validation in two steps: the constructor builds the Simbody twin and times a probe
+// (femdyn's forward and inverse dynamics, its evaluate() up to 3000 coordinates, its energy;
+// Simbody's equations and inverse dynamics, and the first twentieth of its trajectory, within
+// budget / 83 s), then estimate() says what run() would cost and refusal() whether that is
+// beyond the budget. The model must outlive the Validator; run() is called once.
+class Validator {
+ public:
+  Validator(const Model& model, ValidationOptions options);
+  ~Validator();
+  Validator(const Validator&) = delete;
+  Validator& operator=(const Validator&) = delete;
+
+  const WorkEstimate& estimate() const;
+  // "" within the budget and the memory limit, else one line naming `label` (the model file),
+  // n, the estimated time and memory, the budget, and how to proceed.
+  std::string refusal(const std::string& label) const;
+  ValidationReport run();  // the comparison (whatever the estimate)
+  void set_progress(std::function<void(double done, double total)> progress);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Validator(model, options).run(), or OverBudget (naming model.where) beyond the budget.
 ValidationReport validate(const Model& model, const ValidationOptions& options = {});
+
+// Half of /proc/meminfo's MemAvailable (B), or infinity where it cannot be read.
+double default_memory_limit();
 
 // For a model read from a URDF file: femdyn's M^s, h, Q against an independent Simbody model
 // built straight from the XML (urdf_twin.hpp), at the same seeded states. Returns the quantity

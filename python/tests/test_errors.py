@@ -150,6 +150,52 @@ def test_tau_at_the_limit_is_accepted(finger):
 
 
 @pytest.mark.skipif(not femdyn.with_simbody, reason="built without Simbody")
+def test_validate_refuses_work_beyond_its_budget_as_the_cli_does(tmp_path):
+    """A 10,000-body chain is estimated before any state and refused at once with a ValueError
+    whose message is the line `femdyn validate` prints (the estimates differ a little from run to
+    run: the form is compared). The time is a generous guard, not a speed claim."""
+    import re
+    import subprocess
+    import time
+
+    from conftest import BINARY
+
+    path = tmp_path / "chain10000.json"
+    path.write_text(json.dumps({"model": "random_tree",
+                                "params": {"seed": 3, "bodies": 10000, "branching": 0}}))
+    chain = femdyn.load(str(path))
+    start = time.monotonic()
+    with pytest.raises(ValueError) as e:
+        femdyn.validate(chain, budget=30)
+    assert time.monotonic() - start < 60
+    message = str(e.value)
+    cli = subprocess.run([str(BINARY), "validate", str(path), "--budget", "30"],
+                         capture_output=True, text=True)
+    assert cli.returncode == 1 and cli.stdout == ""
+    line = cli.stderr.strip()
+    assert "\n" not in line and line.startswith("femdyn validate: ")
+    numbers = re.compile(r"\d+(\.\d+)?( (s|min|h|days|kB|MB|GB))?")
+    assert numbers.sub("#", message) == numbers.sub("#", line[len("femdyn validate: "):])
+    assert message.startswith(f"{path}: validating n = 10000 coordinates would take ")
+    assert "beyond the budget of 30 s: use --t-end 0 (t_end=0: no trajectory" in message
+    assert "(budget=)" in message
+    with pytest.raises(ValueError, match=r"^budget: expected a positive number of seconds"):
+        femdyn.validate(chain, budget=0)
+    with pytest.raises(ValueError, match=r"^max_memory: expected a positive number of GB"):
+        femdyn.validate(chain, max_memory=-1.0)
+
+
+@pytest.mark.skipif(not femdyn.with_simbody, reason="built without Simbody")
+def test_validate_reports_its_work(finger):
+    r = femdyn.validate(finger, states=2, t_end=0.01, samples=2, max_memory=1.0)
+    assert r["pass"]
+    w = r["work"]
+    assert w["budget_s"] == 120 and w["memory_limit_bytes"] == 1e9
+    assert w["mass_comparison"] == "entries"
+    assert 0 < w["estimated_s"] and 0 < w["wall_time_s"]
+
+
+@pytest.mark.skipif(not femdyn.with_simbody, reason="built without Simbody")
 def test_validate_caps_t_end_as_the_cli_does(finger):
     """The trajectory limit is the CLI's --t-end limit (validation::kMaxTrajectoryTime), which
     `femdyn validate --t-end` reports in its own error; both refuse just above it."""
