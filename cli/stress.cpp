@@ -32,7 +32,9 @@ inertia, near-singular postures, a chain of 1000 links, zero gravity and 1000 g,
 zero-mass chain end. For each: cond(M^s) along the motion, symmetry and definiteness, the
 largest stable step of rk4 and euler (bisection of real runs), every integrator's error at a
 fixed step or tolerance, the energy balance, agreement with Simbody, and a verdict: stable,
-stable only with bdf, ill-conditioned, or refused with the reason.
+stable only with bdf (stiff and dissipative), stiff and undamped (bdf stays stable only by
+damping the fast mode numerically: remove, damp or resolve it, as femdyn check says),
+ill-conditioned, or refused with the reason.
 Writes DIR/stress.md and DIR/stress.csv (default DIR ./stress; existing files need --force).
 --quick: a subset of each class, smaller sizes. --class NAME: one class (springs, ratios,
 speeds, slender bars, postures, size, gravity, singular). --json: the results on stdout.

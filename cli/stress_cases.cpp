@@ -89,7 +89,12 @@ std::vector<StressCase> stress_cases(bool quick) {
                    {0}};
       s.t_end = w >= 1e4 ? 0.02 : w >= 1e3 ? 0.2 : 2;
       s.dt = 1e-4;
-      s.expect = w >= 1e5 ? "stable only with bdf" : "stable";
+      // The stiffest mode: ω undamped, the fast real root ω(ζ + √(ζ² − 1)) overdamped; stiff
+      // when RK4's limit (2.83/ω, 2.785/|λ|) is below the 1e-4 s of an ordinary step.
+      const double fastest = zeta >= 1 ? w * (zeta + std::sqrt(zeta * zeta - 1)) : w;
+      s.expect = 2.8 / fastest >= 1e-4 ? "stable"
+                 : zeta >= 0.5         ? "stable only with bdf"
+                                       : "stiff and undamped";
       c.push_back(s);
     }
   // Mass and length ratios in one chain.

@@ -26,7 +26,8 @@ Builds each model's Simbody twin (same tree, each body's mass properties from it
 elements, same forces) and compares, at K seeded random states (default 20; q within joint
 limits or ±π rad / ±0.5 m, q̇ in ±V, default 2, τ in ±1, q̈ in ±5): M^s, h, Q, q̈ and inverse
 dynamics τ, each as max abs and max relative error ‖femdyn − Simbody‖∞ / ‖Simbody‖∞, against
-the tolerance X (default 1e-10). For a URDF file, also the import itself ("import"): M^s, h, Q
+the tolerance X (default max(1e-10, ε·d²) for a tree d bodies deep: round-off grows with d;
+docs/validation.md). For a URDF file, also the import itself ("import"): M^s, h, Q
 against a second Simbody model built straight from the XML, not from femdyn's reading of it.
 A model with a nonlinear coupling law or a rod spanning two bodies gets a closed-loop twin:
 every joint a mobilizer, each law a coordinate coupler, each rod a body on a LineOrientation
@@ -195,7 +196,10 @@ int cmd_validate(int argc, char** argv) {
   o.states = positive_int(a, "states", o.states, 1);
   o.seed = static_cast<unsigned>(positive_int(a, "seed", static_cast<int>(o.seed), 0));
   o.t_end = nonnegative(a, "t-end", o.t_end);
-  o.tolerance = nonnegative(a, "tol", o.tolerance);
+  if (a.has("tol")) {
+    o.tolerance = nonnegative(a, "tol", o.tolerance);
+    if (!(o.tolerance > 0 && o.tolerance < 1)) throw CliError("--tol expects a number in (0, 1)");
+  }
   o.qd_scale = nonnegative(a, "qd-scale", o.qd_scale);
   if (o.t_end > validation::kMaxTrajectoryTime)
     throw CliError("--t-end expects at most " + format_number(validation::kMaxTrajectoryTime) +

@@ -14,8 +14,8 @@ namespace femdyn::python {
 #ifdef FEMDYN_WITH_SIMBODY
 namespace {
 
-py::dict validate(const PyModel& self, int states, unsigned seed, double tolerance, double t_end,
-                  int samples, double budget, std::optional<double> max_memory) {
+py::dict validate(const PyModel& self, int states, unsigned seed, std::optional<double> tolerance,
+                  double t_end, int samples, double budget, std::optional<double> max_memory) {
   if (states < 1) throw py::value_error("states: expected an integer >= 1");
   // The CLI's limit on --t-end (validation::kMaxTrajectoryTime), shared, not copied.
   if (!(t_end >= 0 && t_end <= validation::kMaxTrajectoryTime))
@@ -23,7 +23,8 @@ py::dict validate(const PyModel& self, int states, unsigned seed, double toleran
                           format_number(validation::kMaxTrajectoryTime) +
                           "] s (0: no trajectory; the limit of femdyn validate --t-end)");
   if (samples < 1) throw py::value_error("samples: expected an integer >= 1");
-  if (!(tolerance > 0)) throw py::value_error("tolerance: expected a number > 0");
+  if (tolerance && !(*tolerance > 0 && *tolerance < 1))
+    throw py::value_error("tolerance: expected a number in (0, 1), or None for the default");
   if (!(budget > 0 && budget < 1e9))
     throw py::value_error("budget: expected a positive number of seconds (below 1e9)");
   if (max_memory && !(*max_memory > 0 && *max_memory < 1e9))
@@ -31,7 +32,7 @@ py::dict validate(const PyModel& self, int states, unsigned seed, double toleran
   validation::ValidationOptions o;
   o.states = states;
   o.seed = seed;
-  o.tolerance = tolerance;
+  if (tolerance) o.tolerance = *tolerance;
   o.t_end = t_end;
   o.samples = samples;
   o.budget = budget;
@@ -107,11 +108,12 @@ py::dict validate(const PyModel& self, int states, unsigned seed, double toleran
 void bind_validate(py::module_& m) {
 #ifdef FEMDYN_WITH_SIMBODY
   m.def("validate", &validate, py::arg("model"), py::arg("states") = 20, py::arg("seed") = 1,
-        py::arg("tolerance") = 1e-10, py::arg("t_end") = 0.25, py::arg("samples") = 50,
+        py::arg("tolerance") = py::none(), py::arg("t_end") = 0.25, py::arg("samples") = 50,
         py::arg("budget") = validation::kDefaultBudget, py::arg("max_memory") = py::none(),
         "The model against its Simbody twin (docs/validation.md): M, h, Q, qdd, tau at `states` "
         "seeded random states and a passive trajectory of t_end s (what `femdyn validate` does, "
-        "less its URDF import check). Estimated first: beyond `budget` seconds or `max_memory` "
+        "less its URDF import check); tolerance None is the CLI's default, max(1e-10, eps d^2) "
+        "for a tree d bodies deep. Estimated first: beyond `budget` seconds or `max_memory` "
         "GB (default: half the available memory) a ValueError with `femdyn validate`'s message. "
         "Returns a dict: quantities {name: {max_abs, max_rel, tolerance, pass}}, trajectory "
         "{...}, notes, work, failure, pass. The GIL is released.");

@@ -606,3 +606,28 @@ TEST_CASE("validation beyond a tiny budget or memory limit is refused; validate(
     CHECK_THAT(what, Catch::Contains("beyond the budget of 1e-07 s: use "));
   }
 }
+
+TEST_CASE("the default pointwise tolerance is 1e-10, and eps d^2 on trees deeper than 670 bodies",
+          "[validation][bounds]") {
+  const double eps = std::numeric_limits<double>::epsilon();
+  CHECK(validation::pointwise_tolerance(load_model(model_path("finger_coupled.json"))) == 1e-10);
+  CHECK(validation::pointwise_tolerance(plugin_chain(600)) == 1e-10);
+  // d is the longest path, not the count of bodies: a chain of 2000 against a branching tree.
+  CHECK(validation::pointwise_tolerance(plugin_chain(2000)) ==
+        Approx(eps * 2000 * 2000).epsilon(1e-12));
+  const Model tree = load_text(
+      R"({"model": "random_tree", "params": {"seed": 5, "bodies": 2000, "branching": 0.5}})");
+  int depth = 0;
+  std::vector<int> d(tree.bodies.size(), 1);
+  for (std::size_t b = 0; b < tree.bodies.size(); ++b) {
+    if (tree.bodies[b].parent >= 0) d[b] = d[tree.bodies[b].parent] + 1;
+    depth = std::max(depth, d[b]);
+  }
+  CHECK(depth < 2000);
+  CHECK(validation::pointwise_tolerance(tree) == std::max(1e-10, eps * depth * depth));
+  // An explicit tolerance is held as given.
+  ValidationOptions o = quick(1, 0);
+  o.tolerance = 1e-9;
+  const ValidationReport r = validation::validate(plugin_chain(50), o);
+  for (const auto& q : r.quantities) CHECK(q.tolerance == 1e-9);
+}

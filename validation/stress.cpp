@@ -69,9 +69,12 @@ StressResult run_stress(const Model& m, const StressScenario& s) {
   if (const Status st = forward_dynamics(m, ws, s.q0, s.qd0, VecX::Zero(m.n())); !st.ok)
     return refused_case("at the initial state: " + st.message);
   Linearization lin;
+  bool stiffest_dissipative = false;  // the stiffness bdf cures (femdyn check's rule)
   if (!s.large) {
     lin = linearize(m, ws, s.q0, s.qd0, VecX::Zero(m.n()));
     r.stiffest = std::abs(lin.stiffest);
+    if (const std::vector<Mode> md = modes(lin, has_dampers(m)); !md.empty())
+      stiffest_dissipative = md.front().dissipative();
   }
 
   // Reference: Dormand–Prince, or BDF when Dormand–Prince cannot (stiff).
@@ -203,9 +206,13 @@ StressResult run_stress(const Model& m, const StressScenario& s) {
   else if (r.cond_max > 1e12)
     r.verdict = "ill-conditioned: cond(M^s) up to " + format_short(r.cond_max) +
                 ", q̈ loses about " + format_short(std::log10(r.cond_max)) + " of 16 digits";
-  else if (stiff)
+  else if (stiff && stiffest_dissipative)
     r.verdict =
         "stable only with bdf: rk4 needs dt < " + format_short(rk4.largest_stable_step) + " s";
+  else if (stiff)  // as femdyn check advises: bdf is stable here, but by damping the oscillation
+    r.verdict = "stiff and undamped: rk4 needs dt < " + format_short(rk4.largest_stable_step) +
+                " s; bdf stays stable only by damping the mode numerically (remove, damp or "
+                "resolve it)";
   else
     r.verdict = "stable";
   return r;

@@ -617,9 +617,10 @@ struct Validator::Impl {
       o.progress(done, total);
     };
     SimbodyTwin& tw = *twin;
+    const double tol = o.tolerance > 0 ? o.tolerance : pointwise_tolerance(m);
     for (const char* name : {"M", "h", "Q", "qdd", "tau"})
-      r.quantities.push_back({name, 0, 0, o.tolerance});
-    if (tm.closed_loop()) r.quantities.push_back({"loop", 0, 0, o.tolerance});
+      r.quantities.push_back({name, 0, 0, tol});
+    if (tm.closed_loop()) r.quantities.push_back({"loop", 0, 0, tol});
     QuantityError &eM = r.quantities[0], &eh = r.quantities[1], &eQ = r.quantities[2],
                   &eqdd = r.quantities[3], &etau = r.quantities[4];
     // The loop's closure at femdyn's θ = g(q), θ̇ = G q̇: Simbody's constraint errors relative
@@ -678,6 +679,17 @@ struct Validator::Impl {
     return r;
   }
 };
+
+double pointwise_tolerance(const Model& m) {
+  std::vector<int> depth(m.bodies.size(), 1);  // bodies on the path from the world
+  int d = 0;
+  for (std::size_t b = 0; b < m.bodies.size(); ++b) {
+    if (const int p = m.bodies[b].parent; p >= 0) depth[b] = depth[p] + 1;  // parents first
+    d = std::max(d, depth[b]);
+  }
+  const double eps = std::numeric_limits<double>::epsilon();
+  return std::max(1e-10, eps * d * d);
+}
 
 Validator::Validator(const Model& model, ValidationOptions options)
     : impl_(std::make_unique<Impl>(model, std::move(options))) {}
@@ -744,7 +756,7 @@ ValidationReport validate(const Model& m, const ValidationOptions& o) {
 
 QuantityError validate_urdf_import(const Model& m, const std::string& path,
                                    const ValidationOptions& o, std::string& failure) {
-  QuantityError e{"import", 0, 0, o.tolerance};
+  QuantityError e{"import", 0, 0, o.tolerance > 0 ? o.tolerance : pointwise_tolerance(m)};
   std::unique_ptr<UrdfTwin> twin;
   try {
     twin = std::make_unique<UrdfTwin>(path, m.gravity);
