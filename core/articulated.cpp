@@ -5,7 +5,7 @@
 
 #include "core/body_inertia.hpp"
 #include "core/body_loads.hpp"
-#include "core/joint.hpp"
+#include "core/joints/kernel.hpp"
 #include "core/kinematics.hpp"
 
 namespace femdyn {
@@ -13,7 +13,7 @@ namespace {
 
 // τ_b on joint j: the actuation and the joint's spring and damper (C = I: θ = q).
 double joint_force(const Joint& J, const Workspace& ws, const VecX& tau) {
-  const int j = J.theta;
+  const int j = J.idx_v;
   return (tau.size() > j ? tau[j] : 0.0) + spring_damper_force(J, ws.theta[j], ws.theta_dot[j]);
 }
 
@@ -36,7 +36,7 @@ Status check_regularity(const Model& model, Workspace& ws) {
       scale = std::max(scale, S.dot(ws.composite[b] * S));
     }
   for (int b = 0; b < nb; ++b) {
-    const int j = model.bodies[b].joint.theta;
+    const int j = model.bodies[b].joint.idx_v;
     if (j < 0) continue;
     const Vec6& S = ws.articulated[b].S;
     const double Mbb = S.dot(ws.composite[b] * S);
@@ -45,7 +45,7 @@ Status check_regularity(const Model& model, Workspace& ws) {
   }
   // Pivots in elimination order, leaves first: a lost pivot makes its ancestors' NaN.
   for (int b = nb - 1; b >= 0; --b) {
-    const int j = model.bodies[b].joint.theta;
+    const int j = model.bodies[b].joint.idx_v;
     if (j < 0) continue;
     const Vec6& S = ws.articulated[b].S;
     if (!(ws.articulated[b].d >= 1e-13 * S.dot(ws.composite[b] * S)))
@@ -70,8 +70,8 @@ Status articulated_forward_dynamics(const Model& model, Workspace& ws, const Vec
     A.V = body.parent >= 0 ? ws.articulated[body.parent].V : Vec6::Zero();
     A.c.setZero();
     if (moves(body.joint)) {
-      A.S = motion_subspace(body.joint, B.R, B.p);
-      const Vec6 vj = A.S * ws.theta_dot[body.joint.theta];
+      A.S = spatial_column(body.joint, B.R, B.p, 0);  // one rate (choose_routes)
+      const Vec6 vj = A.S * ws.theta_dot[body.joint.idx_v];
       A.V += vj;
       A.c = cross_motion(A.V, vj);
     }
@@ -122,7 +122,7 @@ Status articulated_forward_dynamics(const Model& model, Workspace& ws, const Vec
     A.a = (body.parent >= 0 ? ws.articulated[body.parent].a : a_base) + A.c;
     if (!moves(body.joint)) continue;
     const double qdd = (A.u - A.U.dot(A.a)) / A.d;
-    ws.qdd[body.joint.theta] = qdd;
+    ws.qdd[body.joint.idx_v] = qdd;
     A.a += A.S * qdd;
   }
   return {};

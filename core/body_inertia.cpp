@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "core/joint.hpp"
+#include "core/joints/kernel.hpp"
 #include "core/limits.hpp"
 
 namespace femdyn {
@@ -88,9 +88,13 @@ void choose_routes(Model& m) {
   // h and τ: the body-level recursion is exact under the same conditions (couplings are
   // linear), and it is O(bodies) instead of O(N_u) (measured faster on every model).
   m.force_route = m.condensable && m.velocity_forces_rigid ? ForceRoute::Bodies : ForceRoute::Nodes;
-  m.dynamics_route = m.condensable && m.velocity_forces_rigid && m.identity_coupling
-                         ? DynamicsRoute::Articulated
-                         : DynamicsRoute::Cholesky;
+  // The articulated recursion pivots on one rate per body (core/articulated.cpp).
+  const bool one_rate_joints =
+      std::all_of(m.bodies.begin(), m.bodies.end(), [](const Body& b) { return b.joint.nv <= 1; });
+  m.dynamics_route =
+      m.condensable && m.velocity_forces_rigid && m.identity_coupling && one_rate_joints
+          ? DynamicsRoute::Articulated
+          : DynamicsRoute::Cholesky;
 }
 
 MassProperties body_mass_properties(const Model& m, int body) {
@@ -119,48 +123,54 @@ void composite_mass(const Model& m, Workspace& ws) {
   const int nb = static_cast<int>(m.bodies.size());
   composite_inertias(m, ws);
   for (int b = 0; b < nb; ++b)
-    ws.subspace[b] = motion_subspace(m.bodies[b].joint, ws.body[b].R, ws.body[b].p);
+    if (const Joint& J = m.bodies[b].joint; moves(J))
+      spatial_columns(J, ws.body[b].R, ws.body[b].p, ws.subspace.data() + J.idx_v);
   mass_from_composites(m, ws);
 }
+
+namespace {
+
+// Calls f(k, i, S_kᵀ I^c_b S_i) for every rate i of body b's joint and every rate k ≤ i of the
+// joints on b's path (b's own included): the entries of M^s's upper triangle that b's
+// composite inertia gives.
+template <class F>
+void for_path_entries(const Model& m, const Workspace& ws, int b, F&& f) {
+  const Joint& Jb = m.bodies[b].joint;
+  for (int i = Jb.idx_v; i < Jb.idx_v + Jb.nv; ++i) {
+    const Vec6 F_i = ws.composite[b] * ws.subspace[i];
+    for (int a = b; a >= 0; a = m.bodies[a].parent) {
+      const Joint& Ja = m.bodies[a].joint;
+      for (int k = Ja.idx_v; k < Ja.idx_v + Ja.nv && k <= i; ++k) f(k, i, ws.subspace[k].dot(F_i));
+    }
+  }
+}
+
+}  // namespace
 
 void mass_from_composites(const Model& m, Workspace& ws) {
   const int nb = static_cast<int>(m.bodies.size());
   if (m.identity_coupling) {
-    // M^s(k, i) = S_kᵀ I^c_b S_i for the joints k on the path of b (k < i: the upper
+    // M^s(k, i) = S_kᵀ I^c_b S_i for the rates k on the path of b (k ≤ i: the upper
     // triangle, column i written contiguously). The entries off every path are structural
     // zeros, written as zeros when the Workspace is made and never touched: no n² clearing.
-    for (int b = 0; b < nb; ++b) {
-      const int i = m.bodies[b].joint.theta;
-      if (i < 0) continue;
-      const Vec6 F = ws.composite[b] * ws.subspace[b];
-      for (int a = b; a >= 0; a = m.bodies[a].parent) {
-        const int k = m.bodies[a].joint.theta;
-        if (k >= 0) ws.Ms(k, i) = ws.subspace[a].dot(F);
-      }
-    }
+    for (int b = 0; b < nb; ++b)
+      for_path_entries(m, ws, b, [&](int k, int i, double v) { ws.Ms(k, i) = v; });
     return;
   }
   // With couplings, M^s = Cᵀ M_θ C = Σ_{k,i} C_kᵀ M_θ(k, i) C_i over the rows C_k of C: each
-  // path entry M_θ(k, i) (k an ancestor joint of i, or i itself) is scattered through the
+  // path entry M_θ(k, i) (k an ancestor rate of i, or i itself) is scattered through the
   // non-zeros of rows k and i, once for (k, i) and once for (i, k). O(Σ depth · nnz²) and
   // symmetric as built; no M_θ is formed.
   ws.Ms.setZero();
-  for (int b = 0; b < nb; ++b) {
-    const int i = m.bodies[b].joint.theta;
-    if (i < 0) continue;
-    const Vec6 F = ws.composite[b] * ws.subspace[b];
-    for (int a = b; a >= 0; a = m.bodies[a].parent) {
-      const int k = m.bodies[a].joint.theta;
-      if (k < 0) continue;
-      const double v = ws.subspace[a].dot(F);
+  for (int b = 0; b < nb; ++b)
+    for_path_entries(m, ws, b, [&](int k, int i, double v) {
       for (SpRowMat::InnerIterator ck(m.C_sparse, k); ck; ++ck)
         for (SpRowMat::InnerIterator ci(m.C_sparse, i); ci; ++ci) {
           const double w = ck.value() * v * ci.value();
           ws.Ms(ck.col(), ci.col()) += w;
           if (k != i) ws.Ms(ci.col(), ck.col()) += w;
         }
-    }
-  }
+    });
 }
 
 }  // namespace femdyn

@@ -8,6 +8,7 @@
 #include "core/compile_level.hpp"
 #include "core/correlation.hpp"
 #include "core/errors.hpp"
+#include "core/joints/kernel.hpp"
 #include "core/limits.hpp"
 #include "core/mass_solver.hpp"
 #include "core/model.hpp"
@@ -78,10 +79,7 @@ Joint compile_joint(const JointSpec& js, const std::string& body_name) {
     if (!(norm > 1e-12)) throw ModelError(js.where + "/axis", "axis is zero");
     j.axis = js.axis / norm;
   }
-  const Mat3 K = skew(j.axis);
-  j.R_pj_K = j.R_pj * K;
-  j.R_pj_K2 = j.R_pj_K * K;
-  j.axis_parent = j.R_pj * j.axis;
+  prepare_joint(j);
   for (auto [x, what] :
        {std::pair{js.stiffness, "stiffness"}, {js.rest, "rest"}, {js.damping, "damping"}})
     check_magnitude(x, js.where, what);
@@ -226,9 +224,10 @@ Model compile_tree(MechanismSpec spec) {
       throw ModelError(bs.joint.where + "/name", "duplicate joint name '" + b.joint.name + "'");
     b.parent = bs.parent == "world" ? -1 : compiled.at(bs.parent);  // (placed before: tree order)
     compiled.emplace(bs.name, static_cast<int>(k));
-    if (b.joint.type != JointType::Fixed) {
-      b.joint.theta = static_cast<int>(m.theta_joint.size());
-      m.theta_joint.push_back(static_cast<int>(k));
+    // Addresses in θ and θ̇ (equal while every joint has nq = nv), in tree order.
+    if (moves(b.joint)) {
+      b.joint.idx_q = b.joint.idx_v = static_cast<int>(m.theta_joint.size());
+      for (int r = 0; r < b.joint.nv; ++r) m.theta_joint.push_back(static_cast<int>(k));
     }
     m.bodies.push_back(std::move(b));
   }

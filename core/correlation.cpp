@@ -8,7 +8,7 @@
 
 #include "core/equations.hpp"
 #include "core/errors.hpp"
-#include "core/joint.hpp"
+#include "core/joints/kernel.hpp"
 #include "core/kinematics.hpp"
 #include "core/limits.hpp"
 #include "core/names.hpp"
@@ -24,10 +24,11 @@ constexpr const char* kAxis[] = {"x", "y", "z"};
 std::pair<int, Vec3> canonical_point(const Model& m, int b, Vec3 r) {
   while (m.bodies[b].parent >= 0) {
     const Joint& j = m.bodies[b].joint;
-    const bool on_axis =
-        j.type == JointType::Revolute && r.cross(j.axis).norm() <= 1e-12 * (1.0 + r.norm());
-    if (!(j.type == JointType::Fixed || on_axis)) break;
-    r = j.R_pj * r + j.p_pj;
+    if (!fixes_point(j, r)) break;
+    Mat3 R;
+    Vec3 p;
+    neutral_pose(j, R, p);  // the point is where it is at any θ_J
+    r = R * r + p;
     b = m.bodies[b].parent;
   }
   return {b, r};
@@ -100,14 +101,15 @@ struct TSamples {
 // of one sweep,
 //   translation k of a node at x:  revolute (s_a × (x − o_a))_k,  prismatic (s_a)_k
 //   rotation k of body b:           revolute (R_b e_k)·s_a,        prismatic 0,
-// Each entry is a linear functional of the joint's motion subspace S_a = (s_a, o_a × s_a)
-// (core/joint.hpp): T_ia = S_a · w_i with w = (x × e_k, e_k) for a translation, (R_b e_k, 0) for
-// a rotation. So the whole row is bounded by |P_b w| · max_a |S_a|, P_b the projector on the
-// span of the S_a along the path, kept per body as an orthonormal basis of at most six vectors
-// (O(1) per body). A row under the tolerance by that bound (every left-out DOF, e.g. the z of a
-// planar chain) costs O(1); otherwise the path is scanned, stopping at the first entry above
-// `enough` (only whether a row exceeds the tolerance is used), which for a DOF that moves is
-// near its own body. O(N_u + bodies) time, O(N_u + bodies) memory instead of the dense N_u × n T.
+// Each entry is a linear functional of a column of the joint's motion subspace, as a spatial
+// motion S_a (core/joints/kernel.hpp; revolute (s_a, o_a × s_a)): T_ia = S_a · w_i with w = (x ×
+// e_k, e_k) for a translation, (R_b e_k, 0) for a rotation. So the whole row is bounded by |P_b w|
+// · max_a |S_a|, P_b the projector on the span of the S_a along the path, kept per body as an
+// orthonormal basis of at most six vectors (O(1) per body). A row under the tolerance by that bound
+// (every left-out DOF, e.g. the z of a planar chain) costs O(1); otherwise the path is scanned,
+// stopping at the first entry above `enough` (only whether a row exceeds the tolerance is used),
+// which for a DOF that moves is near its own body. O(N_u + bodies) time, O(N_u + bodies) memory
+// instead of the dense N_u × n T.
 struct PathSpan {
   std::array<Vec6, 6> basis;  // orthonormal
   int size = 0;
@@ -125,23 +127,23 @@ void row_max_by_paths(const Model& m, Workspace& ws, std::vector<PathSpan>& span
   for (int b = 0; b < nb; ++b) {  // parents first
     const Body& B = m.bodies[b];
     span[b] = B.parent >= 0 ? span[B.parent] : PathSpan{};
-    if (B.joint.theta < 0) continue;
-    const Vec6 S = motion_subspace(B.joint, ws.body[b].R, ws.body[b].p);
-    PathSpan& P = span[b];
-    P.s_max = std::max(P.s_max, S.norm());
-    Vec6 r = S;  // Gram–Schmidt, twice for orthogonality in floating point
-    for (int pass = 0; pass < 2; ++pass)
-      for (int k = 0; k < P.size; ++k) r -= P.basis[k].dot(r) * P.basis[k];
-    if (P.size < 6 && r.norm() > 1e-9 * S.norm()) P.basis[P.size++] = r.normalized();
-  }
-  const auto over_path = [&](int body, auto&& entry) {
-    double big = 0;
-    for (int a = body; a >= 0 && big <= enough; a = m.bodies[a].parent) {
-      const Joint& j = m.bodies[a].joint;
-      if (j.theta < 0) continue;
-      const Vec3 s = ws.body[a].R * j.axis;
-      big = std::max(big, std::abs(entry(j, s, ws.body[a].p)));
+    for (int c = 0; c < B.joint.nv; ++c) {
+      const Vec6 S = spatial_column(B.joint, ws.body[b].R, ws.body[b].p, c);
+      PathSpan& P = span[b];
+      P.s_max = std::max(P.s_max, S.norm());
+      Vec6 r = S;  // Gram–Schmidt, twice for orthogonality in floating point
+      for (int pass = 0; pass < 2; ++pass)
+        for (int k = 0; k < P.size; ++k) r -= P.basis[k].dot(r) * P.basis[k];
+      if (P.size < 6 && r.norm() > 1e-9 * S.norm()) P.basis[P.size++] = r.normalized();
     }
+  }
+  // max |T_ia| = max |S_a · w| over the columns a of the joints on the path.
+  const auto over_path = [&](int body, const Vec6& w) {
+    double big = 0;
+    for (int a = body; a >= 0 && big <= enough; a = m.bodies[a].parent)
+      for (int c = 0; c < m.bodies[a].joint.nv; ++c)
+        big = std::max(
+            big, std::abs(spatial_column(m.bodies[a].joint, ws.body[a].R, ws.body[a].p, c).dot(w)));
     return big;
   };
   for (int i = 0; i < m.n_u(); ++i) {
@@ -154,18 +156,12 @@ void row_max_by_paths(const Model& m, Workspace& ws, std::vector<PathSpan>& span
       const Vec3 e = Vec3::Unit(d.axis);
       w << x.cross(e), e;
       big = span[node.body].bound(w);
-      if (big > enough)
-        big = over_path(node.body, [&](const Joint& j, const Vec3& s, const Vec3& o) {
-          return j.type == JointType::Revolute ? s.cross(x - o)[d.axis] : s[d.axis];
-        });
+      if (big > enough) big = over_path(node.body, w);
     } else {
       const Vec3 e = ws.body[d.carrier].R.col(d.axis);
       w << e, Vec3::Zero();
       big = span[d.carrier].bound(w);
-      if (big > enough)
-        big = over_path(d.carrier, [&](const Joint& j, const Vec3& s, const Vec3&) {
-          return j.type == JointType::Revolute ? e.dot(s) : 0.0;
-        });
+      if (big > enough) big = over_path(d.carrier, w);
     }
     row_max[i] = std::max(row_max[i], big);
   }

@@ -3,7 +3,7 @@
 #include "core/body_inertia.hpp"
 #include "core/body_loads.hpp"
 #include "core/coupling.hpp"
-#include "core/joint.hpp"
+#include "core/joints/kernel.hpp"
 #include "core/kinematics.hpp"
 
 namespace femdyn {
@@ -26,9 +26,11 @@ Status coupled_forward_dynamics(const Model& model, Workspace& ws, const VecX& q
       A.V.setZero();
       A.a = gravity_base_acceleration(model);
     }
-    ws.subspace[b] = motion_subspace(body.joint, B.R, B.p);
     if (moves(body.joint)) {
-      const Vec6 vj = ws.subspace[b] * ws.theta_dot[body.joint.theta];
+      const Joint& J = body.joint;
+      spatial_columns(J, B.R, B.p, ws.subspace.data() + J.idx_v);
+      Vec6 vj = Vec6::Zero();
+      for (int k = 0; k < J.nv; ++k) vj += ws.subspace[J.idx_v + k] * ws.theta_dot[J.idx_v + k];
       A.V += vj;
       A.a += cross_motion(A.V, vj);
     }
@@ -41,7 +43,8 @@ Status coupled_forward_dynamics(const Model& model, Workspace& ws, const VecX& q
   for (int b = nb - 1; b >= 0; --b) {
     const Body& body = model.bodies[b];
     const ArticulatedBody& A = ws.articulated[b];
-    if (moves(body.joint)) ws.tau_theta[body.joint.theta] = -ws.subspace[b].dot(A.pA);
+    for (int k = 0; k < body.joint.nv; ++k)
+      ws.tau_theta[body.joint.idx_v + k] = -ws.subspace[body.joint.idx_v + k].dot(A.pA);
     if (body.parent >= 0) {
       ws.articulated[body.parent].pA += A.pA;
       ws.composite[body.parent] += ws.composite[b];

@@ -9,7 +9,7 @@
 #include "core/coupled_dynamics.hpp"
 #include "core/coupling.hpp"
 #include "core/coupling_chain.hpp"
-#include "core/joint.hpp"
+#include "core/joints/kernel.hpp"
 #include "core/kinematics.hpp"
 #include "core/mass_solver.hpp"
 #include "core/newton_euler.hpp"

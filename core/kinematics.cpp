@@ -1,61 +1,81 @@
 #include "core/kinematics.hpp"
 
+#include <array>
+
 #include "core/coupling.hpp"
 #include "core/coupling_chain.hpp"
-#include "core/joint.hpp"
+#include "core/joints/kernel.hpp"
 
 namespace femdyn {
 namespace {
 
+// Tree level, one body: its pose, rates and biases from its parent's, through its joint J
+// (core/joints/kernel.hpp). With Δω, Δv the joint's rates at B's origin (world axes) along x
+// and along y, and r = p_B − p_P:
+//   ω_B = ω_P + Δω(x),   v_B = v_P + ω_P × r + Δv(x)
+//   α_B = α_P + ω_B(y) × Δω(x)                                 (d_y of R_B S_ω x)
+//   a_B = a_P + α_P × r + ω_P(x) × (ω_P(y) × r + Δv(y)) + ω_B(y) × Δv(x)
+// (d_y r = ω_P(y) × r + Δv(y); d_y R_B S_v x = ω_B(y) × Δv(x); S_J is constant in B).
+template <class J>
+void tree_step(const Model& model, Workspace& ws, int b, const KinematicsRequest& req) {
+  static const BodyState root;
+  const Joint& j = model.bodies[b].joint;
+  const int parent = model.bodies[b].parent;
+  const BodyState& P = parent < 0 ? root : ws.body[parent];
+  BodyState& B = ws.body[b];
+
+  Mat3 R_J;
+  Vec3 p_J;
+  J::pose(j, J::nq > 0 ? ws.theta.data() + j.idx_q : nullptr, R_J, p_J);
+  B.R.noalias() = P.R * R_J;
+  B.p.noalias() = P.p + P.R * p_J;
+  const Vec3 r = B.p - P.p;
+
+  std::array<Vec3, J::nv + 1> s_w, s_v;  // the columns of S_J in world axes (one spare: nv = 0)
+  for (int k = 0; k < J::nv; ++k) {
+    s_w[k] = world_angular<J>(j, B.R, k);
+    s_v[k] = world_linear<J>(j, B.R, k);
+  }
+  if (req.bias) {
+    Vec3 dw_x = Vec3::Zero(), dw_y = Vec3::Zero(), dv_x = Vec3::Zero(), dv_y = Vec3::Zero();
+    for (int k = 0; k < J::nv; ++k) {
+      const double x = ws.theta_dot[j.idx_v + k], y = ws.theta_dot_y[j.idx_v + k];
+      if constexpr (J::angular) dw_x += s_w[k] * x, dw_y += s_w[k] * y;
+      if constexpr (J::linear) dv_x += s_v[k] * x, dv_y += s_v[k] * y;
+    }
+    B.w = P.w + dw_x;
+    B.w_y = P.w_y + dw_y;
+    B.v = P.v + P.w.cross(r) + dv_x;
+    B.alpha = P.alpha + B.w_y.cross(dw_x);
+    B.a = P.a + P.alpha.cross(r) + P.w.cross(P.w_y.cross(r) + dv_y) + B.w_y.cross(dv_x);
+  }
+  if (req.jacobian) {
+    auto Jw = ws.Jw.middleRows<3>(3 * b);
+    auto Jv = ws.Jv.middleRows<3>(3 * b);
+    if (parent < 0) {
+      Jw.setZero();
+      Jv.setZero();
+    } else {
+      Jw = ws.Jw.middleRows<3>(3 * parent);
+      Jv = ws.Jv.middleRows<3>(3 * parent);
+      Jv.noalias() -= skew(r) * ws.Jw.middleRows<3>(3 * parent);
+    }
+    for (int k = 0; k < J::nv; ++k) {
+      if constexpr (J::angular) coupling_add_row(model, j.idx_v + k, s_w[k], Jw);
+      if constexpr (J::linear) coupling_add_row(model, j.idx_v + k, s_v[k], Jv);
+    }
+  }
+}
+
 // Tree level: body poses, rates and biases, parents first.
 void propagate_tree(const Model& model, Workspace& ws, KinematicsRequest req) {
-  const BodyState root;
   const auto nb = static_cast<Eigen::Index>(model.bodies.size());
   if (req.jacobian && ws.Jw.rows() != 3 * nb) {  // first use only
     ws.Jw.setZero(3 * nb, model.n());
     ws.Jv.setZero(3 * nb, model.n());
   }
-  for (std::size_t b = 0; b < model.bodies.size(); ++b) {
-    const Joint& j = model.bodies[b].joint;
-    const int parent = model.bodies[b].parent;
-    const BodyState& P = parent < 0 ? root : ws.body[parent];
-    BodyState& B = ws.body[b];
-
-    const Vec3 origin = P.p + P.R * j.p_pj;
-    const Vec3 s = P.R * j.axis_parent;  // the joint axis in world (unchanged by its own turn)
-    const double th = j.theta >= 0 ? ws.theta[j.theta] : 0.0;
-    const double thd = j.theta >= 0 ? ws.theta_dot[j.theta] : 0.0;
-    const double thd_y = j.theta >= 0 ? ws.theta_dot_y[j.theta] : 0.0;
-    const bool rev = j.type == JointType::Revolute;
-    const bool pri = j.type == JointType::Prismatic;
-
-    B.R.noalias() = P.R * joint_rotation(j, th);
-    B.p = pri ? Vec3(origin + s * th) : origin;
-    const Vec3 r = B.p - P.p;
-
-    if (req.bias) {
-      B.w = P.w + (rev ? Vec3(s * thd) : Vec3::Zero());
-      B.w_y = P.w_y + (rev ? Vec3(s * thd_y) : Vec3::Zero());
-      B.v = P.v + P.w.cross(r) + (pri ? Vec3(s * thd) : Vec3::Zero());
-      B.alpha = P.alpha + (rev ? Vec3(P.w_y.cross(s) * thd) : Vec3::Zero());
-      B.a = P.a + P.alpha.cross(r) + P.w.cross(P.w_y.cross(r));
-      if (pri) B.a += P.w.cross(s) * thd_y + P.w_y.cross(s) * thd;
-    }
-    if (req.jacobian) {
-      auto Jw = ws.Jw.middleRows<3>(3 * b);
-      auto Jv = ws.Jv.middleRows<3>(3 * b);
-      if (parent < 0) {
-        Jw.setZero();
-        Jv.setZero();
-      } else {
-        Jw = ws.Jw.middleRows<3>(3 * parent);
-        Jv = ws.Jv.middleRows<3>(3 * parent);
-        Jv.noalias() -= skew(r) * ws.Jw.middleRows<3>(3 * parent);
-      }
-      if (rev) coupling_add_row(model, j.theta, s, Jw);
-      if (pri) coupling_add_row(model, j.theta, s, Jv);
-    }
-  }
+  for (int b = 0; b < static_cast<int>(nb); ++b)
+    visit_joint(model.bodies[b].joint.type, [&]<class J>(J) { tree_step<J>(model, ws, b, req); });
 }
 
 // Node level: rows of T, T'[q̇,q̇] and u̇ for every kept transition coordinate.
@@ -156,10 +176,15 @@ void apply_transpose(const Model& model, Workspace& ws, const VecX& f, VecX& y,
   for (int b = nb - 1; b >= 0; --b) {  // children after parents in the list: leaves first
     const Body& body = model.bodies[b];
     const Joint& j = body.joint;
-    if (j.theta >= 0) {
-      const Vec3 s = ws.body[b].R * j.axis;  // the body frame is the joint frame after motion
-      ws.tau_theta[j.theta] = s.dot(j.type == JointType::Revolute ? ws.moment[b] : ws.force[b]);
-    }
+    // τ_k = s_ω,k · N_b + s_v,k · F_b: the power of the wrench (about B's origin) per rate.
+    visit_joint(j.type, [&]<class J>(J) {
+      for (int k = 0; k < J::nv; ++k) {
+        double t = 0;
+        if constexpr (J::angular) t += world_angular<J>(j, ws.body[b].R, k).dot(ws.moment[b]);
+        if constexpr (J::linear) t += world_linear<J>(j, ws.body[b].R, k).dot(ws.force[b]);
+        ws.tau_theta[j.idx_v + k] = t;
+      }
+    });
     if (body.parent >= 0) {
       const Vec3 r = ws.body[b].p - ws.body[body.parent].p;
       ws.force[body.parent] += ws.force[b];

@@ -45,7 +45,8 @@ void propagate_bilinear(const Model& model, Workspace& ws, const VecX& q, const 
 // node x pushes e_k f_i at x, a rotation DOF turns by f_i about the body axis R_b e_k), the
 // wrenches are accumulated from the leaves to the root,
 //     F_p += F_b,   N_p += N_b + (p_b − p_p) × F_b,
-// and projected on each joint's world axis s: τ_θ = sᵀ N_b (revolute), sᵀ F_b (prismatic);
+// and projected on each column of each joint's S (core/joints/kernel.hpp), τ_k = s_ω,kᵀ N_b +
+// s_v,kᵀ F_b (revolute: sᵀ N_b, prismatic: sᵀ F_b);
 // then y = Cᵀ τ_θ. O(N_u + bodies). Uses the body poses of the last propagate.
 void apply_transpose(const Model& model, Workspace& ws, const VecX& f, VecX& y,
                      double torque_scale = 0);

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <stdexcept>
 
+#include "core/joints/kernel.hpp"
+
 namespace femdyn {
 namespace {
 
@@ -30,8 +32,8 @@ Pattern coordinate_pattern(const Model& model) {
   for (int b = 0; b < nb; ++b) {
     const Body& B = model.bodies[b];
     if (B.parent >= 0) std::copy_n(row(moves, B.parent), w, row(moves, b));
-    if (B.joint.theta >= 0)
-      for (SpRowMat::InnerIterator it(model.C_sparse, B.joint.theta); it; ++it)
+    for (int t = B.joint.idx_v; t < B.joint.idx_v + B.joint.nv; ++t)
+      for (SpRowMat::InnerIterator it(model.C_sparse, t); it; ++it)
         row(moves, b)[it.col() / 64] |= std::uint64_t{1} << (it.col() % 64);
   }
   sub = moves;
@@ -40,10 +42,10 @@ Pattern coordinate_pattern(const Model& model) {
       for (std::size_t k = 0; k < w; ++k) row(sub, model.bodies[b].parent)[k] |= row(sub, b)[k];
   Pattern p{n, w, std::vector<std::uint64_t>(static_cast<std::size_t>(n) * w, 0)};
   for (int b = 0; b < nb; ++b) {
-    const int t = model.bodies[b].joint.theta;
-    if (t < 0) continue;
-    for (SpRowMat::InnerIterator it(model.C_sparse, t); it; ++it)
-      for (std::size_t k = 0; k < w; ++k) p.bits[it.col() * w + k] |= row(sub, b)[k];
+    const Joint& J = model.bodies[b].joint;
+    for (int t = J.idx_v; t < J.idx_v + J.nv; ++t)
+      for (SpRowMat::InnerIterator it(model.C_sparse, t); it; ++it)
+        for (std::size_t k = 0; k < w; ++k) p.bits[it.col() * w + k] |= row(sub, b)[k];
   }
   return p;
 }
@@ -103,18 +105,20 @@ std::vector<int> fill_reducing_order(const Pattern& p) {
   return order;
 }
 
-// λ for a tree without couplings, straight from the bodies: the coordinate of the nearest
-// moving ancestor joint. Coordinates are numbered in tree order, so λ(a) < a. O(bodies).
+// λ for a tree without couplings, straight from the bodies: the last rate of the nearest
+// moving ancestor joint for a joint's first rate, the rate before it for the others (a joint's
+// rates are one dense block). Coordinates are numbered in tree order, so λ(a) < a. O(bodies).
 std::vector<int> tree_without_coupling(const Model& model) {
   const int nb = static_cast<int>(model.bodies.size());
   std::vector<int> nearest(nb, -1), lambda(model.n(), -1);  // nearest moving joint at or above b
   for (int b = 0; b < nb; ++b) {
     const Body& B = model.bodies[b];
     const int above = B.parent >= 0 ? nearest[B.parent] : -1;
-    nearest[b] = B.joint.theta >= 0 ? B.joint.theta : above;
-    if (B.joint.theta >= 0) {
-      if (above >= B.joint.theta) return {};
-      lambda[B.joint.theta] = above;
+    const Joint& J = B.joint;
+    nearest[b] = moves(J) ? J.idx_v + J.nv - 1 : above;
+    if (moves(J)) {
+      if (above >= J.idx_v) return {};
+      for (int k = 0; k < J.nv; ++k) lambda[J.idx_v + k] = k == 0 ? above : J.idx_v + k - 1;
     }
   }
   return lambda;

@@ -28,11 +28,12 @@ struct Joint {
   Mat3 R_pj = Mat3::Identity();  // joint frame orientation in the parent body frame
   Vec3 p_pj = Vec3::Zero();      // joint frame origin in the parent body frame
   Vec3 axis = Vec3::UnitZ();     // unit, joint frame
-  int theta = -1;                // index in θ; -1 for a fixed joint
+  int nq = 0, nv = 0;            // its coordinates and rates (core/joints/kernel.hpp)
+  int idx_q = -1, idx_v = -1;    // its first coordinate in θ, first rate in θ̇; -1 when fixed
   double lower = 0, upper = 0;
   double stiffness = 0, rest = 0, damping = 0;
   std::string where;
-  // Derived by compile() for the tree sweep (core/joint.hpp): R_pj [a]×, R_pj [a]×², R_pj a.
+  // Derived by compile() for the pose (core/joints/): R_pj [a]×, R_pj [a]×², R_pj a.
   Mat3 R_pj_K = Mat3::Zero(), R_pj_K2 = Mat3::Zero();
   Vec3 axis_parent = Vec3::UnitZ();
 };

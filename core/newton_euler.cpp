@@ -2,7 +2,7 @@
 
 #include "core/body_loads.hpp"
 #include "core/coupling.hpp"
-#include "core/joint.hpp"
+#include "core/joints/kernel.hpp"
 #include "core/kinematics.hpp"
 
 namespace femdyn {
@@ -57,13 +57,16 @@ void newton_euler(const Model& model, Workspace& ws, const VecX& q, const VecX& 
       A.V.setZero();
       A.a = a_base;
     }
-    if (moves(body.joint)) {
-      const int j = body.joint.theta;
-      A.S = motion_subspace(body.joint, B.R, B.p);
-      const Vec6 vj = A.S * ws.theta_dot[j];
+    if (moves(body.joint)) {  // v_J = S θ̇_J; a += V × v_J (+ S θ̈_J)
+      const Joint& J = body.joint;
+      const Vec6* S = ws.subspace.data() + J.idx_v;
+      spatial_columns(J, B.R, B.p, ws.subspace.data() + J.idx_v);
+      Vec6 vj = Vec6::Zero();
+      for (int k = 0; k < J.nv; ++k) vj += S[k] * ws.theta_dot[J.idx_v + k];
       A.V += vj;
       A.a += cross_motion(A.V, vj);
-      if (qdd) A.a += A.S * ws.theta_dot_y[j];
+      if (qdd)
+        for (int k = 0; k < J.nv; ++k) A.a += S[k] * ws.theta_dot_y[J.idx_v + k];
     }
     B.w = A.V.head<3>();
     A.pA = body_force(model.body_inertia[b], B.R, B.p, A.V, A.a);
@@ -73,7 +76,8 @@ void newton_euler(const Model& model, Workspace& ws, const VecX& q, const VecX& 
   for (int b = nb - 1; b >= 0; --b) {
     const Body& body = model.bodies[b];
     const ArticulatedBody& A = ws.articulated[b];
-    if (moves(body.joint)) ws.tau_theta[body.joint.theta] = A.S.dot(A.pA);
+    for (int k = 0; k < body.joint.nv; ++k)  // τ_k = S_kᵀ f
+      ws.tau_theta[body.joint.idx_v + k] = ws.subspace[body.joint.idx_v + k].dot(A.pA);
     if (body.parent >= 0) ws.articulated[body.parent].pA += A.pA;
   }
   coupling_apply_transpose(model, ws.tau_theta, y);

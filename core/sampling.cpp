@@ -6,6 +6,8 @@
 #include <numbers>
 #include <string>
 
+#include "core/joints/kernel.hpp"
+
 namespace femdyn {
 
 namespace {
@@ -42,7 +44,7 @@ VecX random_posture(const Model& m, std::mt19937& rng) {
     // ±π for a revolute joint, ±0.5 m for a prismatic one, narrowed to the joint's limits; a
     // range that the limits exclude entirely is the limits' first 2π (or 1 m), never wider,
     // so that huge limits (±1e308) never give a huge or infinite draw.
-    const double half = joint && joint->type == JointType::Prismatic ? 0.5 : std::numbers::pi;
+    const double half = joint ? random_half_range(*joint) : std::numbers::pi;
     double lo = -half, hi = half;
     if (joint) {
       lo = std::max(lo, joint->lower);

@@ -11,10 +11,9 @@
 
 #include "core/coupling_function.hpp"
 #include "core/element.hpp"
+#include "core/joints/joint_type.hpp"
 
 namespace femdyn {
-
-enum class JointType { Revolute, Prismatic, Fixed };
 
 struct JointSpec {
   std::string name;

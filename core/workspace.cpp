@@ -20,7 +20,7 @@ Workspace::Workspace(const Model& model) : solver(model) {
   nodal = VecX::Zero(N);
   u_acc = VecX::Zero(N);
   composite.assign(nb, RigidInertia{});
-  subspace.assign(nb, Vec6::Zero());
+  subspace.assign(model.n_theta(), Vec6::Zero());
   if (model.dynamics_route == DynamicsRoute::Articulated || model.force_route == ForceRoute::Bodies)
     articulated.assign(nb, ArticulatedBody{});
   force.assign(nb, Vec3::Zero());

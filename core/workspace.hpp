@@ -49,7 +49,8 @@ struct Workspace {
   VecX u_acc;  // T q̈ + T'[q̇,q̇] (inverse dynamics); also the nodal forces
                // plus the body torques in generalized_force (N_u)
   std::vector<RigidInertia> composite;  // per body: composite inertia I^c_b (world, origin)
-  std::vector<Vec6> subspace;           // per body: its joint's motion subspace S (world, origin)
+  std::vector<Vec6> subspace;  // per rate of θ̇: its column of S (world, origin), at the joint's
+                               // idx_v (core/joints/kernel.hpp)
   std::vector<ArticulatedBody> articulated;  // per body, for the body-level routes only
   std::vector<Vec3> force, moment;  // per body: wrench of Tᵀ f (world; moment about the origin)
   VecX tau_theta;                   // Tᵀ f on the joint coordinates θ

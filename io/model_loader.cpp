@@ -29,11 +29,8 @@ std::string line_col(const std::string& text, std::size_t byte) {
 
 JointType joint_type(const Params& p) {
   const std::string t = p.string("type");
-  if (t == "revolute" || t == "continuous") return JointType::Revolute;
-  if (t == "prismatic") return JointType::Prismatic;
-  if (t == "fixed") return JointType::Fixed;
-  p.fail("type",
-         "unknown joint type '" + t + "' (expected revolute, continuous, prismatic or fixed)");
+  if (const auto type = joint_type_named(t)) return *type;
+  p.fail("type", "unknown joint type '" + t + "' (expected " + joint_type_list() + ")");
 }
 
 JointSpec read_joint(const Params& p) {

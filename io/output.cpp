@@ -7,6 +7,7 @@
 #include <sstream>
 #include <system_error>
 
+#include "core/joints/kernel.hpp"
 #include "io/atomic_file.hpp"
 
 namespace femdyn {
@@ -120,29 +121,27 @@ std::string info_text(const Model& model) {
   out << "joints (" << model.n_theta() << " movable):\n";
   for (const Body& b : model.bodies) {
     const Joint& j = b.joint;
-    const char* type = j.type == JointType::Revolute    ? "revolute"
-                       : j.type == JointType::Prismatic ? "prismatic"
-                                                        : "fixed";
+    const std::string_view type = joint_type_name(j.type);
     out << "  " << j.name << " (" << type << ") "
         << (b.parent < 0 ? std::string("world") : model.bodies[b.parent].name) << " -> " << b.name;
     const CoupledJoint* law = nullptr;
     if (model.coupling_level)
       for (const CoupledJoint& c : model.coupling_level->coupled)
-        if (c.theta == j.theta) law = &c;
+        if (c.theta == j.idx_q) law = &c;
     if (law) {  // θ = f(θ_followed…)
       out << "   theta = " << law->law->form() << " of";
       for (int s : law->sources) out << " " << model.bodies[model.theta_joint[s]].joint.name;
-    } else if (j.theta >= 0) {
+    } else if (moves(j)) {
       out << "   theta =";
       bool first = true;
-      for (SpRowMat::InnerIterator it(model.C_sparse, j.theta); it; ++it) {
+      for (SpRowMat::InnerIterator it(model.C_sparse, j.idx_v); it; ++it) {
         const double c = it.value();
         if (c == 0) continue;
         out << (first ? " " : " + ") << (c == 1 ? "" : num(c) + "*")
             << model.coordinate_names[it.col()];
         first = false;
       }
-      if (model.theta0[j.theta] != 0) out << " + " << model.theta0[j.theta];
+      if (model.theta0[j.idx_q] != 0) out << " + " << model.theta0[j.idx_q];
     }
     out << "\n";
   }

@@ -102,15 +102,11 @@ JointSpec joint_arg(const std::optional<std::string>& type_in,
   }
   const std::string type = type_in.value_or("fixed");
   JointSpec j;
-  if (type == "revolute" || type == "continuous")
-    j.type = JointType::Revolute;
-  else if (type == "prismatic")
-    j.type = JointType::Prismatic;
-  else if (type == "fixed")
-    j.type = JointType::Fixed;
+  if (const auto named = joint_type_named(type))
+    j.type = *named;
   else
-    throw py::value_error("joint type: unknown '" + type +
-                          "' (expected revolute, continuous, prismatic or fixed)");
+    throw py::value_error("joint type: unknown '" + type + "' (expected " + joint_type_list() +
+                          ")");
   if (j.type == JointType::Fixed)
     for (const auto& [arg, given] : motion)
       if (given)

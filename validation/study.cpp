@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "core/integrator.hpp"
+#include "core/joints/kernel.hpp"
 #include "validation/twin.hpp"
 #include "validation/validate.hpp"
 
@@ -75,8 +76,8 @@ struct Measure {
     const int nt = m.n_theta();
     for (int half = 0; half < 2; ++half)
       for (int j = 0; j < nt; ++j) {
-        const bool prismatic = m.bodies[m.theta_joint[j]].joint.type == JointType::Prismatic;
-        group.push_back((prismatic ? 2 : 0) + half);
+        const Joint& J = m.bodies[m.theta_joint[j]].joint;
+        group.push_back((is_translation(J, j - J.idx_v) ? 2 : 0) + half);
       }
     for (const VecX& x : ref)
       for (std::size_t i = 0; i < group.size(); ++i) {

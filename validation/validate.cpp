@@ -16,6 +16,7 @@
 #include "core/errors.hpp"
 #include "core/fixed_step.hpp"
 #include "core/inertia.hpp"
+#include "core/joints/kernel.hpp"
 #include "core/kinematics.hpp"
 #include "core/math.hpp"
 #include "core/model.hpp"
@@ -37,7 +38,7 @@ std::vector<int> path_joints(const Model& m, int a, int b) {
   std::vector<int> out;
   for (const auto* side : {&up_a, &up_b})
     for (int x : *side)
-      if (m.bodies[x].joint.theta >= 0) out.push_back(m.bodies[x].joint.theta);
+      if (moves(m.bodies[x].joint)) out.push_back(m.bodies[x].joint.idx_q);
   return out;
 }
 
@@ -148,7 +149,7 @@ TwinModel twin_model(const Model& m) {
     tb.R_pj = j.R_pj;
     tb.p_pj = j.p_pj;
     tb.axis = j.axis;
-    tb.theta = j.theta;
+    tb.theta = j.idx_q;
     tb.stiffness = j.stiffness;
     tb.rest = j.rest;
     tb.damping = j.damping;
@@ -374,9 +375,9 @@ struct Validator::Impl {
           m.identity_coupling ? 1.0
                               : std::pow(m.C.nonZeros() / std::max(1.0, double(m.n_theta())), 2);
       for (const Body& b : m.bodies) {
-        if (b.joint.theta < 0) continue;
+        if (!moves(b.joint)) continue;
         for (int a = &b - m.bodies.data(); a >= 0; a = m.bodies[a].parent)
-          if (m.bodies[a].joint.theta >= 0) path_entries += per_entry;
+          if (moves(m.bodies[a].joint)) path_entries += per_entry;
       }
       t_eval =
           2 * t_id + kSecondsPerPathEntry * path_entries + kSecondsPerMatrixEntry * double(n) * n;

@@ -1,0 +1,22 @@
+// Fixed joint: the child B is welded to its parent at the joint frame. X_J = identity, no
+// coordinate, S has no column.
+#pragma once
+#include "core/model.hpp"
+
+namespace femdyn {
+
+struct FixedJoint {
+  static constexpr int nq = 0, nv = 0;
+  static constexpr bool angular = false, linear = false;
+
+  static void pose(const Joint& j, const double*, Mat3& R, Vec3& p) {
+    R = j.R_pj;
+    p = j.p_pj;
+  }
+  static Vec3 S_angular(const Joint&, int) { return Vec3::Zero(); }
+  static Vec3 S_linear(const Joint&, int) { return Vec3::Zero(); }
+  static void prepare(Joint&) {}
+  static constexpr double kRandomHalfRange = 0;
+};
+
+}  // namespace femdyn
