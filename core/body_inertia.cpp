@@ -130,31 +130,24 @@ void composite_mass(const Model& m, Workspace& ws) {
 
 namespace {
 
-// Calls f(k, i, S_kᵀ I^c_b S_i) for every rate i of body b's joint and every rate k ≤ i of the
-// joints on b's path (b's own included): the entries of M^s's upper triangle that b's
-// composite inertia gives.
+// Calls f(k, i, S_kᵀ I^c_b S_i) for every rate i (of body b = theta_joint[i]) and every rate
+// k = i, λ(i), λ(λ(i)), … on its path: the entries of M^s's upper triangle (k ≤ i).
 template <class F>
-void for_path_entries(const Model& m, const Workspace& ws, int b, F&& f) {
-  const Joint& Jb = m.bodies[b].joint;
-  for (int i = Jb.idx_v; i < Jb.idx_v + Jb.nv; ++i) {
-    const Vec6 F_i = ws.composite[b] * ws.subspace[i];
-    for (int a = b; a >= 0; a = m.bodies[a].parent) {
-      const Joint& Ja = m.bodies[a].joint;
-      for (int k = Ja.idx_v; k < Ja.idx_v + Ja.nv && k <= i; ++k) f(k, i, ws.subspace[k].dot(F_i));
-    }
+void for_path_entries(const Model& m, const Workspace& ws, F&& f) {
+  for (int i = 0; i < m.n_theta(); ++i) {
+    const Vec6 F_i = ws.composite[m.theta_joint[i]] * ws.subspace[i];
+    for (int k = i; k >= 0; k = m.rate_parent[k]) f(k, i, ws.subspace[k].dot(F_i));
   }
 }
 
 }  // namespace
 
 void mass_from_composites(const Model& m, Workspace& ws) {
-  const int nb = static_cast<int>(m.bodies.size());
   if (m.identity_coupling) {
-    // M^s(k, i) = S_kᵀ I^c_b S_i for the rates k on the path of b (k ≤ i: the upper
+    // M^s(k, i) = S_kᵀ I^c_b S_i for the rates k on the path of i (k ≤ i: the upper
     // triangle, column i written contiguously). The entries off every path are structural
     // zeros, written as zeros when the Workspace is made and never touched: no n² clearing.
-    for (int b = 0; b < nb; ++b)
-      for_path_entries(m, ws, b, [&](int k, int i, double v) { ws.Ms(k, i) = v; });
+    for_path_entries(m, ws, [&](int k, int i, double v) { ws.Ms(k, i) = v; });
     return;
   }
   // With couplings, M^s = Cᵀ M_θ C = Σ_{k,i} C_kᵀ M_θ(k, i) C_i over the rows C_k of C: each
@@ -162,15 +155,14 @@ void mass_from_composites(const Model& m, Workspace& ws) {
   // non-zeros of rows k and i, once for (k, i) and once for (i, k). O(Σ depth · nnz²) and
   // symmetric as built; no M_θ is formed.
   ws.Ms.setZero();
-  for (int b = 0; b < nb; ++b)
-    for_path_entries(m, ws, b, [&](int k, int i, double v) {
-      for (SpRowMat::InnerIterator ck(m.C_sparse, k); ck; ++ck)
-        for (SpRowMat::InnerIterator ci(m.C_sparse, i); ci; ++ci) {
-          const double w = ck.value() * v * ci.value();
-          ws.Ms(ck.col(), ci.col()) += w;
-          if (k != i) ws.Ms(ci.col(), ck.col()) += w;
-        }
-    });
+  for_path_entries(m, ws, [&](int k, int i, double v) {
+    for (SpRowMat::InnerIterator ck(m.C_sparse, k); ck; ++ck)
+      for (SpRowMat::InnerIterator ci(m.C_sparse, i); ci; ++ci) {
+        const double w = ck.value() * v * ci.value();
+        ws.Ms(ck.col(), ci.col()) += w;
+        if (k != i) ws.Ms(ci.col(), ck.col()) += w;
+      }
+  });
 }
 
 }  // namespace femdyn

@@ -213,6 +213,7 @@ Model compile_tree(MechanismSpec spec) {
   std::vector<int> body_of_spec(spec.bodies.size());
   std::set<std::string> joint_names;
   std::map<std::string, int> compiled;  // body name -> index in m.bodies
+  std::vector<int> last_rate;           // body -> the last rate on its path, -1 for none
   for (std::size_t k = 0; k < order.size(); ++k) {
     const BodySpec& bs = spec.bodies[order[k]];
     body_of_spec[order[k]] = static_cast<int>(k);
@@ -224,10 +225,15 @@ Model compile_tree(MechanismSpec spec) {
       throw ModelError(bs.joint.where + "/name", "duplicate joint name '" + b.joint.name + "'");
     b.parent = bs.parent == "world" ? -1 : compiled.at(bs.parent);  // (placed before: tree order)
     compiled.emplace(bs.name, static_cast<int>(k));
-    // Addresses in θ and θ̇ (equal while every joint has nq = nv), in tree order.
+    // Addresses in θ and θ̇ (equal while every joint has nq = nv), in tree order, and λ.
+    last_rate.push_back(b.parent >= 0 ? last_rate[b.parent] : -1);
     if (moves(b.joint)) {
       b.joint.idx_q = b.joint.idx_v = static_cast<int>(m.theta_joint.size());
-      for (int r = 0; r < b.joint.nv; ++r) m.theta_joint.push_back(static_cast<int>(k));
+      for (int r = 0; r < b.joint.nv; ++r) {
+        m.rate_parent.push_back(last_rate.back());
+        last_rate.back() = static_cast<int>(m.theta_joint.size());
+        m.theta_joint.push_back(static_cast<int>(k));
+      }
     }
     m.bodies.push_back(std::move(b));
   }

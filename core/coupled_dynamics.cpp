@@ -26,14 +26,9 @@ Status coupled_forward_dynamics(const Model& model, Workspace& ws, const VecX& q
       A.V.setZero();
       A.a = gravity_base_acceleration(model);
     }
-    if (moves(body.joint)) {
-      const Joint& J = body.joint;
-      spatial_columns(J, B.R, B.p, ws.subspace.data() + J.idx_v);
-      Vec6 vj = Vec6::Zero();
-      for (int k = 0; k < J.nv; ++k) vj += ws.subspace[J.idx_v + k] * ws.theta_dot[J.idx_v + k];
-      A.V += vj;
-      A.a += cross_motion(A.V, vj);
-    }
+    if (const Joint& J = body.joint; moves(J))
+      add_joint_motion(J, B.R, B.p, ws.theta_dot.data() + J.idx_v, nullptr,
+                       ws.subspace.data() + J.idx_v, A.V, A.a);
     const RigidInertia I = inertia_at_origin(model.body_inertia[b], B.R, B.p);
     A.pA = I * A.a + cross_force(A.V, I * A.V);
     ws.composite[b] = I;

@@ -17,8 +17,8 @@ namespace {
 //   a_B = a_P + α_P × r + ω_P(x) × (ω_P(y) × r + Δv(y)) + ω_B(y) × Δv(x)
 // (d_y r = ω_P(y) × r + Δv(y); d_y R_B S_v x = ω_B(y) × Δv(x); S_J is constant in B).
 template <class J>
-void tree_step(const Model& model, Workspace& ws, int b, const KinematicsRequest& req) {
-  static const BodyState root;
+[[gnu::always_inline]] inline void tree_step(const Model& model, Workspace& ws, int b,
+                                             const KinematicsRequest& req, const BodyState& root) {
   const Joint& j = model.bodies[b].joint;
   const int parent = model.bodies[b].parent;
   const BodyState& P = parent < 0 ? root : ws.body[parent];
@@ -32,10 +32,11 @@ void tree_step(const Model& model, Workspace& ws, int b, const KinematicsRequest
   const Vec3 r = B.p - P.p;
 
   std::array<Vec3, J::nv + 1> s_w, s_v;  // the columns of S_J in world axes (one spare: nv = 0)
-  for (int k = 0; k < J::nv; ++k) {
-    s_w[k] = world_angular<J>(j, B.R, k);
-    s_v[k] = world_linear<J>(j, B.R, k);
-  }
+  if (req.bias || req.jacobian)
+    for (int k = 0; k < J::nv; ++k) {
+      if constexpr (J::angular) s_w[k] = world_angular<J>(j, B.R, k);
+      if constexpr (J::linear) s_v[k] = world_linear<J>(j, B.R, k);
+    }
   if (req.bias) {
     Vec3 dw_x = Vec3::Zero(), dw_y = Vec3::Zero(), dv_x = Vec3::Zero(), dv_y = Vec3::Zero();
     for (int k = 0; k < J::nv; ++k) {
@@ -74,8 +75,10 @@ void propagate_tree(const Model& model, Workspace& ws, KinematicsRequest req) {
     ws.Jw.setZero(3 * nb, model.n());
     ws.Jv.setZero(3 * nb, model.n());
   }
+  const BodyState root;
   for (int b = 0; b < static_cast<int>(nb); ++b)
-    visit_joint(model.bodies[b].joint.type, [&]<class J>(J) { tree_step<J>(model, ws, b, req); });
+    visit_joint(model.bodies[b].joint.type,
+                [&]<class J>(J) { tree_step<J>(model, ws, b, req, root); });
 }
 
 // Node level: rows of T, T'[q̇,q̇] and u̇ for every kept transition coordinate.

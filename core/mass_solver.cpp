@@ -105,25 +105,6 @@ std::vector<int> fill_reducing_order(const Pattern& p) {
   return order;
 }
 
-// λ for a tree without couplings, straight from the bodies: the last rate of the nearest
-// moving ancestor joint for a joint's first rate, the rate before it for the others (a joint's
-// rates are one dense block). Coordinates are numbered in tree order, so λ(a) < a. O(bodies).
-std::vector<int> tree_without_coupling(const Model& model) {
-  const int nb = static_cast<int>(model.bodies.size());
-  std::vector<int> nearest(nb, -1), lambda(model.n(), -1);  // nearest moving joint at or above b
-  for (int b = 0; b < nb; ++b) {
-    const Body& B = model.bodies[b];
-    const int above = B.parent >= 0 ? nearest[B.parent] : -1;
-    const Joint& J = B.joint;
-    nearest[b] = moves(J) ? J.idx_v + J.nv - 1 : above;
-    if (moves(J)) {
-      if (above >= J.idx_v) return {};
-      for (int k = 0; k < J.nv; ++k) lambda[J.idx_v + k] = k == 0 ? above : J.idx_v + k - 1;
-    }
-  }
-  return lambda;
-}
-
 }  // namespace
 
 double mass_matrix_fill(const Model& model) {
@@ -138,7 +119,8 @@ double mass_matrix_fill(const Model& model) {
 std::vector<int> coordinate_tree(const Model& model) {
   const int n = model.n();
   if (model.explicit_table || n == 0) return {};
-  if (model.identity_coupling) return tree_without_coupling(model);
+  // Without couplings q = θ̇: λ is compile's, over the joints' rates (Model::rate_parent).
+  if (model.identity_coupling) return model.rate_parent;
   const Pattern p = coordinate_pattern(model);
   std::vector<int> lambda(n, -1);
   for (int a = 0; a < n; ++a) {

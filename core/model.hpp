@@ -125,6 +125,9 @@ struct Model {
   Vec3 gravity = Vec3::Zero();
   std::vector<Body> bodies;      // parents before children
   std::vector<int> theta_joint;  // θ index -> body index of its joint
+  std::vector<int> rate_parent;  // θ̇ index -> λ, the rate before it on its path to the world
+                                 // (a joint's previous column, else the last rate of the nearest
+                                 // moving ancestor joint); -1 at the world. λ(i) < i.
 
   // Coupling level θ = C q + θ0 (nθ x n, sparse: the identity is n entries, not n²).
   SpMat C;

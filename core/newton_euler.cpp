@@ -57,17 +57,10 @@ void newton_euler(const Model& model, Workspace& ws, const VecX& q, const VecX& 
       A.V.setZero();
       A.a = a_base;
     }
-    if (moves(body.joint)) {  // v_J = S θ̇_J; a += V × v_J (+ S θ̈_J)
-      const Joint& J = body.joint;
-      const Vec6* S = ws.subspace.data() + J.idx_v;
-      spatial_columns(J, B.R, B.p, ws.subspace.data() + J.idx_v);
-      Vec6 vj = Vec6::Zero();
-      for (int k = 0; k < J.nv; ++k) vj += S[k] * ws.theta_dot[J.idx_v + k];
-      A.V += vj;
-      A.a += cross_motion(A.V, vj);
-      if (qdd)
-        for (int k = 0; k < J.nv; ++k) A.a += S[k] * ws.theta_dot_y[J.idx_v + k];
-    }
+    if (const Joint& J = body.joint; moves(J))  // V += S θ̇_J; a += V × S θ̇_J (+ S θ̈_J)
+      add_joint_motion(J, B.R, B.p, ws.theta_dot.data() + J.idx_v,
+                       qdd ? ws.theta_dot_y.data() + J.idx_v : nullptr,
+                       ws.subspace.data() + J.idx_v, A.V, A.a);
     B.w = A.V.head<3>();
     A.pA = body_force(model.body_inertia[b], B.R, B.p, A.V, A.a);
   }

@@ -12,8 +12,9 @@ namespace femdyn {
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 
-// a × b for motion vectors: (ω_a × ω_b, ω_a × v_b + v_a × ω_b).
-inline Vec6 cross_motion(const Vec6& a, const Vec6& b) {
+// a × b for motion vectors: (ω_a × ω_b, ω_a × v_b + v_a × ω_b). These small products are
+// always inlined: the recursions call them per body, and a call costs as much as the product.
+[[gnu::always_inline]] inline Vec6 cross_motion(const Vec6& a, const Vec6& b) {
   Vec6 r;
   r.head<3>() = a.head<3>().cross(b.head<3>());
   r.tail<3>() = a.head<3>().cross(b.tail<3>()) + a.tail<3>().cross(b.head<3>());
@@ -21,7 +22,7 @@ inline Vec6 cross_motion(const Vec6& a, const Vec6& b) {
 }
 
 // a ×* f for a motion a and a force f = (n, f): (ω × n + v × f, ω × f).
-inline Vec6 cross_force(const Vec6& a, const Vec6& f) {
+[[gnu::always_inline]] inline Vec6 cross_force(const Vec6& a, const Vec6& f) {
   Vec6 r;
   r.head<3>() = a.head<3>().cross(f.head<3>()) + a.tail<3>().cross(f.tail<3>());
   r.tail<3>() = a.head<3>().cross(f.tail<3>());
@@ -50,7 +51,7 @@ struct RigidInertia {
     return L;
   }
   // Λ v = (I ω + h × v, m v − h × ω): 30 operations instead of the 6 × 6 product.
-  Vec6 operator*(const Vec6& v) const {
+  [[gnu::always_inline]] Vec6 operator*(const Vec6& v) const {
     Vec6 f;
     f.head<3>().noalias() = I * v.head<3>();
     f.head<3>() += h.cross(v.tail<3>());

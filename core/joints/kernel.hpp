@@ -73,6 +73,22 @@ inline void spatial_columns(const Joint& j, const Mat3& R_B, const Vec3& p_B, Ve
   });
 }
 
+// The joint's part of a body's motion in the recursions (spatial, world axes, about the origin),
+// for a joint that moves (nv > 0): its columns S_k into S[0 .. nv), then V += v_J and
+// a += V × v_J (+ Σ S_k θ̈_k when `acc` is given) with v_J = Σ S_k θ̇_k, the rates at `rate`
+// and `acc` (each indexed from the joint's first rate). Only the columns depend on the type,
+// so the per-type code stays a few products.
+inline void add_joint_motion(const Joint& j, const Mat3& R_B, const Vec3& p_B, const double* rate,
+                             const double* acc, Vec6* S, Vec6& V, Vec6& a) {
+  spatial_columns(j, R_B, p_B, S);
+  Vec6 vj = S[0] * rate[0];
+  for (int k = 1; k < j.nv; ++k) vj += S[k] * rate[k];
+  V += vj;
+  a += cross_motion(V, vj);
+  if (acc)
+    for (int k = 0; k < j.nv; ++k) a += S[k] * acc[k];
+}
+
 // The joint's own generalized force on a 1-DOF joint's coordinate: its spring and damper,
 // −k (θ − θ_rest) − c θ̇.
 inline double spring_damper_force(const Joint& j, double theta, double theta_dot) {
