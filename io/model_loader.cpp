@@ -36,51 +36,51 @@ struct JsonOutline {
   std::size_t bodies = 0;  // items of the top-level "bodies" array (0: none, or not an array)
 };
 
+// The index just past the string whose opening quote is text[i], escapes respected.
+std::size_t past_string(const std::string& text, std::size_t i) {
+  for (++i; i < text.size(); ++i) {
+    if (text[i] == '\\')
+      ++i;  // (the escaped character, a quote included)
+    else if (text[i] == '"')
+      return i + 1;
+  }
+  return text.size();
+}
+
 JsonOutline outline(const std::string& text) {
   JsonOutline out;
-  int depth = 0;  // containers open
-  bool in_string = false, escaped = false;
-  std::size_t key_start = 0;  // the last string's first byte, while it is read
-  bool bodies_key = false;    // the last string at depth 1 was "bodies" (a key, if ':' follows)
-  bool in_bodies = false, item_open = false;
-  for (std::size_t i = 0; i < text.size(); ++i) {
+  int depth = 0;            // containers open
+  bool bodies_key = false;  // at depth 1, the last token was the string "bodies" (or its ':')
+  bool in_bodies = false;   // inside the top-level "bodies" array (a later one replaces it)
+  bool counted = false;     // its current item is counted (until the next ',')
+  for (std::size_t i = 0; i < text.size();) {
     const char c = text[i];
-    if (in_string) {
-      if (escaped) {
-        escaped = false;
-      } else if (c == '\\') {
-        escaped = true;
-      } else if (c == '"') {
-        in_string = false;
-        if (depth == 1) bodies_key = text.compare(key_start, i - key_start, "bodies") == 0;
-      }
+    if (std::isspace(static_cast<unsigned char>(c))) {
+      ++i;
       continue;
     }
-    const bool opens = c == '[' || c == '{';
-    if (in_bodies && depth == 2 && !item_open && c != ']' && c != ',' &&
-        !std::isspace(static_cast<unsigned char>(c))) {
-      ++out.bodies;  // an item begins
-      item_open = true;
+    if (in_bodies && depth == 2 && c != ']') {
+      if (c != ',' && !counted) ++out.bodies;  // an item begins
+      counted = c != ',';
     }
-    if (in_bodies && depth == 2 && c == ',') item_open = false;
     if (c == '"') {
-      in_string = true;
-      key_start = i + 1;
-    } else if (opens) {
-      if (++depth > kMaxNesting) {
-        out.too_deep = true;
-        return out;
-      }
-      if (depth == 2 && c == '[' && bodies_key) {  // "bodies": [ (a later "bodies" replaces it)
+      const std::size_t end = past_string(text, i);
+      if (depth == 1) bodies_key = text.compare(i, end - i, "\"bodies\"") == 0;
+      i = end;
+      continue;
+    }
+    if (c == '[' || c == '{') {
+      if (++depth > kMaxNesting) return {.too_deep = true};
+      if (depth == 2 && c == '[' && bodies_key) {
         in_bodies = true;
-        item_open = false;
+        counted = false;
         out.bodies = 0;
       }
     } else if (c == ']' || c == '}') {
       if (--depth == 1) in_bodies = false;
     }
-    if (depth == 1 && c != '"' && c != ':' && !std::isspace(static_cast<unsigned char>(c)))
-      bodies_key = false;  // "bodies" followed by anything but ':' is not the key
+    if (c != ':') bodies_key = false;  // the key is "bodies" only when ':' follows it
+    ++i;
   }
   return out;
 }
