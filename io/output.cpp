@@ -118,6 +118,9 @@ std::string info_text(const Model& model) {
   for (const auto& c : model.coordinate_names) out << " " << c;
   out << "\n";
   out << "joints (" << model.n_theta() << " movable):\n";
+  std::vector<const CoupledJoint*> law_of(model.n_theta(), nullptr);  // θ -> its law, if any
+  if (model.coupling_level)
+    for (const CoupledJoint& c : model.coupling_level->coupled) law_of[c.theta] = &c;
   for (const Body& b : model.bodies) {
     const Joint& j = b.joint;
     const char* type = j.type == JointType::Revolute    ? "revolute"
@@ -125,10 +128,7 @@ std::string info_text(const Model& model) {
                                                         : "fixed";
     out << "  " << j.name << " (" << type << ") "
         << (b.parent < 0 ? std::string("world") : model.bodies[b.parent].name) << " -> " << b.name;
-    const CoupledJoint* law = nullptr;
-    if (model.coupling_level)
-      for (const CoupledJoint& c : model.coupling_level->coupled)
-        if (c.theta == j.theta) law = &c;
+    const CoupledJoint* law = j.theta >= 0 ? law_of[j.theta] : nullptr;
     if (law) {  // θ = f(θ_followed…)
       out << "   theta = " << law->law->form() << " of";
       for (int s : law->sources) out << " " << model.bodies[model.theta_joint[s]].joint.name;

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/inertia.hpp"
+#include "core/limits.hpp"
 #include "io/input_file.hpp"
 
 namespace femdyn {
@@ -126,6 +127,10 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
     link_order.push_back(name);
   }
   if (links.empty()) throw ModelError(source, "no <link> elements");
+  // Every link but the root becomes a body: refused here when too many, before the joints.
+  if (links.size() - 1 > static_cast<std::size_t>(kMaxBodies))
+    throw ModelError(source,
+                     too_many_bodies_text(links.size() - 1) + " (one per <link> but the root)");
 
   // Joints: the tree.
   struct JointInfo {
@@ -166,17 +171,20 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
                                            : "more than one root link: " + list);
   }
   const std::string root = roots[0];
-  // Every link must hang from the root (a cycle elsewhere leaves links unreachable).
-  for (const auto& name : link_order) {
-    std::set<std::string> seen;
-    for (std::string l = name; l != root; l = [&] {
-           for (const JointInfo& ji : joints)
-             if (ji.child == l) return ji.parent;
-           return root;
-         }()) {
-      if (!seen.insert(l).second) c.fail("link '" + name + "'", "is on a loop of joints");
-    }
+  // Every link must hang from the root: every other link has one parent joint, so a link the
+  // walk down from the root does not reach hangs from a loop of joints. One walk, O(links).
+  std::map<std::string, std::vector<std::string>> children;  // link -> child links
+  for (const JointInfo& ji : joints) children[ji.parent].push_back(ji.child);
+  std::set<std::string> reached = {root};
+  for (std::vector<std::string> stack = {root}; !stack.empty();) {
+    const auto below = children.find(stack.back());
+    stack.pop_back();
+    if (below == children.end()) continue;
+    for (const std::string& child : below->second)
+      if (reached.insert(child).second) stack.push_back(child);
   }
+  for (const auto& name : link_order)
+    if (!reached.count(name)) c.fail("link '" + name + "'", "is on a loop of joints");
 
   Json bodies = Json::array(), couplings = Json::array();
   for (const JointInfo& ji : joints) {

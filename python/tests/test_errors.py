@@ -94,6 +94,17 @@ def test_model_errors_name_the_file_and_place(tmp_path):
         femdyn.load(str(tmp_path))
 
 
+def test_a_million_bodies_are_refused_by_count_before_parsing(tmp_path):
+    # load() reads through the same JSON reader as the command line: one linear pass counts the
+    # top-level "bodies" before anything is built (issue 22; the time is not asserted here).
+    big = tmp_path / "million.json"
+    big.write_text('{"bodies": [' + ",".join(['{"a":1}'] * 1_000_000) + "]}")
+    with pytest.raises(femdyn.ModelError,
+                       match=r"million.json: /bodies: 1000000 bodies: more than femdyn's "
+                             r"limit of 200000$"):
+        femdyn.load(str(big))
+
+
 def test_overflow_is_a_numerical_error(finger):
     with pytest.raises(femdyn.NumericalError, match="NaN or Inf"):
         finger.equations(np.zeros(4), np.full(4, 1e200))
