@@ -2,7 +2,11 @@
 // re-exports it). docs/python.md describes the interface.
 #include <pybind11/pybind11.h>
 
+#include <exception>
+#include <new>
+
 #include "core/errors.hpp"
+#include "core/memory.hpp"
 #include "python/py_model.hpp"
 
 PYBIND11_MODULE(_femdyn, m) {
@@ -14,6 +18,18 @@ PYBIND11_MODULE(_femdyn, m) {
   // Bad arguments are ValueError (shapes, NaN) or TypeError (types), as pybind11 raises them.
   py::register_exception<femdyn::ModelError>(m, "ModelError", PyExc_ValueError);
   py::register_exception<NumericalError>(m, "NumericalError", PyExc_ArithmeticError);
+  // Work refused up front by the memory limit (core/memory.hpp) is a ValueError, as validate's
+  // refusal; a std::bad_alloc no estimate foresaw is a MemoryError with femdyn's one line.
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const femdyn::MemoryRefused& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const std::bad_alloc&) {
+      PyErr_SetString(PyExc_MemoryError,
+                      ("femdyn: " + femdyn::out_of_memory_text("computing")).c_str());
+    }
+  });
   bind_model(m);
   bind_batch(m);
   bind_simulate(m);
