@@ -1,5 +1,6 @@
 #include "core/memory.hpp"
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -35,18 +36,31 @@ double default_memory_limit() {
   return std::numeric_limits<double>::infinity();
 }
 
-double memory_limit(double given) { return given > 0 ? given : default_memory_limit(); }
+namespace {
+std::atomic<double> g_default_limit{0};
+}  // namespace
 
-std::string max_memory_option(double bytes) {
-  return "--max-memory " + format_number(std::ceil(1.1 * bytes / 1e8) / 10, "%.1f");
+void set_default_memory_limit(double bytes) { g_default_limit = bytes > 0 ? bytes : 0; }
+
+double memory_limit(double given) {
+  if (given > 0) return given;
+  const double set = g_default_limit;
+  return set > 0 ? set : default_memory_limit();
 }
+
+std::string max_memory_gb(double bytes) {
+  return format_number(std::ceil(1.1 * bytes / 1e8) / 10, "%.1f");
+}
+
+std::string max_memory_option(double bytes) { return "--max-memory " + max_memory_gb(bytes); }
 
 std::string memory_refusal(const std::string& what, double bytes, double given,
                            const std::string& how) {
   const double limit = memory_limit(given);
   if (bytes <= limit) return {};
   return what + " needs " + format_bytes(bytes) + " of memory, beyond the memory limit of " +
-         format_bytes(limit) + (given > 0 ? "" : " (half the available memory)") + ": " + how;
+         format_bytes(limit) +
+         (given > 0 || g_default_limit > 0 ? "" : " (half the available memory)") + ": " + how;
 }
 
 void require_memory(const std::string& what, double bytes, double given, const std::string& how) {

@@ -27,11 +27,17 @@ std::string format_bytes(double bytes);
 // Half of /proc/meminfo's MemAvailable (B), or infinity where it cannot be read.
 double default_memory_limit();
 
-// The limit in force: `given` bytes if > 0, else default_memory_limit().
+// The process's own default, replacing half the available memory when > 0 (Python's
+// femdyn.set_max_memory); 0 restores it.
+void set_default_memory_limit(double bytes);
+
+// The limit in force: `given` bytes if > 0, else the process's default if set, else
+// default_memory_limit().
 double memory_limit(double given = 0);
 
-// The option that raises the limit far enough for `bytes`, with a 10 % margin, in GB with one
-// decimal: "--max-memory 4.9".
+// The limit that would admit `bytes`, with a 10 % margin, in GB with one decimal: "4.9"; and
+// as the command-line option, "--max-memory 4.9".
+std::string max_memory_gb(double bytes);
 std::string max_memory_option(double bytes);
 
 // "" when `bytes` fit within the limit (`given` bytes, 0: the default), else one line:

@@ -57,7 +57,7 @@ void require_batch_memory(const char* what, const Model& m, Eigen::Index k, int 
                      std::to_string(threads) + " threads",
                  bytes, 0,
                  "split the batch into parts of at most " + format_number(rows, "%.0f") +
-                     " rows, or use fewer threads");
+                     " rows, or use fewer threads, or " + set_max_memory_text(bytes));
 }
 
 py::dict equations_batch(const PyModel& self, const Array& q, const OptArray& qd,

@@ -55,9 +55,9 @@ EquationsResult equations(PyModel& self, const Array& q_in, const OptArray& qd_i
   const VecX q = vector_arg(q_in, "q", m), qd = vector_arg(qd_in, "qd", m),
              tau = vector_arg(tau_in, "tau", m, Entries::Bounded);
   // The workspace's M^s and factor, and M twice more on the way out (the result, numpy's).
-  require_memory("equations of n = " + std::to_string(m.n()) + " coordinates",
-                 evaluation_bytes(m) + 2 * dense_bytes(m.n(), m.n()), 0,
-                 "free memory, or use forward_dynamics (no n x n result)");
+  const double bytes = evaluation_bytes(m) + 2 * dense_bytes(m.n(), m.n());
+  require_memory("equations of n = " + std::to_string(m.n()) + " coordinates", bytes, 0,
+                 "use forward_dynamics (no n x n result), or " + set_max_memory_text(bytes));
   Status st;
   equations_at(m, self.ws, q, qd, tau, st);
   EquationsResult r{self.ws.Ms, self.ws.h, self.ws.Q, std::nullopt, st.message};

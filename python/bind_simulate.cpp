@@ -122,8 +122,8 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
                      " and " + format_short(rows) + " rows",
                  bytes, 0,
                  std::string(t_eval_in ? "fewer t_eval times" : "a larger every=") +
-                     (o.kind == IntegratorKind::Bdf ? ", or dopri (no Jacobian)" : "") +
-                     ", or free memory");
+                     (o.kind == IntegratorKind::Bdf ? ", or dopri (no Jacobian)" : "") + ", or " +
+                     set_max_memory_text(bytes));
   // τ: constant (n,), a table (tau_t (m,), tau (m, n)), or none (passive).
   Actuation tau;
   bool driven = false;

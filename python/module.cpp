@@ -1,9 +1,11 @@
 // femdyn._femdyn: the compiled part of the Python package femdyn (python/femdyn/__init__.py
 // re-exports it). docs/python.md describes the interface.
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include <exception>
 #include <new>
+#include <optional>
 
 #include "core/errors.hpp"
 #include "core/memory.hpp"
@@ -30,6 +32,16 @@ PYBIND11_MODULE(_femdyn, m) {
                       ("femdyn: " + femdyn::out_of_memory_text("computing")).c_str());
     }
   });
+  m.def(
+      "set_max_memory",
+      [](std::optional<double> gb) {
+        if (gb && !(*gb > 0 && *gb < 1e9))
+          throw py::value_error("max_memory: expected a positive number of GB");
+        femdyn::set_default_memory_limit(gb ? *gb * 1e9 : 0);
+      },
+      py::arg("gb"),
+      "The memory limit (GB) of every call that estimates its memory first (equations, the "
+      "batches, simulate, validate without max_memory=); None: half the available memory.");
   bind_model(m);
   bind_batch(m);
   bind_simulate(m);
