@@ -36,10 +36,11 @@ M^s and its printed form grow as n²: beyond the memory limit (--max-memory GB, 
 available memory) the command is refused before any work, with the memory it would need.
 )";
 
-// The memory `equations` needs: a workspace that has formed and factorised M^s, and the printed
-// n² + 5n numbers. Text: 18 bytes a number ("% .10e" and a space) in an ostringstream that grows
-// by doubling, then copied out (3x); --json: a JSON value a number (16 bytes, arrays grown by
-// doubling), then the text. Measured on chains of 1,000 to 4,000 bodies (docs/robustness.md).
+// The memory `equations` needs, at most: a workspace that has formed and factorised M^s, and the
+// printed n² + 5n numbers. Text: 18 bytes a number ("% .10e" and a space) in an ostringstream
+// whose capacity is at most twice its text, then copied out (3x); --json: a JSON value a number
+// (16 bytes, in arrays of at most twice the capacity), then its text the same way (about 24
+// bytes a number, 3x). An upper bound by construction, not a measurement.
 double equations_bytes(const Model& m, bool json) {
   const double n = m.n(), numbers = n * n + 5 * n;
   const double printed = json ? (2 * 16 + 3 * 24) * numbers : 3 * 18 * numbers;
