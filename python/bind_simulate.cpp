@@ -112,14 +112,14 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
   // Memory, before any is allocated: the run's matrices and the rows it returns (each recorded
   // in growing vectors, then copied into arrays: 6n + 13 numbers a row), where their number is
   // known: t_eval's times, or a fixed-step run's steps (up to max_steps) over `every`.
-  double rows = static_cast<double>(t_eval.size());
+  double row_count = static_cast<double>(t_eval.size());
   if (!t_eval_in && !is_adaptive(o.kind))
-    rows = std::min(std::ceil(t_end / o.fixed.dt), static_cast<double>(o.fixed.max_steps)) /
-               static_cast<double>(every) +
-           2;
-  const double bytes = integrator_bytes(m, o.kind) + rows * dense_bytes(6.0 * m.n() + 13, 1);
+    row_count = std::min(std::ceil(t_end / o.fixed.dt), static_cast<double>(o.fixed.max_steps)) /
+                    static_cast<double>(every) +
+                2;
+  const double bytes = integrator_bytes(m, o.kind) + row_count * dense_bytes(6.0 * m.n() + 13, 1);
   require_memory("simulate: n = " + std::to_string(m.n()) + " coordinates with " + integrator +
-                     " and " + format_short(rows) + " rows",
+                     " and " + format_short(row_count) + " rows",
                  bytes, 0,
                  std::string(t_eval_in ? "fewer t_eval times" : "a larger every=") +
                      (o.kind == IntegratorKind::Bdf ? ", or dopri (no Jacobian)" : "") + ", or " +
