@@ -88,8 +88,9 @@ double seconds_per_state(const Model& m) {
   return 4 * n * eval + per_cube * (1.4 * std::pow(2 * n, 3) + 0.2 * std::pow(n, 3));
 }
 
-// "cond from 12 to 3.4e+05 (q̈ loses up to 5.53 digits of 16)"; a condition number that
-// overflows double precision (λ_max / λ_min beyond 1.8e308) is said so, never printed as inf.
+// "cond from 12 to 3.4e+05 (q̈ loses up to 5.53 digits of 16)"; from 1e16 on, that no digit is
+// left; a condition number that overflows double precision (λ_max / λ_min beyond 1.8e308) is
+// said so, never printed as inf.
 std::string condition_text(double lo, double hi) {
   const auto cond = [](double c) {
     return std::isfinite(c) ? format_short(c) : std::string("beyond 1.8e308");
@@ -98,6 +99,8 @@ std::string condition_text(double lo, double hi) {
   if (!std::isfinite(hi))
     return range + " (it overflows double precision: M^s is singular to double precision at " +
            "some state and q̈ keeps no correct digit)";
+  if (hi >= 1e16)  // 1/ε: beyond it no digit of q̈ is left, however many "digits lost"
+    return range + " (q̈ keeps no correct digit: M^s is singular to double precision)";
   return range + " (q̈ loses up to " + format_short(std::log10(hi)) + " digits of 16)";
 }
 

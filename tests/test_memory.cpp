@@ -144,6 +144,8 @@ TEST_CASE("check never prints an overflowing condition number as inf", "[memory]
   const Run r = run("check " + path + " --states 3");
   CHECK_THAT(r.out, !Catch::Contains("inf"));
   CHECK_THAT(r.out, Catch::Contains("M^s: "));
+  CHECK_THAT(r.out, Catch::Contains("keeps no correct digit"));
+  CHECK_THAT(r.out, !Catch::Contains("digits of 16"));
   const Run j = run("check " + path + " --states 3 --json");
   CHECK_THAT(j.out, !Catch::Contains("inf"));
 }

@@ -40,8 +40,8 @@ def test_batches_are_refused_up_front(finger, small_limit):
     with pytest.raises(ValueError, match=r"^equations_batch of 2000 states of n = 4 coordinates "
                                          r"on \d+ threads needs .* split the batch into parts"):
         finger.equations_batch(q)
-    with pytest.raises(ValueError, match=r"^forward_dynamics_batch of 2000 states"):
-        finger.forward_dynamics_batch(q, threads=1)
+    with pytest.raises(ValueError, match=r"^forward_dynamics_batch of 20000 states"):
+        finger.forward_dynamics_batch(np.zeros((20000, 4)), threads=1)  # 640 kB of results
 
 
 def test_within_the_limit_nothing_changes(finger):
