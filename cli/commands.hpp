@@ -32,6 +32,9 @@ double number_option(const Args& a, const std::string& opt, double fallback);  /
 double integer_option(const Args& a, const std::string& opt, double fallback, double min,
                       double max = 1e15);
 Model load(const Args& a, std::size_t count = 1);  // the first positional; expects `count`
+// --max-memory GB (a number > 0, below 1e9) as bytes, or 0 when absent: the memory limit's
+// default, half the available memory (core/memory.hpp).
+double max_memory(const Args& a);
 
 int cmd_info(int argc, char** argv);
 int cmd_equations(int argc, char** argv);

@@ -1,8 +1,10 @@
 #include <cstring>
 #include <iostream>
+#include <new>
 
 #include "cli/commands.hpp"
 #include "core/errors.hpp"
+#include "core/memory.hpp"
 
 namespace {
 
@@ -78,6 +80,11 @@ int main(int argc, char** argv) {
     return 2;
   } catch (const femdyn::ModelError& e) {
     std::cerr << "femdyn " << cmd << ": " << e.what() << "\n";
+    return 1;
+  } catch (const std::bad_alloc&) {
+    // The last line of defence: work that allocates by input size is estimated and refused up
+    // front (core/memory.hpp); what no estimate foresaw is still one line of femdyn's.
+    std::cerr << "femdyn " << cmd << ": " << femdyn::out_of_memory_text("running " + cmd) << "\n";
     return 1;
   } catch (const std::exception& e) {
     std::cerr << "femdyn " << cmd << ": " << e.what() << "\n";

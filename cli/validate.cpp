@@ -207,11 +207,7 @@ int cmd_validate(int argc, char** argv) {
   o.budget = number_option(a, "budget", o.budget);
   if (!(o.budget > 0 && o.budget < 1e9))
     throw CliError("--budget expects a positive number of seconds (below 1e9)");
-  if (a.has("max-memory")) {
-    const double gb = number_option(a, "max-memory", 0);
-    if (!(gb > 0 && gb < 1e9)) throw CliError("--max-memory expects a positive number of GB");
-    o.memory_limit = gb * 1e9;
-  }
+  o.memory_limit = max_memory(a);
 
   // Load every model first: a bad file fails before any work.
   std::deque<Model> models;  // (Model is move-only and its move may throw: no vector)

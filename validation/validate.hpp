@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/memory.hpp"  // the memory limit, shared with every command
 #include "core/model.hpp"
 #include "validation/twin.hpp"
 
@@ -152,9 +153,6 @@ class Validator {
 
 // Validator(model, options).run(), or OverBudget (naming model.where) beyond the budget.
 ValidationReport validate(const Model& model, const ValidationOptions& options = {});
-
-// Half of /proc/meminfo's MemAvailable (B), or infinity where it cannot be read.
-double default_memory_limit();
 
 // For a model read from a URDF file: femdyn's M^s, h, Q against an independent Simbody model
 // built straight from the XML (urdf_twin.hpp), at the same seeded states. Returns the quantity
