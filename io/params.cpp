@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/names.hpp"
+
 namespace femdyn {
 
 double json_number(const Json& v, const std::string& where) {
@@ -101,7 +103,8 @@ NodeRef Params::node_from(const Json& v, const std::string& where) const {
   if (v.is_string()) {
     const std::string name = v.get<std::string>();
     if (!nodes_ || !nodes_->count(name))
-      throw ModelError(where, "unknown node '" + name + "' (not in the body's \"nodes\")");
+      throw ModelError(where,
+                       "unknown node " + quoted_text(name) + " (not in the body's \"nodes\")");
     // "other_body/node": a node of another body (its frame), labelled as such.
     return {nodes_->at(name), name.find('/') == std::string::npos ? body_ + "/" + name : name};
   }
@@ -124,7 +127,8 @@ void Params::allow_only(std::initializer_list<const char*> keys) const {
   for (auto it = j_.begin(); it != j_.end(); ++it) {
     bool ok = false;
     for (const char* k : keys) ok = ok || it.key() == k;
-    if (!ok) throw ModelError(where_ + "/" + it.key(), "unknown key '" + it.key() + "'");
+    if (!ok)
+      throw ModelError(where_ + "/" + truncated(it.key()), "unknown key " + quoted_text(it.key()));
   }
 }
 
