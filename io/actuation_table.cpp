@@ -8,33 +8,23 @@
 #include "core/errors.hpp"
 #include "core/limits.hpp"
 #include "core/names.hpp"
+#include "io/csv.hpp"
 #include "io/input_file.hpp"
 
 namespace femdyn {
-namespace {
+ActuationTable::ActuationTable(const std::string& path, const Model& m)
+    : ActuationTable(read_input_file(path), path, m, from_text) {}
 
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> cells;
-  std::string cell;
-  std::istringstream s(line);
-  while (std::getline(s, cell, ',')) {
-    const auto b = cell.find_first_not_of(" \t\r"), e = cell.find_last_not_of(" \t\r");
-    cells.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
-  }
-  if (!line.empty() && line.back() == ',') cells.emplace_back();
-  return cells;
-}
-
-}  // namespace
-
-ActuationTable::ActuationTable(const std::string& path, const Model& m) : path_(path) {
-  std::istringstream in(read_input_file(path));
+ActuationTable::ActuationTable(const std::string& text, const std::string& path, const Model& m,
+                               FromText)
+    : path_(path) {
+  std::istringstream in(text);
   const int n = m.n();
   std::string line;
   int lineno = 1;
   if (!std::getline(in, line))
     throw ModelError(path, "empty file (expected a header t,<coordinates>)");
-  const std::vector<std::string> head = split(line);
+  const std::vector<std::string> head = csv_fields(line, path + ":1");
   if (head.empty() || head[0] != "t")
     throw ModelError(path + ":1", "the first column must be 't' (time in s)");
   std::vector<int> column_of(n, -1);  // coordinate -> CSV column
@@ -44,8 +34,8 @@ ActuationTable::ActuationTable(const std::string& path, const Model& m) : path_(
     if (it == m.coordinate_names.end() && name.rfind("tau_", 0) == 0)
       it = std::find(m.coordinate_names.begin(), m.coordinate_names.end(), name.substr(4));
     if (it == m.coordinate_names.end())
-      throw ModelError(path + ":1", "column " + std::to_string(c + 1) + " '" + name +
-                                        "' is not a coordinate of " + m.name);
+      throw ModelError(path + ":1", "column " + std::to_string(c + 1) + " " + quoted_text(name) +
+                                        " is not a coordinate of " + m.name);
     const auto k = it - m.coordinate_names.begin();
     if (column_of[k] >= 0)
       throw ModelError(path + ":1", "coordinate '" + *it + "' has two columns");
@@ -58,8 +48,8 @@ ActuationTable::ActuationTable(const std::string& path, const Model& m) : path_(
   while (std::getline(in, line)) {
     ++lineno;
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    const std::vector<std::string> cells = split(line);
     const std::string where = path + ":" + std::to_string(lineno);
+    const std::vector<std::string> cells = csv_fields(line, where);
     if (cells.size() != head.size())
       throw ModelError(where, std::to_string(cells.size()) + " columns, the header has " +
                                   std::to_string(head.size()));

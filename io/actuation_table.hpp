@@ -1,7 +1,8 @@
 // τ(t) from a CSV file (femdyn simulate --tau-csv): a header line "t,<c1>,<c2>,…" naming every
 // generalized coordinate once, each as "<name>" or "tau_<name>", in any order; then one row per
 // sample time, strictly increasing. τ is interpolated linearly between rows and held at the
-// last row's value after it. Errors name the file, the line and the column.
+// last row's value after it. Fields may be quoted (RFC 4180, io/csv.hpp). Errors name the file,
+// the line and the column.
 #pragma once
 #include <string>
 #include <vector>
@@ -14,6 +15,10 @@ class ActuationTable {
  public:
   // Throws ModelError ("FILE:LINE: …") on a malformed file.
   ActuationTable(const std::string& path, const Model& model);
+  // The same from the file's text; `path` names it in errors (the CSV fuzz target).
+  struct FromText {};
+  static constexpr FromText from_text{};
+  ActuationTable(const std::string& text, const std::string& path, const Model& model, FromText);
   // From samples already checked by the caller: t strictly increasing (at least 2), tau n × |t|
   // (column r at t[r]); `path` names the source in reports.
   ActuationTable(std::vector<double> t, MatX tau, std::string path)
