@@ -48,7 +48,8 @@ void check_table(const ActuationTable& table, const Model& model) {
 
 void check_round_trip(const TrajectoryTable& table) {
   std::string header;
-  for (const std::string& c : table.columns) header += (header.empty() ? "" : ",") + csv_field(c);
+  for (std::size_t c = 0; c < table.columns.size(); ++c)
+    header += (c ? "," : "") + csv_field(table.columns[c]);
   if (csv_fields(header, "round trip") != table.columns)
     fuzz::bug("trajectory CSV: the header written back reads as other columns");
 }
