@@ -245,8 +245,8 @@ int cmd_check(int argc, char** argv) {
   const double per_state = seconds_per_state(m);
   if (per_state * K > budget) {
     const int fit = static_cast<int>(budget / per_state);
-    std::cerr << "femdyn check: " << a.positional[0] << ": checking " << K << " states of " << n
-              << " coordinates would take about " << format_duration(per_state * K) << " ("
+    std::cerr << "femdyn check: " << escaped(a.positional[0]) << ": checking " << K << " states of "
+              << n << " coordinates would take about " << format_duration(per_state * K) << " ("
               << format_duration(per_state)
               << " a state: 4n evaluations and dense eigenproblems of 2n = " << 2 * n
               << "), beyond the budget of " << format_duration(budget) << ": "

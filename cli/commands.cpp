@@ -127,7 +127,9 @@ double max_memory(const Args& a) {
 
 LoadOptions load_options(const Args& a) {
   LoadOptions opt;
-  opt.warn = [](const std::string& w) { std::cerr << "femdyn: warning: " << w << "\n"; };
+  opt.warn = [](const std::string& w) {
+    std::cerr << "femdyn: warning: " << safe_message(w) << "\n";
+  };
   if (a.has("gravity")) {
     const std::vector<double> g = parse_numbers("gravity", a.options.at("gravity"));
     if (g.size() != 3) throw CliError("--gravity expects 3 values gx,gy,gz");
@@ -164,7 +166,7 @@ Args parse_args(int argc, char** argv, int first, const std::vector<std::string>
       }
       a.options[key] = value;
     } else {
-      throw CliError("unknown option --" + key + " (try --help)");
+      throw CliError("unknown option --" + escaped(truncated(key)) + " (try --help)");
     }
   }
   return a;
@@ -214,7 +216,7 @@ int cmd_equations(int argc, char** argv) {
                           Result{"q̈", ws.qdd.data(), st.ok ? ws.qdd.size() : 0, ws.qdd.size()}})
     for (Eigen::Index i = 0; i < x.size; ++i) {
       if (std::isfinite(x.data[i])) continue;
-      std::cerr << "femdyn equations: " << a.positional[0] << ": at this state " << x.what
+      std::cerr << "femdyn equations: " << escaped(a.positional[0]) << ": at this state " << x.what
                 << " of '" << m.coordinate_names[i % x.rows]
                 << "' is NaN or Inf (the forces or the state overflow double precision)\n";
       return 1;
@@ -239,8 +241,8 @@ int cmd_equations(int argc, char** argv) {
   else
     std::cout << equations_text(m, ws, q, qd, tau, st.ok, D);
   if (!st.ok) {
-    std::cerr << "femdyn equations: " << a.positional[0] << ": at this state " << st.message
-              << "\n";
+    std::cerr << "femdyn equations: " << escaped(a.positional[0]) << ": at this state "
+              << safe_message(st.message) << "\n";
     return 1;
   }
   return 0;

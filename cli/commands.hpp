@@ -6,12 +6,14 @@
 #include <string>
 #include <vector>
 
+#include "core/errors.hpp"
 #include "io/model_loader.hpp"
 
 namespace femdyn::cli {
 
-struct CliError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+// A bad command line (exit 2). A femdyn::Error: its message is made safe to print as a whole.
+struct CliError : Error {
+  using Error::Error;
 };
 
 // Parsed arguments: positionals and --options (flags map to "").

@@ -11,6 +11,7 @@
 #include "cli/progress.hpp"
 #include "core/integrator.hpp"
 #include "core/memory.hpp"
+#include "core/names.hpp"
 #include "core/recorded_run.hpp"
 #include "io/actuation_table.hpp"
 #include "io/atomic_file.hpp"
@@ -121,8 +122,8 @@ class InterruptGuard {
 IntegratorOptions integrator_options(const Args& a) {
   IntegratorOptions o;
   if (a.has("integrator") && !parse_integrator(a.options.at("integrator"), o.kind))
-    throw CliError("--integrator: '" + a.options.at("integrator") +
-                   "' is not one of rk4, euler, dopri, bdf");
+    throw CliError("--integrator: " + quoted_text(a.options.at("integrator")) +
+                   " is not one of rk4, euler, dopri, bdf");
   if (is_adaptive(o.kind)) {
     if (a.has("dt"))
       throw CliError(std::string("--dt sets the step of rk4 and euler; ") +
@@ -236,7 +237,7 @@ int cmd_simulate(int argc, char** argv) {
   progress.finish();
   if (run.interrupted) {
     std::cerr << "femdyn simulate: interrupted at t = " << integ->t() << " s"
-              << (out ? "; " + out->path() + " was not written" : std::string()) << "\n";
+              << (out ? "; " + escaped(out->path()) + " was not written" : std::string()) << "\n";
     return 130;  // `out` discards its temporary file
   }
   const Status& st = run.status;
@@ -308,11 +309,12 @@ int cmd_simulate(int argc, char** argv) {
               << balance_name << ": max |E(t) - E(0) - W(t)| = " << num(max_balance) << " J ("
               << num(run.relative_balance()) << " of the " << num(scale)
               << " J the motion started with and was given) over " << rows << " rows\n";
-    if (out) std::cout << "wrote " << out->path() << " (" << rows << " rows)\n";
+    if (out) std::cout << "wrote " << escaped(out->path()) << " (" << rows << " rows)\n";
   }
   if (!st.ok) {
-    std::cerr << "femdyn simulate: " << a.positional[0] << ": " << st.message
-              << (out ? "; the rows up to t = " + num(simulated) + " s are in " + out->path()
+    std::cerr << "femdyn simulate: " << escaped(a.positional[0]) << ": " << safe_message(st.message)
+              << (out ? "; the rows up to t = " + num(simulated) + " s are in " +
+                            escaped(out->path())
                       : std::string())
               << "\n";
     return 1;

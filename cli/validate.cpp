@@ -103,12 +103,12 @@ Json report_json(const std::string& path, const Model& m, const validation::Vali
 
 void print_text(const std::string& path, const validation::ValidationReport& r) {
   if (!r.failure.empty()) {
-    std::cout << path << ": no comparison possible: " << r.failure << "\n";
+    std::cout << escaped(path) << ": no comparison possible: " << safe_message(r.failure) << "\n";
     for (const auto& n : r.notes) std::cout << "note: " << n << "\n";
     std::cout << "FAIL\n";
     return;
   }
-  std::cout << path << " (" << r.n << " coordinates) against Simbody, " << r.states
+  std::cout << escaped(path) << " (" << r.n << " coordinates) against Simbody, " << r.states
             << " seeded random states\n"
             << "quantity   max abs err   max rel err   tolerance   result\n";
   for (const auto& q : r.quantities)

@@ -9,26 +9,11 @@
 #include "core/limits.hpp"
 #include "core/memory.hpp"
 #include "core/names.hpp"
+#include "io/csv.hpp"
 #include "io/input_file.hpp"
 
 namespace femdyn {
 namespace {
-
-// The cells of a line, trimmed of blanks: one more than its commas (none for an empty line).
-std::vector<std::string> split(std::string_view line) {
-  std::vector<std::string> cells;
-  if (line.empty()) return cells;
-  for (std::size_t start = 0;;) {
-    const std::size_t comma = std::min(line.find(',', start), line.size());
-    const std::string_view cell = line.substr(start, comma - start);
-    const auto b = cell.find_first_not_of(" \t\r"), e = cell.find_last_not_of(" \t\r");
-    cells.emplace_back(b == std::string_view::npos ? std::string_view()
-                                                   : cell.substr(b, e - b + 1));
-    if (comma == line.size()) break;
-    start = comma + 1;
-  }
-  return cells;
-}
 
 // The lines of a file's text, read in place.
 class Lines {
@@ -57,17 +42,20 @@ class Lines {
 }  // namespace
 
 ActuationTable::ActuationTable(const std::string& path, const Model& m, double memory_given)
+    : ActuationTable(read_input_file(path), path, m, from_text, memory_given) {}
+
+ActuationTable::ActuationTable(const std::string& text, const std::string& path, const Model& m,
+                               FromText, double memory_given)
     : path_(path), n_(m.n()) {
   // The text is read once and parsed in place; each row's numbers go straight into t_ and tau_,
   // reserved for the lines the file has: the memory is the file's size and 8 (n + 1) bytes a
   // row.
-  const std::string text = read_input_file(path);
   Lines in(text);
   const int n = m.n();
   std::string_view line;
   int lineno = 1;
   if (!in.next(line)) throw ModelError(path, "empty file (expected a header t,<coordinates>)");
-  const std::vector<std::string> head = split(line);
+  const std::vector<std::string> head = csv_fields(line, path + ":1");
   if (head.empty() || head[0] != "t")
     throw ModelError(path + ":1", "the first column must be 't' (time in s)");
   std::vector<int> column_of(n, -1);  // coordinate -> CSV column
@@ -77,8 +65,8 @@ ActuationTable::ActuationTable(const std::string& path, const Model& m, double m
     if (it == m.coordinate_names.end() && name.rfind("tau_", 0) == 0)
       it = std::find(m.coordinate_names.begin(), m.coordinate_names.end(), name.substr(4));
     if (it == m.coordinate_names.end())
-      throw ModelError(path + ":1", "column " + std::to_string(c + 1) + " '" + name +
-                                        "' is not a coordinate of " + m.name);
+      throw ModelError(path + ":1", "column " + std::to_string(c + 1) + " " + quoted_text(name) +
+                                        " is not a coordinate of " + m.name);
     const auto k = it - m.coordinate_names.begin();
     if (column_of[k] >= 0)
       throw ModelError(path + ":1", "coordinate '" + *it + "' has two columns");
@@ -91,8 +79,8 @@ ActuationTable::ActuationTable(const std::string& path, const Model& m, double m
   while (in.next(line)) {
     ++lineno;
     if (line.find_first_not_of(" \t\r") == std::string_view::npos) continue;
-    const std::vector<std::string> cells = split(line);
     const std::string where = path + ":" + std::to_string(lineno);
+    const std::vector<std::string> cells = csv_fields(line, where);
     if (cells.size() != head.size())
       throw ModelError(where, std::to_string(cells.size()) + " columns, the header has " +
                                   std::to_string(head.size()));

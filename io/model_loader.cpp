@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/limits.hpp"
+#include "core/names.hpp"
 #include "io/catalog.hpp"
 #include "io/input_file.hpp"
 #include "io/params.hpp"
@@ -90,8 +91,8 @@ JointType joint_type(const Params& p) {
   if (t == "revolute" || t == "continuous") return JointType::Revolute;
   if (t == "prismatic") return JointType::Prismatic;
   if (t == "fixed") return JointType::Fixed;
-  p.fail("type",
-         "unknown joint type '" + t + "' (expected revolute, continuous, prismatic or fixed)");
+  p.fail("type", "unknown joint type " + quoted_text(t) +
+                     " (expected revolute, continuous, prismatic or fixed)");
 }
 
 JointSpec read_joint(const Params& p) {
@@ -170,8 +171,8 @@ BodySpec read_body(const Catalog& catalog, const Json& jb, const std::string& wh
       const std::string type = ep.string("type");
       const ElementType* t = catalog.elements.find(type);
       if (!t)
-        ep.fail("type",
-                "unknown element type '" + type + "' (known: " + catalog.elements.names() + ")");
+        ep.fail("type", "unknown element type " + quoted_text(type) +
+                            " (known: " + catalog.elements.names() + ")");
       ElementSink sink(b.elements, ep.where());
       t->make(ep, sink);
     }
@@ -355,7 +356,8 @@ Json expand_plugin(const Catalog& catalog, const Json& root, const std::string& 
   const std::string name = p.string("model");
   const ModelPlugin* plugin = catalog.plugins.find(name);
   if (!plugin)
-    p.fail("model", "unknown model plugin '" + name + "' (known: " + catalog.plugins.names() + ")");
+    p.fail("model", "unknown model plugin " + quoted_text(name) +
+                        " (known: " + catalog.plugins.names() + ")");
   static const Json empty = Json::object();
   Json doc = plugin->expand(p.has("params") ? p.child("params") : Params(empty, p.path("params")));
   for (const char* key : {"name", "description", "gravity"})
@@ -377,7 +379,7 @@ MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std
                                   "couplings", "loads",       "correlation_table", "$schema"};
     bool ok = false;
     for (const char* k : known) ok = ok || it.key() == k;
-    if (!ok) throw ModelError(path(it.key()), "unknown key '" + it.key() + "'");
+    if (!ok) throw ModelError(path(truncated(it.key())), "unknown key " + quoted_text(it.key()));
   }
   if (root.contains("name")) {
     if (!root["name"].is_string()) throw ModelError(path("name"), "expected a string");

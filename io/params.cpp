@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/names.hpp"
+
 namespace femdyn {
 
 double json_number(const Json& v, const std::string& where) {
@@ -116,7 +118,8 @@ NodeRef Params::node_from(const Json& v, const std::string& where) const {
     };
     const Vec3* at = find(nodes_);
     if (!at) at = find(other_nodes_);
-    if (!at) throw ModelError(where, "unknown node '" + name + "' (not in the body's \"nodes\")");
+    if (!at) throw ModelError(where,
+                       "unknown node " + quoted_text(name) + " (not in the body's \"nodes\")");
     return {*at, name.find('/') == std::string::npos ? body_ + "/" + name : name};
   }
   const Vec3 p = json_vec3(v, where);
@@ -138,7 +141,8 @@ void Params::allow_only(std::initializer_list<const char*> keys) const {
   for (auto it = j_.begin(); it != j_.end(); ++it) {
     bool ok = false;
     for (const char* k : keys) ok = ok || it.key() == k;
-    if (!ok) throw ModelError(where_ + "/" + it.key(), "unknown key '" + it.key() + "'");
+    if (!ok)
+      throw ModelError(where_ + "/" + truncated(it.key()), "unknown key " + quoted_text(it.key()));
   }
 }
 

@@ -10,6 +10,7 @@
 
 #include "core/inertia.hpp"
 #include "core/limits.hpp"
+#include "core/names.hpp"
 #include "io/input_file.hpp"
 
 namespace femdyn {
@@ -34,7 +35,8 @@ double number_attr(const Ctx& c, const XMLElement* e, const char* attr, double f
   char* end = nullptr;
   const double x = std::strtod(s, &end);
   while (end && *end == ' ') ++end;
-  if (end == s || (end && *end)) c.fail(who, std::string(attr) + "=\"" + s + "\" is not a number");
+  if (end == s || (end && *end))
+    c.fail(who, std::string(attr) + "=\"" + echo_text(s) + "\" is not a number");
   if (!std::isfinite(x)) c.fail(who, std::string(attr) + " is NaN or Inf");
   return x;
 }
@@ -47,13 +49,15 @@ Vec3 vec_attr(const Ctx& c, const XMLElement* e, const char* attr, const Vec3& f
   Vec3 v;
   std::string tok[3], extra;
   for (int i = 0; i < 3; ++i) {
-    if (!(in >> tok[i])) c.fail(who, std::string(attr) + "=\"" + s + "\" needs 3 numbers");
+    if (!(in >> tok[i]))
+      c.fail(who, std::string(attr) + "=\"" + echo_text(s) + "\" needs 3 numbers");
     char* end = nullptr;
     v[i] = std::strtod(tok[i].c_str(), &end);
-    if (*end) c.fail(who, std::string(attr) + "=\"" + s + "\" is not 3 numbers");
+    if (*end) c.fail(who, std::string(attr) + "=\"" + echo_text(s) + "\" is not 3 numbers");
     if (!std::isfinite(v[i])) c.fail(who, std::string(attr) + " is NaN or Inf");
   }
-  if (in >> extra) c.fail(who, std::string(attr) + "=\"" + s + "\" has more than 3 numbers");
+  if (in >> extra)
+    c.fail(who, std::string(attr) + "=\"" + echo_text(s) + "\" has more than 3 numbers");
   return v;
 }
 
@@ -152,8 +156,8 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
     const char* cl = ch ? ch->Attribute("link") : nullptr;
     if (!pl) c.fail(who, "has no <parent link=…>");
     if (!cl) c.fail(who, "has no <child link=…>");
-    if (!links.count(pl)) c.fail(who, std::string("parent link '") + pl + "' does not exist");
-    if (!links.count(cl)) c.fail(who, std::string("child link '") + cl + "' does not exist");
+    if (!links.count(pl)) c.fail(who, "parent link " + quoted_text(pl) + " does not exist");
+    if (!links.count(cl)) c.fail(who, "child link " + quoted_text(cl) + " does not exist");
     if (std::string(pl) == cl) c.fail(who, "connects link '" + std::string(cl) + "' to itself");
     auto [it, fresh] = parent_joint.emplace(cl, name);
     if (!fresh)
@@ -192,9 +196,10 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
     const char* type_c = ji.e->Attribute("type");
     const std::string type = type_c ? type_c : "";
     if (type == "floating" || type == "planar")
-      c.fail(who, "type '" + type + "' is not supported (revolute, continuous, prismatic, fixed)");
+      c.fail(who, "type " + quoted_text(type) +
+                      " is not supported (revolute, continuous, prismatic, fixed)");
     if (type != "revolute" && type != "continuous" && type != "prismatic" && type != "fixed")
-      c.fail(who, "unknown type '" + type + "'");
+      c.fail(who, "unknown type " + quoted_text(type));
     if (ji.child == "world") c.fail(who, "a link named 'world' can only be the root");
     const Origin o = origin_of(c, ji.e, who);
     Json joint = {{"name", ji.name},
@@ -223,8 +228,7 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
       if (const XMLElement* mimic = ji.e->FirstChildElement("mimic")) {
         const char* leader = mimic->Attribute("joint");
         if (!leader) c.fail(who, "<mimic> has no joint");
-        if (!joint_names.count(leader))
-          c.fail(who, std::string("mimics unknown joint '") + leader + "'");
+        if (!joint_names.count(leader)) c.fail(who, "mimics unknown joint " + quoted_text(leader));
         couplings.push_back({{"joint", ji.name},
                              {"follows", leader},
                              {"ratio", number_attr(c, mimic, "multiplier", 1.0, who)},

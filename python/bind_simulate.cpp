@@ -8,6 +8,7 @@
 #include "core/integrator.hpp"
 #include "core/limits.hpp"
 #include "core/memory.hpp"
+#include "core/names.hpp"
 #include "core/recorded_run.hpp"
 #include "io/actuation_table.hpp"
 #include "python/py_model.hpp"
@@ -20,8 +21,9 @@ using OptArray = std::optional<Array>;
 IntegratorOptions options_of(const std::string& integrator, std::optional<double> dt,
                              std::optional<double> rtol, std::optional<double> atol) {
   IntegratorOptions o;
-  if (!parse_integrator(integrator, o.kind))
-    throw py::value_error("integrator: '" + integrator + "' is not one of rk4, euler, dopri, bdf");
+  if (!parse_integrator(text_arg(integrator, "integrator"), o.kind))
+    throw py::value_error("integrator: " + quoted_text(integrator) +
+                          " is not one of rk4, euler, dopri, bdf");
   if (is_adaptive(o.kind)) {
     if (dt)
       throw py::value_error("dt sets the step of rk4 and euler; " + integrator +

@@ -239,7 +239,7 @@ bool integrate(const Model& m, Workspace& ws, const VecX& q0, const VecX& qd0,
   rk4.reset(0, q0, qd0);
   for (double target : times) {
     const Status st = rk4.advance_to(target);
-    if (st.non_finite) throw std::runtime_error("along the trajectory: " + st.message);
+    if (st.non_finite) throw femdyn::Error("along the trajectory: " + st.message);
     if (!st.ok) return false;
     joint_state(m, ws, rk4.q(), rk4.qd());
     VecX x(2 * m.n_theta());

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/errors.hpp"
 #include "core/memory.hpp"  // the memory limit, shared with every command
 #include "core/model.hpp"
 #include "validation/twin.hpp"
@@ -76,9 +77,9 @@ struct WorkEstimate {
 };
 
 // Refused up front: what() is the one line Validator::refusal gives.
-class OverBudget : public std::runtime_error {
+class OverBudget : public Error {
  public:
-  using std::runtime_error::runtime_error;
+  using Error::Error;
 };
 
 // One compared quantity: max over the states of ‖x_femdyn − x_simbody‖∞ and of that divided by
