@@ -118,7 +118,8 @@ NodeRef Params::node_from(const Json& v, const std::string& where) const {
     };
     const Vec3* at = find(nodes_);
     if (!at) at = find(other_nodes_);
-    if (!at) throw ModelError(where,
+    if (!at)
+      throw ModelError(where,
                        "unknown node " + quoted_text(name) + " (not in the body's \"nodes\")");
     return {*at, name.find('/') == std::string::npos ? body_ + "/" + name : name};
   }

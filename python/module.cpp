@@ -6,8 +6,6 @@
 #include <exception>
 #include <new>
 #include <optional>
-
-#include <new>
 #include <stdexcept>
 
 #include "core/errors.hpp"
