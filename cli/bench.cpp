@@ -18,6 +18,7 @@
 #include "core/equations.hpp"
 #include "core/math.hpp"
 #include "core/sampling.hpp"
+#include "io/output.hpp"
 #include "validation/twin.hpp"
 #include "validation/validate.hpp"
 
@@ -327,7 +328,7 @@ int cmd_bench(int argc, char** argv) {
 
   if (a.has("json")) {
     if (!skipped.empty()) std::cerr << "femdyn bench: D not timed (" << skipped << ")\n";
-    std::cout << report_json(path, m, rows).dump(2) << "\n";
+    std::cout << json_text(report_json(path, m, rows)) << "\n";
   } else {
     print_table(path, n, K, method, rows, skipped);
   }

@@ -308,7 +308,7 @@ int cmd_check(int argc, char** argv) {
     j["suspicious_bodies"] = flags;
     j["notes"] = notes;
     if (!d.singular_message.empty()) j["singular"] = d.singular_message;
-    std::cout << j.dump(2) << "\n";
+    std::cout << json_text(j) << "\n";
   } else {
     std::cout << "model: " << m.name << " (" << n << " coordinates, " << m.bodies.size()
               << " bodies), " << K << " states\n";

@@ -180,7 +180,7 @@ int cmd_info(int argc, char** argv) {
   }
   const Model m = load(a);
   if (a.has("json"))
-    std::cout << info_json(m).dump(2) << "\n";
+    std::cout << json_text(info_json(m)) << "\n";
   else
     std::cout << info_text(m);
   return 0;

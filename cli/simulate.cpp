@@ -15,6 +15,7 @@
 #include "core/recorded_run.hpp"
 #include "io/actuation_table.hpp"
 #include "io/atomic_file.hpp"
+#include "io/output.hpp"
 #include "io/trajectory_csv.hpp"
 
 namespace femdyn::cli {
@@ -293,7 +294,7 @@ int cmd_simulate(int argc, char** argv) {
       j["options"] = {{"dt", o.fixed.dt}};
     if (out) j["out"] = out->path();
     if (!st.ok) j["failure"] = st.message;
-    std::cout << j.dump(2) << "\n";
+    std::cout << json_text(j) << "\n";
   } else {
     std::cout << "model: " << m.name << " (" << m.n() << " coordinates)\n"
               << "integrator: " << integ->name() << " ("

@@ -18,6 +18,7 @@
 #include "io/atomic_file.hpp"
 #include "io/csv.hpp"
 #include "io/model_loader.hpp"
+#include "io/output.hpp"
 
 namespace femdyn::cli {
 namespace {
@@ -175,7 +176,7 @@ int cmd_stress(int argc, char** argv) {
     }
   }
   if (a.has("json"))
-    std::cout << results.dump(2) << "\n";
+    std::cout << json_text(results) << "\n";
   else
     std::cout << md.str() << "wrote " << escaped((dir / "stress.md").string()) << ", stress.csv\n";
   return 0;

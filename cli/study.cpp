@@ -22,6 +22,7 @@
 #include "core/sampling.hpp"
 #include "io/atomic_file.hpp"
 #include "io/csv.hpp"
+#include "io/output.hpp"
 
 #ifndef FEMDYN_BUILD_TYPE
 #define FEMDYN_BUILD_TYPE "unknown"
@@ -549,7 +550,7 @@ int cmd_study(int argc, char** argv) {
               << (dir / "study.gp").string() << " is written, study.png is not\n";
 
   if (a.has("json")) {
-    std::cout << report_json(rep, command, o).dump(2) << "\n";
+    std::cout << json_text(report_json(rep, command, o)) << "\n";
     return 0;
   }
   // The summary table on stdout.

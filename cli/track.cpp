@@ -93,10 +93,13 @@ int cmd_track(int argc, char** argv) {
     }
   }
   if (a.has("json")) {
-    std::cout << Json{{"model", m.name},       {"n", m.n()}, {"coordinates", m.coordinate_names},
-                      {"duration", T},         {"steps", N}, {"max_tracking_error", max_err},
-                      {"max_abs_tau", max_tau}}
-                     .dump(2)
+    std::cout << json_text(Json{{"model", m.name},
+                                {"n", m.n()},
+                                {"coordinates", m.coordinate_names},
+                                {"duration", T},
+                                {"steps", N},
+                                {"max_tracking_error", max_err},
+                                {"max_abs_tau", max_tau}})
               << "\n";
   } else {
     std::cout << "model: " << m.name << "\nquintic motion over " << T << " s, " << N

@@ -254,7 +254,7 @@ int cmd_validate(int argc, char** argv) {
     else
       print_text(a.positional[i], r);
   }
-  if (a.has("json")) std::cout << (reports.size() == 1 ? reports[0] : reports).dump(2) << "\n";
+  if (a.has("json")) std::cout << json_text((reports.size() == 1 ? reports[0] : reports)) << "\n";
   return all_pass ? 0 : 1;
 }
 

@@ -50,6 +50,27 @@ void print_mat(std::ostringstream& out, const MatX& m) {
 
 }  // namespace
 
+std::string json_text(const Json& doc) {
+  const std::string raw = doc.dump(2, ' ', false, Json::error_handler_t::replace);
+  std::string out;
+  out.reserve(raw.size());
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const auto c = static_cast<unsigned char>(raw[i]);
+    const auto next = i + 1 < raw.size() ? static_cast<unsigned char>(raw[i + 1]) : 0;
+    if (c == 0x7f) {
+      out += "\\u007f";
+    } else if (c == 0xc2 && next >= 0x80 && next <= 0x9f) {  // C1: only inside strings
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(next));
+      out += buf;
+      ++i;
+    } else {
+      out += raw[i];
+    }
+  }
+  return out;
+}
+
 Json equations_json(const Model& model, const Workspace& ws, const VecX& q, const VecX& qd,
                     const VecX& tau, bool have_qdd, const std::vector<MatX>& D) {
   Json j;

@@ -11,6 +11,7 @@
 #include "core/names.hpp"
 #include "io/actuation_table.hpp"
 #include "io/csv.hpp"
+#include "io/output.hpp"
 #include "io/trajectory_csv.hpp"
 #include "io/urdf_loader.hpp"
 #include "tests/helpers.hpp"
@@ -287,4 +288,25 @@ TEST_CASE("CLI: simulate --out and track --csv quote a name with a comma", "[ech
   CHECK(csv_fields(header, "track.csv") == std::vector<std::string>{"t", "q_ref_a,b", "q_ref_c",
                                                                     "tau_a,b", "tau_c", "q_sim_a,b",
                                                                     "q_sim_c"});
+}
+
+TEST_CASE(
+    "the JSON of --json: DEL and C1 as \\u escapes, invalid UTF-8 as U+FFFD, and it parses back",
+    "[echo]") {
+  const nlohmann::json doc{{"path", std::string("a\x7f") + "b\xc2\x9b" + "c\xff" + "d\x1b"},
+                           {"n", 3}};
+  const std::string text = json_text(doc);
+  for (const char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    CHECK((c >= 0x20 || c == '\n'));  // the indentation's line breaks only
+    CHECK(c != 0x7f);
+  }
+  CHECK(text.find("\xc2\x9b") == std::string::npos);
+  const nlohmann::json back = nlohmann::json::parse(text);
+  CHECK(back["path"] ==
+        "a\x7f"
+        "b\xc2\x9b"
+        "c\xef\xbf\xbd"
+        "d\x1b");  // U+FFFD for the bad byte
+  CHECK(back["n"] == 3);
 }
