@@ -1,5 +1,8 @@
 #include "core/memory.hpp"
 
+#include <sys/resource.h>
+
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -26,14 +29,21 @@ std::string format_bytes(double bytes) {
 }
 
 double default_memory_limit() {
+  // Half the available memory, and half the process's address-space limit (ulimit -v) when one
+  // is set: beyond that an allocation would fail however much memory the machine has.
+  double limit = std::numeric_limits<double>::infinity();
   std::ifstream in("/proc/meminfo");
   std::string line;
   while (std::getline(in, line)) {  // "MemAvailable:   23705392 kB"
     double kib = 0;
-    if (line.rfind("MemAvailable:", 0) == 0 && std::sscanf(line.c_str() + 13, "%lf", &kib) == 1)
-      return 0.5 * kib * 1024;
+    if (line.rfind("MemAvailable:", 0) == 0 && std::sscanf(line.c_str() + 13, "%lf", &kib) == 1) {
+      limit = 0.5 * kib * 1024;
+      break;
+    }
   }
-  return std::numeric_limits<double>::infinity();
+  if (rlimit r{}; getrlimit(RLIMIT_AS, &r) == 0 && r.rlim_cur != RLIM_INFINITY)
+    limit = std::min(limit, 0.5 * static_cast<double>(r.rlim_cur));
+  return limit;
 }
 
 namespace {

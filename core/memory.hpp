@@ -24,7 +24,8 @@ inline double dense_bytes(double rows, double cols) { return 8 * rows * cols; }
 // "812 kB", "4.4 MB", "1.23 GB"; "unlimited" for infinity.
 std::string format_bytes(double bytes);
 
-// Half of /proc/meminfo's MemAvailable (B), or infinity where it cannot be read.
+// Half of /proc/meminfo's MemAvailable (B), and at most half the address-space limit
+// (RLIMIT_AS, ulimit -v) when one is set; infinity where neither is known.
 double default_memory_limit();
 
 // The process's own default, replacing half the available memory when > 0 (Python's

@@ -3,6 +3,8 @@
 // needs and how to proceed. The tests set a small --max-memory, so that nothing depends on the
 // machine's memory; and the smaller items of the same round (a compact τ table, the condition
 // number that overflows, a run too short for SUNDIALS).
+#include <sys/resource.h>
+
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <fstream>
@@ -148,4 +150,19 @@ TEST_CASE("check never prints an overflowing condition number as inf", "[memory]
   CHECK_THAT(r.out, !Catch::Contains("digits of 16"));
   const Run j = run("check " + path + " --states 3 --json");
   CHECK_THAT(j.out, !Catch::Contains("inf"));
+}
+
+TEST_CASE("the default memory limit is at most half the address-space limit (ulimit -v)",
+          "[memory]") {
+  rlimit old{};
+  REQUIRE(getrlimit(RLIMIT_AS, &old) == 0);
+  rlimit lowered = old;
+  lowered.rlim_cur = static_cast<rlim_t>(1) << 50;  // 1 PiB: above anything this process maps
+  if (old.rlim_cur != RLIM_INFINITY && old.rlim_cur < lowered.rlim_cur)
+    lowered.rlim_cur = old.rlim_cur;
+  REQUIRE(setrlimit(RLIMIT_AS, &lowered) == 0);
+  const double limit = default_memory_limit();
+  setrlimit(RLIMIT_AS, &old);
+  CHECK(limit <= 0.5 * static_cast<double>(lowered.rlim_cur));
+  CHECK(limit > 0);
 }
