@@ -28,6 +28,23 @@ std::string format_bytes(double bytes) {
   return format_number(bytes / 1e3, "%.3g") + " kB";
 }
 
+namespace {
+
+// Half the process's address-space limit (ulimit -v), infinity when none is set.
+double half_address_space_limit() {
+  if (rlimit r{}; getrlimit(RLIMIT_AS, &r) == 0 && r.rlim_cur != RLIM_INFINITY)
+    return 0.5 * static_cast<double>(r.rlim_cur);
+  return std::numeric_limits<double>::infinity();
+}
+
+// What the default limit is, for a refusal.
+std::string default_limit_source() {
+  return default_memory_limit() == half_address_space_limit() ? "half of ulimit -v"
+                                                              : "half the available memory";
+}
+
+}  // namespace
+
 double default_memory_limit() {
   // Half the available memory, and half the process's address-space limit (ulimit -v) when one
   // is set: beyond that an allocation would fail however much memory the machine has.
@@ -41,9 +58,7 @@ double default_memory_limit() {
       break;
     }
   }
-  if (rlimit r{}; getrlimit(RLIMIT_AS, &r) == 0 && r.rlim_cur != RLIM_INFINITY)
-    limit = std::min(limit, 0.5 * static_cast<double>(r.rlim_cur));
-  return limit;
+  return std::min(limit, half_address_space_limit());
 }
 
 namespace {
@@ -70,7 +85,7 @@ std::string memory_refusal(const std::string& what, double bytes, double given,
   if (bytes <= limit) return {};
   return what + " needs " + format_bytes(bytes) + " of memory, beyond the memory limit of " +
          format_bytes(limit) +
-         (given > 0 || g_default_limit > 0 ? "" : " (half the available memory)") + ": " + how;
+         (given > 0 || g_default_limit > 0 ? "" : " (" + default_limit_source() + ")") + ": " + how;
 }
 
 void require_memory(const std::string& what, double bytes, double given, const std::string& how) {
