@@ -43,8 +43,10 @@ void translate(std::exception_ptr p) {
   } catch (const py::builtin_exception& e) {  // py::value_error, type_error, …
     e.set_error();
     reset_message(e.what());
-  } catch (const std::bad_alloc& e) {
-    raise(PyExc_MemoryError, e.what());
+  } catch (const femdyn::MemoryRefused& e) {  // refused up front: a ValueError, as validate's
+    raise(PyExc_ValueError, e.what());
+  } catch (const std::bad_alloc&) {  // no estimate foresaw it: femdyn's one line
+    raise(PyExc_MemoryError, ("femdyn: " + femdyn::out_of_memory_text("computing")).c_str());
   } catch (const std::out_of_range& e) {
     raise(PyExc_IndexError, e.what());
   } catch (const std::overflow_error& e) {
@@ -74,18 +76,6 @@ PYBIND11_MODULE(_femdyn, m) {
   py::register_exception_translator(&translate);
   py::register_exception<femdyn::ModelError>(m, "ModelError", PyExc_ValueError);
   py::register_exception<NumericalError>(m, "NumericalError", PyExc_ArithmeticError);
-  // Work refused up front by the memory limit (core/memory.hpp) is a ValueError, as validate's
-  // refusal; a std::bad_alloc no estimate foresaw is a MemoryError with femdyn's one line.
-  py::register_exception_translator([](std::exception_ptr p) {
-    try {
-      if (p) std::rethrow_exception(p);
-    } catch (const femdyn::MemoryRefused& e) {
-      PyErr_SetString(PyExc_ValueError, e.what());
-    } catch (const std::bad_alloc&) {
-      PyErr_SetString(PyExc_MemoryError,
-                      ("femdyn: " + femdyn::out_of_memory_text("computing")).c_str());
-    }
-  });
   m.def(
       "set_max_memory",
       [](std::optional<double> gb) {

@@ -29,15 +29,6 @@ const std::pair<std::string, std::string> kControls[] = {
 // One line, printable: what every message must be.
 bool one_printable_line(const std::string& s) { return printable_text(s); }
 
-std::string text_error(const std::string& text) {
-  try {
-    load_text(text);
-  } catch (const ModelError& e) {
-    return e.what();
-  }
-  return "(loaded)";
-}
-
 std::string urdf_error(const std::string& text) {
   try {
     urdf_to_model(text, "r.urdf");

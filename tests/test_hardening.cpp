@@ -40,30 +40,9 @@ std::string load_error(const std::string& path) {
   return "(loaded)";
 }
 
-std::string text_error(const std::string& text) {
-  try {
-    load_text(text);
-  } catch (const ModelError& e) {
-    return e.what();
-  }
-  return "(loaded)";
-}
-
 json pendulum() {
   std::ifstream in(model_path("pendulum.json"));
   return json::parse(in);
-}
-
-// A planar serial chain of `n` links of 0.1 m, a point mass at each link's end.
-std::string planar_chain(int n) {
-  json bodies = json::array();
-  for (int i = 0; i < n; ++i)
-    bodies.push_back(
-        {{"name", "b" + std::to_string(i)},
-         {"parent", i == 0 ? std::string("world") : "b" + std::to_string(i - 1)},
-         {"joint", {{"type", "revolute"}, {"axis", {0, 0, 1}}, {"origin", {{"xyz", {0.1, 0, 0}}}}}},
-         {"elements", {{{"type", "lumped_point"}, {"node", {0.1, 0, 0}}, {"mass", 1}}}}});
-  return json{{"name", "chain"}, {"gravity", {0, -9.81, 0}}, {"bodies", bodies}}.dump();
 }
 
 }  // namespace

@@ -19,22 +19,6 @@ using namespace femdyn;
 using namespace femdyn::test;
 using nlohmann::json;
 
-namespace {
-
-// A planar serial chain of `n` links, a point mass at each link's end.
-std::string planar_chain(int n) {
-  json bodies = json::array();
-  for (int i = 0; i < n; ++i)
-    bodies.push_back(
-        {{"name", "b" + std::to_string(i)},
-         {"parent", i == 0 ? std::string("world") : "b" + std::to_string(i - 1)},
-         {"joint", {{"type", "revolute"}, {"axis", {0, 0, 1}}, {"origin", {{"xyz", {0.1, 0, 0}}}}}},
-         {"elements", {{{"type", "lumped_point"}, {"node", {0.1, 0, 0}}, {"mass", 1}}}}});
-  return json{{"name", "chain"}, {"gravity", {0, -9.81, 0}}, {"bodies", bodies}}.dump();
-}
-
-}  // namespace
-
 TEST_CASE("memory: the refusal is one line with the size, the limit and the way on", "[memory]") {
   CHECK(memory_refusal("x", 1e6, 2e6, "use less").empty());
   CHECK(memory_refusal("the equations of n = 10000 coordinates", 4.4e9, 2e9,
