@@ -18,6 +18,7 @@
 #include "core/equations.hpp"
 #include "core/math.hpp"
 #include "core/sampling.hpp"
+#include "io/output.hpp"
 #include "validation/twin.hpp"
 #include "validation/validate.hpp"
 
@@ -108,7 +109,7 @@ void check_agreement(const std::string& path, const Model& m, Workspace& ws, fv:
   evaluate(m, ws, s.q[0], s.qd[0], s.tau[0]);
   const double dM = relative_error(ws.Ms, e.M, 1e-6), dh = relative_error(ws.h, e.h, 1e-6);
   if (dM < 1e-8 && dh < 1e-8 && dqdd < 1e-8) return;
-  std::cerr << "femdyn bench: warning: " << path
+  std::cerr << "femdyn bench: warning: " << escaped(path)
             << ": femdyn and Simbody differ at the first state (relative M^s " << format_short(dM)
             << ", h " << format_short(dh) << ", q̈ "
             << (st.ok ? format_short(dqdd) : "not computed: " + st.message)
@@ -194,8 +195,9 @@ std::string ns_text(double x) { return format_number(x, "%.0f"); }
 
 void print_table(const std::string& path, int n, int K, const Method& method,
                  const std::vector<Row>& rows, const std::string& skipped) {
-  std::cout << path << " (" << n << " coordinates) against Simbody: median ns per call over "
-            << method.batches << " batches of ~" << method.batch_time_ns / 1e6 << " ms, " << K
+  std::cout << escaped(path) << " (" << n
+            << " coordinates) against Simbody: median ns per call over " << method.batches
+            << " batches of ~" << method.batch_time_ns / 1e6 << " ms, " << K
             << " states, build " FEMDYN_BUILD_TYPE "\n";
   char line[200];
   std::snprintf(line, sizeof line, "%-8s %10s %10s %15s   %-21s %s\n", "quantity", "femdyn",
@@ -326,7 +328,7 @@ int cmd_bench(int argc, char** argv) {
 
   if (a.has("json")) {
     if (!skipped.empty()) std::cerr << "femdyn bench: D not timed (" << skipped << ")\n";
-    std::cout << report_json(path, m, rows).dump(2) << "\n";
+    std::cout << json_text(report_json(path, m, rows)) << "\n";
   } else {
     print_table(path, n, K, method, rows, skipped);
   }

@@ -13,6 +13,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
+#include "core/memory.hpp"
 #include "core/sampling.hpp"
 #include "core/stability.hpp"
 #include "io/output.hpp"
@@ -22,12 +23,12 @@ namespace {
 
 constexpr const char* kHelp =
     R"(usage: femdyn check MODEL [--states K] [--seed S] [--tol r] [--budget SECONDS] [--json]
-                    [--gravity gx,gy,gz]
+                    [--max-memory GB] [--gravity gx,gy,gz]
 
 Diagnoses the model at K seeded states (default 10: q = 0 at rest, then q within the joint
 limits and q̇ in ±1):
-  - cond(M^s) = λ_max/λ_min over the states (q̈ loses about log10 cond digits), symmetry and
-    positive definiteness;
+  - cond(M^s) = λ_max/λ_min over the states (q̈ loses about log10 cond digits; a cond that
+    overflows double precision is said so), symmetry and positive definiteness;
   - the modes of the linearised dynamics A = ∂(q̇, q̈)/∂(q, q̇) (central differences of
     forward dynamics), each labelled: oscillatory (with a damping ratio only where the model
     has dampers), saddle (an unstable equilibrium), decaying (overdamped), growing; the
@@ -45,7 +46,8 @@ limits and q̇ in ±1):
     (remove, damp or resolve it: bdf does not cure it).
 Work is bounded: the time of the whole check is estimated first (4n evaluations and a dense
 eigenproblem of 2n per state); beyond --budget seconds (default 120) it is refused with the
-estimate. A progress line shows on a terminal.
+estimate, and beyond the memory limit (--max-memory GB, default half the available memory)
+with the memory it needs. A progress line shows on a terminal.
 Exit 0: no fault (notes may be printed); 1: M^s is singular at a sampled state, a body is
 flagged, or the check would exceed its budget; 2: a bad command line.
 )";
@@ -86,6 +88,24 @@ double seconds_per_state(const Model& m) {
   return 4 * n * eval + per_cube * (1.4 * std::pow(2 * n, 3) + 0.2 * std::pow(n, 3));
 }
 
+// "cond from 12 to 3.4e+05 (q̈ loses up to 5.53 digits of 16)"; from 1e16 on, that no digit is
+// left; a condition number that overflows double precision (λ_max / λ_min beyond 1.8e308) is
+// said so, never printed as inf.
+std::string condition_text(double lo, double hi) {
+  const auto cond = [](double c) {
+    return std::isfinite(c) ? format_short(c) : std::string("beyond 1.8e308");
+  };
+  const std::string range = "cond from " + cond(lo) + " to " + cond(hi);
+  if (!std::isfinite(hi))
+    return range + " (it overflows double precision: M^s is singular to double precision at " +
+           "some state and q̈ keeps no correct digit)";
+  if (hi >= 1e16)  // 1/ε: beyond it no digit of q̈ is left, however many "digits lost"
+    return range + " (q̈ keeps no correct digit: M^s is singular to double precision)";
+  return range + " (q̈ loses up to " + format_short(std::log10(hi)) + " digits of 16)";
+}
+
+Json finite_or_null(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
+
 struct Diagnosis {
   double cond_lo = std::numeric_limits<double>::infinity(), cond_hi = 0, asym = 0;
   int singular_states = 0;
@@ -101,8 +121,10 @@ void diagnose_state(const Model& m, Workspace& ws, const VecX& q, const VecX& qd
   evaluate(m, ws, q, qd, tau);
   const MassMatrixHealth h = mass_matrix_health(ws.Ms);
   d.asym = std::max(d.asym, h.asymmetry);
-  d.cond_lo = std::min(d.cond_lo, h.condition);
-  d.cond_hi = std::max(d.cond_hi, h.condition);
+  if (h.positive_definite) {  // (a singular state is counted apart, not as cond = inf)
+    d.cond_lo = std::min(d.cond_lo, h.condition);
+    d.cond_hi = std::max(d.cond_hi, h.condition);
+  }
   if (!h.positive_definite) {
     ++d.singular_states;
     const Status st = ws.solver.factorize(ws.Ms);
@@ -199,8 +221,8 @@ Json mode_json(const Model& m, const Mode& md) {
 }  // namespace
 
 int cmd_check(int argc, char** argv) {
-  const Args a =
-      parse_args(argc, argv, 2, {"help", "json"}, {"states", "seed", "tol", "budget", "gravity"});
+  const Args a = parse_args(argc, argv, 2, {"help", "json"},
+                            {"states", "seed", "tol", "budget", "gravity", "max-memory"});
   if (a.has("help")) {
     std::cout << kHelp;
     return 0;
@@ -214,12 +236,17 @@ int cmd_check(int argc, char** argv) {
   if (!(budget > 0)) throw CliError("--budget expects a positive number of seconds");
   const int n = m.n();
 
-  // Bounded work: estimated up front, refused beyond the budget.
+  // Bounded work: estimated up front, refused beyond the memory limit and the budget. Memory:
+  // the workspace's M^s, the 2n x 2n linearisation A and its eigenproblem (the real Schur form,
+  // its vectors and the complex eigenvectors, about 6 matrices of 2n).
+  const double bytes = evaluation_bytes(m) + 6 * dense_bytes(2 * n, 2 * n);
+  require_memory(a.positional[0] + ": checking n = " + std::to_string(n) + " coordinates", bytes,
+                 max_memory(a), "use " + max_memory_option(bytes) + " if that much memory is free");
   const double per_state = seconds_per_state(m);
   if (per_state * K > budget) {
     const int fit = static_cast<int>(budget / per_state);
-    std::cerr << "femdyn check: " << a.positional[0] << ": checking " << K << " states of " << n
-              << " coordinates would take about " << format_duration(per_state * K) << " ("
+    std::cerr << "femdyn check: " << escaped(a.positional[0]) << ": checking " << K << " states of "
+              << n << " coordinates would take about " << format_duration(per_state * K) << " ("
               << format_duration(per_state)
               << " a state: 4n evaluations and dense eigenproblems of 2n = " << 2 * n
               << "), beyond the budget of " << format_duration(budget) << ": "
@@ -249,25 +276,27 @@ int cmd_check(int argc, char** argv) {
   const Advice advice = advise(m, d, tol);
 
   if (a.has("json")) {
-    Json j = {{"model", m.name},
-              {"n", n},
-              {"coordinates", m.coordinate_names},
-              {"states", K},
-              {"condition", {{"min", d.cond_lo}, {"max", d.cond_hi}}},
-              {"digits_lost", std::log10(d.cond_hi)},
-              {"asymmetry", d.asym},
-              {"singular_states", d.singular_states},
-              {"stiffest_mode", mode_json(m, d.stiffest)},
-              {"fastest_motion", mode_json(m, d.fastest)},
-              {"recommendation", advice.text},
-              {"recommended",
-               {{"integrator", advice.integrator},
-                {"tol", tol},
-                {"rk4_dt", advice.dt_rk4},
-                {"euler_dt", advice.dt_euler},
-                {"rk4_error_per_period", advice.error_per_period},
-                {"period", advice.period},
-                {"stability_limited", advice.stability_limited}}}};
+    Json j = {
+        {"model", m.name},
+        {"n", n},
+        {"coordinates", m.coordinate_names},
+        {"states", K},
+        {"condition", {{"min", finite_or_null(d.cond_lo)}, {"max", finite_or_null(d.cond_hi)}}},
+        {"condition_overflows", d.singular_states < K && !std::isfinite(d.cond_hi)},
+        {"digits_lost", finite_or_null(std::log10(d.cond_hi))},
+        {"asymmetry", d.asym},
+        {"singular_states", d.singular_states},
+        {"stiffest_mode", mode_json(m, d.stiffest)},
+        {"fastest_motion", mode_json(m, d.fastest)},
+        {"recommendation", advice.text},
+        {"recommended",
+         {{"integrator", advice.integrator},
+          {"tol", tol},
+          {"rk4_dt", advice.dt_rk4},
+          {"euler_dt", advice.dt_euler},
+          {"rk4_error_per_period", advice.error_per_period},
+          {"period", advice.period},
+          {"stability_limited", advice.stability_limited}}}};
     Json steps = Json::object();
     for (int i = 0; i < 3; ++i)
       steps[integrator_name(kExplicit[i])] =
@@ -279,7 +308,7 @@ int cmd_check(int argc, char** argv) {
     j["suspicious_bodies"] = flags;
     j["notes"] = notes;
     if (!d.singular_message.empty()) j["singular"] = d.singular_message;
-    std::cout << j.dump(2) << "\n";
+    std::cout << json_text(j) << "\n";
   } else {
     std::cout << "model: " << m.name << " (" << n << " coordinates, " << m.bodies.size()
               << " bodies), " << K << " states\n";
@@ -287,9 +316,8 @@ int cmd_check(int argc, char** argv) {
       std::cout << "M^s: singular at " << d.singular_states << " of " << K
                 << " states: " << d.singular_message << "\n";
     if (d.singular_states < K)
-      std::cout << "M^s: cond from " << format_short(d.cond_lo) << " to " << format_short(d.cond_hi)
-                << " (q̈ loses up to " << format_short(std::log10(d.cond_hi))
-                << " digits of 16), symmetric to " << format_short(d.asym)
+      std::cout << "M^s: " << condition_text(d.cond_lo, d.cond_hi) << ", symmetric to "
+                << format_short(d.asym)
                 << (d.singular_states ? "" : ", positive definite at every state") << "\n";
     std::cout << "stiffest mode: |λ| = " << format_short(d.stiffest.omega) << " 1/s, "
               << d.stiffest.text() << ", in " << where(m, d.stiffest.coordinate) << "\n"

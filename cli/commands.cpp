@@ -8,6 +8,7 @@
 
 #include "core/equations.hpp"
 #include "core/limits.hpp"
+#include "core/memory.hpp"
 #include "core/names.hpp"
 #include "io/model_loader.hpp"
 #include "io/output.hpp"
@@ -24,14 +25,27 @@ table N_m (one row per element; per node x y z rx ry rz; 0 = left out).
 
 constexpr const char* kEquationsHelp =
     R"(usage: femdyn equations MODEL [--q a,b,…] [--qd …] [--tau …] [--tensor] [--json]
-                        [--gravity gx,gy,gz]
+                        [--max-memory GB] [--gravity gx,gy,gz]
 
 Prints the system equations M^s(q) q̈ + h(q, q̇) = Q(q, q̇, τ) at the state, and
 q̈ = (M^s)⁻¹(Q − h). Omitted q, q̇, τ are zero; τ is the actuation force on each generalized
 coordinate. --tensor adds D (n x n x n) with h_a = Σ_bc D_abc q̇_b q̇_c.
 --json prints one object: {"n", "coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd"[, "D"]}
 (n the number of coordinates, "coordinates" their names).
+M^s and its printed form grow as n²: beyond the memory limit (--max-memory GB, default half the
+available memory) the command is refused before any work, with the memory it would need.
 )";
+
+// The memory `equations` needs, at most: a workspace that has formed and factorised M^s, and the
+// printed n² + 5n numbers. Text: 18 bytes a number ("% .10e" and a space) in an ostringstream
+// whose capacity is at most twice its text, then copied out (3x); --json: a JSON value a number
+// (16 bytes, in arrays of at most twice the capacity), then its text the same way (about 24
+// bytes a number, 3x). An upper bound by construction, not a measurement.
+double equations_bytes(const Model& m, bool json) {
+  const double n = m.n(), numbers = n * n + 5 * n;
+  const double printed = json ? (2 * 16 + 3 * 24) * numbers : 3 * 18 * numbers;
+  return evaluation_bytes(m) + printed;
+}
 
 }  // namespace
 
@@ -104,9 +118,18 @@ Model load(const Args& a, std::size_t count) {
   return load_model(a.positional[0], load_options(a));
 }
 
+double max_memory(const Args& a) {
+  if (!a.has("max-memory")) return 0;
+  const double gb = number_option(a, "max-memory", 0);
+  if (!(gb > 0 && gb < 1e9)) throw CliError("--max-memory expects a positive number of GB");
+  return gb * 1e9;
+}
+
 LoadOptions load_options(const Args& a) {
   LoadOptions opt;
-  opt.warn = [](const std::string& w) { std::cerr << "femdyn: warning: " << w << "\n"; };
+  opt.warn = [](const std::string& w) {
+    std::cerr << "femdyn: warning: " << safe_message(w) << "\n";
+  };
   if (a.has("gravity")) {
     const std::vector<double> g = parse_numbers("gravity", a.options.at("gravity"));
     if (g.size() != 3) throw CliError("--gravity expects 3 values gx,gy,gz");
@@ -143,7 +166,7 @@ Args parse_args(int argc, char** argv, int first, const std::vector<std::string>
       }
       a.options[key] = value;
     } else {
-      throw CliError("unknown option --" + key + " (try --help)");
+      throw CliError("unknown option --" + escaped(truncated(key)) + " (try --help)");
     }
   }
   return a;
@@ -157,15 +180,15 @@ int cmd_info(int argc, char** argv) {
   }
   const Model m = load(a);
   if (a.has("json"))
-    std::cout << info_json(m).dump(2) << "\n";
+    std::cout << json_text(info_json(m)) << "\n";
   else
     std::cout << info_text(m);
   return 0;
 }
 
 int cmd_equations(int argc, char** argv) {
-  const Args a =
-      parse_args(argc, argv, 2, {"help", "json", "tensor"}, {"gravity", "q", "qd", "tau"});
+  const Args a = parse_args(argc, argv, 2, {"help", "json", "tensor"},
+                            {"gravity", "q", "qd", "tau", "max-memory"});
   if (a.has("help")) {
     std::cout << kEquationsHelp;
     return 0;
@@ -173,6 +196,11 @@ int cmd_equations(int argc, char** argv) {
   const Model m = load(a);
   const VecX q = state_vector(a, "q", m), qd = state_vector(a, "qd", m),
              tau = state_vector(a, "tau", m);
+  require_memory(
+      a.positional[0] + ": the equations of n = " + std::to_string(m.n()) + " coordinates",
+      equations_bytes(m, a.has("json")), max_memory(a),
+      "use " + max_memory_option(equations_bytes(m, a.has("json"))) +
+          " if that much memory is free");
   Workspace ws(m);
   const Status st = forward_dynamics(m, ws, q, qd, tau);
   evaluate(m, ws, q, qd, tau);
@@ -188,7 +216,7 @@ int cmd_equations(int argc, char** argv) {
                           Result{"q̈", ws.qdd.data(), st.ok ? ws.qdd.size() : 0, ws.qdd.size()}})
     for (Eigen::Index i = 0; i < x.size; ++i) {
       if (std::isfinite(x.data[i])) continue;
-      std::cerr << "femdyn equations: " << a.positional[0] << ": at this state " << x.what
+      std::cerr << "femdyn equations: " << escaped(a.positional[0]) << ": at this state " << x.what
                 << " of '" << m.coordinate_names[i % x.rows]
                 << "' is NaN or Inf (the forces or the state overflow double precision)\n";
       return 1;
@@ -213,8 +241,8 @@ int cmd_equations(int argc, char** argv) {
   else
     std::cout << equations_text(m, ws, q, qd, tau, st.ok, D);
   if (!st.ok) {
-    std::cerr << "femdyn equations: " << a.positional[0] << ": at this state " << st.message
-              << "\n";
+    std::cerr << "femdyn equations: " << escaped(a.positional[0]) << ": at this state "
+              << safe_message(st.message) << "\n";
     return 1;
   }
   return 0;

@@ -6,12 +6,14 @@
 #include <string>
 #include <vector>
 
+#include "core/errors.hpp"
 #include "io/model_loader.hpp"
 
 namespace femdyn::cli {
 
-struct CliError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+// A bad command line (exit 2). A femdyn::Error: its message is made safe to print as a whole.
+struct CliError : Error {
+  using Error::Error;
 };
 
 // Parsed arguments: positionals and --options (flags map to "").
@@ -32,6 +34,9 @@ double number_option(const Args& a, const std::string& opt, double fallback);  /
 double integer_option(const Args& a, const std::string& opt, double fallback, double min,
                       double max = 1e15);
 Model load(const Args& a, std::size_t count = 1);  // the first positional; expects `count`
+// --max-memory GB (a number > 0, below 1e9) as bytes, or 0 when absent: the memory limit's
+// default, half the available memory (core/memory.hpp).
+double max_memory(const Args& a);
 
 int cmd_info(int argc, char** argv);
 int cmd_equations(int argc, char** argv);

@@ -112,10 +112,10 @@ int cmd_compare(int argc, char** argv) {
       j["rtol"] = rtol;
       j["pass"] = code == 0;
     }
-    std::cout << j.dump(2) << "\n";
+    std::cout << json_text(j) << "\n";
     return code;
   }
-  std::cout << "A: " << a.positional[0] << "\nB: " << B.where << "\n"
+  std::cout << "A: " << escaped(a.positional[0]) << "\nB: " << escaped(B.where) << "\n"
             << K
             << (a.has("q") ? " given state"
                            : " seeded random states (seed " + std::to_string(seed) + ")")

@@ -46,7 +46,7 @@ int cmd_import(int argc, char** argv) {
   } catch (const std::runtime_error& e) {
     throw CliError(e.what());
   }
-  std::cerr << "femdyn import: wrote " << out << "\n";
+  std::cerr << "femdyn import: wrote " << escaped(out) << "\n";
   return 0;
 }
 

@@ -1,8 +1,12 @@
 #include <cstring>
 #include <iostream>
+#include <new>
+#include <string>
 
 #include "cli/commands.hpp"
 #include "core/errors.hpp"
+#include "core/memory.hpp"
+#include "core/names.hpp"
 
 namespace {
 
@@ -29,6 +33,13 @@ every command takes --help, and --gravity gx,gy,gz to override the model's gravi
 models: JSON files (docs/model-format.md) or URDF files (*.urdf; gravity (0, 0, -9.81) unless
 --gravity; docs/tutorial.md).
 )";
+
+// The last line of defence: whatever reaches here is printed as one safe line, though
+// femdyn's own errors are safe already (femdyn::Error). The command is user text too.
+void report(const std::string& cmd, const char* what) {
+  std::cerr << "femdyn " << femdyn::safe_message(femdyn::truncated(cmd)) << ": "
+            << femdyn::safe_message(what) << "\n";
+}
 
 }  // namespace
 
@@ -72,15 +83,20 @@ int main(int argc, char** argv) {
     if (cmd == "validate")
       throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
 #endif
-    throw CliError("unknown command '" + cmd + "' (try femdyn --help)");
+    throw CliError("unknown command " + femdyn::quoted_text(cmd) + " (try femdyn --help)");
   } catch (const CliError& e) {
-    std::cerr << "femdyn " << cmd << ": " << e.what() << "\n";
+    report(cmd, e.what());
     return 2;
   } catch (const femdyn::ModelError& e) {
-    std::cerr << "femdyn " << cmd << ": " << e.what() << "\n";
+    report(cmd, e.what());
+    return 1;
+  } catch (const std::bad_alloc&) {
+    // The last line of defence: work that allocates by input size is estimated and refused up
+    // front (core/memory.hpp); what no estimate foresaw is still one line of femdyn's.
+    std::cerr << "femdyn " << cmd << ": " << femdyn::out_of_memory_text("running " + cmd) << "\n";
     return 1;
   } catch (const std::exception& e) {
-    std::cerr << "femdyn " << cmd << ": " << e.what() << "\n";
+    report(cmd, e.what());
     return 1;
   }
 }

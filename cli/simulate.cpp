@@ -10,9 +10,12 @@
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
 #include "core/integrator.hpp"
+#include "core/memory.hpp"
+#include "core/names.hpp"
 #include "core/recorded_run.hpp"
 #include "io/actuation_table.hpp"
 #include "io/atomic_file.hpp"
+#include "io/output.hpp"
 #include "io/trajectory_csv.hpp"
 
 namespace femdyn::cli {
@@ -22,7 +25,7 @@ constexpr const char* kHelp =
     R"(usage: femdyn simulate MODEL --t-end T [--integrator rk4|euler|dopri|bdf]
                         [--dt h | --rtol r --atol a] [--q0 …] [--qd0 …] [--tau … | --tau-csv FILE]
                         [--out traj.csv] [--every k | --sample-dt s] [--max-steps N] [--force]
-                        [--json] [--gravity gx,gy,gz]
+                        [--max-memory GB] [--json] [--gravity gx,gy,gz]
 
 Integrates M^s q̈ + h = Q from (q0, q̇0) (default 0) over [0, T] and prints a summary:
 integrator, steps, rejected steps, evaluations of forward dynamics, Jacobians, wall time,
@@ -48,7 +51,10 @@ a numerical fault writes the rows up to the last good step and says so). --json 
 summary as one object.
 Before it starts, a fixed-step run that needs more than --max-steps steps (default 1e7) or a
 dt below the time's resolution is refused with its step count and estimated time, and an
-output larger than the free disk space is refused with its size. A solution that diverges
+output larger than the free disk space is refused with its size, and a run whose memory (the
+model's n x n matrices, bdf's Jacobian, the --sample-dt times, the --tau-csv table) exceeds the
+memory limit (--max-memory GB, default half the available memory) with the memory it needs. An
+adaptive run (dopri, bdf) over less than 1e-100 s is refused. A solution that diverges
 (its energy grows far beyond what it started with and was given) stops as a failure that names
 the stiffest mode and the step it allows. A joint that leaves its declared limits gets one
 warning (the joint, the time, the value). Exit 1 on a numerical fault or a divergence (the
@@ -117,8 +123,8 @@ class InterruptGuard {
 IntegratorOptions integrator_options(const Args& a) {
   IntegratorOptions o;
   if (a.has("integrator") && !parse_integrator(a.options.at("integrator"), o.kind))
-    throw CliError("--integrator: '" + a.options.at("integrator") +
-                   "' is not one of rk4, euler, dopri, bdf");
+    throw CliError("--integrator: " + quoted_text(a.options.at("integrator")) +
+                   " is not one of rk4, euler, dopri, bdf");
   if (is_adaptive(o.kind)) {
     if (a.has("dt"))
       throw CliError(std::string("--dt sets the step of rk4 and euler; ") +
@@ -139,9 +145,10 @@ IntegratorOptions integrator_options(const Args& a) {
 }
 
 int cmd_simulate(int argc, char** argv) {
-  const Args a = parse_args(argc, argv, 2, {"help", "json", "force"},
-                            {"gravity", "t-end", "integrator", "dt", "rtol", "atol", "q0", "qd0",
-                             "tau", "tau-csv", "out", "every", "sample-dt", "max-steps"});
+  const Args a =
+      parse_args(argc, argv, 2, {"help", "json", "force"},
+                 {"gravity", "t-end", "integrator", "dt", "rtol", "atol", "q0", "qd0", "tau",
+                  "tau-csv", "out", "every", "sample-dt", "max-steps", "max-memory"});
   if (a.has("help")) {
     std::cout << kHelp;
     return 0;
@@ -155,13 +162,27 @@ int cmd_simulate(int argc, char** argv) {
   const long every = static_cast<long>(integer_option(a, "every", 1, 1));
   if (a.has("every") && a.has("sample-dt"))
     throw CliError("--every and --sample-dt exclude each other");
-  std::optional<std::vector<double>> sample_times;
+  // Memory: the run's matrices and the sample times, before either is allocated.
+  const double memory_given = max_memory(a);
+  double sample_dt = 0;
   if (a.has("sample-dt")) {
-    const double s = number_option(a, "sample-dt", 0);
-    if (!(s > 0) || t_end / s > 1e9)
+    sample_dt = number_option(a, "sample-dt", 0);
+    if (!(sample_dt > 0) || t_end / sample_dt > 1e9)
       throw CliError("--sample-dt expects a positive interval, at most 1e9 rows over --t-end");
-    sample_times = output_times(t_end, s);
   }
+  const double run_bytes =
+      integrator_bytes(m, o.kind) + (sample_dt > 0 ? 8 * (std::ceil(t_end / sample_dt) + 1) : 0);
+  require_memory(a.positional[0] + ": simulating n = " + std::to_string(m.n()) +
+                     " coordinates with " + integrator_name(o.kind) +
+                     (sample_dt > 0 ? " and " + format_short(std::ceil(t_end / sample_dt) + 1) +
+                                          " sample times"
+                                    : std::string()),
+                 run_bytes, memory_given,
+                 "use " + max_memory_option(run_bytes) + " if that much memory is free" +
+                     (sample_dt > 0 ? ", or a larger --sample-dt" : "") +
+                     (o.kind == IntegratorKind::Bdf ? ", or dopri (no Jacobian)" : ""));
+  std::optional<std::vector<double>> sample_times;
+  if (sample_dt > 0) sample_times = output_times(t_end, sample_dt);
 
   // τ: constant, a table, or none (passive).
   if (a.has("tau") && a.has("tau-csv")) throw CliError("--tau and --tau-csv exclude each other");
@@ -173,7 +194,7 @@ int cmd_simulate(int argc, char** argv) {
     driven = !u.isZero(0);
     if (driven) tau = [u](double, VecX& out) { out = u; };
   } else if (a.has("tau-csv")) {
-    table.emplace(a.options.at("tau-csv"), m);
+    table.emplace(a.options.at("tau-csv"), m, memory_given);
     if (table->t_first() > 0 || table->t_last() < t_end)
       throw CliError("--tau-csv " + table->path() + " covers t in [" + num(table->t_first()) +
                      ", " + num(table->t_last()) + "] s; it must cover [0, " + num(t_end) + "] s");
@@ -217,7 +238,7 @@ int cmd_simulate(int argc, char** argv) {
   progress.finish();
   if (run.interrupted) {
     std::cerr << "femdyn simulate: interrupted at t = " << integ->t() << " s"
-              << (out ? "; " + out->path() + " was not written" : std::string()) << "\n";
+              << (out ? "; " + escaped(out->path()) + " was not written" : std::string()) << "\n";
     return 130;  // `out` discards its temporary file
   }
   const Status& st = run.status;
@@ -273,7 +294,7 @@ int cmd_simulate(int argc, char** argv) {
       j["options"] = {{"dt", o.fixed.dt}};
     if (out) j["out"] = out->path();
     if (!st.ok) j["failure"] = st.message;
-    std::cout << j.dump(2) << "\n";
+    std::cout << json_text(j) << "\n";
   } else {
     std::cout << "model: " << m.name << " (" << m.n() << " coordinates)\n"
               << "integrator: " << integ->name() << " ("
@@ -289,11 +310,12 @@ int cmd_simulate(int argc, char** argv) {
               << balance_name << ": max |E(t) - E(0) - W(t)| = " << num(max_balance) << " J ("
               << num(run.relative_balance()) << " of the " << num(scale)
               << " J the motion started with and was given) over " << rows << " rows\n";
-    if (out) std::cout << "wrote " << out->path() << " (" << rows << " rows)\n";
+    if (out) std::cout << "wrote " << escaped(out->path()) << " (" << rows << " rows)\n";
   }
   if (!st.ok) {
-    std::cerr << "femdyn simulate: " << a.positional[0] << ": " << st.message
-              << (out ? "; the rows up to t = " + num(simulated) + " s are in " + out->path()
+    std::cerr << "femdyn simulate: " << escaped(a.positional[0]) << ": " << safe_message(st.message)
+              << (out ? "; the rows up to t = " + num(simulated) + " s are in " +
+                            escaped(out->path())
                       : std::string())
               << "\n";
     return 1;

@@ -14,8 +14,11 @@
 #include "cli/commands.hpp"
 #include "cli/stress_cases.hpp"
 #include "core/errors.hpp"
+#include "core/names.hpp"
 #include "io/atomic_file.hpp"
+#include "io/csv.hpp"
 #include "io/model_loader.hpp"
+#include "io/output.hpp"
 
 namespace femdyn::cli {
 namespace {
@@ -56,7 +59,7 @@ int cmd_stress(int argc, char** argv) {
   if (a.has("class")) {
     std::erase_if(cases, [&](const StressCase& c) { return c.klass != a.options.at("class"); });
     if (cases.empty())
-      throw CliError("--class: no class '" + a.options.at("class") + "' (try --help)");
+      throw CliError("--class: no class " + quoted_text(a.options.at("class")) + " (try --help)");
   }
   const fs::path dir = a.has("out") ? fs::path(a.options.at("out")) : fs::path("stress");
   const bool write = !a.has("json") || a.has("out");
@@ -159,11 +162,11 @@ int cmd_stress(int argc, char** argv) {
       md << "— | — | — | — | — | — | — | " << r.verdict << " |\n";
     std::string verdict = r.verdict;
     std::replace(verdict.begin(), verdict.end(), ',', ';');
-    csv << c.klass << "," << c.name << "," << r.n << "," << r.cond_min << "," << r.cond_max << ","
-        << r.positive_definite << "," << r.stiffest << "," << step(0) << "," << step(1) << ","
-        << theory(0) << "," << theory(1) << "," << c.dt << "," << err(0) << "," << err(1) << ","
-        << err(2) << "," << err(3) << "," << r.energy_error << "," << r.simbody_error << ",\""
-        << verdict << "\"\n";
+    csv << csv_field(c.klass) << "," << csv_field(c.name) << "," << r.n << "," << r.cond_min << ","
+        << r.cond_max << "," << r.positive_definite << "," << r.stiffest << "," << step(0) << ","
+        << step(1) << "," << theory(0) << "," << theory(1) << "," << c.dt << "," << err(0) << ","
+        << err(1) << "," << err(2) << "," << err(3) << "," << r.energy_error << ","
+        << r.simbody_error << ",\"" << verdict << "\"\n";
   }
   if (write) {
     for (const auto& [name, text] : {std::pair{"stress.md", md.str()}, {"stress.csv", csv.str()}}) {
@@ -173,9 +176,9 @@ int cmd_stress(int argc, char** argv) {
     }
   }
   if (a.has("json"))
-    std::cout << results.dump(2) << "\n";
+    std::cout << json_text(results) << "\n";
   else
-    std::cout << md.str() << "wrote " << (dir / "stress.md").string() << ", stress.csv\n";
+    std::cout << md.str() << "wrote " << escaped((dir / "stress.md").string()) << ", stress.csv\n";
   return 0;
 }
 

@@ -21,6 +21,8 @@
 #include "cli/commands.hpp"
 #include "core/sampling.hpp"
 #include "io/atomic_file.hpp"
+#include "io/csv.hpp"
+#include "io/output.hpp"
 
 #ifndef FEMDYN_BUILD_TYPE
 #define FEMDYN_BUILD_TYPE "unknown"
@@ -225,12 +227,12 @@ std::string csv_text(const StudyReport& rep, const std::string& command) {
     for (char c : {',', '#', '\n'}) std::replace(failure.begin(), failure.end(), c, ';');
     std::replace(failure.begin(), failure.end(), '"', '\'');
     const auto [lo, hi] = std::minmax_element(r.times.begin(), r.times.end());
-    s << r.engine << "," << r.integrator << "," << r.setting << "," << r.value << "," << r.error
-      << "," << r.position_error << "," << r.rate_error << "," << r.final_error << ","
-      << r.energy_drift << "," << r.wall_time << "," << r.times.size() << "," << r.warm_up_time
-      << "," << (r.times.empty() ? 0 : *lo) << "," << (r.times.empty() ? 0 : *hi) << ","
-      << r.rhs_evals << "," << r.steps << "," << r.ok << "," << r.resolved << ",\"" << failure
-      << "\"\n";
+    s << csv_field(r.engine) << "," << csv_field(r.integrator) << "," << csv_field(r.setting) << ","
+      << r.value << "," << r.error << "," << r.position_error << "," << r.rate_error << ","
+      << r.final_error << "," << r.energy_drift << "," << r.wall_time << "," << r.times.size()
+      << "," << r.warm_up_time << "," << (r.times.empty() ? 0 : *lo) << ","
+      << (r.times.empty() ? 0 : *hi) << "," << r.rhs_evals << "," << r.steps << "," << r.ok << ","
+      << r.resolved << ",\"" << failure << "\"\n";
   }
   return s.str();
 }
@@ -548,20 +550,21 @@ int cmd_study(int argc, char** argv) {
               << (dir / "study.gp").string() << " is written, study.png is not\n";
 
   if (a.has("json")) {
-    std::cout << report_json(rep, command, o).dump(2) << "\n";
+    std::cout << json_text(report_json(rep, command, o)) << "\n";
     return 0;
   }
   // The summary table on stdout.
-  std::cout << "model: " << rep.model << " (" << rep.n << " coordinates), t = 0…" << rep.t_end
-            << " s, " << rep.runs.size() << " runs\nreference: " << rep.reference_method
-            << ", estimated error " << sci(rep.reference_error)
-            << "\nsampling: " << sampling_short(rep) << "; wall time: " << timing_text(rep) << "\n";
+  std::cout << "model: " << escaped(rep.model) << " (" << rep.n << " coordinates), t = 0…"
+            << rep.t_end << " s, " << rep.runs.size()
+            << " runs\nreference: " << rep.reference_method << ", estimated error "
+            << sci(rep.reference_error) << "\nsampling: " << sampling_short(rep)
+            << "; wall time: " << timing_text(rep) << "\n";
   if (!rep.same_formulation) std::cout << "formulation: " << formulation_text(rep) << "\n";
   std::istringstream lines(md);
   std::string line;
   while (std::getline(lines, line))
     if (line.rfind("| target", 0) == 0 || line.rfind("| 1e-", 0) == 0) std::cout << line << "\n";
-  std::cout << "wrote " << (dir / "study.csv").string() << ", study.md, study.gp"
+  std::cout << "wrote " << escaped((dir / "study.csv").string()) << ", study.md, study.gp"
             << (plotted ? ", study.png" : "") << "\n";
   return 0;
 }

@@ -8,6 +8,7 @@
 #include "cli/commands.hpp"
 #include "core/fixed_step.hpp"
 #include "core/quintic.hpp"
+#include "io/csv.hpp"
 #include "io/output.hpp"
 
 namespace femdyn::cli {
@@ -65,9 +66,10 @@ int cmd_track(int argc, char** argv) {
   std::ostringstream csv;
   csv.precision(12);
   csv << "t";
-  for (const auto& c : m.coordinate_names) csv << ",q_ref_" << c;
-  for (const auto& c : m.coordinate_names) csv << ",tau_" << c;
-  for (const auto& c : m.coordinate_names) csv << ",q_sim_" << c;
+  // Names quoted where they need it (RFC 4180): a coordinate "a,b" stays one column.
+  for (const auto& c : m.coordinate_names) csv << ',' << csv_field("q_ref_" + c);
+  for (const auto& c : m.coordinate_names) csv << ',' << csv_field("tau_" + c);
+  for (const auto& c : m.coordinate_names) csv << ',' << csv_field("q_sim_" + c);
   csv << "\n";
   for (int k = 0; k <= N; ++k) {
     const double t = k * dt;
@@ -91,10 +93,13 @@ int cmd_track(int argc, char** argv) {
     }
   }
   if (a.has("json")) {
-    std::cout << Json{{"model", m.name},       {"n", m.n()}, {"coordinates", m.coordinate_names},
-                      {"duration", T},         {"steps", N}, {"max_tracking_error", max_err},
-                      {"max_abs_tau", max_tau}}
-                     .dump(2)
+    std::cout << json_text(Json{{"model", m.name},
+                                {"n", m.n()},
+                                {"coordinates", m.coordinate_names},
+                                {"duration", T},
+                                {"steps", N},
+                                {"max_tracking_error", max_err},
+                                {"max_abs_tau", max_tau}})
               << "\n";
   } else {
     std::cout << "model: " << m.name << "\nquintic motion over " << T << " s, " << N

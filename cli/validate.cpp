@@ -103,12 +103,12 @@ Json report_json(const std::string& path, const Model& m, const validation::Vali
 
 void print_text(const std::string& path, const validation::ValidationReport& r) {
   if (!r.failure.empty()) {
-    std::cout << path << ": no comparison possible: " << r.failure << "\n";
+    std::cout << escaped(path) << ": no comparison possible: " << safe_message(r.failure) << "\n";
     for (const auto& n : r.notes) std::cout << "note: " << n << "\n";
     std::cout << "FAIL\n";
     return;
   }
-  std::cout << path << " (" << r.n << " coordinates) against Simbody, " << r.states
+  std::cout << escaped(path) << " (" << r.n << " coordinates) against Simbody, " << r.states
             << " seeded random states\n"
             << "quantity   max abs err   max rel err   tolerance   result\n";
   for (const auto& q : r.quantities)
@@ -207,11 +207,7 @@ int cmd_validate(int argc, char** argv) {
   o.budget = number_option(a, "budget", o.budget);
   if (!(o.budget > 0 && o.budget < 1e9))
     throw CliError("--budget expects a positive number of seconds (below 1e9)");
-  if (a.has("max-memory")) {
-    const double gb = number_option(a, "max-memory", 0);
-    if (!(gb > 0 && gb < 1e9)) throw CliError("--max-memory expects a positive number of GB");
-    o.memory_limit = gb * 1e9;
-  }
+  o.memory_limit = max_memory(a);
 
   // Load every model first: a bad file fails before any work.
   std::deque<Model> models;  // (Model is move-only and its move may throw: no vector)
@@ -258,7 +254,7 @@ int cmd_validate(int argc, char** argv) {
     else
       print_text(a.positional[i], r);
   }
-  if (a.has("json")) std::cout << (reports.size() == 1 ? reports[0] : reports).dump(2) << "\n";
+  if (a.has("json")) std::cout << json_text((reports.size() == 1 ? reports[0] : reports)) << "\n";
   return all_pass ? 0 : 1;
 }
 

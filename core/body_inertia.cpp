@@ -97,6 +97,21 @@ void choose_routes(Model& m) {
           : DynamicsRoute::Cholesky;
 }
 
+std::vector<MassProperties> body_mass_properties(const Model& m) {
+  std::vector<MassProperties> sum(m.bodies.size());
+  std::vector<Vec3> first_moment(m.bodies.size(), Vec3::Zero());
+  for (const ElementEntry& e : m.elements) {
+    if (e.spans) continue;  // a spanning element moves with no one body
+    const MassProperties p = e.element->mass_properties();
+    sum[e.body].mass += p.mass;
+    first_moment[e.body] += p.mass * p.com;
+    sum[e.body].inertia_origin += p.inertia_origin;
+  }
+  for (std::size_t b = 0; b < sum.size(); ++b)
+    if (sum[b].mass > 0) sum[b].com = first_moment[b] / sum[b].mass;
+  return sum;
+}
+
 MassProperties body_mass_properties(const Model& m, int body) {
   MassProperties sum;
   Vec3 first_moment = Vec3::Zero();

@@ -36,6 +36,8 @@ void choose_routes(Model& model);
 // The sum of the body's elements' mass properties (body frame); an element that spans bodies
 // (a rod) moves with no single body and is left out.
 MassProperties body_mass_properties(const Model& model, int body);
+// The same for every body at once, in O(elements).
+std::vector<MassProperties> body_mass_properties(const Model& model);
 
 // ws.composite: the composite inertias I^c_b (world axes, about the origin) from the body poses.
 void composite_inertias(const Model& model, Workspace& ws);

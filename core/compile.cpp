@@ -203,9 +203,7 @@ Model compile_tree(MechanismSpec spec) {
                   "gravity");
   check_name(spec.name, spec.where + "/name", "model name");
   if (static_cast<long long>(spec.bodies.size()) > kMaxBodies)
-    throw ModelError(spec.where + "/bodies", std::to_string(spec.bodies.size()) +
-                                                 " bodies: more than femdyn's limit of " +
-                                                 std::to_string(kMaxBodies));
+    throw ModelError(spec.where + "/bodies", too_many_bodies_text(spec.bodies.size()));
   m.gravity = spec.gravity;
   if (spec.bodies.empty()) throw ModelError(spec.where + "/bodies", "the model has no bodies");
 

@@ -1,16 +1,27 @@
-// User-input errors found while compiling a mechanism. `where` is the location label supplied
-// by the front end (for JSON models "file.json: /bodies/3/joint"); compile appends JSON-pointer
-// segments to it ("/origin/xyz") to name a field.
+// Errors femdyn reports to its user. femdyn::Error is the base of all of them: its constructor
+// makes the whole message safe to print (core/message.hpp: one line, control characters
+// escaped, bounded length), so no message can echo user text raw, whoever formats it.
+// ModelError: user-input errors found while reading or compiling a mechanism. `where` is the
+// location label supplied by the front end (for JSON models "file.json: /bodies/3/joint");
+// compile appends JSON-pointer segments to it ("/origin/xyz") to name a field.
 #pragma once
 #include <stdexcept>
 #include <string>
+#include <string_view>
+
+#include "core/message.hpp"
 
 namespace femdyn {
 
-class ModelError : public std::runtime_error {
+class Error : public std::runtime_error {
+ public:
+  explicit Error(std::string_view text) : std::runtime_error(safe_message(text)) {}
+};
+
+class ModelError : public Error {
  public:
   ModelError(const std::string& where, const std::string& what)
-      : std::runtime_error(where.empty() ? what : where + ": " + what) {}
+      : Error(where.empty() ? what : where + ": " + what) {}
 };
 
 }  // namespace femdyn

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/fixed_step.hpp"
+#include "core/memory.hpp"
 #include "core/stability.hpp"
 #include "core/sundials_integrators.hpp"
 
@@ -117,6 +118,16 @@ Status Integrator::step() {
 }
 
 Status Integrator::plan(double) { return {}; }
+
+double integrator_bytes(const Model& m, IntegratorKind kind) {
+  const double n = m.n();
+  const bool forms_mass = m.dynamics_route == DynamicsRoute::Cholesky ||
+                          m.mass_route == MassRoute::Transform || m.coupling_level;
+  // Without M^s (the articulated and composite routes): buffers of n and per body only.
+  double bytes = forms_mass ? evaluation_bytes(m) : 2e3 * static_cast<double>(m.bodies.size());
+  if (kind == IntegratorKind::Bdf) bytes += 2 * dense_bytes(2 * n + 1, 2 * n + 1);
+  return bytes;
+}
 
 Status Integrator::watch() {
   const int n = motion_.n();

@@ -23,6 +23,13 @@ inline constexpr long long kMaxFileBytes = 256LL << 20;  // a model file: 256 Mi
 inline constexpr int kMaxNesting = 64;                   // JSON nesting depth
 inline constexpr double kMaxTensorEntries = 2e7;         // D and T' (equations --tensor): 160 MB
 
+// "1000000 bodies: more than femdyn's limit of 200000", wherever the bodies are counted (the
+// JSON text before it is parsed, a URDF's links, compile()).
+inline std::string too_many_bodies_text(std::size_t bodies) {
+  return std::to_string(bodies) + " bodies: more than femdyn's limit of " +
+         std::to_string(kMaxBodies);
+}
+
 inline std::string magnitude_text(double x) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3g", x);

@@ -312,22 +312,28 @@ std::string divergence_cause(const Model& m, IntegratorKind kind, double dt,
 std::vector<SuspiciousBody> suspicious_bodies(const Model& m) {
   std::vector<SuspiciousBody> out;
   const int nb = static_cast<int>(m.bodies.size());
-  std::vector<MassProperties> p(nb);
-  for (int b = 0; b < nb; ++b) p[b] = body_mass_properties(m, b);
+  const std::vector<MassProperties> p = body_mass_properties(m);
+  // Each body's heaviest child, the first in file order among equals (-1: none with mass).
+  std::vector<int> heaviest_child(nb, -1);
+  for (int c = 0; c < nb; ++c) {
+    const int parent = m.bodies[c].parent;
+    if (parent >= 0 &&
+        p[c].mass > (heaviest_child[parent] < 0 ? 0 : p[heaviest_child[parent]].mass))
+      heaviest_child[parent] = c;
+  }
   const auto flag = [&](int b, const std::string& why) {
     out.push_back({b, m.bodies[b].name, why});
   };
   for (int b = 0; b < nb; ++b) {
-    // Neighbours: the parent and the children, among bodies that carry mass.
+    // Neighbours: the parent and the children, among bodies that carry mass (the parent first
+    // among equals: it comes before its children).
     double heaviest = 0;
     std::string heaviest_name;
-    for (int c = 0; c < nb; ++c) {
-      const bool neighbour = c == m.bodies[b].parent || m.bodies[c].parent == b;
-      if (neighbour && p[c].mass > heaviest) {
+    for (const int c : {m.bodies[b].parent, heaviest_child[b]})
+      if (c >= 0 && p[c].mass > heaviest) {
         heaviest = p[c].mass;
         heaviest_name = m.bodies[c].name;
       }
-    }
     const double mass = p[b].mass;
     if (mass > 0 && heaviest > 0 && mass < 1e-6 * heaviest)
       flag(b, "near-zero mass: " + format_short(mass) + " kg, " + format_short(mass / heaviest) +

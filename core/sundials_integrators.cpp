@@ -6,8 +6,10 @@
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace femdyn {
 
@@ -105,6 +107,19 @@ Status Adaptive::failure(int flag) {
 
 std::string Adaptive::setting() const {
   return "rtol " + format_short(options_.rtol) + ", atol " + format_short(options_.atol);
+}
+
+Status Adaptive::plan(double t_end) {
+  const double span = t_end - t_;
+  if (!(span > 0)) return {};
+  const double t_max = std::max(std::abs(t_), std::abs(t_end));
+  if (span < kMinAdaptiveSpan || span <= 4 * std::numeric_limits<double>::epsilon() * t_max)
+    return {false, "a run of " + format_short(span) + " s from t = " + format_short(t_) +
+                       " s is too short for " + name() +
+                       ": an adaptive integrator needs at least 1e-100 s and more than the "
+                       "resolution of the time (its first step is estimated from the span); use "
+                       "rk4 or euler, whose one step lands on t_end"};
+  return {};
 }
 
 Status Adaptive::advance(double t_out) {

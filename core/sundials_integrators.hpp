@@ -19,6 +19,11 @@ namespace femdyn {
 // the .cpp).
 struct SundialsRun;
 
+// The shortest run an adaptive integrator takes (s): SUNDIALS' first-step estimate divides by
+// the span squared, which overflows double precision below about 1e-154 s; the bound mirrors
+// kMaxMagnitude (core/limits.hpp) as its reciprocal.
+inline constexpr double kMinAdaptiveSpan = 1e-100;
+
 class Adaptive : public Integrator {
  public:
   ~Adaptive() override;
@@ -28,6 +33,7 @@ class Adaptive : public Integrator {
   Status advance(double t_out) override;
   Status one_step() override;
   std::string setting() const override;
+  Status plan(double t_end) override;  // a span SUNDIALS cannot start on, refused
   Status finish(int flag, double t_reached, double t_target);
   // What SUNDIALS' return code means for the user, with the step size where it failed.
   Status failure(int flag);

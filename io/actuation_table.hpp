@@ -1,7 +1,8 @@
 // τ(t) from a CSV file (femdyn simulate --tau-csv): a header line "t,<c1>,<c2>,…" naming every
 // generalized coordinate once, each as "<name>" or "tau_<name>", in any order; then one row per
 // sample time, strictly increasing. τ is interpolated linearly between rows and held at the
-// last row's value after it. Errors name the file, the line and the column.
+// last row's value after it. Fields may be quoted (RFC 4180, io/csv.hpp). Errors name the file,
+// the line and the column.
 #pragma once
 #include <string>
 #include <vector>
@@ -12,12 +13,17 @@ namespace femdyn {
 
 class ActuationTable {
  public:
-  // Throws ModelError ("FILE:LINE: …") on a malformed file.
-  ActuationTable(const std::string& path, const Model& model);
+  // Throws ModelError ("FILE:LINE: …") on a malformed file, MemoryRefused (core/memory.hpp)
+  // when its rows would need more memory than the limit (`memory_given` bytes, 0: the default).
+  ActuationTable(const std::string& path, const Model& model, double memory_given = 0);
+  // The same from the file's text; `path` names it in errors (the CSV fuzz target).
+  struct FromText {};
+  static constexpr FromText from_text{};
+  ActuationTable(const std::string& text, const std::string& path, const Model& model, FromText,
+                 double memory_given = 0);
   // From samples already checked by the caller: t strictly increasing (at least 2), tau n × |t|
   // (column r at t[r]); `path` names the source in reports.
-  ActuationTable(std::vector<double> t, MatX tau, std::string path)
-      : path_(std::move(path)), t_(std::move(t)), tau_(std::move(tau)) {}
+  ActuationTable(std::vector<double> t, const MatX& tau, std::string path);
 
   void operator()(double t, VecX& tau) const;  // no allocation
   double t_first() const { return t_.front(); }
@@ -25,9 +31,11 @@ class ActuationTable {
   const std::string& path() const { return path_; }
 
  private:
+  void reserve_rows(std::size_t rows, double memory_given);
   std::string path_;
+  int n_ = 0;
   std::vector<double> t_;
-  MatX tau_;  // n x samples
+  std::vector<double> tau_;  // n x samples, column-major: the n τ of row r from r n
 };
 
 }  // namespace femdyn

@@ -6,25 +6,30 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "core/errors.hpp"
+
 namespace femdyn {
 
 AtomicFile::AtomicFile(std::string path, bool replace) : path_(std::move(path)) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  if (path_.empty()) throw std::runtime_error("the output path is empty");
-  if (fs::is_directory(path_, ec)) throw std::runtime_error(path_ + ": is a directory");
+  if (path_.empty()) throw Error("the output path is empty");
+  // A C++ or Python caller may pass one; the system would see only the part before it.
+  if (path_.find('\0') != std::string::npos)
+    throw Error(path_ + ": the path contains a NUL character");
+  if (fs::is_directory(path_, ec)) throw Error(path_ + ": is a directory");
   // A device, FIFO or socket is never renamed over (as root, /dev/full would be replaced).
   const fs::file_status st = fs::status(path_, ec);
   if (fs::exists(st) && !fs::is_regular_file(st))
-    throw std::runtime_error(path_ + ": is not a regular file (femdyn writes regular files only)");
+    throw Error(path_ + ": is not a regular file (femdyn writes regular files only)");
   if (!replace && fs::exists(fs::symlink_status(path_, ec)))
-    throw std::runtime_error(path_ + ": exists (use --force to replace it)");
+    throw Error(path_ + ": exists (use --force to replace it)");
   const fs::path target(path_);
   tmp_ = (target.parent_path() /
           ("." + target.filename().string() + ".tmp-" + std::to_string(::getpid())))
              .string();
   out_.open(tmp_, std::ios::binary | std::ios::trunc);
-  if (!out_) throw std::runtime_error(path_ + ": cannot write (directory missing or not writable)");
+  if (!out_) throw Error(path_ + ": cannot write (directory missing or not writable)");
   open_ = true;
 }
 
@@ -43,13 +48,13 @@ void AtomicFile::commit() {
   out_.close();
   if (!written || out_.fail()) {
     discard();
-    throw std::runtime_error(path_ + ": write failed (disk full?); nothing was written");
+    throw Error(path_ + ": write failed (disk full?); nothing was written");
   }
   std::error_code ec;
   std::filesystem::rename(tmp_, path_, ec);
   if (ec) {
     discard();
-    throw std::runtime_error(path_ + ": cannot rename into place: " + ec.message());
+    throw Error(path_ + ": cannot rename into place: " + ec.message());
   }
   open_ = false;
 }

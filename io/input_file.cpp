@@ -12,6 +12,9 @@
 namespace femdyn {
 
 std::string read_input_file(const std::string& path) {
+  // A C++ or Python caller may pass one; the system would open only the part before it.
+  if (path.find('\0') != std::string::npos)
+    throw ModelError(path, "the path contains a NUL character");
   // O_NONBLOCK: opening a FIFO without a writer returns at once instead of waiting for one.
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) throw ModelError(path, std::string("cannot open file: ") + std::strerror(errno));

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/limits.hpp"
+#include "core/names.hpp"
 #include "io/catalog.hpp"
 #include "io/input_file.hpp"
 #include "io/params.hpp"
@@ -27,10 +28,68 @@ std::string line_col(const std::string& text, std::size_t byte) {
   return "line " + std::to_string(line) + ", column " + std::to_string(col);
 }
 
+// What one linear pass over a JSON text tells before it is parsed: whether it nests deeper
+// than kMaxNesting, and how many items its top-level "bodies" array holds. nlohmann's parser
+// with a callback (the earlier depth check) rescans the enclosing array at every object it
+// closes, which is quadratic in long arrays of objects; this scan and a plain parse are linear.
+struct JsonOutline {
+  bool too_deep = false;
+  std::size_t bodies = 0;  // items of the top-level "bodies" array (0: none, or not an array)
+};
+
+// The index just past the string whose opening quote is text[i], escapes respected.
+std::size_t past_string(const std::string& text, std::size_t i) {
+  for (++i; i < text.size(); ++i) {
+    if (text[i] == '\\')
+      ++i;  // (the escaped character, a quote included)
+    else if (text[i] == '"')
+      return i + 1;
+  }
+  return text.size();
+}
+
+JsonOutline outline(const std::string& text) {
+  JsonOutline out;
+  int depth = 0;            // containers open
+  bool bodies_key = false;  // at depth 1, the last token was the string "bodies" (or its ':')
+  bool in_bodies = false;   // inside the top-level "bodies" array (a later one replaces it)
+  bool counted = false;     // its current item is counted (until the next ',')
+  for (std::size_t i = 0; i < text.size();) {
+    const char c = text[i];
+    if (std::isspace(static_cast<unsigned char>(c))) {
+      ++i;
+      continue;
+    }
+    if (in_bodies && depth == 2 && c != ']') {
+      if (c != ',' && !counted) ++out.bodies;  // an item begins
+      counted = c != ',';
+    }
+    if (c == '"') {
+      const std::size_t end = past_string(text, i);
+      if (depth == 1) bodies_key = text.compare(i, end - i, "\"bodies\"") == 0;
+      i = end;
+      continue;
+    }
+    if (c == '[' || c == '{') {
+      if (++depth > kMaxNesting) return {.too_deep = true};
+      if (depth == 2 && c == '[' && bodies_key) {
+        in_bodies = true;
+        counted = false;
+        out.bodies = 0;
+      }
+    } else if (c == ']' || c == '}') {
+      if (--depth == 1) in_bodies = false;
+    }
+    if (c != ':') bodies_key = false;  // the key is "bodies" only when ':' follows it
+    ++i;
+  }
+  return out;
+}
+
 JointType joint_type(const Params& p) {
   const std::string t = p.string("type");
   if (const auto type = joint_type_named(t)) return *type;
-  p.fail("type", "unknown joint type '" + t + "' (expected " + joint_type_list() + ")");
+  p.fail("type", "unknown joint type " + quoted_text(t) + " (expected " + joint_type_list() + ")");
 }
 
 JointSpec read_joint(const Params& p) {
@@ -93,7 +152,7 @@ BodySpec read_body(const Catalog& catalog, const Json& jb, const std::string& wh
   b.name = p.string("name");
   b.parent = p.string("parent");
   b.joint = read_joint(p.child("joint"));
-  std::map<std::string, Vec3> nodes = other_nodes;  // "body/node", and this body's by name
+  std::map<std::string, Vec3> nodes;  // this body's by name ("body/node" in other_nodes)
   if (p.has("nodes")) {
     const Json& jn = jb.at("nodes");
     if (!jn.is_object()) p.fail("nodes", "expected an object {name: [x, y, z]}");
@@ -104,12 +163,13 @@ BodySpec read_body(const Catalog& catalog, const Json& jb, const std::string& wh
     const Json& je = jb.at("elements");
     if (!je.is_array()) p.fail("elements", "expected an array");
     for (std::size_t e = 0; e < je.size(); ++e) {
-      const Params ep(je[e], p.path("elements") + "/" + std::to_string(e), b.name, &nodes);
+      const Params ep(je[e], p.path("elements") + "/" + std::to_string(e), b.name, &nodes,
+                      &other_nodes);
       const std::string type = ep.string("type");
       const ElementType* t = catalog.elements.find(type);
       if (!t)
-        ep.fail("type",
-                "unknown element type '" + type + "' (known: " + catalog.elements.names() + ")");
+        ep.fail("type", "unknown element type " + quoted_text(type) +
+                            " (known: " + catalog.elements.names() + ")");
       ElementSink sink(b.elements, ep.where());
       t->make(ep, sink);
     }
@@ -248,7 +308,18 @@ CouplingSpec read_coupling(const Params& p) {
   return c;
 }
 
-LoadSpec read_load(const Params& p, const Json& bodies) {
+// The bodies' JSON objects by name (a list: a duplicate name is reported by compile()).
+using BodiesByName = std::map<std::string, std::vector<const Json*>>;
+
+BodiesByName bodies_by_name(const Json& bodies) {
+  BodiesByName by_name;
+  for (const Json& b : bodies)
+    if (b.is_object() && b.contains("name") && b["name"].is_string())
+      by_name[b["name"].get<std::string>()].push_back(&b);
+  return by_name;
+}
+
+LoadSpec read_load(const Params& p, const BodiesByName& bodies) {
   p.allow_only({"body", "point", "node", "force", "torque"});
   LoadSpec l;
   l.where = p.where();
@@ -256,11 +327,12 @@ LoadSpec read_load(const Params& p, const Json& bodies) {
   if (p.has("node") && p.has("point")) p.fail("point", "give either point or node, not both");
   if (p.has("node")) {
     std::map<std::string, Vec3> nodes;
-    for (const Json& b : bodies)
-      if (b.is_object() && b.contains("name") && b["name"] == l.body && b.contains("nodes") &&
-          b["nodes"].is_object())
-        for (auto it = b["nodes"].begin(); it != b["nodes"].end(); ++it)
-          nodes[it.key()] = json_vec3(it.value(), p.path("node"));
+    const auto named = bodies.find(l.body);
+    if (named != bodies.end())
+      for (const Json* b : named->second)
+        if (b->contains("nodes") && (*b)["nodes"].is_object())
+          for (auto it = (*b)["nodes"].begin(); it != (*b)["nodes"].end(); ++it)
+            nodes[it.key()] = json_vec3(it.value(), p.path("node"));
     const Params np(p.json(), p.where(), l.body, &nodes);
     l.point = np.node("node").position;
   } else {
@@ -281,7 +353,8 @@ Json expand_plugin(const Catalog& catalog, const Json& root, const std::string& 
   const std::string name = p.string("model");
   const ModelPlugin* plugin = catalog.plugins.find(name);
   if (!plugin)
-    p.fail("model", "unknown model plugin '" + name + "' (known: " + catalog.plugins.names() + ")");
+    p.fail("model", "unknown model plugin " + quoted_text(name) +
+                        " (known: " + catalog.plugins.names() + ")");
   static const Json empty = Json::object();
   Json doc = plugin->expand(p.has("params") ? p.child("params") : Params(empty, p.path("params")));
   for (const char* key : {"name", "description", "gravity"})
@@ -303,7 +376,7 @@ MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std
                                   "couplings", "loads",       "correlation_table", "$schema"};
     bool ok = false;
     for (const char* k : known) ok = ok || it.key() == k;
-    if (!ok) throw ModelError(path(it.key()), "unknown key '" + it.key() + "'");
+    if (!ok) throw ModelError(path(truncated(it.key())), "unknown key " + quoted_text(it.key()));
   }
   if (root.contains("name")) {
     if (!root["name"].is_string()) throw ModelError(path("name"), "expected a string");
@@ -313,6 +386,8 @@ MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std
   if (!root.contains("bodies") || !root["bodies"].is_array())
     throw ModelError(path("bodies"), "expected an array of bodies");
   const Json& bodies = root["bodies"];
+  if (bodies.size() > static_cast<std::size_t>(kMaxBodies))  // before anything is built for them
+    throw ModelError(path("bodies"), too_many_bodies_text(bodies.size()));
   const std::map<std::string, Vec3> qualified = qualified_nodes(bodies);
   for (std::size_t i = 0; i < bodies.size(); ++i)
     spec.bodies.push_back(
@@ -325,9 +400,10 @@ MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std
   }
   if (root.contains("loads")) {
     if (!root["loads"].is_array()) throw ModelError(path("loads"), "expected an array");
+    const BodiesByName by_name = bodies_by_name(bodies);
     for (std::size_t i = 0; i < root["loads"].size(); ++i)
       spec.loads.push_back(
-          read_load(Params(root["loads"][i], path("loads/" + std::to_string(i))), bodies));
+          read_load(Params(root["loads"][i], path("loads/" + std::to_string(i))), by_name));
   }
   if (root.contains("correlation_table")) {
     // [[…], …]  or  {"rows": [[…], …], "join": "same" | "deepest"}
@@ -378,16 +454,17 @@ CouplingSpec parse_coupling(const Json& coupling, const std::string& where) {
 
 MechanismSpec parse_spec(const std::string& text, const std::string& source,
                          const Catalog& catalog) {
+  // The nesting depth and the number of bodies are bounded (core/limits.hpp) by one pass over
+  // the text, before a deep or huge document can cost anything.
+  const JsonOutline shape = outline(text);
+  if (shape.too_deep)
+    throw ModelError(source, "JSON nested deeper than " + std::to_string(kMaxNesting) +
+                                 " levels (femdyn's limit)");
+  if (shape.bodies > static_cast<std::size_t>(kMaxBodies))
+    throw ModelError(source + ": /bodies", too_many_bodies_text(shape.bodies));
   Json root;
   try {
-    // The nesting depth is bounded while parsing (core/limits.hpp), before a deep document
-    // can exhaust anything.
-    root = Json::parse(text, [&](int depth, Json::parse_event_t, Json&) {
-      if (depth > kMaxNesting)
-        throw ModelError(source, "JSON nested deeper than " + std::to_string(kMaxNesting) +
-                                     " levels (femdyn's limit)");
-      return true;
-    });
+    root = Json::parse(text);
   } catch (const Json::parse_error& e) {
     std::string what = e.what();
     const auto colon = what.rfind(": ");

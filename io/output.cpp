@@ -51,6 +51,27 @@ void print_mat(std::ostringstream& out, const MatX& m) {
 
 }  // namespace
 
+std::string json_text(const Json& doc) {
+  const std::string raw = doc.dump(2, ' ', false, Json::error_handler_t::replace);
+  std::string out;
+  out.reserve(raw.size());
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const auto c = static_cast<unsigned char>(raw[i]);
+    const auto next = i + 1 < raw.size() ? static_cast<unsigned char>(raw[i + 1]) : 0;
+    if (c == 0x7f) {
+      out += "\\u007f";
+    } else if (c == 0xc2 && next >= 0x80 && next <= 0x9f) {  // C1: only inside strings
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(next));
+      out += buf;
+      ++i;
+    } else {
+      out += raw[i];
+    }
+  }
+  return out;
+}
+
 Json equations_json(const Model& model, const Workspace& ws, const VecX& q, const VecX& qd,
                     const VecX& tau, bool have_qdd, const std::vector<MatX>& D) {
   Json j;
@@ -119,15 +140,15 @@ std::string info_text(const Model& model) {
   for (const auto& c : model.coordinate_names) out << " " << c;
   out << "\n";
   out << "joints (" << model.n_theta() << " movable):\n";
+  std::vector<const CoupledJoint*> law_of(model.n_theta(), nullptr);  // θ -> its law, if any
+  if (model.coupling_level)
+    for (const CoupledJoint& c : model.coupling_level->coupled) law_of[c.theta] = &c;
   for (const Body& b : model.bodies) {
     const Joint& j = b.joint;
     const std::string_view type = joint_type_name(j.type);
     out << "  " << j.name << " (" << type << ") "
         << (b.parent < 0 ? std::string("world") : model.bodies[b.parent].name) << " -> " << b.name;
-    const CoupledJoint* law = nullptr;
-    if (model.coupling_level)
-      for (const CoupledJoint& c : model.coupling_level->coupled)
-        if (c.theta == j.idx_q) law = &c;
+    const CoupledJoint* law = j.idx_q >= 0 ? law_of[j.idx_q] : nullptr;
     if (law) {  // θ = f(θ_followed…)
       out << "   theta = " << law->law->form() << " of";
       for (int s : law->sources) out << " " << model.bodies[model.theta_joint[s]].joint.name;

@@ -29,6 +29,12 @@ std::string correlation_table_text(const Model& model);
 // rows) on one line, two-space indent. Numbers keep full (round-trip) precision.
 std::string readable_json(const Json& doc);
 
+// The JSON text of a --json output: nlohmann's dump (indent 2), with invalid UTF-8 written as
+// U+FFFD instead of nlohmann's exception, and DEL and the C1 controls (U+0080–U+009F), which it
+// leaves raw, as \u escapes: no --json output can carry a control character to a terminal
+// (docs/robustness.md).
+std::string json_text(const Json& doc);
+
 // Writes content to path through an AtomicFile (io/atomic_file.hpp): readers never see a
 // half-written file. Replaces an existing file.
 void write_file_atomic(const std::string& path, const std::string& content, bool replace);

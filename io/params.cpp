@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/names.hpp"
+
 namespace femdyn {
 
 double json_number(const Json& v, const std::string& where) {
@@ -19,8 +21,13 @@ Vec3 json_vec3(const Json& v, const std::string& where) {
 }
 
 Params::Params(const Json& object, std::string where, std::string body,
-               const std::map<std::string, Vec3>* nodes)
-    : j_(object), where_(std::move(where)), body_(std::move(body)), nodes_(nodes) {
+               const std::map<std::string, Vec3>* nodes,
+               const std::map<std::string, Vec3>* other_nodes)
+    : j_(object),
+      where_(std::move(where)),
+      body_(std::move(body)),
+      nodes_(nodes),
+      other_nodes_(other_nodes) {
   if (!j_.is_object()) throw ModelError(where_, "expected an object");
 }
 
@@ -33,7 +40,9 @@ void Params::fail(const char* key, const std::string& what) const {
   throw ModelError(path(key), what);
 }
 
-Params Params::child(const char* key) const { return Params(at(key), path(key), body_, nodes_); }
+Params Params::child(const char* key) const {
+  return Params(at(key), path(key), body_, nodes_, other_nodes_);
+}
 
 double Params::number(const char* key) const { return json_number(at(key), path(key)); }
 
@@ -100,10 +109,19 @@ Mat3 Params::inertia(const char* key) const {
 NodeRef Params::node_from(const Json& v, const std::string& where) const {
   if (v.is_string()) {
     const std::string name = v.get<std::string>();
-    if (!nodes_ || !nodes_->count(name))
-      throw ModelError(where, "unknown node '" + name + "' (not in the body's \"nodes\")");
-    // "other_body/node": a node of another body (its frame), labelled as such.
-    return {nodes_->at(name), name.find('/') == std::string::npos ? body_ + "/" + name : name};
+    // The body's own node by that name, else "other_body/node": a node of another body (its
+    // frame), labelled as such.
+    const auto find = [&](const std::map<std::string, Vec3>* table) -> const Vec3* {
+      if (!table) return nullptr;
+      const auto it = table->find(name);
+      return it == table->end() ? nullptr : &it->second;
+    };
+    const Vec3* at = find(nodes_);
+    if (!at) at = find(other_nodes_);
+    if (!at)
+      throw ModelError(where,
+                       "unknown node " + quoted_text(name) + " (not in the body's \"nodes\")");
+    return {*at, name.find('/') == std::string::npos ? body_ + "/" + name : name};
   }
   const Vec3 p = json_vec3(v, where);
   char buf[96];
@@ -124,7 +142,8 @@ void Params::allow_only(std::initializer_list<const char*> keys) const {
   for (auto it = j_.begin(); it != j_.end(); ++it) {
     bool ok = false;
     for (const char* k : keys) ok = ok || it.key() == k;
-    if (!ok) throw ModelError(where_ + "/" + it.key(), "unknown key '" + it.key() + "'");
+    if (!ok)
+      throw ModelError(where_ + "/" + truncated(it.key()), "unknown key " + quoted_text(it.key()));
   }
 }
 

@@ -22,9 +22,11 @@ struct NodeRef {
 
 class Params {
  public:
-  // where: "file: /json/pointer"; nodes: the body's named nodes (may be null).
+  // where: "file: /json/pointer"; nodes: the body's named nodes (may be null); other_nodes:
+  // the nodes of every body as "body/node" (may be null), looked up after the body's own.
   Params(const Json& object, std::string where, std::string body = "",
-         const std::map<std::string, Vec3>* nodes = nullptr);
+         const std::map<std::string, Vec3>* nodes = nullptr,
+         const std::map<std::string, Vec3>* other_nodes = nullptr);
 
   bool has(const char* key) const { return j_.contains(key); }
   std::string path(const char* key) const { return where_ + "/" + key; }
@@ -57,6 +59,7 @@ class Params {
   std::string where_;
   std::string body_;
   const std::map<std::string, Vec3>* nodes_;
+  const std::map<std::string, Vec3>* other_nodes_;
 };
 
 // Helpers shared by the loaders.

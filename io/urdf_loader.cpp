@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "core/inertia.hpp"
+#include "core/limits.hpp"
+#include "core/names.hpp"
 #include "io/input_file.hpp"
 
 namespace femdyn {
@@ -33,7 +35,8 @@ double number_attr(const Ctx& c, const XMLElement* e, const char* attr, double f
   char* end = nullptr;
   const double x = std::strtod(s, &end);
   while (end && *end == ' ') ++end;
-  if (end == s || (end && *end)) c.fail(who, std::string(attr) + "=\"" + s + "\" is not a number");
+  if (end == s || (end && *end))
+    c.fail(who, std::string(attr) + "=\"" + echo_text(s) + "\" is not a number");
   if (!std::isfinite(x)) c.fail(who, std::string(attr) + " is NaN or Inf");
   return x;
 }
@@ -46,13 +49,15 @@ Vec3 vec_attr(const Ctx& c, const XMLElement* e, const char* attr, const Vec3& f
   Vec3 v;
   std::string tok[3], extra;
   for (int i = 0; i < 3; ++i) {
-    if (!(in >> tok[i])) c.fail(who, std::string(attr) + "=\"" + s + "\" needs 3 numbers");
+    if (!(in >> tok[i]))
+      c.fail(who, std::string(attr) + "=\"" + echo_text(s) + "\" needs 3 numbers");
     char* end = nullptr;
     v[i] = std::strtod(tok[i].c_str(), &end);
-    if (*end) c.fail(who, std::string(attr) + "=\"" + s + "\" is not 3 numbers");
+    if (*end) c.fail(who, std::string(attr) + "=\"" + echo_text(s) + "\" is not 3 numbers");
     if (!std::isfinite(v[i])) c.fail(who, std::string(attr) + " is NaN or Inf");
   }
-  if (in >> extra) c.fail(who, std::string(attr) + "=\"" + s + "\" has more than 3 numbers");
+  if (in >> extra)
+    c.fail(who, std::string(attr) + "=\"" + echo_text(s) + "\" has more than 3 numbers");
   return v;
 }
 
@@ -126,6 +131,10 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
     link_order.push_back(name);
   }
   if (links.empty()) throw ModelError(source, "no <link> elements");
+  // Every link but the root becomes a body: refused here when too many, before the joints.
+  if (links.size() - 1 > static_cast<std::size_t>(kMaxBodies))
+    throw ModelError(source,
+                     too_many_bodies_text(links.size() - 1) + " (one per <link> but the root)");
 
   // Joints: the tree.
   struct JointInfo {
@@ -147,8 +156,8 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
     const char* cl = ch ? ch->Attribute("link") : nullptr;
     if (!pl) c.fail(who, "has no <parent link=…>");
     if (!cl) c.fail(who, "has no <child link=…>");
-    if (!links.count(pl)) c.fail(who, std::string("parent link '") + pl + "' does not exist");
-    if (!links.count(cl)) c.fail(who, std::string("child link '") + cl + "' does not exist");
+    if (!links.count(pl)) c.fail(who, "parent link " + quoted_text(pl) + " does not exist");
+    if (!links.count(cl)) c.fail(who, "child link " + quoted_text(cl) + " does not exist");
     if (std::string(pl) == cl) c.fail(who, "connects link '" + std::string(cl) + "' to itself");
     auto [it, fresh] = parent_joint.emplace(cl, name);
     if (!fresh)
@@ -166,17 +175,20 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
                                            : "more than one root link: " + list);
   }
   const std::string root = roots[0];
-  // Every link must hang from the root (a cycle elsewhere leaves links unreachable).
-  for (const auto& name : link_order) {
-    std::set<std::string> seen;
-    for (std::string l = name; l != root; l = [&] {
-           for (const JointInfo& ji : joints)
-             if (ji.child == l) return ji.parent;
-           return root;
-         }()) {
-      if (!seen.insert(l).second) c.fail("link '" + name + "'", "is on a loop of joints");
-    }
+  // Every link must hang from the root: every other link has one parent joint, so a link the
+  // walk down from the root does not reach hangs from a loop of joints. One walk, O(links).
+  std::map<std::string, std::vector<std::string>> children;  // link -> child links
+  for (const JointInfo& ji : joints) children[ji.parent].push_back(ji.child);
+  std::set<std::string> reached = {root};
+  for (std::vector<std::string> stack = {root}; !stack.empty();) {
+    const auto below = children.find(stack.back());
+    stack.pop_back();
+    if (below == children.end()) continue;
+    for (const std::string& child : below->second)
+      if (reached.insert(child).second) stack.push_back(child);
   }
+  for (const auto& name : link_order)
+    if (!reached.count(name)) c.fail("link '" + name + "'", "is on a loop of joints");
 
   Json bodies = Json::array(), couplings = Json::array();
   for (const JointInfo& ji : joints) {
@@ -184,9 +196,10 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
     const char* type_c = ji.e->Attribute("type");
     const std::string type = type_c ? type_c : "";
     if (type == "floating" || type == "planar")
-      c.fail(who, "type '" + type + "' is not supported (revolute, continuous, prismatic, fixed)");
+      c.fail(who, "type " + quoted_text(type) +
+                      " is not supported (revolute, continuous, prismatic, fixed)");
     if (type != "revolute" && type != "continuous" && type != "prismatic" && type != "fixed")
-      c.fail(who, "unknown type '" + type + "'");
+      c.fail(who, "unknown type " + quoted_text(type));
     if (ji.child == "world") c.fail(who, "a link named 'world' can only be the root");
     const Origin o = origin_of(c, ji.e, who);
     Json joint = {{"name", ji.name},
@@ -215,8 +228,7 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
       if (const XMLElement* mimic = ji.e->FirstChildElement("mimic")) {
         const char* leader = mimic->Attribute("joint");
         if (!leader) c.fail(who, "<mimic> has no joint");
-        if (!joint_names.count(leader))
-          c.fail(who, std::string("mimics unknown joint '") + leader + "'");
+        if (!joint_names.count(leader)) c.fail(who, "mimics unknown joint " + quoted_text(leader));
         couplings.push_back({{"joint", ji.name},
                              {"follows", leader},
                              {"ratio", number_attr(c, mimic, "multiplier", 1.0, who)},

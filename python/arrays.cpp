@@ -3,8 +3,21 @@
 #include <cmath>
 
 #include "core/limits.hpp"
+#include "core/names.hpp"
 
 namespace femdyn::python {
+
+const std::string& text_arg(const std::string& s, const char* name) {
+  if (const auto at = s.find('\0'); at != std::string::npos)
+    throw py::value_error(std::string(name) + ": " + quoted_text(s) +
+                          " contains a NUL character (at byte " + std::to_string(at) + ")");
+  return s;
+}
+
+const std::optional<std::string>& text_arg(const std::optional<std::string>& s, const char* name) {
+  if (s) text_arg(*s, name);
+  return s;
+}
 
 std::string shape_text(const py::array& a) {
   std::string s = "(";

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/errors.hpp"
 #include "core/model.hpp"
 
 namespace femdyn::python {
@@ -20,30 +21,36 @@ using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 using RowMatX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 // A numerical failure at a state (a singular M^s, a q̈ that overflows): femdyn.NumericalError.
-class NumericalError : public std::runtime_error {
+class NumericalError : public Error {
  public:
-  using std::runtime_error::runtime_error;
+  using Error::Error;
 };
 
 // "(3,)", "(5, 4)".
 std::string shape_text(const py::array& a);
 
-// What the entries of an argument may be. Finite: a state (q, q̇, q̈), where an overflow is a
-// NumericalError at that state. Bounded: an actuation τ, a physical input like the model's
-// numbers and the CLI's --tau and --tau-csv, finite and |x| ≤ kMaxMagnitude (core/limits.hpp).
+// What the entries of an argument may be. Bounded: a physical input (a state q, q̇, q̈, an
+// actuation τ), like the model's numbers and the CLI's --q, --qd, --tau and --tau-csv: finite
+// and |x| ≤ kMaxMagnitude (core/limits.hpp), one limit everywhere. Finite: any finite number.
 enum class Entries { Finite, Bounded };
 
-// A state vector: shape (n,), every entry finite (and bounded if asked). Absent (None, where
+// A state vector: shape (n,), every entry bounded (or finite if asked). Absent (None, where
 // allowed) is zero.
 VecX vector_arg(const Array& a, const char* name, const Model& model,
-                Entries entries = Entries::Finite);
+                Entries entries = Entries::Bounded);
 VecX vector_arg(const std::optional<Array>& a, const char* name, const Model& model,
-                Entries entries = Entries::Finite);
+                Entries entries = Entries::Bounded);
 
-// A batch of states: shape (k, n) with finite (bounded) entries, seen in place (row i = state
+// A batch of states: shape (k, n) with bounded (finite) entries, seen in place (row i = state
 // i). `k` is the number of rows required, or -1 for the first batch argument (which sets k).
 Eigen::Map<const RowMatX> batch_arg(const Array& a, const char* name, const Model& model,
-                                    Eigen::Index k, Entries entries = Entries::Finite);
+                                    Eigen::Index k, Entries entries = Entries::Bounded);
+
+// A str argument (a path, a name, a choice), refused with ValueError if it holds a NUL character,
+// as Python's open() refuses it: the system, and C++ code that takes C strings, would see only
+// the part before it ("a\0b.json" would open "a").
+const std::string& text_arg(const std::string& s, const char* name);
+const std::optional<std::string>& text_arg(const std::optional<std::string>& s, const char* name);
 
 // A fresh C-ordered float64 array of the given shape.
 py::array_t<double> new_array(std::initializer_list<py::ssize_t> shape);

@@ -6,6 +6,8 @@
 #include <limits>
 
 #include "core/equations.hpp"
+#include "core/integrator.hpp"
+#include "core/memory.hpp"
 #include "python/parallel.hpp"
 #include "python/py_model.hpp"
 
@@ -15,8 +17,8 @@ namespace {
 using OptArray = std::optional<Array>;
 
 // The k states of a batch, row i of each a state: q sets k; q̇ and the third argument (τ or
-// q̈) default to zero rows. The arrays are read in place (numpy's memory). τ is bounded as a
-// physical input (|x| ≤ 1e100), the states only finite (arrays.hpp).
+// q̈) default to zero rows. The arrays are read in place (numpy's memory). Every entry is bounded
+// as a physical input (|x| ≤ 1e100, arrays.hpp).
 struct Batch {
   Eigen::Index k = 0, n = 0;
   const double *q = nullptr, *qd = nullptr, *third = nullptr;
@@ -44,11 +46,27 @@ struct RowState {
   }
 };
 
+// Refuses a batch whose results (`per_row` bytes a row) and per-thread workspaces
+// (`per_thread`) exceed the memory limit (core/memory.hpp), before they are allocated.
+void require_batch_memory(const char* what, const Model& m, Eigen::Index k, int threads,
+                          double per_row, double per_thread) {
+  const double bytes = static_cast<double>(k) * per_row + threads * per_thread;
+  const double rows = std::max(1.0, std::floor((memory_limit() - threads * per_thread) / per_row));
+  require_memory(std::string(what) + " of " + std::to_string(k) +
+                     " states of n = " + std::to_string(m.n()) + " coordinates on " +
+                     std::to_string(threads) + " threads",
+                 bytes, 0,
+                 "split the batch into parts of at most " + format_number(rows, "%.0f") +
+                     " rows, or use fewer threads, or " + set_max_memory_text(bytes));
+}
+
 py::dict equations_batch(const PyModel& self, const Array& q, const OptArray& qd,
                          const OptArray& tau, int threads) {
   const Model& m = *self.model;
   const Batch b(m, q, qd, tau, "tau", Entries::Bounded);
   const py::ssize_t k = b.k, n = b.n;
+  require_batch_memory("equations_batch", m, k, batch_threads(k, threads),
+                       dense_bytes(n + 3, n) + 64, evaluation_bytes(m));
   py::array_t<double> M = new_array({k, n, n}), h = new_array({k, n}), Q = new_array({k, n}),
                       qdd = new_array({k, n});
   py::array_t<bool> ok(std::vector<py::ssize_t>{k});
@@ -94,9 +112,11 @@ template <bool Forward>
 py::array_t<double> dynamics_batch(const PyModel& self, const Array& q, const OptArray& qd,
                                    const OptArray& third, int threads) {
   const Model& m = *self.model;
-  const Batch b(m, q, qd, third, Forward ? "tau" : "qdd",
-                Forward ? Entries::Bounded : Entries::Finite);
+  const Batch b(m, q, qd, third, Forward ? "tau" : "qdd", Entries::Bounded);
   const py::ssize_t k = b.k, n = b.n;
+  require_batch_memory(Forward ? "forward_dynamics_batch" : "inverse_dynamics_batch", m, k,
+                       batch_threads(k, threads), dense_bytes(1, n),
+                       integrator_bytes(m, IntegratorKind::Rk4));  // a workspace's, at most
   py::array_t<double> out = new_array({k, n});
   double* po = out.mutable_data();
   const int nthreads = batch_threads(k, threads);

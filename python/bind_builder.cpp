@@ -7,6 +7,7 @@
 #include <cmath>
 #include <variant>
 
+#include "core/names.hpp"
 #include "io/model_loader.hpp"
 #include "models/builder.hpp"
 #include "python/py_model.hpp"
@@ -20,12 +21,12 @@ Json to_json(const py::handle& v, const std::string& name) {
   if (py::isinstance<py::bool_>(v)) return v.cast<bool>();
   if (py::isinstance<py::int_>(v)) return v.cast<long long>();
   if (py::isinstance<py::float_>(v)) return v.cast<double>();
-  if (py::isinstance<py::str>(v)) return v.cast<std::string>();
+  if (py::isinstance<py::str>(v)) return text_arg(v.cast<std::string>(), name.c_str());
   if (py::isinstance<py::dict>(v)) {
     Json out = Json::object();
     for (const auto& [key, value] : v.cast<py::dict>()) {
       if (!py::isinstance<py::str>(key)) throw py::type_error(name + ": keys must be strings");
-      out[key.cast<std::string>()] = to_json(value, name);
+      out[text_arg(key.cast<std::string>(), name.c_str())] = to_json(value, name);
     }
     return out;
   }
@@ -64,7 +65,7 @@ Mat3 mat3_arg(const Array& a, const char* name) {
 
 // A node: its name (str) or a position (3,).
 NodeDescription node_arg(const py::object& node, const char* name) {
-  if (py::isinstance<py::str>(node)) return node.cast<std::string>();
+  if (py::isinstance<py::str>(node)) return text_arg(node.cast<std::string>(), name);
   return vec3_arg(node.cast<Array>(), name);
 }
 
@@ -105,8 +106,8 @@ JointSpec joint_arg(const std::optional<std::string>& type_in,
   if (const auto named = joint_type_named(type))
     j.type = *named;
   else
-    throw py::value_error("joint type: unknown '" + type + "' (expected " + joint_type_list() +
-                          ")");
+    throw py::value_error("joint type: unknown " + quoted_text(type) + " (expected " +
+                          joint_type_list() + ")");
   if (j.type == JointType::Fixed)
     for (const auto& [arg, given] : motion)
       if (given)
@@ -132,7 +133,7 @@ void bind_builder(py::module_& m) {
                                "A mechanism described in code: bodies, nodes, elements, "
                                "couplings, loads; build() compiles it (docs/python.md)")
       .def(py::init([](const std::string& name, const std::optional<Array>& gravity) {
-             auto b = std::make_unique<MechanismBuilder>(name);
+             auto b = std::make_unique<MechanismBuilder>(text_arg(name, "name"));
              if (gravity) b->gravity(vec3_arg(*gravity, "gravity"));
              return b;
            }),
@@ -144,8 +145,9 @@ void bind_builder(py::module_& m) {
              const OptArray& axis, const OptArray& xyz, const OptArray& rpy,
              const std::optional<std::pair<double, double>>& limits, OptNumber stiffness,
              OptNumber rest, OptNumber damping) {
-            b.body(name, parent,
-                   joint_arg(type, joint, axis, xyz, rpy, limits, stiffness, rest, damping));
+            b.body(text_arg(name, "name"), text_arg(parent, "parent"),
+                   joint_arg(text_arg(type, "type"), text_arg(joint, "joint"), axis, xyz, rpy,
+                             limits, stiffness, rest, damping));
           },
           py::arg("name"), py::arg("parent") = "world", py::arg("type") = py::none(),
           py::arg("joint") = py::none(), py::arg("axis") = py::none(), py::arg("xyz") = py::none(),
@@ -161,26 +163,30 @@ void bind_builder(py::module_& m) {
       .def(
           "node",
           [](MechanismBuilder& b, const std::string& body, const std::string& name,
-             const Array& position) { b.node(body, name, vec3_arg(position, "position")); },
+             const Array& position) {
+            b.node(text_arg(body, "body"), text_arg(name, "name"), vec3_arg(position, "position"));
+          },
           py::arg("body"), py::arg("name"), py::arg("position"))
       .def(
           "lumped_point",
           [](MechanismBuilder& b, const std::string& body, const py::object& node, double mass) {
-            b.lumped_point(body, node_arg(node, "node"), mass);
+            b.lumped_point(text_arg(body, "body"), node_arg(node, "node"), mass);
           },
           py::arg("body"), py::arg("node"), py::arg("mass"))
       .def(
           "rotary_node",
           [](MechanismBuilder& b, const std::string& body, const py::object& node,
              const Array& inertia) {
-            b.rotary_node(body, node_arg(node, "node"), mat3_arg(inertia, "inertia"));
+            b.rotary_node(text_arg(body, "body"), node_arg(node, "node"),
+                          mat3_arg(inertia, "inertia"));
           },
           py::arg("body"), py::arg("node"), py::arg("inertia"))
       .def(
           "rigid_body",
           [](MechanismBuilder& b, const std::string& body, double mass, const Array& com,
              const Array& inertia) {
-            b.rigid_body(body, mass, vec3_arg(com, "com"), mat3_arg(inertia, "inertia"));
+            b.rigid_body(text_arg(body, "body"), mass, vec3_arg(com, "com"),
+                         mat3_arg(inertia, "inertia"));
           },
           py::arg("body"), py::arg("mass"), py::arg("com"), py::arg("inertia"),
           "mass, centre of mass and inertia about it (body axes)")
@@ -188,7 +194,7 @@ void bind_builder(py::module_& m) {
           "space_bar",
           [](MechanismBuilder& b, const std::string& body, const py::object& a,
              const py::object& b_node, double mass, const Array& inertia) {
-            b.space_bar(body, node_arg(a, "a"), node_arg(b_node, "b"), mass,
+            b.space_bar(text_arg(body, "body"), node_arg(a, "a"), node_arg(b_node, "b"), mass,
                         mat3_arg(inertia, "inertia"));
           },
           py::arg("body"), py::arg("a"), py::arg("b"), py::arg("mass"), py::arg("inertia"),
@@ -196,8 +202,9 @@ void bind_builder(py::module_& m) {
       .def(
           "rod",
           [](MechanismBuilder& b, const std::string& body, const py::object& a,
-             const py::object& b_node,
-             double mass) { b.rod(body, node_arg(a, "a"), node_arg(b_node, "b"), mass); },
+             const py::object& b_node, double mass) {
+            b.rod(text_arg(body, "body"), node_arg(a, "a"), node_arg(b_node, "b"), mass);
+          },
           py::arg("body"), py::arg("a"), py::arg("b"), py::arg("mass"),
           "a slender rod; a node 'other_body/name' lies on another body")
       .def(
@@ -205,7 +212,7 @@ void bind_builder(py::module_& m) {
           [](MechanismBuilder& b, const std::string& joint, const py::object& follows,
              const py::kwargs& law) {
             Json c = to_json(law, "coupling");
-            c["joint"] = joint;
+            c["joint"] = text_arg(joint, "joint");
             c["follows"] = to_json(follows, "follows");
             b.coupling(parse_coupling(c, b.next_coupling()));
           },
@@ -216,7 +223,7 @@ void bind_builder(py::module_& m) {
           "load",
           [](MechanismBuilder& b, const std::string& body, const Array& point, const Array& force,
              const Array& torque) {
-            b.load(body, vec3_arg(point, "point"), vec3_arg(force, "force"),
+            b.load(text_arg(body, "body"), vec3_arg(point, "point"), vec3_arg(force, "force"),
                    vec3_arg(torque, "torque"));
           },
           py::arg("body"), py::arg("point") = Vec3(0, 0, 0), py::arg("force") = Vec3(0, 0, 0),

@@ -6,6 +6,7 @@
 
 #include "core/equations.hpp"
 #include "core/limits.hpp"
+#include "core/memory.hpp"
 #include "io/model_loader.hpp"
 #include "io/output.hpp"
 #include "python/py_model.hpp"
@@ -41,10 +42,11 @@ std::unique_ptr<PyModel> load(const std::string& path, const OptArray& gravity) 
   std::unique_ptr<PyModel> model;
   {
     py::gil_scoped_release release;
-    model = std::make_unique<PyModel>(load_model(path, options));
+    model = std::make_unique<PyModel>(load_model(text_arg(path, "path"), options));
   }
   for (const std::string& w : warnings)
-    if (PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0) throw py::error_already_set();
+    if (PyErr_WarnEx(PyExc_UserWarning, safe_message(w).c_str(), 1) != 0)
+      throw py::error_already_set();
   return model;
 }
 
@@ -53,6 +55,10 @@ EquationsResult equations(PyModel& self, const Array& q_in, const OptArray& qd_i
   const Model& m = *self.model;
   const VecX q = vector_arg(q_in, "q", m), qd = vector_arg(qd_in, "qd", m),
              tau = vector_arg(tau_in, "tau", m, Entries::Bounded);
+  // The workspace's M^s and factor, and M twice more on the way out (the result, numpy's).
+  const double bytes = evaluation_bytes(m) + 2 * dense_bytes(m.n(), m.n());
+  require_memory("equations of n = " + std::to_string(m.n()) + " coordinates", bytes, 0,
+                 "use forward_dynamics (no n x n result), or " + set_max_memory_text(bytes));
   Status st;
   equations_at(m, self.ws, q, qd, tau, st);
   EquationsResult r{self.ws.Ms, self.ws.h, self.ws.Q, std::nullopt, st.message};

@@ -7,6 +7,8 @@
 
 #include "core/integrator.hpp"
 #include "core/limits.hpp"
+#include "core/memory.hpp"
+#include "core/names.hpp"
 #include "core/recorded_run.hpp"
 #include "io/actuation_table.hpp"
 #include "python/py_model.hpp"
@@ -19,8 +21,9 @@ using OptArray = std::optional<Array>;
 IntegratorOptions options_of(const std::string& integrator, std::optional<double> dt,
                              std::optional<double> rtol, std::optional<double> atol) {
   IntegratorOptions o;
-  if (!parse_integrator(integrator, o.kind))
-    throw py::value_error("integrator: '" + integrator + "' is not one of rk4, euler, dopri, bdf");
+  if (!parse_integrator(text_arg(integrator, "integrator"), o.kind))
+    throw py::value_error("integrator: " + quoted_text(integrator) +
+                          " is not one of rk4, euler, dopri, bdf");
   if (is_adaptive(o.kind)) {
     if (dt)
       throw py::value_error("dt sets the step of rk4 and euler; " + integrator +
@@ -108,6 +111,21 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
         throw py::value_error("t_eval: expected nondecreasing times in [0, t_end]; entry " +
                               std::to_string(i) + " is not");
   }
+  // Memory, before any is allocated: the run's matrices and the rows it returns (each recorded
+  // in growing vectors, then copied into arrays: 6n + 13 numbers a row), where their number is
+  // known: t_eval's times, or a fixed-step run's steps (up to max_steps) over `every`.
+  double row_count = static_cast<double>(t_eval.size());
+  if (!t_eval_in && !is_adaptive(o.kind))
+    row_count = std::min(std::ceil(t_end / o.fixed.dt), static_cast<double>(o.fixed.max_steps)) /
+                    static_cast<double>(every) +
+                2;
+  const double bytes = integrator_bytes(m, o.kind) + row_count * dense_bytes(6.0 * m.n() + 13, 1);
+  require_memory("simulate: n = " + std::to_string(m.n()) + " coordinates with " + integrator +
+                     " and " + format_short(row_count) + " rows",
+                 bytes, 0,
+                 std::string(t_eval_in ? "fewer t_eval times" : "a larger every=") +
+                     (o.kind == IntegratorKind::Bdf ? ", or dopri (no Jacobian)" : "") + ", or " +
+                     set_max_memory_text(bytes));
   // τ: constant (n,), a table (tau_t (m,), tau (m, n)), or none (passive).
   Actuation tau;
   bool driven = false;

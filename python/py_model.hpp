@@ -5,6 +5,7 @@
 #pragma once
 #include <memory>
 
+#include "core/memory.hpp"
 #include "core/workspace.hpp"
 #include "python/arrays.hpp"
 
@@ -29,6 +30,12 @@ struct EquationsResult {
 // so the same numbers). Throws NumericalError if M^s, h, Q or q̈ is not finite.
 void equations_at(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau,
                   Status& status);
+
+// How to raise the memory limit (core/memory.hpp) from Python far enough for `bytes`:
+// "femdyn.set_max_memory(4.9) if that much memory is free".
+inline std::string set_max_memory_text(double bytes) {
+  return "femdyn.set_max_memory(" + max_memory_gb(bytes) + ") if that much memory is free";
+}
 
 void bind_model(py::module_& m);
 void bind_batch(py::module_& m);

@@ -28,6 +28,27 @@ std::vector<std::string> bundled_models() {
 
 Model load_text(const std::string& json_text) { return compile(parse_spec(json_text, "test")); }
 
+std::string text_error(const std::string& json_text) {
+  try {
+    load_text(json_text);
+  } catch (const ModelError& e) {
+    return e.what();
+  }
+  return "(loaded)";
+}
+
+std::string planar_chain(int n) {
+  using nlohmann::json;
+  json bodies = json::array();
+  for (int i = 0; i < n; ++i)
+    bodies.push_back(
+        {{"name", "b" + std::to_string(i)},
+         {"parent", i == 0 ? std::string("world") : "b" + std::to_string(i - 1)},
+         {"joint", {{"type", "revolute"}, {"axis", {0, 0, 1}}, {"origin", {{"xyz", {0.1, 0, 0}}}}}},
+         {"elements", {{{"type", "lumped_point"}, {"node", {0.1, 0, 0}}, {"mass", 1}}}}});
+  return json{{"name", "chain"}, {"gravity", {0, -9.81, 0}}, {"bodies", bodies}}.dump();
+}
+
 std::string arm_json(double k, double c, double g) {
   std::ostringstream s;
   s.precision(17);

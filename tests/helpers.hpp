@@ -16,6 +16,12 @@ namespace femdyn::test {
 std::string model_path(const std::string& name);  // FEMDYN_SOURCE_DIR/models/name
 std::vector<std::string> bundled_models();        // file names of models/*.json, sorted
 Model load_text(const std::string& json_text);
+// The ModelError's message of load_text(json_text), or "(loaded)".
+std::string text_error(const std::string& json_text);
+
+// A planar serial chain of `n` links of 0.1 m, a 1 kg point mass at each link's end, under
+// gravity, as JSON text.
+std::string planar_chain(int n);
 
 // One revolute joint 'theta' about y carrying a 1 kg point 1 m out along x (1 kg·m² about the
 // joint; body 'arm'), with a joint spring k and damper c (ω = √k, ζ = c / 2ω), under gravity g

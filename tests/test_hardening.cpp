@@ -12,7 +12,9 @@
 
 #include "core/errors.hpp"
 #include "core/sampling.hpp"
+#include "io/urdf_loader.hpp"
 #include "tests/helpers.hpp"
+#include "validation/scaling_models.hpp"
 #include "validation/twin.hpp"
 
 using namespace femdyn;
@@ -38,30 +40,9 @@ std::string load_error(const std::string& path) {
   return "(loaded)";
 }
 
-std::string text_error(const std::string& text) {
-  try {
-    load_text(text);
-  } catch (const ModelError& e) {
-    return e.what();
-  }
-  return "(loaded)";
-}
-
 json pendulum() {
   std::ifstream in(model_path("pendulum.json"));
   return json::parse(in);
-}
-
-// A planar serial chain of `n` links of 0.1 m, a point mass at each link's end.
-std::string planar_chain(int n) {
-  json bodies = json::array();
-  for (int i = 0; i < n; ++i)
-    bodies.push_back(
-        {{"name", "b" + std::to_string(i)},
-         {"parent", i == 0 ? std::string("world") : "b" + std::to_string(i - 1)},
-         {"joint", {{"type", "revolute"}, {"axis", {0, 0, 1}}, {"origin", {{"xyz", {0.1, 0, 0}}}}}},
-         {"elements", {{{"type", "lumped_point"}, {"node", {0.1, 0, 0}}, {"mass", 1}}}}});
-  return json{{"name", "chain"}, {"gravity", {0, -9.81, 0}}, {"bodies", bodies}}.dump();
 }
 
 }  // namespace
@@ -352,4 +333,100 @@ TEST_CASE("an interrupted simulate leaves the old output file intact", "[hardeni
   for ([[maybe_unused]] const auto& f : fs::directory_iterator(dir)) ++files;
   CHECK(files == 1);  // no temporary file left beside it
   fs::remove_all(dir);
+}
+
+// Issue 22: readers and compile linear in n. The inputs are generated here; their times are
+// measured in femdyn_bench (docs/performance.md), never asserted.
+TEST_CASE("a JSON array of 1,000,000 objects is read, and as bodies refused by count",
+          "[hardening][scale]") {
+  std::string objects;
+  objects.reserve(8'000'000);
+  for (int i = 0; i < 1'000'000; ++i) objects += i ? ",{\"a\":1}" : "{\"a\":1}";
+  // Parsed whole (nlohmann's plain parser, linear), then refused by the first check after it.
+  CHECK(text_error(R"({"stuff": [)" + objects + "]}") == "test: /stuff: unknown key 'stuff'");
+  // As bodies: counted before the text is parsed.
+  CHECK(text_error(R"({"bodies": [)" + objects + "]}") ==
+        "test: /bodies: 1000000 bodies: more than femdyn's limit of 200000");
+  // The count is of the top-level "bodies" only, wherever it is, and strings cannot fool it.
+  CHECK(text_error(R"({"name": "\"bodies\": [{},{}]", "x": {"bodies": [)" + objects + "]}}") ==
+        "test: /x: unknown key 'x'");
+  // The same from a file, from the command line and through femdyn.load (load_model).
+  const fs::path file = scratch() / "million.json";
+  std::ofstream(file.string()) << R"({"bodies": [)" << objects << "]}";
+  CHECK(load_error(file.string()) ==
+        file.string() + ": /bodies: 1000000 bodies: more than femdyn's limit of 200000");
+  const Run cli = run("info " + file.string());
+  CHECK(cli.code == 1);
+  CHECK(cli.out == "femdyn info: " + file.string() +
+                       ": /bodies: 1000000 bodies: more than femdyn's limit of 200000\n");
+  fs::remove(file);
+}
+
+TEST_CASE("the nesting limit counts containers, not brackets inside strings", "[hardening]") {
+  // 64 levels: the top-level object and 63 arrays.
+  const std::string deep = std::string(63, '[') + std::string(63, ']');
+  CHECK_THAT(text_error(R"({"name": "x", "description": )" + deep + "}"),
+             !Catch::Contains("nested deeper"));
+  CHECK_THAT(text_error(R"({"name": ")" + std::string(100, '[') + R"(\\\"", "bodies": []})"),
+             !Catch::Contains("nested deeper"));
+  CHECK(text_error(R"({"description": )" + deep.substr(0, 63) + "[" + deep.substr(63) + "]}") ==
+        "test: JSON nested deeper than 64 levels (femdyn's limit)");
+}
+
+TEST_CASE("200,000 bodies with elements load; one more is refused before parsing",
+          "[hardening][scale]") {
+  const Model chain = load_text(scaling::model_json(200'000, false));
+  CHECK(chain.n() == 200'000);
+  CHECK(chain.elements.size() == 200'000);
+  const Model tree = load_text(scaling::model_json(50'000, true));
+  CHECK(tree.n() == 50'000);
+  CHECK(text_error(scaling::model_json(200'001, false)) ==
+        "test: /bodies: 200001 bodies: more than femdyn's limit of 200000");
+}
+
+namespace {
+
+// A URDF serial chain of `links` links (a 1 kg link on each revolute joint but the root).
+std::string urdf_chain(int links) {
+  std::string s = R"(<robot name="long"><link name="l0"/>)";
+  s.reserve(300 * static_cast<std::size_t>(links));
+  const auto joint = [&](const std::string& name, int parent, int child) {
+    s += R"(<joint name=")" + name + R"(" type="revolute"><parent link="l)" +
+         std::to_string(parent) + R"("/><child link="l)" + std::to_string(child) +
+         R"("/><origin xyz="0 0 0.01"/><axis xyz="0 1 0"/></joint>)";
+  };
+  for (int i = 1; i < links; ++i) {
+    s += R"(<link name="l)" + std::to_string(i) +
+         R"("><inertial><mass value="1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0" )"
+         R"(ixz="0" iyz="0"/></inertial></link>)";
+    joint("j" + std::to_string(i), i - 1, i);
+  }
+  return s + "</robot>";
+}
+
+}  // namespace
+
+TEST_CASE("a 10,000-link URDF is read; its links are checked in one walk", "[hardening][scale]") {
+  const UrdfResult r = urdf_to_model(urdf_chain(10'000), "long.urdf");
+  CHECK(r.model["bodies"].size() == 9'999);
+  CHECK(parse_model_json(r.model, "long.urdf").bodies.size() == 9'999);
+  // As a MODEL file: converted, read and compiled.
+  const fs::path file = scratch() / "long.urdf";
+  std::ofstream(file.string()) << urdf_chain(10'000);
+  CHECK(load_model(file.string()).n() == 9'999);
+  fs::remove(file);
+  // Two links that hang from each other and not from the root: found by the same walk.
+  std::string loop = urdf_chain(10'000);
+  loop.insert(loop.size() - 8,
+              R"(<link name="a"/><link name="b"/>)"
+              R"(<joint name="ab" type="fixed"><parent link="a"/><child link="b"/></joint>)"
+              R"(<joint name="ba" type="fixed"><parent link="b"/><child link="a"/></joint>)");
+  CHECK_THROWS_WITH(urdf_to_model(loop, "long.urdf"),
+                    "long.urdf: link 'a': is on a loop of joints");
+  // More links than the body limit: refused by count before the joints are read.
+  std::string many = R"(<robot name="many">)";
+  for (int i = 0; i < 200'002; ++i) many += R"(<link name="l)" + std::to_string(i) + R"("/>)";
+  CHECK_THROWS_WITH(
+      urdf_to_model(many + "</robot>", "many.urdf"),
+      "many.urdf: 200001 bodies: more than femdyn's limit of 200000 (one per <link> but the root)");
 }

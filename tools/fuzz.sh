@@ -2,7 +2,7 @@
 # Fuzzing (docs/robustness.md#fuzzing): builds the libFuzzer targets of tests/fuzz/ in
 # ./build-fuzz (clang++, -DFEMDYN_FUZZ=ON, ASan + UBSan) and runs each for SECONDS (default 60)
 # on its seed corpus. Exits 1 if a target found a bug (a crash, sanitizer report, unexpected
-# exception, timeout, out-of-memory or NaN), naming the input kept in build-fuzz/artifacts/.
+# exception, an error message with a control character, timeout, out-of-memory or NaN), naming the input kept in build-fuzz/artifacts/.
 #   tools/fuzz.sh [SECONDS]          e.g. CI: tools/fuzz.sh 60
 #   FEMDYN_FUZZ_NAN_CHECK=1 tools/fuzz.sh   NaN/Inf results on finite input count as bugs
 set -euo pipefail
@@ -34,6 +34,7 @@ targets=(
   "json_model 8192 tests/fuzz/json_model.dict models"
   "urdf 20480 tests/fuzz/urdf.dict models/urdf tests/robots"
   "vector 256 - tests/fuzz/corpus/vector"
+  "csv 4096 tests/fuzz/csv.dict tests/fuzz/corpus/csv"
 )
 found=()
 for spec in "${targets[@]}"; do

@@ -1,10 +1,13 @@
 #!/usr/bin/env python3
 """Writes docs/performance.md (and the data and plot beside it) from a femdyn_bench JSON run.
 
-Usage: performance_report.py BENCH.json OUT_DIR DOC.md
+Usage: performance_report.py BENCH.json OUT_DIR DOC.md [--load]
   BENCH.json  femdyn_bench --benchmark_repetitions=R --benchmark_report_aggregates_only=true
               --benchmark_out=BENCH.json --benchmark_out_format=json
-  OUT_DIR     receives times.csv (median ns per call), scaling.gp and scaling.png (gnuplot)
+  OUT_DIR     receives times.csv (median ns per call), scaling.gp and scaling.png (gnuplot),
+              load.csv (the load/ benchmarks: seconds and peak memory against bodies)
+  --load      BENCH.json holds only the load/ benchmarks: rewrite that section of DOC.md
+              ("Loading and compiling against n") and load.csv, keep the rest
 Every number in the page comes from BENCH.json; nothing is typed in except the targets of
 issue 11 and the figures other engines were measured at elsewhere (labelled so).
 """
@@ -17,7 +20,102 @@ import subprocess
 import sys
 
 bench_path, out_dir, doc_path = sys.argv[1:4]
+only_load = sys.argv[4:5] == ["--load"]
 run = json.load(open(bench_path))
+
+def slope(series, lo, hi):
+    """Least-squares exponent p in t ~ n^p over lo <= n <= hi."""
+    pts = [(math.log(n), math.log(v)) for n, v in series if lo <= n <= hi and v]
+    if len(pts) < 2:
+        return None
+    mx = sum(x for x, _ in pts) / len(pts)
+    my = sum(y for _, y in pts) / len(pts)
+    return sum((x - mx) * (y - my) for x, y in pts) / sum((x - mx) ** 2 for x, _ in pts)
+
+def load_section(run):
+    """The section "Loading and compiling against n" from the run's load/chain/N and
+    load/tree/N benchmarks (load_model: read, parse, compile); [] when the run has none.
+    Also writes OUT_DIR/load.csv."""
+    loads = {}
+    for b in run["benchmarks"]:
+        name = b.get("run_name", b["name"])
+        if not name.startswith("load/") or b.get("aggregate_name", "median") != "median":
+            continue
+        _, kind, size = name.split("/")[:3]
+        scale = {"ns": 1e-9, "us": 1e-6, "ms": 1e-3, "s": 1}[b["time_unit"]]
+        loads[(kind, int(size))] = (b["cpu_time"] * scale, b.get("peak_MB"), b["real_time"] * scale)
+    if not loads:
+        return []
+    sizes = sorted({n for _, n in loads})
+    with open(os.path.join(out_dir, "load.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["model", "bodies", "cpu_seconds", "elapsed_seconds", "peak_MB"])
+        for (kind, n), (sec, mem, real) in sorted(loads.items()):
+            w.writerow([kind, n, f"{sec:.4g}", f"{real:.4g}", f"{mem:.0f}" if mem else ""])
+    series = lambda kind, k: [(n, loads[(kind, n)][k]) for n in sizes if (kind, n) in loads]
+    secs = lambda x: "–" if x is None else (f"{x:.2f} s" if x >= 0.1 else f"{x * 1e3:.0f} ms")
+    mb = lambda x: "–" if x is None else f"{x:.0f} MB"
+    ctx = run.get("context", {})
+    out = []
+    P = out.append
+    P("## Loading and compiling against n")
+    P("")
+    P(f"Run {ctx.get('date', '?')} on {ctx.get('num_cpus', '?')} CPUs (`{ctx.get('host_name', '?')}`). "
+      "`load_model()` of a generated JSON file — reading, parsing, the spec, `compile()` (tree "
+      "order, node level, correlation table, routes, the mass-matrix check) — on a serial chain "
+      "(prismatic joints along x, y, z in turn) and a binary tree (revolute joints about x, y, z "
+      "in turn), each body carrying one lumped point at a named node "
+      "(validation/scaling_models.hpp). Median CPU time per load (the process's, which is "
+      "what the work costs when other programs share the machine), the elapsed time beside "
+      "it; memory is the peak resident memory the loads "
+      "added to the process (its VmHWM while loading, reset before each size, less its VmRSS "
+      "before). The data: "
+      "[performance/load.csv](performance/load.csv).")
+    P("")
+    P("| bodies | chain CPU | elapsed | memory | tree CPU | elapsed | memory |")
+    P("|---:|---:|---:|---:|---:|---:|---:|")
+    for n in sizes:
+        none = (None, None, None)
+        c, tr = loads.get(("chain", n), none), loads.get(("tree", n), none)
+        P(f"| {n:,} | {secs(c[0])} | {secs(c[2])} | {mb(c[1])} | "
+          f"{secs(tr[0])} | {secs(tr[2])} | {mb(tr[1])} |")
+    P("")
+    lo, hi = sizes[0], sizes[-1]
+    P("Fitted exponents p in t ∝ n^p (least squares on log t against log n, t the CPU time; "
+      "memory likewise):")
+    P("")
+    P(f"| model | time, {lo:,}–{hi:,} | time, 10,000–{hi:,} | memory, {lo:,}–{hi:,} | "
+      f"memory, 10,000–{hi:,} |")
+    P("|---|---:|---:|---:|---:|")
+    fmt = lambda p: "–" if p is None else f"{p:.2f}"
+    for kind in ("chain", "tree"):
+        P(f"| {kind} | {fmt(slope(series(kind, 0), lo, hi))} | "
+          f"{fmt(slope(series(kind, 0), 10000, hi))} | {fmt(slope(series(kind, 1), lo, hi))} | "
+          f"{fmt(slope(series(kind, 1), 10000, hi))} |")
+    P("")
+    P("To reproduce this section alone (about two minutes; the rest of the page is kept): "
+      "`tools/update-performance-docs.sh --load`. Other sizes: `./build/femdyn_bench "
+      "--benchmark_filter='^load/' --load-sizes=1000,10000,100000`.")
+    P("")
+    return out
+
+
+if only_load:
+    # Replace this section of DOC.md (or add it before "## Targets"); the rest is kept.
+    section = load_section(run)
+    if not section:
+        sys.exit(f"no load/ benchmarks in {bench_path}")
+    doc = open(doc_path).read().split("\n")
+    head = "## Loading and compiling against n"
+    if head in doc:
+        i = doc.index(head)
+        j = next((k for k in range(i + 1, len(doc)) if doc[k].startswith("## ")), len(doc))
+    else:
+        i = j = doc.index("## Targets") if "## Targets" in doc else len(doc)
+    doc[i:j] = section
+    open(doc_path, "w").write("\n".join(doc))
+    print(f"wrote the load section of {doc_path}", file=sys.stderr)
+    sys.exit(0)
 
 # name "femdyn/forward/chain512" (+ "_median" aggregate) -> median real time in ns
 times = {}
@@ -68,15 +166,6 @@ with open(os.path.join(out_dir, "times.csv"), "w", newline="") as f:
         for op, _ in ops + [("evaluate", "")]:
             w.writerow([m, n_of(m), op] + [round(t(e, op, m), 1) if t(e, op, m) else ""
                                             for e in ("femdyn", "simbody", "reference")])
-
-def slope(series, lo, hi):
-    """Least-squares exponent p in t ~ n^p over lo <= n <= hi."""
-    pts = [(math.log(n), math.log(v)) for n, v in series if lo <= n <= hi and v]
-    if len(pts) < 2:
-        return None
-    mx = sum(x for x, _ in pts) / len(pts)
-    my = sum(y for _, y in pts) / len(pts)
-    return sum((x - mx) * (y - my) for x, y in pts) / sum((x - mx) ** 2 for x, _ in pts)
 
 # The plot: time against n on chains, log-log.
 with open(os.path.join(out_dir, "chains.dat"), "w") as f:
@@ -208,6 +297,8 @@ if any(t("femdyn", "rest", m) for m in named):
     P("")
     P("A model whose gravity is zero already (the finger) has no \"without gravity\" entry.")
     P("")
+
+lines.extend(load_section(run))
 
 # Targets of issue 11 (this machine's fastest of Simbody, MuJoCo, Pinocchio).
 targets = [("finger", "forward", 800), ("finger", "mass", 250), ("hand16", "forward", 3100),

@@ -14,6 +14,10 @@
 //   femdyn/weightless/M evaluate() on the model without gravity (models with gravity only)
 //   reference/{mass,bias,forward,inverse}/M: femdyn on the reference routes (Tᵀ M T, node-level
 //   sweeps, Cholesky) where n ≤ 128, for the crossovers.
+// and, for the growth of loading with n, on generated chains and binary trees of --load-sizes=
+// bodies (default 1,000 to 200,000) with one lumped point each (validation/scaling_models.hpp):
+//   load/chain/N, load/tree/N  load_model() of the JSON file: read, parse, compile; counter
+//                              peak_MB, the peak resident memory loading added to the process.
 // Simbody's side is SimbodyTwin::time_* (validation/twin.hpp): its own work only. This file
 // does not include Simbody, so it is compiled like the rest of femdyn (C++20, NDEBUG).
 // Exits 1 if an engine disagrees with Simbody or femdyn allocates in a timed call.
@@ -21,11 +25,16 @@
 // Heap allocations are counted (validation/alloc_counter.hpp) and reported per iteration as the
 // counter `allocs`; femdyn's hot path is documented allocation-free and must show 0.
 #include <benchmark/benchmark.h>
+#include <malloc.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <random>
 #include <set>
@@ -38,6 +47,7 @@
 #include "core/sampling.hpp"
 #include "io/model_loader.hpp"
 #include "validation/alloc_counter.hpp"
+#include "validation/scaling_models.hpp"
 #include "validation/twin.hpp"
 #include "validation/validate.hpp"
 
@@ -175,6 +185,45 @@ void register_case(Case* c) {
       [](Case& c) { inverse_dynamics(*c.reference, *c.ws_ref, c.q, c.qd, c.qdd); });
 }
 
+// Memory a load takes: the process's peak resident memory while loading above what it held
+// before (Linux: VmHWM and VmRSS of /proc/self/status; the peak is reset by writing 5 to
+// /proc/self/clear_refs). In MB; 0 where unavailable.
+double status_mb(const char* field) {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind(field, 0) == 0) return std::stod(line.substr(std::strlen(field))) / 1024.0;
+  return 0;
+}
+
+double reset_peak_memory() {  // returns the resident memory before the load
+  malloc_trim(0);             // (what earlier benchmarks freed goes back to the system first)
+  std::ofstream("/proc/self/clear_refs") << "5";
+  return status_mb("VmRSS:");
+}
+
+// load/KIND/N: load_model() of a generated file of N bodies (written once, outside the timing,
+// and removed afterwards); counter peak_MB, the peak resident memory the loads added.
+void register_load(bool tree, int bodies) {
+  const std::string name =
+      std::string("load/") + (tree ? "tree" : "chain") + "/" + std::to_string(bodies);
+  benchmark::RegisterBenchmark(name.c_str(), [tree, bodies, name](benchmark::State& state) {
+    const std::filesystem::path path =
+        std::filesystem::temp_directory_path() /
+        ("femdyn_bench_" + std::to_string(getpid()) + "_" + std::to_string(bodies) + ".json");
+    std::ofstream(path) << scaling::model_json(bodies, tree);
+    const double before = reset_peak_memory();
+    try {
+      for (auto _ : state) benchmark::DoNotOptimize(load_model(path.string()).n());
+    } catch (const std::exception& e) {
+      failures().insert(name + ": " + e.what());
+      state.SkipWithError("the model did not load");
+    }
+    std::filesystem::remove(path);
+    state.counters["n"] = bodies;
+    state.counters["peak_MB"] = status_mb("VmHWM:") - before;
+  })->Unit(benchmark::kMillisecond);
+}
+
 MechanismSpec random_spec(int seed, int bodies, double branching) {
   const std::string text = R"({"model": "random_tree", "params": {"seed": )" +
                            std::to_string(seed) + R"(, "bodies": )" + std::to_string(bodies) +
@@ -183,21 +232,31 @@ MechanismSpec random_spec(int seed, int bodies, double branching) {
   return parse_spec(text, "random");
 }
 
+// Removes "--flag=a,b,…" from argv and returns its integers ("--flag=" gives none), or
+// `fallback` when the flag is not given.
+std::vector<int> take_sizes(int& argc, char** argv, const std::string& flag,
+                            std::vector<int> fallback) {
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]).rfind(flag, 0) == 0) {
+      std::vector<int> sizes;
+      std::stringstream list(argv[i] + flag.size());
+      for (std::string item; std::getline(list, item, ',');) sizes.push_back(std::stoi(item));
+      for (int k = i; k + 1 < argc; ++k) argv[k] = argv[k + 1];
+      --argc;
+      return sizes;
+    }
+  return fallback;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const std::string root = std::string(FEMDYN_SOURCE_DIR) + "/";
   // --sizes=a,b,...: the random chains and trees (default 8 to 1024); --sizes= for none.
-  std::vector<int> sizes = {8, 16, 32, 64, 128, 256, 512, 1024};
-  for (int i = 1; i < argc; ++i)
-    if (std::string(argv[i]).rfind("--sizes=", 0) == 0) {
-      sizes.clear();
-      std::stringstream list(argv[i] + 8);
-      for (std::string item; std::getline(list, item, ',');) sizes.push_back(std::stoi(item));
-      for (int k = i; k + 1 < argc; ++k) argv[k] = argv[k + 1];
-      --argc;
-      break;
-    }
+  std::vector<int> sizes = take_sizes(argc, argv, "--sizes=", {8, 16, 32, 64, 128, 256, 512, 1024});
+  // --load-sizes=a,b,...: the generated chains and trees loaded (default 1,000 to 200,000).
+  std::vector<int> load_sizes = take_sizes(
+      argc, argv, "--load-sizes=", {1000, 2000, 5000, 10000, 20000, 50000, 100000, 200000});
   try {
     const auto file = [&](std::string path) { return [path] { return read_spec(path); }; };
     const auto random = [](int seed, int n, double branching) {
@@ -218,6 +277,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   for (const auto& c : cases()) register_case(c.get());
+  for (const bool tree : {false, true})
+    for (int n : load_sizes) register_load(tree, n);
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

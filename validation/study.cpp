@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "core/errors.hpp"
 #include "core/integrator.hpp"
 #include "core/joints/kernel.hpp"
 #include "validation/twin.hpp"
@@ -198,8 +199,7 @@ StudyReport run_study(const Model& m, const StudyOptions& o,
         .adaptive = {
             .rtol = rtol, .atol = rtol, .max_steps = 100'000'000, .stop_at_outputs = true}};
     Sampled s = femdyn_run(m, ro, o, times);
-    if (!s.status.ok)
-      throw std::runtime_error("the reference solution failed: " + s.status.message);
+    if (!s.status.ok) throw femdyn::Error("the reference solution failed: " + s.status.message);
     return s;
   };
   rep.reference_rtol = 1e-14;

@@ -155,14 +155,14 @@ struct SimbodyTwin::Impl {
       try {
         add_body(j);
       } catch (const std::exception& e) {
-        throw std::runtime_error("Simbody refuses body '" + escaped(j.name) +
-                                 "': " + one_line(e.what()));
+        throw femdyn::Error("Simbody refuses body '" + escaped(j.name) +
+                            "': " + one_line(e.what()));
       }
     }
     try {
       rods = loops::add_rods(m, mobod);
     } catch (const std::exception& e) {
-      throw std::runtime_error("Simbody refuses a rod: " + one_line(e.what()));
+      throw femdyn::Error("Simbody refuses a rod: " + one_line(e.what()));
     }
     finish_system();
   }
@@ -389,7 +389,7 @@ TwinEquations SimbodyTwin::equations(const VecX& q, const VecX& qd, const VecX& 
   try {
     return equations_unguarded(q, qd, tau, V);
   } catch (const std::exception& e) {  // SimTK's multi-line text, as one line
-    throw std::runtime_error("Simbody failed at this state: " + one_line(e.what()));
+    throw femdyn::Error("Simbody failed at this state: " + one_line(e.what()));
   }
 }
 
@@ -479,7 +479,7 @@ VecX SimbodyTwin::inverse_dynamics(const VecX& q, const VecX& qd, const VecX& qd
   try {
     return inverse_dynamics_unguarded(q, qd, qdd);
   } catch (const std::exception& e) {
-    throw std::runtime_error("Simbody failed at this state: " + one_line(e.what()));
+    throw femdyn::Error("Simbody failed at this state: " + one_line(e.what()));
   }
 }
 
@@ -635,7 +635,7 @@ std::vector<SimbodyIntegrator> simbody_integrators() {
 std::vector<TwinSample> SimbodyTwin::simulate(const VecX& q0, const VecX& qd0,
                                               const std::vector<double>& times, double accuracy) {
   TwinRun run = simulate(q0, qd0, times, accuracy, SimbodyIntegrator::RungeKuttaMerson);
-  if (!run.stats.ok && can_simulate()) throw std::runtime_error(run.stats.failure);
+  if (!run.stats.ok && can_simulate()) throw femdyn::Error(run.stats.failure);
   return std::move(run.samples);
 }
 

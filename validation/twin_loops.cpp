@@ -30,8 +30,8 @@ class LawConstraint final : public SimTK::Function {
     f(x);
     if (c.size() == 1) return c[0] == 0 ? 1.0 : -df_[c[0] - 1];
     if (c.size() == 2) return c[0] == 0 || c[1] == 0 ? 0.0 : -d2f_[(c[0] - 1) * k_ + c[1] - 1];
-    throw std::runtime_error("coupling law of joint '" + escaped(law_.name) +
-                             "': derivatives above the second are not available");
+    throw femdyn::Error("coupling law of joint '" + escaped(law_.name) +
+                        "': derivatives above the second are not available");
   }
   int getArgumentSize() const override { return 1 + k_; }
   int getMaxDerivativeOrder() const override { return 2; }
@@ -41,8 +41,8 @@ class LawConstraint final : public SimTK::Function {
     for (int i = 0; i < k_; ++i) x_[i] = x[1 + i];
     double value = 0;
     if (!law_.law(x_.data(), value, df_.data(), d2f_.data()))
-      throw std::runtime_error("the coupling law of joint '" + escaped(law_.name) +
-                               "' is not defined at this posture");
+      throw femdyn::Error("the coupling law of joint '" + escaped(law_.name) +
+                          "' is not defined at this posture");
     return value;
   }
   TwinLaw law_;
@@ -66,8 +66,8 @@ void joint_state(const TwinModel& m, const VecX& q, const VecX& qd, VecX& theta,
     for (std::size_t i = 0; i < k; ++i) x[i] = theta[law.sources[i]];
     double f = 0;
     if (!law.law(x.data(), f, df.data(), d2f.data()))
-      throw std::runtime_error("the coupling law of joint '" + escaped(law.name) +
-                               "' is not defined at this state");
+      throw femdyn::Error("the coupling law of joint '" + escaped(law.name) +
+                          "' is not defined at this state");
     theta[law.theta] = f;
     double rate = 0;
     for (std::size_t i = 0; i < k; ++i) rate += df[i] * theta_dot[law.sources[i]];

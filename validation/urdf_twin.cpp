@@ -9,6 +9,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/errors.hpp"
+
 namespace femdyn::validation {
 
 namespace {
@@ -72,9 +74,9 @@ UrdfTwin::UrdfTwin(const std::string& path, const Eigen::Vector3d& gravity)
   Impl& s = *impl_;
   tinyxml2::XMLDocument doc;
   if (doc.LoadFile(path.c_str()) != tinyxml2::XML_SUCCESS)
-    throw std::runtime_error(path + ": cannot read");
+    throw femdyn::Error(path + ": cannot read");
   const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
-  if (!robot) throw std::runtime_error(path + ": no <robot>");
+  if (!robot) throw femdyn::Error(path + ": no <robot>");
   std::map<std::string, const tinyxml2::XMLElement*> links, joint_to_child;
   for (auto* l = robot->FirstChildElement("link"); l; l = l->NextSiblingElement("link"))
     links[l->Attribute("name")] = l;

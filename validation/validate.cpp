@@ -216,15 +216,6 @@ const double kTightRatio = std::pow(100.0, 0.25);
 //   memory per body of the twin (Simbody's system and state) and of femdyn's workspaces.
 constexpr double kBytesPerBody = 20e3;
 
-double dense_bytes(double rows, double cols) { return 8 * rows * cols; }
-
-std::string format_bytes(double bytes) {
-  if (!std::isfinite(bytes)) return "unlimited";
-  if (bytes >= 1e9) return format_number(bytes / 1e9, "%.3g") + " GB";
-  if (bytes >= 1e6) return format_number(bytes / 1e6, "%.3g") + " MB";
-  return format_number(bytes / 1e3, "%.3g") + " kB";
-}
-
 void accumulate(QuantityError& e, const MatX& femdyn, const MatX& simbody) {
   const double d = max_abs(femdyn - simbody);
   const double scale = max_abs(simbody);
@@ -249,7 +240,7 @@ bool integrate(const Model& m, Workspace& ws, const VecX& q0, const VecX& qd0,
   rk4.reset(0, q0, qd0);
   for (double target : times) {
     const Status st = rk4.advance_to(target);
-    if (st.non_finite) throw std::runtime_error("along the trajectory: " + st.message);
+    if (st.non_finite) throw femdyn::Error("along the trajectory: " + st.message);
     if (!st.ok) return false;
     joint_state(m, ws, rk4.q(), rk4.qd());
     VecX x(2 * m.n_theta());
@@ -270,17 +261,6 @@ bool ValidationReport::pass() const {
   for (const QuantityError& q : quantities)
     if (!q.pass()) return false;
   return trajectory.pass();
-}
-
-double default_memory_limit() {
-  std::ifstream in("/proc/meminfo");
-  std::string line;
-  while (std::getline(in, line)) {  // "MemAvailable:   23705392 kB"
-    double kib = 0;
-    if (line.rfind("MemAvailable:", 0) == 0 && std::sscanf(line.c_str() + 13, "%lf", &kib) == 1)
-      return 0.5 * kib * 1024;
-  }
-  return std::numeric_limits<double>::infinity();
 }
 
 struct Validator::Impl {
@@ -304,7 +284,7 @@ struct Validator::Impl {
     estimate.n = m.n();
     estimate.states = o.states;
     estimate.budget = o.budget;
-    estimate.memory_limit = o.memory_limit > 0 ? o.memory_limit : default_memory_limit();
+    estimate.memory_limit = memory_limit(o.memory_limit);
     estimate.dense_mass = r.dense_mass = m.n() <= kDenseMassLimit;
     if (build()) probe();
     estimate.setup = seconds_since(start);
@@ -735,8 +715,7 @@ std::string Validator::refusal(const std::string& label) const {
                    (e.at_least ? " or more" : "") + " (budget=)");
   }
   if (memory)
-    ways.push_back("--max-memory " + format_number(std::ceil(1.1 * e.bytes / 1e8) / 10, "%.1f") +
-                   " (max_memory=, GB) if that much memory is free");
+    ways.push_back(max_memory_option(e.bytes) + " (max_memory=, GB) if that much memory is free");
   for (std::size_t i = 0; i < ways.size(); ++i)
     text += (i == 0 ? "" : i + 1 == ways.size() ? ", or " : ", ") + ways[i];
   return text;

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "core/errors.hpp"
+#include "core/memory.hpp"  // the memory limit, shared with every command
 #include "core/model.hpp"
 #include "validation/twin.hpp"
 
@@ -75,9 +77,9 @@ struct WorkEstimate {
 };
 
 // Refused up front: what() is the one line Validator::refusal gives.
-class OverBudget : public std::runtime_error {
+class OverBudget : public Error {
  public:
-  using std::runtime_error::runtime_error;
+  using Error::Error;
 };
 
 // One compared quantity: max over the states of ‖x_femdyn − x_simbody‖∞ and of that divided by
@@ -152,9 +154,6 @@ class Validator {
 
 // Validator(model, options).run(), or OverBudget (naming model.where) beyond the budget.
 ValidationReport validate(const Model& model, const ValidationOptions& options = {});
-
-// Half of /proc/meminfo's MemAvailable (B), or infinity where it cannot be read.
-double default_memory_limit();
 
 // For a model read from a URDF file: femdyn's M^s, h, Q against an independent Simbody model
 // built straight from the XML (urdf_twin.hpp), at the same seeded states. Returns the quantity

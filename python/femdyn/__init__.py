@@ -46,6 +46,7 @@ try:
         ModelError,
         NumericalError,
         load,
+        set_max_memory,
         simulate,
         with_simbody,
     )
@@ -59,8 +60,8 @@ from ._sweep import grid, sweep  # noqa: F401,E402  (pandas and dask are importe
 if with_simbody:
     from ._femdyn import validate  # noqa: F401
 
-__all__ = ["Builder", "Equations", "Model", "ModelError", "NumericalError", "grid", "load", "simulate",
-           "sweep", "with_simbody"] + (["validate"] if with_simbody else [])
+__all__ = ["Builder", "Equations", "Model", "ModelError", "NumericalError", "grid", "load",
+           "set_max_memory", "simulate", "sweep", "with_simbody"] + (["validate"] if with_simbody else [])
 
 for _cls in (Builder, Equations, Model, ModelError, NumericalError):
     _cls.__module__ = "femdyn"

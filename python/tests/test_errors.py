@@ -94,25 +94,48 @@ def test_model_errors_name_the_file_and_place(tmp_path):
         femdyn.load(str(tmp_path))
 
 
-def test_overflow_is_a_numerical_error(finger):
-    with pytest.raises(femdyn.NumericalError, match="NaN or Inf"):
-        finger.equations(np.zeros(4), np.full(4, 1e200))
-    with pytest.raises(femdyn.NumericalError, match="^row 1: .*NaN or Inf"):
-        finger.forward_dynamics_batch(np.zeros((3, 4)), np.array([[0.0] * 4, [1e200] * 4,
-                                                                 [0.0] * 4]))
-
-
-def test_failed_simulation(finger):
-    with pytest.raises(femdyn.NumericalError):
-        femdyn.simulate(finger, 1.0, integrator="euler", dt=0.5, qd0=np.full(4, 1e150))
-    r = femdyn.simulate(finger, 1.0, integrator="euler", dt=0.5, qd0=np.full(4, 1e150),
-                        check=False)
-    assert not r["stats"]["ok"] and r["stats"]["failure"]
-    assert len(r["t"]) >= 1 and np.isfinite(r["q"]).all()
+def test_a_million_bodies_are_refused_by_count_before_parsing(tmp_path):
+    # load() reads through the same JSON reader as the command line: one linear pass counts the
+    # top-level "bodies" before anything is built (issue 22; the time is not asserted here).
+    big = tmp_path / "million.json"
+    big.write_text('{"bodies": [' + ",".join(['{"a":1}'] * 1_000_000) + "]}")
+    with pytest.raises(femdyn.ModelError,
+                       match=r"million.json: /bodies: 1000000 bodies: more than femdyn's "
+                             r"limit of 200000$"):
+        femdyn.load(str(big))
 
 
 LIMIT = ("is out of range (|x| ≤ 1e100: beyond it the equations' products overflow double "
          "precision)")
+
+
+def test_states_are_held_to_the_cli_limit(finger):
+    """q, q̇ and q̈ are physical inputs like the CLI's --q and --qd: beyond 1e100 a ValueError
+    before any work (issue 22: Python took q = 1e300), with the argument, row and entry named."""
+    with pytest.raises(ValueError) as e:
+        finger.equations(np.zeros(4), np.full(4, 1e200))
+    assert str(e.value) == f"qd: entry 0 ('abduction') 1e+200 {LIMIT}"
+    with pytest.raises(ValueError) as e:
+        finger.equations(np.array([0, 1e300, 0, 0]))
+    assert str(e.value) == f"q: entry 1 ('mcp') 1e+300 {LIMIT}"
+    with pytest.raises(ValueError) as e:
+        finger.forward_dynamics_batch(np.zeros((3, 4)), np.array([[0.0] * 4, [1e200] * 4,
+                                                                 [0.0] * 4]))
+    assert str(e.value) == f"qd: row 1, entry 0 ('abduction') 1e+200 {LIMIT}"
+    with pytest.raises(ValueError, match=r"^qdd: row 0, entry 2 \('pip'\) -1e\+101 "):
+        finger.inverse_dynamics_batch(np.zeros((1, 4)), None, [[0, 0, -1e101, 0]])
+    with pytest.raises(ValueError, match=r"^q0: entry 0 \('abduction'\) 1e\+300 "):
+        femdyn.simulate(finger, 0.1, q0=[1e300, 0, 0, 0])
+    assert np.isfinite(finger.equations(np.zeros(4), np.full(4, 1e100)).h).all()
+
+
+def test_failed_simulation(finger):
+    with pytest.raises(femdyn.NumericalError):
+        femdyn.simulate(finger, 1.0, integrator="euler", dt=0.5, qd0=np.full(4, 1e100))
+    r = femdyn.simulate(finger, 1.0, integrator="euler", dt=0.5, qd0=np.full(4, 1e100),
+                        check=False)
+    assert not r["stats"]["ok"] and r["stats"]["failure"]
+    assert len(r["t"]) >= 1 and np.isfinite(r["q"]).all()
 
 
 @pytest.mark.parametrize("call,message", [
@@ -142,8 +165,7 @@ def test_tau_is_held_to_the_physical_limit(finger, call, message):
 
 
 def test_tau_at_the_limit_is_accepted(finger):
-    """1e100 itself is within the limit; the states are only required to be finite (an overflow
-    at a state is a NumericalError, test_overflow_is_a_numerical_error)."""
+    """1e100 itself is within the limit, for τ as for the states."""
     tau = np.array([1e100, 0, 0, 0])
     assert np.isfinite(finger.equations(np.zeros(4), None, tau).Q).all()
     assert finger.forward_dynamics_batch(np.zeros((1, 4)), None, tau[None, :]).shape == (1, 4)

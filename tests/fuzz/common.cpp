@@ -37,6 +37,14 @@ void note(const std::string& what) {
   if (verbose) std::fprintf(stderr, "femdyn fuzz: %s\n", what.c_str());
 }
 
+void check_message(const char* stage, const std::string& what) {
+  if (!printable_text(what))
+    bug(std::string(stage) +
+        ": the error message holds a control character or a byte that is "
+        "not UTF-8 (shown escaped): " +
+        escaped(what));
+}
+
 std::uint64_t hash(const std::uint8_t* data, std::size_t size) {
   std::uint64_t h = 1469598103934665603ull;
   for (std::size_t i = 0; i < size; ++i) h = (h ^ data[i]) * 1099511628211ull;

@@ -1,9 +1,12 @@
-// Shared by the fuzz targets (json_model.cpp, urdf.cpp, vector.cpp): what counts as a bug.
-//   Expected: femdyn::ModelError or another std::runtime_error (a one-line message), or a
-//   failed Status.
+// Shared by the fuzz targets (json_model.cpp, urdf.cpp, vector.cpp, csv.cpp): what counts as a
+// bug.
+//   Expected: femdyn::ModelError or another std::runtime_error whose message is one line of
+//   printable text (core/message.hpp printable_text), or a failed Status.
 //   A bug (abort(), so libFuzzer keeps the input): a crash or sanitizer report, a hang (libFuzzer
-//   -timeout), an exception of any other type, and — with the NaN check on — NaN or Inf in
-//   M^s, h, Q or q̈ while forward_dynamics() returned ok and every number of the input was finite.
+//   -timeout), an exception of any other type, an error message (what()) that holds a control
+//   character (C0 including a line break, DEL, C1) or a byte that is not UTF-8, and — with the
+//   NaN check on — NaN or Inf in M^s, h, Q or q̈ while forward_dynamics() returned ok and every
+//   number of the input was finite.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -11,6 +14,7 @@
 #include <string>
 #include <typeinfo>
 
+#include "core/message.hpp"
 #include "core/model.hpp"
 #include "io/params.hpp"
 
@@ -34,14 +38,18 @@ std::uint64_t hash(const std::uint8_t* data, std::size_t size);  // FNV-1a
 
 bool all_finite(const Json& j);  // every number in the document is finite
 
-// Runs fn(); ModelError and std::runtime_error are expected and return false; any other
-// exception is a bug. True if fn() returned normally.
+// A message that would write a control character to the terminal (or a second line) is a bug.
+void check_message(const char* stage, const std::string& what);
+
+// Runs fn(); ModelError and std::runtime_error are expected and return false, if their message
+// is printable (check_message); any other exception is a bug. True if fn() returned normally.
 template <class F>
 bool expected_errors_only(const char* stage, F&& fn) {
   try {
     fn();
     return true;
   } catch (const std::runtime_error& e) {  // ModelError, CliError, other one-line errors
+    check_message(stage, e.what());
     note(std::string(stage) + ": expected error: " + e.what());
     return false;
   } catch (const std::exception& e) {
