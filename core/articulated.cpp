@@ -69,8 +69,12 @@ Status articulated_forward_dynamics(const Model& model, Workspace& ws, const Vec
     BodyState& B = ws.body[b];
     A.V = body.parent >= 0 ? ws.articulated[body.parent].V : Vec6::Zero();
     A.c.setZero();
-    if (const Joint& J = body.joint; moves(J))  // one rate (choose_routes): S into A.S
-      add_joint_motion(J, B.R, B.p, ws.theta_dot.data() + J.idx_v, nullptr, &A.S, A.V, A.c);
+    if (const Joint& J = body.joint; moves(J)) {  // one rate (choose_routes)
+      A.S = spatial_column(J, B.R, B.p, 0);
+      const Vec6 vj = A.S * ws.theta_dot[J.idx_v];
+      A.V += vj;
+      A.c = cross_motion(A.V, vj);
+    }
     B.w = A.V.head<3>();
     const RigidInertia I = inertia_at_origin(model.body_inertia[b], B.R, B.p);
     A.IA = I.matrix();

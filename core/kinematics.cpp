@@ -46,9 +46,9 @@ template <class J>
     }
     B.w = P.w + dw_x;
     B.w_y = P.w_y + dw_y;
-    B.v = P.v + P.w.cross(r) + dv_x;
-    B.alpha = P.alpha + B.w_y.cross(dw_x);
-    B.a = P.a + P.alpha.cross(r) + P.w.cross(P.w_y.cross(r) + dv_y) + B.w_y.cross(dv_x);
+    B.v = P.v + cross3(P.w, r) + dv_x;
+    B.alpha = P.alpha + cross3(B.w_y, dw_x);
+    B.a = P.a + cross3(P.alpha, r) + cross3(P.w, cross3(P.w_y, r) + dv_y) + cross3(B.w_y, dv_x);
   }
   if (req.jacobian) {
     auto Jw = ws.Jw.middleRows<3>(3 * b);

@@ -12,6 +12,14 @@ using Mat3 = Eigen::Matrix3d;
 using VecX = Eigen::VectorXd;
 using MatX = Eigen::MatrixXd;
 
+// a × b for 3-vectors (or 3-blocks), spelled out: in the long per-body recursions GCC stops
+// inlining Eigen's cross(), and a call costs more than the product.
+template <class A, class B>
+[[gnu::always_inline]] inline Vec3 cross3(const Eigen::MatrixBase<A>& a,
+                                          const Eigen::MatrixBase<B>& b) {
+  return Vec3(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]);
+}
+
 // [a]x, the cross-product matrix: skew(a) * b = a x b.
 inline Mat3 skew(const Vec3& a) {
   Mat3 s;

@@ -16,16 +16,16 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;
 // always inlined: the recursions call them per body, and a call costs as much as the product.
 [[gnu::always_inline]] inline Vec6 cross_motion(const Vec6& a, const Vec6& b) {
   Vec6 r;
-  r.head<3>() = a.head<3>().cross(b.head<3>());
-  r.tail<3>() = a.head<3>().cross(b.tail<3>()) + a.tail<3>().cross(b.head<3>());
+  r.head<3>() = cross3(a.head<3>(), b.head<3>());
+  r.tail<3>() = cross3(a.head<3>(), b.tail<3>()) + cross3(a.tail<3>(), b.head<3>());
   return r;
 }
 
 // a ×* f for a motion a and a force f = (n, f): (ω × n + v × f, ω × f).
 [[gnu::always_inline]] inline Vec6 cross_force(const Vec6& a, const Vec6& f) {
   Vec6 r;
-  r.head<3>() = a.head<3>().cross(f.head<3>()) + a.tail<3>().cross(f.tail<3>());
-  r.tail<3>() = a.head<3>().cross(f.tail<3>());
+  r.head<3>() = cross3(a.head<3>(), f.head<3>()) + cross3(a.tail<3>(), f.tail<3>());
+  r.tail<3>() = cross3(a.head<3>(), f.tail<3>());
   return r;
 }
 
@@ -54,8 +54,8 @@ struct RigidInertia {
   [[gnu::always_inline]] Vec6 operator*(const Vec6& v) const {
     Vec6 f;
     f.head<3>().noalias() = I * v.head<3>();
-    f.head<3>() += h.cross(v.tail<3>());
-    f.tail<3>() = m * v.tail<3>() - h.cross(v.head<3>());
+    f.head<3>() += cross3(h, v.tail<3>());
+    f.tail<3>() = m * v.tail<3>() - cross3(h, v.head<3>());
     return f;
   }
   // A sum of rigid inertias about one point is one: the composites stay in this form.

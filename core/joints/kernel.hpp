@@ -59,7 +59,8 @@ template <class J>
 Vec6 spatial_column(const Joint& j, const Mat3& R_B, const Vec3& p_B, int k) {
   Vec6 S;
   const Vec3 w = world_angular<J>(j, R_B, k);
-  S << w, world_linear<J>(j, R_B, k) + p_B.cross(w);
+  S.head<3>() = w;
+  S.tail<3>() = world_linear<J>(j, R_B, k) + cross3(p_B, w);
   return S;
 }
 inline Vec6 spatial_column(const Joint& j, const Mat3& R_B, const Vec3& p_B, int k) {
@@ -78,15 +79,23 @@ inline void spatial_columns(const Joint& j, const Mat3& R_B, const Vec3& p_B, Ve
 // a += V × v_J (+ Σ S_k θ̈_k when `acc` is given) with v_J = Σ S_k θ̇_k, the rates at `rate`
 // and `acc` (each indexed from the joint's first rate). Only the columns depend on the type,
 // so the per-type code stays a few products.
-inline void add_joint_motion(const Joint& j, const Mat3& R_B, const Vec3& p_B, const double* rate,
-                             const double* acc, Vec6* S, Vec6& V, Vec6& a) {
-  spatial_columns(j, R_B, p_B, S);
-  Vec6 vj = S[0] * rate[0];
-  for (int k = 1; k < j.nv; ++k) vj += S[k] * rate[k];
+template <class J>
+[[gnu::always_inline]] inline void add_joint_motion(const Joint& j, const Mat3& R_B,
+                                                    const Vec3& p_B, const double* rate,
+                                                    const double* acc, Vec6* S, Vec6& V, Vec6& a) {
+  Vec6 vj = Vec6::Zero();
+  for (int k = 0; k < J::nv; ++k) {
+    S[k] = spatial_column<J>(j, R_B, p_B, k);
+    vj += S[k] * rate[k];
+  }
   V += vj;
   a += cross_motion(V, vj);
   if (acc)
-    for (int k = 0; k < j.nv; ++k) a += S[k] * acc[k];
+    for (int k = 0; k < J::nv; ++k) a += S[k] * acc[k];
+}
+inline void add_joint_motion(const Joint& j, const Mat3& R_B, const Vec3& p_B, const double* rate,
+                             const double* acc, Vec6* S, Vec6& V, Vec6& a) {
+  visit_joint(j.type, [&]<class J>(J) { add_joint_motion<J>(j, R_B, p_B, rate, acc, S, V, a); });
 }
 
 // The joint's own generalized force on a 1-DOF joint's coordinate: its spring and damper,
