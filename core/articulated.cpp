@@ -14,7 +14,8 @@ namespace {
 // τ_b on joint j: the actuation and the joint's spring and damper (C = I: θ = q).
 double joint_force(const Joint& J, const Workspace& ws, const VecX& tau) {
   const int j = J.idx_v;
-  return (tau.size() > j ? tau[j] : 0.0) + spring_damper_force(J, ws.theta[j], ws.theta_dot[j]);
+  return (tau.size() > j ? tau[j] : 0.0) +
+         spring_damper_force(J, ws.theta[J.idx_q], ws.theta_dot[j]);
 }
 
 Status dependent_pivot(const Model& model, int j) {
@@ -70,7 +71,7 @@ Status articulated_forward_dynamics(const Model& model, Workspace& ws, const Vec
     A.V = body.parent >= 0 ? ws.articulated[body.parent].V : Vec6::Zero();
     A.c.setZero();
     if (const Joint& J = body.joint; moves(J)) {  // one rate (choose_routes)
-      A.S = spatial_column(J, B.R, B.p, 0);
+      A.S = spatial_column(J, B.R, parent_rotation(model, ws.body, b), B.p, 0);
       const Vec6 vj = A.S * ws.theta_dot[J.idx_v];
       A.V += vj;
       A.c = cross_motion(A.V, vj);

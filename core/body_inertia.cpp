@@ -139,7 +139,8 @@ void composite_mass(const Model& m, Workspace& ws) {
   composite_inertias(m, ws);
   for (int b = 0; b < nb; ++b)
     if (const Joint& J = m.bodies[b].joint; moves(J))
-      spatial_columns(J, ws.body[b].R, ws.body[b].p, ws.subspace.data() + J.idx_v);
+      spatial_columns(J, ws.body[b].R, parent_rotation(m, ws.body, b), ws.body[b].p,
+                      ws.subspace.data() + J.idx_v);
   mass_from_composites(m, ws);
 }
 

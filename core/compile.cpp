@@ -64,6 +64,26 @@ std::vector<int> tree_order(const MechanismSpec& spec) {
   return order;
 }
 
+// The parameters only some types read: universal's second axis (unit, normal to the first),
+// helical's pitch.
+void check_joint_parameters(const JointSpec& js, Joint& j) {
+  if (js.type == JointType::Universal) {
+    if (!js.axis2) throw ModelError(js.where + "/axis2", "a universal joint needs its second axis");
+    check_magnitude(*js.axis2, js.where + "/axis2", "axis2");
+    if (!(js.axis2->norm() > 1e-12)) throw ModelError(js.where + "/axis2", "axis2 is zero");
+    j.axis2 = js.axis2->normalized();
+    if (std::abs(j.axis2.dot(j.axis)) > 1e-9)
+      throw ModelError(js.where + "/axis2",
+                       "a universal joint's two axes must be normal to each other");
+  } else if (js.axis2) {
+    throw ModelError(js.where + "/axis2", "only a universal joint has a second axis");
+  }
+  if (js.type != JointType::Helical && js.pitch != 0)
+    throw ModelError(js.where + "/pitch", "only a helical joint has a pitch");
+  check_magnitude(js.pitch, js.where + "/pitch", "pitch");
+  j.pitch = js.pitch;
+}
+
 Joint compile_joint(const JointSpec& js, const std::string& body_name) {
   Joint j;
   j.name = js.name.empty() ? body_name : js.name;
@@ -79,10 +99,16 @@ Joint compile_joint(const JointSpec& js, const std::string& body_name) {
     if (!(norm > 1e-12)) throw ModelError(js.where + "/axis", "axis is zero");
     j.axis = js.axis / norm;
   }
+  check_joint_parameters(js, j);
   prepare_joint(j);
   for (auto [x, what] :
        {std::pair{js.stiffness, "stiffness"}, {js.rest, "rest"}, {js.damping, "damping"}})
     check_magnitude(x, js.where, what);
+  if (j.nv != 1 &&
+      (js.stiffness != 0 || js.damping != 0 || std::isfinite(js.lower) || std::isfinite(js.upper)))
+    throw ModelError(js.where, std::string("a ") + std::string(joint_type_name(j.type)) +
+                                   " joint takes no spring, damper or limits (only joints of "
+                                   "one coordinate do)");
   if (js.stiffness < 0) throw ModelError(js.where + "/spring", "negative stiffness");
   if (js.damping < 0) throw ModelError(js.where + "/damping", "negative damping");
   if (std::isnan(js.lower) || std::isnan(js.upper) || js.lower > js.upper)
@@ -95,17 +121,47 @@ Joint compile_joint(const JointSpec& js, const std::string& body_name) {
   return j;
 }
 
+// Couplings join joints of one rate (a coupled multi-rate joint would need a law per rate).
+void check_one_rate(const Model& m, int t, const std::string& where) {
+  const Joint& j = m.bodies[m.theta_joint[t]].joint;
+  if (j.nv != 1)
+    throw ModelError(where, "joint '" + j.name + "' is " + std::string(joint_type_name(j.type)) +
+                                " (" + std::to_string(j.nv) +
+                                " rates): couplings join joints of one coordinate");
+}
+
+// The names of the entries of q: the rates' names while θ and θ̇ have the same layout, else
+// (a joint with nq ≠ nv, allowed only without couplings) each joint's coordinates in tree order.
+void name_configuration(Model& m) {
+  bool flat = true;
+  for (const Body& b : m.bodies) flat = flat && is_flat(b.joint);
+  if (flat) {
+    m.configuration_names = m.coordinate_names;
+    return;
+  }
+  if (!m.identity_coupling)
+    throw ModelError(m.where,
+                     "couplings in a model with a spherical or free joint are not "
+                     "supported yet (couplings join one-coordinate joints of a model "
+                     "whose joints all have nq = nv)");
+  for (const Body& b : m.bodies)
+    for (int k = 0; k < b.joint.nq; ++k)
+      m.configuration_names.push_back(
+          b.joint.nq == 1 ? b.joint.name : b.joint.name + "." + coordinate_name(b.joint, k));
+}
+
 // The coupling level: C (nθ x n) and θ0 from the couplings; the remaining movable joints,
 // in tree order, are the generalized coordinates q.
 void compile_coupling(const MechanismSpec& spec, Model& m) {
-  std::map<std::string, int> theta_of;  // joint name -> θ index
-  for (std::size_t t = 0; t < m.theta_joint.size(); ++t)
+  std::map<std::string, int> theta_of;                  // joint name -> θ index
+  for (std::size_t t = m.theta_joint.size(); t-- > 0;)  // a joint's first rate
     theta_of[m.bodies[m.theta_joint[t]].joint.name] = static_cast<int>(t);
   std::map<int, const CouplingSpec*> coupled;
   for (const CouplingSpec& c : spec.couplings) {
     auto it = theta_of.find(c.joint);
     if (it == theta_of.end())
       throw ModelError(c.where + "/joint", "unknown or fixed joint " + quoted_text(c.joint));
+    check_one_rate(m, it->second, c.where + "/joint");
     if (!coupled.emplace(it->second, &c).second)
       throw ModelError(c.where + "/joint", "joint '" + c.joint + "' is coupled twice");
     check_magnitude(c.offset, c.where + "/offset", "offset");
@@ -114,6 +170,7 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
     for (const auto& [name, ratio] : c.terms) {
       if (!theta_of.count(name))
         throw ModelError(c.where + "/follows", "unknown or fixed joint " + quoted_text(name));
+      check_one_rate(m, theta_of.at(name), c.where + "/follows");
       check_magnitude(ratio, c.where + "/ratio", "ratio");
     }
   }
@@ -122,7 +179,8 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
   for (int t = 0; t < nt; ++t)
     if (!coupled.count(t)) {
       q_of[t] = static_cast<int>(m.coordinate_names.size());
-      m.coordinate_names.push_back(m.bodies[m.theta_joint[t]].joint.name);
+      const Joint& j = m.bodies[m.theta_joint[t]].joint;
+      m.coordinate_names.push_back(j.nv == 1 ? j.name : j.name + "." + rate_name(j, t - j.idx_v));
     }
   const int n = static_cast<int>(m.coordinate_names.size());
   if (nt == 0) throw ModelError(m.where, "has no movable joint: there is no motion to compute");
@@ -223,10 +281,12 @@ Model compile_tree(MechanismSpec spec) {
       throw ModelError(bs.joint.where + "/name", "duplicate joint name '" + b.joint.name + "'");
     b.parent = bs.parent == "world" ? -1 : compiled.at(bs.parent);  // (placed before: tree order)
     compiled.emplace(bs.name, static_cast<int>(k));
-    // Addresses in θ and θ̇ (equal while every joint has nq = nv), in tree order, and λ.
+    // Addresses in θ and θ̇ (they differ after a joint with nq ≠ nv), in tree order, and λ.
     last_rate.push_back(b.parent >= 0 ? last_rate[b.parent] : -1);
     if (moves(b.joint)) {
-      b.joint.idx_q = b.joint.idx_v = static_cast<int>(m.theta_joint.size());
+      b.joint.idx_q = m.n_theta_q;
+      m.n_theta_q += b.joint.nq;
+      b.joint.idx_v = static_cast<int>(m.theta_joint.size());
       for (int r = 0; r < b.joint.nv; ++r) {
         m.rate_parent.push_back(last_rate.back());
         last_rate.back() = static_cast<int>(m.theta_joint.size());
@@ -236,6 +296,7 @@ Model compile_tree(MechanismSpec spec) {
     m.bodies.push_back(std::move(b));
   }
   compile_coupling(spec, m);
+  name_configuration(m);
   build_node_level(spec, body_of_spec, m);
   condense_body_inertia(m);
   choose_routes(m);

@@ -107,6 +107,12 @@ Model compile_with_coupling_level(MechanismSpec spec) {
   tree_spec.couplings.clear();
   Model tree = compile_tree(tree_spec);
   Model m = compile_tree(std::move(tree_spec));
+  for (const Body& b : m.bodies)
+    if (b.joint.nv > 1)
+      throw ModelError(b.joint.where, "joint '" + b.joint.name + "' is " +
+                                          std::string(joint_type_name(b.joint.type)) +
+                                          ": a model with coupling laws takes joints of one "
+                                          "coordinate only (not supported yet)");
 
   std::map<std::string, int> theta_of;  // joint name -> θ index
   for (int t = 0; t < m.n_theta(); ++t) theta_of[m.bodies[m.theta_joint[t]].joint.name] = t;
@@ -160,6 +166,7 @@ Model compile_with_coupling_level(MechanismSpec spec) {
   m.C_sparse = m.C;
   m.theta0 = s.theta - s.G * q_ref;
   m.identity_coupling = false;
+  m.configuration_names = m.coordinate_names;
   m.mass_pattern = MassPattern{};  // (M^s is reduced and factorised densely: coupling_chain)
   m.dynamics_route = DynamicsRoute::Cholesky;
   m.coupling_level = std::move(level);

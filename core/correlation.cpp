@@ -12,6 +12,7 @@
 #include "core/kinematics.hpp"
 #include "core/limits.hpp"
 #include "core/names.hpp"
+#include "core/sampling.hpp"
 
 namespace femdyn {
 namespace {
@@ -128,7 +129,8 @@ void row_max_by_paths(const Model& m, Workspace& ws, std::vector<PathSpan>& span
     const Body& B = m.bodies[b];
     span[b] = B.parent >= 0 ? span[B.parent] : PathSpan{};
     for (int c = 0; c < B.joint.nv; ++c) {
-      const Vec6 S = spatial_column(B.joint, ws.body[b].R, ws.body[b].p, c);
+      const Vec6 S =
+          spatial_column(B.joint, ws.body[b].R, parent_rotation(m, ws.body, b), ws.body[b].p, c);
       PathSpan& P = span[b];
       P.s_max = std::max(P.s_max, S.norm());
       Vec6 r = S;  // Gram–Schmidt, twice for orthogonality in floating point
@@ -142,8 +144,9 @@ void row_max_by_paths(const Model& m, Workspace& ws, std::vector<PathSpan>& span
     double big = 0;
     for (int a = body; a >= 0 && big <= enough; a = m.bodies[a].parent)
       for (int c = 0; c < m.bodies[a].joint.nv; ++c)
-        big = std::max(
-            big, std::abs(spatial_column(m.bodies[a].joint, ws.body[a].R, ws.body[a].p, c).dot(w)));
+        big = std::max(big, std::abs(spatial_column(m.bodies[a].joint, ws.body[a].R,
+                                                    parent_rotation(m, ws.body, a), ws.body[a].p, c)
+                                         .dot(w)));
     return big;
   };
   for (int i = 0; i < m.n_u(); ++i) {
@@ -211,9 +214,9 @@ std::vector<VecX> sample_states(const Model& m, int count) {
   std::uniform_real_distribution<double> uni(-2.0, 2.0);
   std::vector<VecX> qs;
   for (int s = 0; s < count; ++s) {
-    VecX q(m.n());
-    for (int a = 0; a < m.n(); ++a) q[a] = uni(rng);
-    qs.push_back(q);
+    VecX xi(m.n());
+    for (int a = 0; a < m.n(); ++a) xi[a] = uni(rng);
+    qs.push_back(integrate_posture(m, neutral_posture(m), xi));  // (q = ξ when flat)
   }
   return qs;
 }
@@ -432,7 +435,7 @@ void check_mass_matrix(const Model& m) {
   if (m.n() == 0) return;
   Workspace ws(m);
   std::vector<VecX> states = sample_states(m, 2);
-  states.insert(states.begin(), VecX::Zero(m.n()));
+  states.insert(states.begin(), neutral_posture(m));
   const VecX rest = VecX::Zero(m.n());
   for (const VecX& q : states) {
     // The model's own route: the articulated recursion checks its pivots in O(bodies); the

@@ -27,8 +27,9 @@ Status coupled_forward_dynamics(const Model& model, Workspace& ws, const VecX& q
       A.a = gravity_base_acceleration(model);
     }
     if (const Joint& J = body.joint; moves(J))
-      add_joint_motion(J, B.R, B.p, ws.theta_dot.data() + J.idx_v, nullptr,
-                       ws.subspace.data() + J.idx_v, A.V, A.a);
+      add_joint_motion(J, B.R, parent_rotation(model, ws.body, b), B.p,
+                       ws.theta_dot.data() + J.idx_v, nullptr, ws.subspace.data() + J.idx_v, A.V,
+                       A.a);
     const RigidInertia I = inertia_at_origin(model.body_inertia[b], B.R, B.p);
     A.pA = I * A.a + cross_force(A.V, I * A.V);
     ws.composite[b] = I;

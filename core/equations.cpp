@@ -67,7 +67,8 @@ void add_joint_forces(const Model& model, const Workspace& ws, bool with_rates, 
                       VecX& y) {
   for (int j = 0; j < model.n_theta(); ++j) {
     const Joint& J = model.bodies[model.theta_joint[j]].joint;
-    const double f = spring_damper_force(J, ws.theta[j], with_rates ? ws.theta_dot[j] : 0.0);
+    if (J.nv != 1) continue;  // (springs and dampers are on joints of one coordinate)
+    const double f = spring_damper_force(J, ws.theta[J.idx_q], with_rates ? ws.theta_dot[j] : 0.0);
     if (f != 0) coupling_add_row(model, j, sign * f, y);
   }
 }
@@ -274,7 +275,8 @@ Energy energy(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) 
   }
   for (int j = 0; j < model.n_theta(); ++j) {
     const Joint& J = model.bodies[model.theta_joint[j]].joint;
-    E.potential += 0.5 * J.stiffness * (ws.theta[j] - J.rest) * (ws.theta[j] - J.rest);
+    if (J.stiffness == 0) continue;
+    E.potential += 0.5 * J.stiffness * (ws.theta[J.idx_q] - J.rest) * (ws.theta[J.idx_q] - J.rest);
   }
   return E;
 }

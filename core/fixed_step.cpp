@@ -38,6 +38,7 @@ Status FixedStep::advance(double t_out) {
     if (!st.ok) return st.non_finite ? diverged() : explain(std::move(st));
     if (!motion_.check_state(t_next, y_next_.data()).ok) return diverged();
     y_.swap(y_next_);
+    motion_.recenter(y_.data());  // (a manifold's chart follows every step)
     t_ = t_next;
     if (on_grid) ++k_;
     ++stats_.steps;
@@ -97,8 +98,9 @@ SymplecticEuler::SymplecticEuler(const Model& model, const FixedStepOptions& opt
 Status SymplecticEuler::take_step(double h) {
   const int n = motion_.n();
   if (Status st = motion_.rhs(t_, y_.data(), f_.data()); !st.ok) return st;
-  y_next_.segment(n, n) = y_.segment(n, n) + h * f_.segment(n, n);  // q̇ first
-  y_next_.head(n) = y_.head(n) + h * y_next_.segment(n, n);         // then q with the new q̇
+  y_next_.segment(n, n) = y_.segment(n, n) + h * f_.segment(n, n);     // q̇ first
+  motion_.chart_rates(y_.data(), y_next_.data() + n, y_next_.data());  // then q with the new q̇
+  y_next_.head(n) = y_.head(n) + h * y_next_.head(n);
   y_next_[2 * n] = y_[2 * n] + h * f_[2 * n];
   return {};
 }

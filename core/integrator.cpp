@@ -85,10 +85,15 @@ Integrator::Integrator(const Model& model, Actuation tau)
 
 void Integrator::reset(double t0, const VecX& q0, const VecX& qd0, double t_stop) {
   const int n = motion_.n();
-  if (q0.size() != n || qd0.size() != n)
-    throw std::invalid_argument("Integrator::reset: expected q0, qd0 of size " + std::to_string(n));
-  y_ << q0, qd0, 0.0;
+  const int nq = motion_.model().n_q();
+  if (q0.size() != nq || qd0.size() != n)
+    throw std::invalid_argument("Integrator::reset: expected q0 of size " + std::to_string(nq) +
+                                " and qd0 of size " + std::to_string(n));
+  motion_.start_chart(q0, y_.data());
+  y_.segment(n, n) = qd0;
+  y_[2 * n] = 0.0;
   y0_ = y_;
+  q0_ = q0;
   t_ = t0_ = t0;
   t_stop_ = t_stop;
   stats_ = {};
@@ -154,7 +159,7 @@ Status Integrator::diverged() {
             at_time(t_) + "the solution diverges (the state holds " + format_short(watch_.gain()) +
                 " J more energy than the " + format_short(watch_.supplied()) +
                 " J it started with and was given): " +
-                divergence_cause(motion_.model(), kind(), fixed_dt(), setting(), y0_.head(n),
+                divergence_cause(motion_.model(), kind(), fixed_dt(), setting(), q0_,
                                  y0_.segment(n, n), tau0),
             -1};
   st.diverged = true;

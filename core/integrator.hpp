@@ -86,7 +86,11 @@ class Integrator {
   virtual std::string setting() const = 0;
 
   double t() const { return t_; }
-  auto q() const { return y_.head(motion_.n()); }
+  VecX q() const {  // (y holds chart coordinates when a joint's q is not a vector space)
+    VecX q;
+    motion_.configuration(y_.data(), q);
+    return q;
+  }
   auto qd() const { return y_.segment(motion_.n(), motion_.n()); }
   double work() const { return y_[2 * motion_.n()]; }
   const VecX& y() const { return y_; }
@@ -108,7 +112,7 @@ class Integrator {
   // The fixed step, or 0 for an adaptive method (for the divergence's cause).
   virtual double fixed_dt() const { return 0; }
   Motion motion_;
-  VecX y_, y0_;
+  VecX y_, y0_, q0_;
   double t_ = 0, t0_ = 0, t_stop_ = 0;
   IntegratorStats stats_;
   DivergenceWatch watch_;

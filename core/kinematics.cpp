@@ -34,21 +34,28 @@ template <class J>
   std::array<Vec3, J::nv + 1> s_w, s_v;  // the columns of S_J in world axes (one spare: nv = 0)
   if (req.bias || req.jacobian)
     for (int k = 0; k < J::nv; ++k) {
-      if constexpr (J::angular) s_w[k] = world_angular<J>(j, B.R, k);
-      if constexpr (J::linear) s_v[k] = world_linear<J>(j, B.R, k);
+      if constexpr (J::angular) s_w[k] = world_angular<J>(j, B.R, P.R, k);
+      if constexpr (J::linear) s_v[k] = world_linear<J>(j, B.R, P.R, k);
     }
   if (req.bias) {
+    // The joint's motion at the rates x and y; at x split by the frame each column is fixed in
+    // (B or P), whose angular velocity at y turns it (kernel.hpp).
     Vec3 dw_x = Vec3::Zero(), dw_y = Vec3::Zero(), dv_x = Vec3::Zero(), dv_y = Vec3::Zero();
+    Vec3 dw_xP = Vec3::Zero(), dv_xP = Vec3::Zero();
     for (int k = 0; k < J::nv; ++k) {
       const double x = ws.theta_dot[j.idx_v + k], y = ws.theta_dot_y[j.idx_v + k];
-      if constexpr (J::angular) dw_x += s_w[k] * x, dw_y += s_w[k] * y;
-      if constexpr (J::linear) dv_x += s_v[k] * x, dv_y += s_v[k] * y;
+      if constexpr (J::angular) (J::in_parent(k) ? dw_xP : dw_x) += s_w[k] * x, dw_y += s_w[k] * y;
+      if constexpr (J::linear) (J::in_parent(k) ? dv_xP : dv_x) += s_v[k] * x, dv_y += s_v[k] * y;
     }
-    B.w = P.w + dw_x;
+    B.w = P.w + dw_x + dw_xP;
     B.w_y = P.w_y + dw_y;
-    B.v = P.v + cross3(P.w, r) + dv_x;
+    B.v = P.v + cross3(P.w, r) + dv_x + dv_xP;
     B.alpha = P.alpha + cross3(B.w_y, dw_x);
     B.a = P.a + cross3(P.alpha, r) + cross3(P.w, cross3(P.w_y, r) + dv_y) + cross3(B.w_y, dv_x);
+    if constexpr (J::in_parent(0) || J::in_parent(J::nv - 1)) {
+      B.alpha += cross3(P.w_y, dw_xP);
+      B.a += cross3(P.w_y, dv_xP);
+    }
   }
   if (req.jacobian) {
     auto Jw = ws.Jw.middleRows<3>(3 * b);
@@ -179,12 +186,13 @@ void apply_transpose(const Model& model, Workspace& ws, const VecX& f, VecX& y,
   for (int b = nb - 1; b >= 0; --b) {  // children after parents in the list: leaves first
     const Body& body = model.bodies[b];
     const Joint& j = body.joint;
+    const Mat3& R_P = parent_rotation(model, ws.body, b);
     // τ_k = s_ω,k · N_b + s_v,k · F_b: the power of the wrench (about B's origin) per rate.
     visit_joint(j.type, [&]<class J>(J) {
       for (int k = 0; k < J::nv; ++k) {
         double t = 0;
-        if constexpr (J::angular) t += world_angular<J>(j, ws.body[b].R, k).dot(ws.moment[b]);
-        if constexpr (J::linear) t += world_linear<J>(j, ws.body[b].R, k).dot(ws.force[b]);
+        if constexpr (J::angular) t += world_angular<J>(j, ws.body[b].R, R_P, k).dot(ws.moment[b]);
+        if constexpr (J::linear) t += world_linear<J>(j, ws.body[b].R, R_P, k).dot(ws.force[b]);
         ws.tau_theta[j.idx_v + k] = t;
       }
     });

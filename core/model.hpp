@@ -28,6 +28,8 @@ struct Joint {
   Mat3 R_pj = Mat3::Identity();  // joint frame orientation in the parent body frame
   Vec3 p_pj = Vec3::Zero();      // joint frame origin in the parent body frame
   Vec3 axis = Vec3::UnitZ();     // unit, joint frame
+  Vec3 axis2 = Vec3::UnitX();    // unit: universal's second axis (B), planar's e₁ (joint frame)
+  double pitch = 0;              // helical: advance per turn of θ, m/rad
   int nq = 0, nv = 0;            // its coordinates and rates (core/joints/kernel.hpp)
   int idx_q = -1, idx_v = -1;    // its first coordinate in θ, first rate in θ̇; -1 when fixed
   double lower = 0, upper = 0;
@@ -36,6 +38,7 @@ struct Joint {
   // Derived by compile() for the pose (core/joints/): R_pj [a]×, R_pj [a]×², R_pj a.
   Mat3 R_pj_K = Mat3::Zero(), R_pj_K2 = Mat3::Zero();
   Vec3 axis_parent = Vec3::UnitZ();
+  Vec3 axis2_parent = Vec3::UnitX(), axis3_parent = Vec3::UnitY();  // planar: R_pj e₁, R_pj e₂
 };
 
 struct Body {
@@ -132,7 +135,9 @@ struct Model {
   // Coupling level θ = C q + θ0 (nθ x n, sparse: the identity is n entries, not n²).
   SpMat C;
   VecX theta0;
-  std::vector<std::string> coordinate_names;  // n: the independent joints
+  std::vector<std::string> coordinate_names;  // n: the independent rates v (q̇ for 1-DOF joints)
+  std::vector<std::string> configuration_names;  // n_q: the entries of q (e.g. base.qw)
+  int n_theta_q = 0;                             // the joints' coordinates θ (Σ nq)
 
   // Node level.
   std::vector<SystemNode> nodes;
@@ -172,7 +177,8 @@ struct Model {
   bool has_nodal_forces = false;     // gravity or loads present
   bool has_velocity_forces = false;  // some element has a gyroscopic term
 
-  int n() const { return static_cast<int>(C.cols()); }
+  int n() const { return static_cast<int>(C.cols()); }  // rates v: M^s is n × n
+  int n_q() const { return static_cast<int>(configuration_names.size()); }  // coordinates q
   int n_theta() const { return static_cast<int>(theta_joint.size()); }
   int n_u() const { return static_cast<int>(dofs.size()); }
   std::string dof_name(int i) const { return dof_name_of(dofs.at(i)); }

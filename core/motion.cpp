@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/joints/kernel.hpp"
+
 namespace femdyn {
 
 std::string at_time(double t) {
@@ -26,6 +28,61 @@ double nonconservative_power(const Model& model, const Workspace& ws, const VecX
 Motion::Motion(const Model& model, Actuation tau)
     : model_(model), tau_(std::move(tau)), ws_(model) {
   q_ = qd_ = u_ = VecX::Zero(model.n());
+  for (const Body& b : model.bodies) flat_ = flat_ && is_flat(b.joint);
+  if (!flat_) {
+    q_c_ = q_ = VecX::Zero(model.n_q());
+    for (const Body& b : model.bodies)
+      if (moves(b.joint)) neutral_configuration(b.joint, q_c_.data() + b.joint.idx_q);
+  }
+}
+
+// (Without couplings, as compile requires of a non-flat model: θ = q, θ̇ = v, and each joint's
+// addresses idx_q, idx_v are its places in q and v.)
+void Motion::start_chart(const VecX& q, double* y) {
+  if (flat_) {
+    Eigen::Map<VecX>(y, n()) = q;
+    return;
+  }
+  q_c_ = q;
+  Eigen::Map<VecX>(y, n()).setZero();
+}
+
+void Motion::configuration(const double* y, VecX& q) const {
+  if (flat_) {
+    q = Eigen::Map<const VecX>(y, n());
+    return;
+  }
+  q.resize(model_.n_q());
+  for (const Body& b : model_.bodies)
+    if (const Joint& J = b.joint; moves(J))
+      integrate_configuration(J, q_c_.data() + J.idx_q, y + J.idx_v, q.data() + J.idx_q);
+}
+
+void Motion::recenter(double* y) {
+  if (flat_) return;
+  VecX q;
+  configuration(y, q);
+  q_c_ = q;
+  Eigen::Map<VecX>(y, n()).setZero();
+}
+
+double Motion::chart_extent(const double* y) const {
+  double extent = 0;
+  if (flat_) return extent;
+  for (const Body& b : model_.bodies)
+    if (const Joint& J = b.joint; !is_flat(J))  // the rotation is a non-flat joint's last 3 rates
+      extent = std::max(extent, Eigen::Map<const Vec3>(y + J.idx_v + J.nv - 3).norm());
+  return extent;
+}
+
+void Motion::chart_rates(const double* xi, const double* v, double* xi_dot) const {
+  if (flat_) {
+    std::copy(v, v + n(), xi_dot);
+    return;
+  }
+  for (const Body& b : model_.bodies)
+    if (const Joint& J = b.joint; moves(J))
+      chart_rate(J, q_c_.data() + J.idx_q, xi + J.idx_v, v + J.idx_v, xi_dot + J.idx_v);
 }
 
 Status Motion::check_state(double t, const double* y) const {
@@ -44,7 +101,7 @@ Status Motion::check_state(double t, const double* y) const {
 Status Motion::rhs(double t, const double* y, double* ydot) {
   ++evaluations_;
   const int n = model_.n();
-  q_ = Eigen::Map<const VecX>(y, n);
+  configuration(y, q_);
   qd_ = Eigen::Map<const VecX>(y + n, n);
   actuation(t, u_);
   if (Status st = check_state(t, y); !st.ok) return st;
@@ -55,7 +112,7 @@ Status Motion::rhs(double t, const double* y, double* ydot) {
     st.message = at_time(t) + st.message;
     return st;
   }
-  Eigen::Map<VecX>(ydot, n) = qd_;
+  chart_rates(y, y + n, ydot);
   Eigen::Map<VecX>(ydot + n, n) = ws_.qdd;
   ydot[2 * n] = nonconservative_power(model_, ws_, qd_, u_);
   return {};
@@ -70,7 +127,7 @@ void Motion::actuation(double t, VecX& tau) const {
 
 Energy Motion::energy_at(const double* y) {
   const int n = model_.n();
-  q_ = Eigen::Map<const VecX>(y, n);
+  configuration(y, q_);
   qd_ = Eigen::Map<const VecX>(y + n, n);
   return energy(model_, ws_, q_, qd_);
 }

@@ -3,6 +3,15 @@
 //
 //   y = (q, q̇, W),   ẏ = f(t, y) = (q̇,  q̈ = (M^s)⁻¹ (Q(q, q̇, τ(t)) − h(q, q̇)),  P_nc),
 //
+// for a model whose coordinates form a vector space (every joint flat: q̇ = v). With a spherical
+// or free joint (nq ≠ nv) q lives on a manifold, and y holds chart coordinates instead:
+//
+//   y = (ξ, v, W),   q = q_c ⊕ ξ,   ξ̇ = chart rate (core/joints/kernel.hpp), v̇ = (M^s)⁻¹ (Q − h),
+//
+// around a chart centre q_c that the integrators move to the current q (recenter) after every
+// fixed step, and whenever a rotation in ξ passes kChartLimit for the adaptive ones. Quaternions
+// are therefore advanced by the exponential map and stay of norm 1 to round-off.
+//
 // with W the work done by the non-conservative forces (actuation τ, joint dampers, body torques)
 // and P_nc its power, so that E(t) − E(0) = W(t) for the mechanical energy E of
 // core/equations.hpp (docs/simulation.md). Every evaluation goes through forward_dynamics and is
@@ -25,6 +34,18 @@ class Motion {
   const Model& model() const { return model_; }
   int n() const { return model_.n(); }
   int size() const { return 2 * model_.n() + 1; }  // dim y
+  // Whether y holds q itself (every joint flat) rather than chart coordinates around q_c.
+  bool flat() const { return flat_; }
+  // y's configuration part for q (the chart then centred on q); q of the configuration at y.
+  void start_chart(const VecX& q, double* y);
+  void configuration(const double* y, VecX& q) const;
+  // Moves the chart centre to the configuration at y (ξ = 0 after); nothing when flat.
+  void recenter(double* y);
+  // The largest rotation angle in y's chart coordinates (0 when flat).
+  double chart_extent(const double* y) const;
+  // ξ̇ at (ξ, v): v when flat.
+  void chart_rates(const double* xi, const double* v, double* xi_dot) const;
+  static constexpr double kChartLimit = 1.0;  // rad
 
   // ẏ = f(t, y) into ydot (both of size(); may be SUNDIALS' arrays). Counts the evaluation.
   Status rhs(double t, const double* y, double* ydot);
@@ -44,7 +65,9 @@ class Motion {
   const Model& model_;
   Actuation tau_;
   Workspace ws_;
-  VecX q_, qd_, u_;  // buffers: q, q̇, τ at the evaluated state
+  bool flat_ = true;
+  VecX q_c_;         // the chart centre (non-flat)
+  VecX q_, qd_, u_;  // buffers: q, q̇ (v), τ at the evaluated state
   long evaluations_ = 0;
 };
 

@@ -58,9 +58,9 @@ void newton_euler(const Model& model, Workspace& ws, const VecX& q, const VecX& 
       A.a = a_base;
     }
     if (const Joint& J = body.joint; moves(J))  // V += S θ̇_J; a += V × S θ̇_J (+ S θ̈_J)
-      add_joint_motion(J, B.R, B.p, ws.theta_dot.data() + J.idx_v,
-                       qdd ? ws.theta_dot_y.data() + J.idx_v : nullptr,
-                       ws.subspace.data() + J.idx_v, A.V, A.a);
+      add_joint_motion(
+          J, B.R, parent_rotation(model, ws.body, b), B.p, ws.theta_dot.data() + J.idx_v,
+          qdd ? ws.theta_dot_y.data() + J.idx_v : nullptr, ws.subspace.data() + J.idx_v, A.V, A.a);
     B.w = A.V.head<3>();
     A.pA = body_force(model.body_inertia[b], B.R, B.p, A.V, A.a);
   }

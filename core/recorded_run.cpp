@@ -31,7 +31,7 @@ class LimitWatch {
     for (int& j : limited_) {
       if (j < 0) continue;
       const Joint& J = model_.bodies[model_.theta_joint[j]].joint;
-      const double x = ws_.theta[j];
+      const double x = ws_.theta[J.idx_q];  // (limits are on joints of one coordinate)
       if (x >= J.lower && x <= J.upper) continue;
       out.push_back({j, J.name, t, x, J.lower, J.upper});
       j = -1;  // once per joint

@@ -25,9 +25,52 @@ std::vector<const Joint*> coordinate_joints(const Model& m) {
   return joint_of;
 }
 
+// One coordinate of a one-coordinate joint (or of none: ±π).
+double random_within_limits(const Joint* joint, std::mt19937& rng) {
+  // ±π for a revolute joint, ±0.5 m for a prismatic one, narrowed to the joint's limits; a
+  // range that the limits exclude entirely is the limits' first 2π (or 1 m), never wider,
+  // so that huge limits (±1e308) never give a huge or infinite draw.
+  const double half = joint ? random_half_range(*joint) : std::numbers::pi;
+  double lo = -half, hi = half;
+  if (joint) {
+    lo = std::max(lo, joint->lower);
+    hi = std::min(hi, joint->upper);
+    if (lo > hi) {
+      lo = std::isfinite(joint->lower) ? joint->lower : joint->upper - 2 * half;
+      hi = std::min(joint->upper, lo + 2 * half);
+    }
+  }
+  return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
+
+// Whether every joint is flat: q then holds one entry per coordinate, as named.
+bool flat_model(const Model& m) {
+  return std::all_of(m.bodies.begin(), m.bodies.end(),
+                     [](const Body& b) { return is_flat(b.joint); });
+}
+
+// With a spherical or free joint (no couplings then: θ = q): each joint's configuration in turn,
+// a one-coordinate joint's by `one`, any other's by `many`.
+template <class One, class Many>
+VecX per_joint(const Model& m, One&& one, Many&& many) {
+  VecX q(m.n_q());
+  for (const Body& b : m.bodies)
+    if (const Joint& J = b.joint; moves(J)) {
+      if (J.nq == 1)
+        q[J.idx_q] = one(J);
+      else
+        many(J, q.data() + J.idx_q);
+    }
+  return q;
+}
+
 }  // namespace
 
 VecX reference_posture(const Model& m) {
+  if (!flat_model(m))
+    return per_joint(
+        m, [](const Joint& J) { return std::clamp(0.0, J.lower, J.upper); },
+        [](const Joint& J, double* q) { neutral_configuration(J, q); });
   const std::vector<const Joint*> joint_of = coordinate_joints(m);
   const int n = static_cast<int>(joint_of.size());
   VecX q(n);
@@ -37,26 +80,32 @@ VecX reference_posture(const Model& m) {
 }
 
 VecX random_posture(const Model& m, std::mt19937& rng) {
+  if (!flat_model(m))
+    return per_joint(
+        m, [&](const Joint& J) { return random_within_limits(&J, rng); },
+        [&](const Joint& J, double* q) { random_configuration(J, rng, q); });
   const std::vector<const Joint*> joint_of = coordinate_joints(m);
   VecX q(m.n());
   for (int a = 0; a < m.n(); ++a) {
-    const Joint* joint = joint_of[a];
-    // ±π for a revolute joint, ±0.5 m for a prismatic one, narrowed to the joint's limits; a
-    // range that the limits exclude entirely is the limits' first 2π (or 1 m), never wider,
-    // so that huge limits (±1e308) never give a huge or infinite draw.
-    const double half = joint ? random_half_range(*joint) : std::numbers::pi;
-    double lo = -half, hi = half;
-    if (joint) {
-      lo = std::max(lo, joint->lower);
-      hi = std::min(hi, joint->upper);
-      if (lo > hi) {
-        lo = std::isfinite(joint->lower) ? joint->lower : joint->upper - 2 * half;
-        hi = std::min(joint->upper, lo + 2 * half);
-      }
-    }
-    q[a] = std::uniform_real_distribution<double>(lo, hi)(rng);
+    q[a] = random_within_limits(joint_of[a], rng);
   }
   return q;
+}
+
+VecX neutral_posture(const Model& m) {
+  if (flat_model(m)) return VecX::Zero(m.n());
+  return per_joint(
+      m, [](const Joint&) { return 0.0; },
+      [](const Joint& J, double* q) { neutral_configuration(J, q); });
+}
+
+VecX integrate_posture(const Model& m, const VecX& q, const VecX& xi) {
+  if (flat_model(m)) return q + xi;
+  VecX out(m.n_q());
+  for (const Body& b : m.bodies)
+    if (const Joint& J = b.joint; moves(J))
+      integrate_configuration(J, q.data() + J.idx_q, xi.data() + J.idx_v, out.data() + J.idx_q);
+  return out;
 }
 
 VecX random_uniform(int n, double scale, std::mt19937& rng) {

@@ -123,9 +123,31 @@ Status Adaptive::plan(double t_end) {
 }
 
 Status Adaptive::advance(double t_out) {
+  if (!motion_.flat()) return advance_on_manifold(t_out);
   double t_reached = t_;
   const int flag = evolve(t_out, t_reached, false);
   return finish(flag, t_reached, t_out);
+}
+
+Status Adaptive::advance_on_manifold(double t_out) {
+  set_stop_time(std::min(t_out, t_stop_));
+  while (t_ < t_out) {
+    double t_reached = t_;
+    const int flag = evolve(t_out, t_reached, true);
+    if (Status st = finish(flag, t_reached, t_reached); !st.ok) return st;
+    if (motion_.chart_extent(y_.data()) > Motion::kChartLimit) {
+      restarted_ = stats_;
+      const double h = current_step();
+      motion_.recenter(y_.data());
+      restarting_ = true;
+      start();
+      restarting_ = false;
+      set_initial_step(h);
+      set_stop_time(std::min(t_out, t_stop_));
+    }
+  }
+  if (std::isfinite(t_stop_)) set_stop_time(t_stop_);
+  return {};
 }
 
 Status Adaptive::one_step() {
@@ -136,6 +158,9 @@ Status Adaptive::one_step() {
 
 Status Adaptive::finish(int flag, double t_reached, double t_target) {
   read_stats();
+  stats_.steps += restarted_.steps;
+  stats_.rejected += restarted_.rejected;
+  stats_.jac_evals += restarted_.jac_evals;
   stats_.rhs_evals = motion_.evaluations();
   if (flag >= 0) {  // CV_SUCCESS, CV_TSTOP_RETURN
     t_ = t_target;
@@ -152,6 +177,7 @@ DormandPrince::DormandPrince(const Model& model, const AdaptiveOptions& options,
     : Adaptive(model, options, std::move(tau)) {}
 
 void DormandPrince::start() {
+  if (!restarting_) restarted_ = {};  // a new run, not a restart on a moved chart
   run_ = std::make_unique<SundialsRun>();
   SundialsRun& r = *run_;
   open(r, y_);
@@ -181,6 +207,9 @@ void DormandPrince::read_stats() {
   stats_.rejected = v;
 }
 
+void DormandPrince::set_stop_time(double t) { ERKStepSetStopTime(run_->arkode, t); }
+void DormandPrince::set_initial_step(double h) { ERKStepSetInitStep(run_->arkode, h); }
+
 double DormandPrince::current_step() const {
   double h = 0;
   ERKStepGetCurrentStep(run_->arkode, &h);
@@ -195,6 +224,7 @@ Bdf::Bdf(const Model& model, const AdaptiveOptions& options, Actuation tau)
       f_pert_(VecX::Zero(y_.size())) {}
 
 void Bdf::start() {
+  if (!restarting_) restarted_ = {};  // a new run, not a restart on a moved chart
   run_ = std::make_unique<SundialsRun>();
   SundialsRun& r = *run_;
   open(r, y_);
@@ -248,6 +278,9 @@ void Bdf::read_stats() {
   CVodeGetNumJacEvals(run_->cvode, &v);
   stats_.jac_evals = v;
 }
+
+void Bdf::set_stop_time(double t) { CVodeSetStopTime(run_->cvode, t); }
+void Bdf::set_initial_step(double h) { CVodeSetInitStep(run_->cvode, h); }
 
 double Bdf::current_step() const {
   double h = 0;

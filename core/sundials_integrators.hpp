@@ -41,6 +41,12 @@ class Adaptive : public Integrator {
   virtual int evolve(double t_out, double& t_reached, bool one_step) = 0;
   virtual void read_stats() = 0;
   virtual double current_step() const = 0;
+  // Never step past t (ARKODE's / CVODE's stop time), and the first step of a restarted run.
+  virtual void set_stop_time(double t) = 0;
+  virtual void set_initial_step(double h) = 0;
+  // On a manifold (Motion::flat() false): steps to t_out, the chart moved and the method
+  // restarted there whenever a rotation in it passes Motion::kChartLimit.
+  Status advance_on_manifold(double t_out);
 
  public:                                             // reached from the C callbacks
   int rhs(double t, const double* y, double* ydot);  // 0, or < 0 after recording rhs_failure_
@@ -51,6 +57,8 @@ class Adaptive : public Integrator {
   std::unique_ptr<SundialsRun> run_;
   Status rhs_failure_;            // the last failed evaluation of f
   std::string sundials_message_;  // the last message SUNDIALS sent to its error handler
+  IntegratorStats restarted_;     // the statistics of the runs before the last restart
+  bool restarting_ = false;
 };
 
 class DormandPrince final : public Adaptive {
@@ -63,6 +71,8 @@ class DormandPrince final : public Adaptive {
   int evolve(double t_out, double& t_reached, bool one_step) override;
   void read_stats() override;
   double current_step() const override;
+  void set_stop_time(double t) override;
+  void set_initial_step(double h) override;
 };
 
 class Bdf final : public Adaptive {
@@ -77,6 +87,8 @@ class Bdf final : public Adaptive {
   int evolve(double t_out, double& t_reached, bool one_step) override;
   void read_stats() override;
   double current_step() const override;
+  void set_stop_time(double t) override;
+  void set_initial_step(double h) override;
   VecX y_pert_, f_pert_;  // Jacobian buffers
 };
 

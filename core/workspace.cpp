@@ -7,7 +7,7 @@ namespace femdyn {
 Workspace::Workspace(const Model& model) : solver(model) {
   const int n = model.n(), nt = model.n_theta(), N = model.n_u();
   const int nb = static_cast<int>(model.bodies.size());
-  theta = VecX::Zero(nt);
+  theta = VecX::Zero(model.n_theta_q);
   theta_dot = VecX::Zero(nt);
   theta_dot_y = VecX::Zero(nt);
   body.assign(nb, BodyState{});

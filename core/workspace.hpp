@@ -22,6 +22,13 @@ struct BodyState {
 // Per body, the body-level recursions' quantities (core/articulated.hpp, core/newton_euler.hpp),
 // spatial vectors in world axes about the world origin (core/spatial.hpp). Newton–Euler keeps
 // its body forces in pA.
+// R_P for body b: its parent's orientation, the identity under the world.
+inline const Mat3 kWorldRotation = Mat3::Identity();
+inline const Mat3& parent_rotation(const Model& m, const std::vector<BodyState>& body, int b) {
+  const int p = m.bodies[b].parent;
+  return p < 0 ? kWorldRotation : body[p].R;
+}
+
 struct ArticulatedBody {
   Mat6 IA = Mat6::Zero();  // articulated inertia I^A
   Vec6 S = Vec6::Zero();   // joint motion subspace

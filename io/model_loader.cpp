@@ -93,7 +93,7 @@ JointType joint_type(const Params& p) {
 }
 
 JointSpec read_joint(const Params& p) {
-  p.allow_only({"name", "type", "origin", "axis", "limits", "spring", "damping"});
+  p.allow_only({"name", "type", "origin", "axis", "axis2", "pitch", "limits", "spring", "damping"});
   JointSpec j;
   j.where = p.where();
   j.name = p.has("name") ? p.string("name") : "";
@@ -104,7 +104,15 @@ JointSpec read_joint(const Params& p) {
     j.xyz = o.vec3_or("xyz", Vec3::Zero());
     j.rpy = o.vec3_or("rpy", Vec3::Zero());
   }
-  if (j.type != JointType::Fixed) j.axis = p.vec3("axis");
+  const bool any_axis = j.type == JointType::Spherical || j.type == JointType::Free;
+  if (any_axis && p.has("axis"))
+    p.fail("axis", "a spherical or free joint turns about every axis: it takes no axis");
+  if (j.type != JointType::Fixed && !any_axis) j.axis = p.vec3("axis");
+  if (p.has("axis2")) j.axis2 = p.vec3("axis2");  // (compile: universal only)
+  if (j.type == JointType::Helical)
+    j.pitch = p.number("pitch");
+  else if (p.has("pitch"))
+    p.fail("pitch", "only a helical joint has a pitch");
   if (j.type == JointType::Fixed)
     for (const char* key : {"axis", "limits", "spring", "damping"})
       if (p.has(key))

@@ -105,7 +105,8 @@ TEST_CASE("JSON: unknown joint and element types and keys, plugin params: echoed
     j["bodies"][0]["joint"]["type"] = "hinge" + raw;
     std::string e = text_error(j.dump());
     CHECK(e == "test: /bodies/0/joint/type: unknown joint type 'hinge" + shown +
-                   "' (expected revolute, continuous, prismatic or fixed)");
+                   "' (expected revolute, continuous, prismatic, fixed, helical, screw, universal, "
+                   "planar, spherical, ball or free)");
     j = pendulum();
     j["bodies"][0]["elements"][0]["type"] = "point" + raw;
     e = text_error(j.dump());

@@ -45,7 +45,8 @@ TEST_CASE("bad-input classes give their pinned messages", "[errors]") {
              Equals("bad.json: /bodies/1/joint/axis: axis is zero"));
   CHECK_THAT(error_of(chain(R"({"type": "hinge", "axis": [0, 0, 1]})")),
              Equals("bad.json: /bodies/1/joint/type: unknown joint type 'hinge' (expected "
-                    "revolute, continuous, prismatic or fixed)"));
+                    "revolute, continuous, prismatic, fixed, helical, screw, universal, planar, "
+                    "spherical, ball or free)"));
   CHECK_THAT(error_of(chain(R"({"type": "revolute", "axis": [0, 1, 0]})",
                             R"([{"type": "blob", "node": [0, 0, 0]}])")),
              Equals("bad.json: /bodies/1/elements/0/type: unknown element type 'blob' (known: "

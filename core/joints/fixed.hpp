@@ -1,11 +1,12 @@
 // Fixed joint: the child B is welded to its parent at the joint frame. X_J = identity, no
 // coordinate, S has no column.
 #pragma once
+#include "core/joints/flat.hpp"
 #include "core/model.hpp"
 
 namespace femdyn {
 
-struct FixedJoint {
+struct FixedJoint : FlatJoint<0> {
   static constexpr int nq = 0, nv = 0;
   static constexpr bool angular = false, linear = false;
 
@@ -15,6 +16,7 @@ struct FixedJoint {
   }
   static Vec3 S_angular(const Joint&, int) { return Vec3::Zero(); }
   static Vec3 S_linear(const Joint&, int) { return Vec3::Zero(); }
+  static constexpr bool in_parent(int) { return false; }  // every column fixed in B
   static void prepare(Joint&) {}
   static constexpr double kRandomHalfRange = 0;
 };

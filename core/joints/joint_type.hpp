@@ -8,18 +8,25 @@
 
 namespace femdyn {
 
-enum class JointType { Revolute, Prismatic, Fixed };
+enum class JointType { Revolute, Prismatic, Fixed, Helical, Universal, Planar, Spherical, Free };
 
 // The names a model file may give each type ("continuous" is URDF's unlimited revolute).
 struct JointTypeName {
   std::string_view name;
   JointType type;
 };
-inline constexpr std::array<JointTypeName, 4> kJointTypeNames{{
+inline constexpr std::array<JointTypeName, 11> kJointTypeNames{{
     {"revolute", JointType::Revolute},
     {"continuous", JointType::Revolute},
     {"prismatic", JointType::Prismatic},
     {"fixed", JointType::Fixed},
+    {"helical", JointType::Helical},
+    {"screw", JointType::Helical},
+    {"universal", JointType::Universal},
+    {"planar", JointType::Planar},
+    {"spherical", JointType::Spherical},
+    {"ball", JointType::Spherical},
+    {"free", JointType::Free},
 }};
 
 inline std::optional<JointType> joint_type_named(std::string_view name) {
@@ -35,7 +42,7 @@ inline std::string_view joint_type_name(JointType type) {
   return "?";
 }
 
-// "revolute, continuous, prismatic or fixed": the names, for a message.
+// "revolute, continuous, prismatic, …, spherical, ball or free": the names, for a message.
 inline std::string joint_type_list() {
   std::string out;
   for (std::size_t k = 0; k < kJointTypeNames.size(); ++k) {

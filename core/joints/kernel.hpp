@@ -5,18 +5,30 @@
 // A joint joins the parent body P to the child B through its joint frame, fixed on P at
 // (R_pj, p_pj). Its nq coordinates θ_J (at Joint::idx_q in θ) place B:
 //   R_B = R_P R_pj R_J(θ_J),   p_B = p_P + R_P (p_pj + R_pj p_J(θ_J))        (J::pose)
-// Its nv rates θ̇_J (at Joint::idx_v in θ̇) move B relative to P, in B's axes about B's origin:
-//   (Δω, Δv) = S_J θ̇_J,   S_J = [S_ω; S_v] (6 × nv)                         (J::S_angular,
-//   S_linear)
-// In world axes the columns are s_ω = R_B S_ω, s_v = R_B S_v; as a spatial motion about the
-// world origin (core/spatial.hpp) a column is (s_ω, s_v + p_B × s_ω). Every type so far has
-// S_J constant in B and nq = nv (its θ̇_J is the derivative of θ_J): c_J = Ṡ_J θ̇_J = 0.
+// Its nv rates θ̇_J (at Joint::idx_v in θ̇) move B relative to P, about B's origin:
+//   (Δω, Δv) = S_J θ̇_J,   S_J = [S_ω; S_v] (6 × nv)              (J::S_angular, J::S_linear)
+// Each column of S_J is constant in one of two frames: in B (given in B's axes), or in the
+// parent's joint frame (J::in_parent(k); given in P's axes). In world axes a column is
+// s = R_B S or s = R_P S; as a spatial motion about the world origin (core/spatial.hpp) it is
+// (s_ω, s_v + p_B × s_ω). Its rate of change is then the frame's: ṡ = V_B × s or V_P × s, so
+//   c_J = Ṡ_J θ̇_J = V_B × (S_B θ̇_B) + V_P × (S_P θ̇_P)     (the columns fixed in B, in P),
+// the whole bias a joint type needs, with no per-type derivative (Featherstone's c_J).
+// A type whose coordinates are not a vector space (spherical, free: nq ≠ nv) says how to move
+// on its configuration manifold: q ⊕ ξ (J::integrate), q₁ ⊖ q₀ (J::difference), and ξ̇ in the
+// chart ξ ↦ q_c ⊕ ξ (J::chart_rate); core/joints/flat.hpp gives the rest of them q + ξ.
 #pragma once
 #include <array>
+#include <random>
+#include <string>
 
 #include "core/joints/fixed.hpp"
+#include "core/joints/free.hpp"
+#include "core/joints/helical.hpp"
+#include "core/joints/planar.hpp"
 #include "core/joints/prismatic.hpp"
 #include "core/joints/revolute.hpp"
+#include "core/joints/spherical.hpp"
+#include "core/joints/universal.hpp"
 
 namespace femdyn {
 
@@ -28,6 +40,16 @@ decltype(auto) visit_joint(JointType type, F&& f) {
       return f(RevoluteJoint{});
     case JointType::Prismatic:
       return f(PrismaticJoint{});
+    case JointType::Helical:
+      return f(HelicalJoint{});
+    case JointType::Universal:
+      return f(UniversalJoint{});
+    case JointType::Planar:
+      return f(PlanarJoint{});
+    case JointType::Spherical:
+      return f(SphericalJoint{});
+    case JointType::Free:
+      return f(FreeJoint{});
     case JointType::Fixed:
       break;
   }
@@ -42,60 +64,69 @@ inline void joint_pose(const Joint& j, const VecX& theta, Mat3& R, Vec3& p) {
   visit_joint(j.type, [&]<class J>(J) { J::pose(j, q, R, p); });
 }
 
-// Column k of S_J in world axes: its angular and linear halves, at B's origin.
+// Column k of S_J in world axes: its angular and linear halves, at B's origin. R_P is the
+// parent's orientation (the identity for the world), read only by columns fixed in P.
 template <class J>
-Vec3 world_angular(const Joint& j, const Mat3& R_B, int k) {
-  if constexpr (J::angular) return R_B * J::S_angular(j, k);
+[[gnu::always_inline]] inline Vec3 world_angular(const Joint& j, const Mat3& R_B, const Mat3& R_P,
+                                                 int k) {
+  if constexpr (J::angular) return (J::in_parent(k) ? R_P : R_B) * J::S_angular(j, k);
   return Vec3::Zero();
 }
 template <class J>
-Vec3 world_linear(const Joint& j, const Mat3& R_B, int k) {
-  if constexpr (J::linear) return R_B * J::S_linear(j, k);
+[[gnu::always_inline]] inline Vec3 world_linear(const Joint& j, const Mat3& R_B, const Mat3& R_P,
+                                                int k) {
+  if constexpr (J::linear) return (J::in_parent(k) ? R_P : R_B) * J::S_linear(j, k);
   return Vec3::Zero();
 }
 
 // Column k of S_J as a spatial motion about the world origin: (s_ω, s_v + p_B × s_ω).
 template <class J>
-Vec6 spatial_column(const Joint& j, const Mat3& R_B, const Vec3& p_B, int k) {
+Vec6 spatial_column(const Joint& j, const Mat3& R_B, const Mat3& R_P, const Vec3& p_B, int k) {
   Vec6 S;
-  const Vec3 w = world_angular<J>(j, R_B, k);
+  const Vec3 w = world_angular<J>(j, R_B, R_P, k);
   S.head<3>() = w;
-  S.tail<3>() = world_linear<J>(j, R_B, k) + cross3(p_B, w);
+  S.tail<3>() = world_linear<J>(j, R_B, R_P, k) + cross3(p_B, w);
   return S;
 }
-inline Vec6 spatial_column(const Joint& j, const Mat3& R_B, const Vec3& p_B, int k) {
-  return visit_joint(j.type, [&]<class J>(J) { return spatial_column<J>(j, R_B, p_B, k); });
+inline Vec6 spatial_column(const Joint& j, const Mat3& R_B, const Mat3& R_P, const Vec3& p_B,
+                           int k) {
+  return visit_joint(j.type, [&]<class J>(J) { return spatial_column<J>(j, R_B, R_P, p_B, k); });
 }
 
 // All nv columns of S_J as spatial motions about the world origin, into S[0 .. nv).
-inline void spatial_columns(const Joint& j, const Mat3& R_B, const Vec3& p_B, Vec6* S) {
+inline void spatial_columns(const Joint& j, const Mat3& R_B, const Mat3& R_P, const Vec3& p_B,
+                            Vec6* S) {
   visit_joint(j.type, [&]<class J>(J) {
-    for (int k = 0; k < J::nv; ++k) S[k] = spatial_column<J>(j, R_B, p_B, k);
+    for (int k = 0; k < J::nv; ++k) S[k] = spatial_column<J>(j, R_B, R_P, p_B, k);
   });
 }
 
 // The joint's part of a body's motion in the recursions (spatial, world axes, about the origin),
-// for a joint that moves (nv > 0): its columns S_k into S[0 .. nv), then V += v_J and
-// a += V × v_J (+ Σ S_k θ̈_k when `acc` is given) with v_J = Σ S_k θ̇_k, the rates at `rate`
-// and `acc` (each indexed from the joint's first rate). Only the columns depend on the type,
-// so the per-type code stays a few products.
+// for a joint that moves (nv > 0): its columns S_k into S[0 .. nv), then, with V = V_P on entry,
+// V += v_J and a += V_B × v_J,B + V_P × v_J,P (+ Σ S_k θ̈_k when `acc` is given), v_J = Σ S_k θ̇_k
+// split by the frame each column is fixed in; the rates at `rate` and `acc` (each indexed from
+// the joint's first rate).
 template <class J>
 [[gnu::always_inline]] inline void add_joint_motion(const Joint& j, const Mat3& R_B,
-                                                    const Vec3& p_B, const double* rate,
-                                                    const double* acc, Vec6* S, Vec6& V, Vec6& a) {
-  Vec6 vj = Vec6::Zero();
+                                                    const Mat3& R_P, const Vec3& p_B,
+                                                    const double* rate, const double* acc, Vec6* S,
+                                                    Vec6& V, Vec6& a) {
+  Vec6 vj = Vec6::Zero(), vj_parent = Vec6::Zero();
   for (int k = 0; k < J::nv; ++k) {
-    S[k] = spatial_column<J>(j, R_B, p_B, k);
-    vj += S[k] * rate[k];
+    S[k] = spatial_column<J>(j, R_B, R_P, p_B, k);
+    (J::in_parent(k) ? vj_parent : vj) += S[k] * rate[k];
   }
-  V += vj;
+  const Vec6 V_P = V;
+  V += vj + vj_parent;
   a += cross_motion(V, vj);
+  if constexpr (J::in_parent(0) || J::in_parent(J::nv - 1)) a += cross_motion(V_P, vj_parent);
   if (acc)
     for (int k = 0; k < J::nv; ++k) a += S[k] * acc[k];
 }
-inline void add_joint_motion(const Joint& j, const Mat3& R_B, const Vec3& p_B, const double* rate,
-                             const double* acc, Vec6* S, Vec6& V, Vec6& a) {
-  visit_joint(j.type, [&]<class J>(J) { add_joint_motion<J>(j, R_B, p_B, rate, acc, S, V, a); });
+inline void add_joint_motion(const Joint& j, const Mat3& R_B, const Mat3& R_P, const Vec3& p_B,
+                             const double* rate, const double* acc, Vec6* S, Vec6& V, Vec6& a) {
+  visit_joint(j.type,
+              [&]<class J>(J) { add_joint_motion<J>(j, R_B, R_P, p_B, rate, acc, S, V, a); });
 }
 
 // The joint's own generalized force on a 1-DOF joint's coordinate: its spring and damper,
@@ -111,23 +142,90 @@ inline double spring_damper_force(const Joint& j, double theta, double theta_dot
 // joint: S_ω,k × r + S_v,k = 0 for each column (relative to 1 + |r|).
 inline bool fixes_point(const Joint& j, const Vec3& r) {
   return visit_joint(j.type, [&]<class J>(J) {
-    for (int k = 0; k < J::nv; ++k)
-      if ((J::S_angular(j, k).cross(r) + J::S_linear(j, k)).norm() > 1e-12 * (1.0 + r.norm()))
-        return false;
+    const double tol = 1e-12 * (1.0 + r.norm());
+    for (int k = 0; k < J::nv; ++k) {
+      const Vec3 w = J::S_angular(j, k), v = J::S_linear(j, k);
+      // A column fixed in P is in P's axes, r in B's: only the origin of B is sure to stay.
+      const Vec3 r_k = J::in_parent(k) && !w.isZero() && r.norm() > tol ? Vec3::Constant(1) : r;
+      if ((w.cross(r_k) + v).norm() > tol) return false;
+    }
     return true;
   });
 }
 
-// B's orientation and origin in the parent's frame at θ_J = 0.
+// B's orientation and origin in the parent's frame at the neutral configuration.
 inline void neutral_pose(const Joint& j, Mat3& R, Vec3& p) {
-  const std::array<double, 7> zero{};
-  visit_joint(j.type, [&]<class J>(J) { J::pose(j, zero.data(), R, p); });
+  std::array<double, 7> q{};
+  visit_joint(j.type, [&]<class J>(J) {
+    J::neutral(q.data());
+    J::pose(j, q.data(), R, p);
+  });
+}
+
+// The joint's neutral configuration into q[0 .. nq): 0, or the identity rotation.
+inline void neutral_configuration(const Joint& j, double* q) {
+  visit_joint(j.type, [&]<class J>(J) { J::neutral(q); });
+}
+
+// Whether θ_J is a vector space (θ ⊕ ξ = θ + ξ, θ̇_J the derivative of θ_J).
+inline bool is_flat(const Joint& j) {
+  return visit_joint(j.type, []<class J>(J) { return J::flat; });
+}
+
+// out = q ⊕ ξ on the joint's configuration manifold (q, out: nq entries; ξ: nv).
+inline void integrate_configuration(const Joint& j, const double* q, const double* xi,
+                                    double* out) {
+  visit_joint(j.type, [&]<class J>(J) { J::integrate(j, q, xi, out); });
+}
+
+// ξ = q₁ ⊖ q₀: the chart coordinates (nv) of q₁ around q₀.
+inline void configuration_difference(const Joint& j, const double* q0, const double* q1,
+                                     double* xi) {
+  visit_joint(j.type, [&]<class J>(J) { J::difference(j, q0, q1, xi); });
+}
+
+// ξ̇ in the chart ξ ↦ q_c ⊕ ξ for the rates v (nv each).
+inline void chart_rate(const Joint& j, const double* q_c, const double* xi, const double* v,
+                       double* xi_dot) {
+  visit_joint(j.type, [&]<class J>(J) { J::chart_rate(j, q_c, xi, v, xi_dot); });
+}
+
+// A random configuration of a joint of more than one rate into q[0 .. nq): each flat coordinate
+// uniform within the type's half range (±π for angles), a rotation uniform over SO(3).
+inline void random_configuration(const Joint& j, std::mt19937& rng, double* q) {
+  std::normal_distribution<double> normal;
+  visit_joint(j.type, [&]<class J>(J) {
+    if constexpr (J::flat) {
+      for (int k = 0; k < J::nq; ++k) {
+        const double half = J::S_angular(j, k).isZero() ? J::kRandomHalfRange : 3.141592653589793;
+        q[k] = std::uniform_real_distribution<double>(-half, half)(rng);
+      }
+    } else {
+      const int rot = J::nq - 4;  // the quaternion is last
+      for (int k = 0; k < rot; ++k)
+        q[k] =
+            std::uniform_real_distribution<double>(-J::kRandomHalfRange, J::kRandomHalfRange)(rng);
+      Eigen::Vector4d g;
+      for (int k = 0; k < 4; ++k) g[k] = normal(rng);  // normalised Gaussian: uniform on S³
+      g.normalize();
+      if (g[0] < 0) g = -g;
+      for (int k = 0; k < 4; ++k) q[rot + k] = g[k];
+    }
+  });
 }
 
 // Whether rate k moves B by translation alone (a length, m), not by a turn (an angle, rad).
 inline bool is_translation(const Joint& j, int k) {
   return visit_joint(j.type,
                      [&]<class J>(J) { return !J::angular || J::S_angular(j, k).isZero(); });
+}
+
+// The suffixes naming coordinate k and rate k of a joint of several ("qw", "wx"; "" for one).
+inline std::string coordinate_name(const Joint& j, int k) {
+  return visit_joint(j.type, [&]<class J>(J) { return std::string(J::coordinate_name(k)); });
+}
+inline std::string rate_name(const Joint& j, int k) {
+  return visit_joint(j.type, [&]<class J>(J) { return std::string(J::rate_name(k)); });
 }
 
 // Compile: the type's sizes and the constants its pose uses.

@@ -2,11 +2,12 @@
 //   X_J(θ) = (1, a θ),   S = (0, a) in B's axes (B keeps the joint frame's orientation),
 //   c_J = 0.
 #pragma once
+#include "core/joints/flat.hpp"
 #include "core/model.hpp"
 
 namespace femdyn {
 
-struct PrismaticJoint {
+struct PrismaticJoint : FlatJoint<1> {
   static constexpr int nq = 1, nv = 1;
   static constexpr bool angular = false, linear = true;
 
@@ -16,6 +17,7 @@ struct PrismaticJoint {
   }
   static Vec3 S_angular(const Joint&, int) { return Vec3::Zero(); }
   static Vec3 S_linear(const Joint& j, int) { return j.axis; }
+  static constexpr bool in_parent(int) { return false; }  // every column fixed in B
   static void prepare(Joint& j);
   static constexpr double kRandomHalfRange = 0.5;  // ±0.5 m
 };

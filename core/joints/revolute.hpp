@@ -6,11 +6,12 @@
 #pragma once
 #include <cmath>
 
+#include "core/joints/flat.hpp"
 #include "core/model.hpp"
 
 namespace femdyn {
 
-struct RevoluteJoint {
+struct RevoluteJoint : FlatJoint<1> {
   static constexpr int nq = 1, nv = 1;
   static constexpr bool angular = true, linear = false;  // the non-zero halves of S
 
@@ -23,6 +24,7 @@ struct RevoluteJoint {
   static Vec3 S_angular(const Joint& j, int) { return j.axis; }
   static Vec3 S_linear(const Joint&, int) { return Vec3::Zero(); }
   // Compile: the constants pose() uses.
+  static constexpr bool in_parent(int) { return false; }  // every column fixed in B
   static void prepare(Joint& j);
   // Half the width of the range a random configuration is drawn from (validation, sampling).
   static constexpr double kRandomHalfRange = 3.141592653589793;  // ±π rad

@@ -36,7 +36,7 @@ def test_value_errors_are_one_escaped_line(raw, shown):
     with pytest.raises(ValueError) as e:
         b.body("arm", type="hinge" + raw)
     assert str(e.value) == ("joint type: unknown 'hinge" + shown +
-                            "' (expected revolute, continuous, prismatic or fixed)")
+                            "' (expected revolute, continuous, prismatic, fixed, helical, screw, universal, planar, spherical, ball or free)")
     model = femdyn.load(model_path("models/pendulum.json"))
     with pytest.raises(ValueError) as e:
         femdyn.simulate(model, 0.1, integrator="rk4" + raw)

@@ -86,7 +86,7 @@ def test_model_errors_name_the_file_and_place(tmp_path):
     with pytest.raises(femdyn.ModelError, match="bad.json"):
         femdyn.load(str(bad))
     doc = json.loads(open(model_path("models/pendulum.json")).read())
-    doc["bodies"][0]["joint"]["type"] = "screw"
+    doc["bodies"][0]["joint"]["type"] = "gearbox"
     bad.write_text(json.dumps(doc))
     with pytest.raises(femdyn.ModelError, match=r"bad.json: /bodies/0/joint"):
         femdyn.load(str(bad))
