@@ -264,7 +264,7 @@ int cmd_check(int argc, char** argv) {
   {
     Progress progress(K, "states");
     for (int k = 0; k < K; ++k) {
-      const VecX q = k == 0 ? VecX::Zero(n) : random_posture(m, rng);
+      const VecX q = k == 0 ? neutral_posture(m) : random_posture(m, rng);
       const VecX qd = k == 0 ? VecX::Zero(n) : random_uniform(n, 1.0, rng);
       diagnose_state(m, ws, q, qd, dampers, d);
       progress.update(k + 1);

@@ -10,6 +10,7 @@
 #include "core/limits.hpp"
 #include "core/memory.hpp"
 #include "core/names.hpp"
+#include "core/sampling.hpp"
 #include "io/model_loader.hpp"
 #include "io/output.hpp"
 
@@ -92,6 +93,21 @@ VecX state_vector(const Args& a, const std::string& opt, const Model& m) {
                    std::to_string(m.n()) + " (" + names + ")");
   }
   return Eigen::Map<const VecX>(v.data(), m.n());
+}
+
+VecX configuration_vector(const Args& a, const std::string& opt, const Model& m) {
+  if (!a.has(opt)) return neutral_posture(m);
+  const std::vector<double> v = parse_numbers(opt, a.options.at(opt));
+  if (static_cast<int>(v.size()) != m.n_q()) {
+    std::string names;
+    for (const auto& c : m.configuration_names) names += (names.empty() ? "" : ", ") + c;
+    throw CliError("--" + opt + " has " + std::to_string(v.size()) + " values, expected " +
+                   std::to_string(m.n_q()) + " (" + names + ")");
+  }
+  VecX q = Eigen::Map<const VecX>(v.data(), m.n_q());
+  if (const std::string bad = normalize_quaternions(m, q); !bad.empty())
+    throw CliError("--" + opt + ": " + bad);
+  return q;
 }
 
 double number_option(const Args& a, const std::string& opt, double fallback) {
@@ -194,7 +210,7 @@ int cmd_equations(int argc, char** argv) {
     return 0;
   }
   const Model m = load(a);
-  const VecX q = state_vector(a, "q", m), qd = state_vector(a, "qd", m),
+  const VecX q = configuration_vector(a, "q", m), qd = state_vector(a, "qd", m),
              tau = state_vector(a, "tau", m);
   require_memory(
       a.positional[0] + ": the equations of n = " + std::to_string(m.n()) + " coordinates",

@@ -28,6 +28,9 @@ Args parse_args(int argc, char** argv, int first, const std::vector<std::string>
 
 // Shared by the commands.
 std::vector<double> parse_numbers(const std::string& opt, const std::string& text);
+// q from --opt (n_q values, each quaternion of norm 1 within 1e-6, then normalised), or the
+// neutral configuration.
+VecX configuration_vector(const Args& a, const std::string& opt, const Model& m);
 VecX state_vector(const Args& a, const std::string& opt, const Model& m);      // zero if absent
 LoadOptions load_options(const Args& a);                                       // --gravity
 double number_option(const Args& a, const std::string& opt, double fallback);  // one number

@@ -67,7 +67,7 @@ int cmd_compare(int argc, char** argv) {
   for (int k = 0; k < K; ++k) {
     VecX q, qd;
     if (a.has("q")) {
-      q = state_vector(a, "q", A);
+      q = configuration_vector(a, "q", A);
       qd = state_vector(a, "qd", A);
     } else {
       q = random_posture(A, rng);

@@ -158,7 +158,7 @@ int cmd_simulate(int argc, char** argv) {
   const double t_end = number_option(a, "t-end", 0);
   if (!(t_end > 0) || t_end > 1e9) throw CliError("--t-end expects a time in (0, 1e9] s");
   const IntegratorOptions o = integrator_options(a);
-  const VecX q0 = state_vector(a, "q0", m), qd0 = state_vector(a, "qd0", m);
+  const VecX q0 = configuration_vector(a, "q0", m), qd0 = state_vector(a, "qd0", m);
   const long every = static_cast<long>(integer_option(a, "every", 1, 1));
   if (a.has("every") && a.has("sample-dt"))
     throw CliError("--every and --sample-dt exclude each other");
@@ -229,7 +229,7 @@ int cmd_simulate(int argc, char** argv) {
   const RecordedRun run = run_recorded(
       *integ, t_end, every, sample_times ? &*sample_times : nullptr,
       [&](const Integrator& i, const Energy& E) {
-        if (out) write_trajectory_row(out->stream(), i.t(), i.y(), E);
+        if (out) write_trajectory_row(out->stream(), i.t(), i.state(), E);
       },
       [&](double t) {
         progress.update(t);

@@ -504,7 +504,7 @@ int cmd_study(int argc, char** argv) {
   o.t_end = number_option(a, "t-end", o.quick ? 0.5 : 1.0);
   if (!(o.t_end > 0) || o.t_end > 100) throw CliError("--t-end expects a time in (0, 100] s");
   std::mt19937 rng(1);
-  o.q0 = a.has("q0") ? state_vector(a, "q0", m) : random_posture(m, rng);
+  o.q0 = a.has("q0") ? configuration_vector(a, "q0", m) : random_posture(m, rng);
   o.qd0 = a.has("qd0") ? state_vector(a, "qd0", m) : random_uniform(m.n(), 1.0, rng);
 
   // Outputs: checked before any work; each file appears whole.

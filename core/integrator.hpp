@@ -93,6 +93,13 @@ class Integrator {
   }
   auto qd() const { return y_.segment(motion_.n(), motion_.n()); }
   double work() const { return y_[2 * motion_.n()]; }
+  // (q, q̇, W) as reported (n_q + n + 1 entries): y itself unless y holds chart coordinates.
+  VecX state() const {
+    if (motion_.flat()) return y_;
+    VecX s(y_.size() + motion_.model().n_q() - motion_.n());
+    s << q(), y_.tail(motion_.n() + 1);
+    return s;
+  }
   const VecX& y() const { return y_; }
   const IntegratorStats& stats() const { return stats_; }
   Motion& motion() { return motion_; }

@@ -43,12 +43,6 @@ double random_within_limits(const Joint* joint, std::mt19937& rng) {
   return std::uniform_real_distribution<double>(lo, hi)(rng);
 }
 
-// Whether every joint is flat: q then holds one entry per coordinate, as named.
-bool flat_model(const Model& m) {
-  return std::all_of(m.bodies.begin(), m.bodies.end(),
-                     [](const Body& b) { return is_flat(b.joint); });
-}
-
 // With a spherical or free joint (no couplings then: θ = q): each joint's configuration in turn,
 // a one-coordinate joint's by `one`, any other's by `many`.
 template <class One, class Many>
@@ -65,6 +59,11 @@ VecX per_joint(const Model& m, One&& one, Many&& many) {
 }
 
 }  // namespace
+
+bool flat_model(const Model& m) {
+  return std::all_of(m.bodies.begin(), m.bodies.end(),
+                     [](const Body& b) { return is_flat(b.joint); });
+}
 
 VecX reference_posture(const Model& m) {
   if (!flat_model(m))
@@ -106,6 +105,29 @@ VecX integrate_posture(const Model& m, const VecX& q, const VecX& xi) {
     if (const Joint& J = b.joint; moves(J))
       integrate_configuration(J, q.data() + J.idx_q, xi.data() + J.idx_v, out.data() + J.idx_q);
   return out;
+}
+
+VecX chart_rates(const Model& m, const VecX& q, const VecX& xi, const VecX& v) {
+  if (flat_model(m)) return v;
+  VecX out(m.n());
+  for (const Body& b : m.bodies)
+    if (const Joint& J = b.joint; moves(J))
+      chart_rate(J, q.data() + J.idx_q, xi.data() + J.idx_v, v.data() + J.idx_v,
+                 out.data() + J.idx_v);
+  return out;
+}
+
+std::string normalize_quaternions(const Model& m, VecX& q) {
+  for (const Body& b : m.bodies)
+    if (const Joint& J = b.joint; moves(J) && !is_flat(J)) {
+      auto quat = q.segment<4>(J.idx_q + J.nq - 4);  // (the quaternion is last)
+      const double norm = quat.norm();
+      if (!(std::abs(norm - 1) <= 1e-6))
+        return "the quaternion of joint '" + J.name + "' has norm " + std::to_string(norm) +
+               ", expected 1";
+      quat /= norm;
+    }
+  return "";
 }
 
 VecX random_uniform(int n, double scale, std::mt19937& rng) {

@@ -15,6 +15,13 @@ VecX random_uniform(int n, double scale, std::mt19937& rng);
 VecX neutral_posture(const Model& model);
 // q ⊕ ξ joint by joint (ξ of size n, in each joint's chart around its q; no couplings if a
 // joint is not flat).
-VecX integrate_posture(const Model& model, const VecX& q, const VecX& xi);  // each entry in ±scale
+VecX integrate_posture(const Model& model, const VecX& q, const VecX& xi);
+// ξ̇ = the chart rates at (q ⊕ ξ) for the rates v, joint by joint (v when flat).
+VecX chart_rates(const Model& model, const VecX& q, const VecX& xi, const VecX& v);
+// Whether every joint is flat (q holds one entry per rate, q ⊕ ξ = q + ξ).
+bool flat_model(const Model& model);
+// Each quaternion in q normalised; "" if each had norm 1 within 1e-6, else the first that did
+// not ("quaternion of joint 'base' has norm 0.5, expected 1").
+std::string normalize_quaternions(const Model& model, VecX& q);  // each entry in ±scale
 
 }  // namespace femdyn

@@ -6,6 +6,8 @@
 #include <limits>
 #include <numbers>
 
+#include "core/sampling.hpp"
+
 namespace femdyn {
 namespace {
 
@@ -127,13 +129,19 @@ Linearization linearize(const Model& m, Workspace& ws, const VecX& q, const VecX
   lin.A = MatX::Zero(2 * n, 2 * n);
   lin.A.topRightCorner(n, n).setIdentity();
   VecX qp = q, qdp = qd, plus(n);
-  // Column j of [K D] by central differences: (q̈(y + δ e_j) − q̈(y − δ e_j)) / 2δ.
+  // Column j of [K D] by central differences: (q̈(y + δ e_j) − q̈(y − δ e_j)) / 2δ. With a
+  // spherical or free joint y = (ξ, v) in the chart around q (core/motion.hpp): q moves by
+  // q ⊕ δ e_j, and the top rows are ∂ξ̇/∂(ξ, v) = [∂ξ̇/∂ξ, 1] at ξ = 0.
+  const bool flat = flat_model(m);
   for (int j = 0; j < 2 * n; ++j) {
     VecX& x = j < n ? qp : qdp;
     const int i = j % n;
-    const double x0 = x[i], delta = 1e-6 * std::max(1.0, std::abs(x0));
+    const double x0 = x[i], delta = 1e-6 * std::max(1.0, flat || j >= n ? std::abs(x0) : 0.0);
     for (int side : {1, -1}) {
-      x[i] = x0 + side * delta;
+      if (flat || j >= n)
+        x[i] = x0 + side * delta;
+      else
+        qp = integrate_posture(m, q, VecX::Unit(n, i) * (side * delta));
       lin.status = forward_dynamics(m, ws, qp, qdp, tau);
       if (!lin.status.ok) return lin;
       if (side == 1)
@@ -141,8 +149,16 @@ Linearization linearize(const Model& m, Workspace& ws, const VecX& q, const VecX
       else
         lin.A.block(n, j, n, 1) = (plus - ws.qdd) / (2 * delta);
     }
-    x[i] = x0;
+    if (flat || j >= n)
+      x[i] = x0;
+    else
+      qp = q;
   }
+  if (!flat)
+    for (int j = 0; j < n; ++j) {
+      const VecX e = VecX::Unit(n, j) * 1e-6;
+      lin.A.block(0, j, n, 1) = (chart_rates(m, q, e, qd) - chart_rates(m, q, -e, qd)) / 2e-6;
+    }
   if (!lin.A.allFinite()) {  // (an eigensolver given NaN may never return)
     lin.status = {false,
                   "the linearised dynamics are NaN or Inf at this state (the state or the "

@@ -139,6 +139,11 @@ std::string info_text(const Model& model) {
   out << "coordinates (n = " << model.n() << "):";
   for (const auto& c : model.coordinate_names) out << " " << c;
   out << "\n";
+  if (model.configuration_names != model.coordinate_names) {  // a spherical or free joint
+    out << "configuration q (n_q = " << model.n_q() << "):";
+    for (const auto& c : model.configuration_names) out << " " << c;
+    out << "\n";
+  }
   out << "joints (" << model.n_theta() << " movable):\n";
   std::vector<const CoupledJoint*> law_of(model.n_theta(), nullptr);  // θ -> its law, if any
   if (model.coupling_level)
@@ -148,10 +153,12 @@ std::string info_text(const Model& model) {
     const std::string_view type = joint_type_name(j.type);
     out << "  " << j.name << " (" << type << ") "
         << (b.parent < 0 ? std::string("world") : model.bodies[b.parent].name) << " -> " << b.name;
-    const CoupledJoint* law = j.idx_q >= 0 ? law_of[j.idx_q] : nullptr;
+    const CoupledJoint* law = j.idx_v >= 0 ? law_of[j.idx_v] : nullptr;
     if (law) {  // θ = f(θ_followed…)
       out << "   theta = " << law->law->form() << " of";
       for (int s : law->sources) out << " " << model.bodies[model.theta_joint[s]].joint.name;
+    } else if (j.nv > 1) {  // (never coupled)
+      out << "   " << j.nq << " coordinates, " << j.nv << " rates";
     } else if (moves(j)) {
       out << "   theta =";
       bool first = true;
@@ -162,7 +169,7 @@ std::string info_text(const Model& model) {
             << model.coordinate_names[it.col()];
         first = false;
       }
-      if (model.theta0[j.idx_q] != 0) out << " + " << model.theta0[j.idx_q];
+      if (model.theta0[j.idx_v] != 0) out << " + " << model.theta0[j.idx_v];
     }
     out << "\n";
   }

@@ -30,7 +30,7 @@ double number(const std::string& cell, const std::string& where, std::size_t col
 
 void write_trajectory_header(std::ostream& out, const Model& m) {
   out << "t";
-  for (const auto& c : m.coordinate_names) out << ',' << csv_field("q_" + c);
+  for (const auto& c : m.configuration_names) out << ',' << csv_field("q_" + c);
   for (const auto& c : m.coordinate_names) out << ',' << csv_field("qd_" + c);
   out << ",kinetic,potential,total,work\n";
 }

@@ -4,6 +4,7 @@
 
 #include "core/limits.hpp"
 #include "core/names.hpp"
+#include "core/sampling.hpp"
 
 namespace femdyn::python {
 
@@ -58,6 +59,27 @@ VecX vector_arg(const Array& a, const char* name, const Model& model, Entries en
 VecX vector_arg(const std::optional<Array>& a, const char* name, const Model& model,
                 Entries entries) {
   return a ? vector_arg(*a, name, model, entries) : VecX::Zero(model.n());
+}
+
+VecX configuration_arg(const Array& a, const char* name, const Model& model) {
+  if (flat_model(model)) return vector_arg(a, name, model);
+  const Eigen::Index nq = model.n_q();
+  if (a.ndim() != 1 || a.shape(0) != nq)
+    throw py::value_error(std::string(name) + ": expected shape (" + std::to_string(nq) +
+                          ",), got " + shape_text(a));
+  VecX q = Eigen::Map<const VecX>(a.data(), nq);
+  for (Eigen::Index i = 0; i < nq; ++i)
+    if (!std::isfinite(q[i]) || std::abs(q[i]) > kMaxMagnitude)
+      throw py::value_error(std::string(name) + ": entry " + std::to_string(i) + " ('" +
+                            model.configuration_names[i] + "') " +
+                            (std::isfinite(q[i]) ? out_of_range_text(q[i]) : "is NaN or Inf"));
+  if (const std::string bad = normalize_quaternions(model, q); !bad.empty())
+    throw py::value_error(std::string(name) + ": " + bad);
+  return q;
+}
+
+VecX configuration_arg(const std::optional<Array>& a, const char* name, const Model& model) {
+  return a ? configuration_arg(*a, name, model) : neutral_posture(model);
 }
 
 Eigen::Map<const RowMatX> batch_arg(const Array& a, const char* name, const Model& model,

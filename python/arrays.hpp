@@ -40,6 +40,10 @@ VecX vector_arg(const Array& a, const char* name, const Model& model,
                 Entries entries = Entries::Bounded);
 VecX vector_arg(const std::optional<Array>& a, const char* name, const Model& model,
                 Entries entries = Entries::Bounded);
+// A configuration q: shape (n_q,), finite and bounded, each quaternion of norm 1 within 1e-6
+// (then normalised); the neutral configuration when absent.
+VecX configuration_arg(const Array& a, const char* name, const Model& model);
+VecX configuration_arg(const std::optional<Array>& a, const char* name, const Model& model);
 
 // A batch of states: shape (k, n) with bounded (finite) entries, seen in place (row i = state
 // i). `k` is the number of rows required, or -1 for the first batch argument (which sets k).

@@ -8,6 +8,7 @@
 #include "core/equations.hpp"
 #include "core/integrator.hpp"
 #include "core/memory.hpp"
+#include "core/sampling.hpp"
 #include "python/parallel.hpp"
 #include "python/py_model.hpp"
 
@@ -26,6 +27,10 @@ struct Batch {
   Batch(const Model& m, const Array& q_in, const OptArray& qd_in, const OptArray& third_in,
         const char* third_name, Entries third_entries)
       : n(m.n()), zeros(VecX::Zero(m.n())) {
+    if (!flat_model(m))
+      throw py::value_error(
+          "q: batches of configurations with a spherical or free joint are not "
+          "supported yet (call the model once per state)");
     q = batch_arg(q_in, "q", m, -1).data();
     k = q_in.shape(0);
     if (qd_in) qd = batch_arg(*qd_in, "qd", m, k).data();

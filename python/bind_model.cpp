@@ -53,7 +53,7 @@ std::unique_ptr<PyModel> load(const std::string& path, const OptArray& gravity) 
 EquationsResult equations(PyModel& self, const Array& q_in, const OptArray& qd_in,
                           const OptArray& tau_in) {
   const Model& m = *self.model;
-  const VecX q = vector_arg(q_in, "q", m), qd = vector_arg(qd_in, "qd", m),
+  const VecX q = configuration_arg(q_in, "q", m), qd = vector_arg(qd_in, "qd", m),
              tau = vector_arg(tau_in, "tau", m, Entries::Bounded);
   // The workspace's M^s and factor, and M twice more on the way out (the result, numpy's).
   const double bytes = evaluation_bytes(m) + 2 * dense_bytes(m.n(), m.n());
@@ -68,8 +68,9 @@ EquationsResult equations(PyModel& self, const Array& q_in, const OptArray& qd_i
 
 VecX forward(PyModel& self, const Array& q, const OptArray& qd, const OptArray& tau) {
   const Model& m = *self.model;
-  const Status st = forward_dynamics(m, self.ws, vector_arg(q, "q", m), vector_arg(qd, "qd", m),
-                                     vector_arg(tau, "tau", m, Entries::Bounded));
+  const Status st =
+      forward_dynamics(m, self.ws, configuration_arg(q, "q", m), vector_arg(qd, "qd", m),
+                       vector_arg(tau, "tau", m, Entries::Bounded));
   if (!st.ok) throw NumericalError("at this state " + st.message);
   require_finite(m, self.ws.qdd.data(), m.n(), m.n(), "q̈");
   return self.ws.qdd;
@@ -77,7 +78,7 @@ VecX forward(PyModel& self, const Array& q, const OptArray& qd, const OptArray& 
 
 VecX inverse(PyModel& self, const Array& q, const OptArray& qd, const OptArray& qdd) {
   const Model& m = *self.model;
-  inverse_dynamics(m, self.ws, vector_arg(q, "q", m), vector_arg(qd, "qd", m),
+  inverse_dynamics(m, self.ws, configuration_arg(q, "q", m), vector_arg(qd, "qd", m),
                    vector_arg(qdd, "qdd", m));
   require_finite(m, self.ws.tau.data(), m.n(), m.n(), "τ");
   return self.ws.tau;
@@ -86,7 +87,7 @@ VecX inverse(PyModel& self, const Array& q, const OptArray& qd, const OptArray& 
 // D as an (n, n, n) array, D[a, b, c] = D_abc, h_a = Σ_bc D_abc q̇_b q̇_c.
 py::array_t<double> tensor(PyModel& self, const Array& q_in) {
   const Model& m = *self.model;
-  const VecX q = vector_arg(q_in, "q", m);
+  const VecX q = configuration_arg(q_in, "q", m);
   const double n = m.n(), entries = std::max(n * n * n, m.n_u() * n * n);
   if (entries > kMaxTensorEntries)
     throw py::value_error("tensor: D needs " + std::to_string(static_cast<long>(entries)) +
@@ -104,7 +105,7 @@ py::array_t<double> tensor(PyModel& self, const Array& q_in) {
 
 py::dict energy_of(PyModel& self, const Array& q, const OptArray& qd) {
   const Model& m = *self.model;
-  const Energy e = energy(m, self.ws, vector_arg(q, "q", m), vector_arg(qd, "qd", m));
+  const Energy e = energy(m, self.ws, configuration_arg(q, "q", m), vector_arg(qd, "qd", m));
   py::dict d;
   d["kinetic"] = e.kinetic;
   d["potential"] = e.potential;

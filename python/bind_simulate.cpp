@@ -100,7 +100,7 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
       throw py::value_error("max_steps: expected an integer in [1, 1e15]");
     o.fixed.max_steps = o.adaptive.max_steps = static_cast<long>(*max_steps);
   }
-  const VecX q0 = vector_arg(q0_in, "q0", m), qd0 = vector_arg(qd0_in, "qd0", m);
+  const VecX q0 = configuration_arg(q0_in, "q0", m), qd0 = vector_arg(qd0_in, "qd0", m);
   std::vector<double> t_eval;
   if (t_eval_in) {
     const Array& te = *t_eval_in;
@@ -150,7 +150,7 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
     long step = 0;
     run = run_recorded(
         *integ, t_end, every, t_eval_in ? &t_eval : nullptr,
-        [&rows](const Integrator& i, const Energy& E) { rows.add(i.t(), i.y(), E, i.work()); },
+        [&rows](const Integrator& i, const Energy& E) { rows.add(i.t(), i.state(), E, i.work()); },
         [&step](double) {
           if (++step % 256 != 0) return false;
           py::gil_scoped_acquire acquire;
@@ -165,12 +165,12 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
   if (run.refused) throw py::value_error(st.message);  // before any work: the arguments' fault
   if (!st.ok && check) throw NumericalError(st.message);
 
-  const py::ssize_t k = static_cast<py::ssize_t>(rows.t.size()), n = m.n();
-  py::array_t<double> q = new_array({k, n}), qd = new_array({k, n});
+  const py::ssize_t k = static_cast<py::ssize_t>(rows.t.size()), n = m.n(), nq = m.n_q();
+  py::array_t<double> q = new_array({k, nq}), qd = new_array({k, n});
   for (py::ssize_t i = 0; i < k; ++i) {
-    const double* y = rows.y.data() + i * 2 * n;
-    std::copy(y, y + n, q.mutable_data(i, 0));
-    std::copy(y + n, y + 2 * n, qd.mutable_data(i, 0));
+    const double* y = rows.y.data() + i * (nq + n);
+    std::copy(y, y + nq, q.mutable_data(i, 0));
+    std::copy(y + nq, y + nq + n, qd.mutable_data(i, 0));
   }
   std::vector<double> total(rows.kinetic.size());
   for (std::size_t i = 0; i < total.size(); ++i) total[i] = rows.kinetic[i] + rows.potential[i];

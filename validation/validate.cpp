@@ -143,6 +143,13 @@ TwinModel twin_model(const Model& m) {
     TwinBody tb;
     tb.name = m.bodies[b].name;
     tb.parent = m.bodies[b].parent;
+    if (j.type != JointType::Revolute && j.type != JointType::Prismatic &&
+        j.type != JointType::Fixed)
+      throw ModelError(j.where, "joint '" + j.name + "' is " +
+                                    std::string(joint_type_name(j.type)) +
+                                    ": the Simbody twin maps revolute, prismatic and fixed joints "
+                                    "only (its Ball, Free, Universal, Planar and Screw mobilizers "
+                                    "are not mapped yet)");
     tb.joint = j.type == JointType::Revolute    ? TwinBody::Joint::Revolute
                : j.type == JointType::Prismatic ? TwinBody::Joint::Prismatic
                                                 : TwinBody::Joint::Fixed;

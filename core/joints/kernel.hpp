@@ -32,6 +32,13 @@
 
 namespace femdyn {
 
+// f(J{}) out of line: the types of several rates are kept out of the hot loops that the
+// one-rate types (most joints of most trees) run through inlined.
+template <class J, class F>
+[[gnu::noinline]] decltype(auto) visit_outlined(F& f) {
+  return f(J{});
+}
+
 // f(J{}) for the joint type J of `type`: the one switch over the joint types.
 template <class F>
 decltype(auto) visit_joint(JointType type, F&& f) {
@@ -41,15 +48,15 @@ decltype(auto) visit_joint(JointType type, F&& f) {
     case JointType::Prismatic:
       return f(PrismaticJoint{});
     case JointType::Helical:
-      return f(HelicalJoint{});
+      return visit_outlined<HelicalJoint>(f);
     case JointType::Universal:
-      return f(UniversalJoint{});
+      return visit_outlined<UniversalJoint>(f);
     case JointType::Planar:
-      return f(PlanarJoint{});
+      return visit_outlined<PlanarJoint>(f);
     case JointType::Spherical:
-      return f(SphericalJoint{});
+      return visit_outlined<SphericalJoint>(f);
     case JointType::Free:
-      return f(FreeJoint{});
+      return visit_outlined<FreeJoint>(f);
     case JointType::Fixed:
       break;
   }
