@@ -14,8 +14,8 @@
 
 #include "core/coupling_level.hpp"
 #include "core/element.hpp"
+#include "core/joints/joint_type.hpp"
 #include "core/spatial.hpp"
-#include "core/spec.hpp"
 
 namespace femdyn {
 
@@ -178,8 +178,5 @@ struct Model {
   std::string dof_name(int i) const { return dof_name_of(dofs.at(i)); }
   std::string dof_name_of(const SystemDof& d) const;  // e.g. "link2/tip.x" or "link2.rz"
 };
-
-// Compiles a spec; throws ModelError naming spec `where` labels on bad input.
-Model compile(MechanismSpec spec);
 
 }  // namespace femdyn

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "compile/compile.hpp"
 #include "core/limits.hpp"
 #include "core/names.hpp"
 #include "io/catalog.hpp"

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "compile/compile.hpp"
 #include "models/random_tree.hpp"
 
 namespace femdyn::test {

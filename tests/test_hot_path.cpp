@@ -5,7 +5,7 @@
 #include <catch2/catch.hpp>
 #include <cstdlib>
 
-#include "core/integrator.hpp"
+#include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
 #include "validation/alloc_counter.hpp"
 

@@ -42,6 +42,7 @@
 #include <string>
 #include <vector>
 
+#include "compile/compile.hpp"
 #include "core/equations.hpp"
 #include "core/math.hpp"
 #include "core/sampling.hpp"

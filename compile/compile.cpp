@@ -1,12 +1,14 @@
 // compile(): MechanismSpec -> Model. Tree order and joints, the coupling level θ = C q + θ0,
-// then the node level and the correlation table (core/correlation.cpp).
+// then the node level and the correlation table (compile/correlation.cpp).
+#include "compile/compile.hpp"
+
 #include <cmath>
 #include <map>
 #include <set>
 
+#include "compile/compile_level.hpp"
+#include "compile/correlation.hpp"
 #include "core/body_inertia.hpp"
-#include "core/compile_level.hpp"
-#include "core/correlation.hpp"
 #include "core/errors.hpp"
 #include "core/joints/kernel.hpp"
 #include "core/limits.hpp"

@@ -2,6 +2,7 @@
 // of every joint is compiled twice from the spec (once as Model::tree, once as the model
 // itself), and the model's coordinates become the joints that no coupling sets.
 #pragma once
+#include "compile/spec.hpp"
 #include "core/model.hpp"
 #include "core/workspace.hpp"
 

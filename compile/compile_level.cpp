@@ -1,4 +1,4 @@
-#include "core/compile_level.hpp"
+#include "compile/compile_level.hpp"
 
 #include <algorithm>
 #include <cmath>
