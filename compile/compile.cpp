@@ -189,14 +189,14 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
 
 }  // namespace
 
-Model compile(MechanismSpec spec) {
-  if (has_coupling_law(spec)) return compile_with_coupling_level(std::move(spec));
-  Model m = compile_tree(std::move(spec));
+Model compile(MechanismSpec spec, const CompileOptions& options) {
+  if (has_coupling_law(spec)) return compile_with_coupling_level(std::move(spec), options);
+  Model m = compile_tree(std::move(spec), options);
   check_rigid_spans(m);
   return m;
 }
 
-Model compile_tree(MechanismSpec spec) {
+Model compile_tree(MechanismSpec spec, const CompileOptions& options) {
   Model m;
   m.name = spec.name;
   m.where = spec.where.size() >= 2 ? spec.where.substr(0, spec.where.size() - 2) : spec.where;
@@ -240,7 +240,7 @@ Model compile_tree(MechanismSpec spec) {
   compile_coupling(spec, m);
   build_node_level(spec, body_of_spec, m);
   condense_body_inertia(m);
-  choose_routes(m);
+  choose_routes(m, options.routes);
   analyse_mass_pattern(m);
   check_mass_matrix(m);
   return m;

@@ -102,11 +102,11 @@ void check_range(const CoupledJoint& j, const Model& m) {
 
 }  // namespace
 
-Model compile_with_coupling_level(MechanismSpec spec) {
+Model compile_with_coupling_level(MechanismSpec spec, const CompileOptions& options) {
   MechanismSpec tree_spec = spec;  // (elements are shared, immutable)
   tree_spec.couplings.clear();
-  Model tree = compile_tree(tree_spec);
-  Model m = compile_tree(std::move(tree_spec));
+  Model tree = compile_tree(tree_spec, options);
+  Model m = compile_tree(std::move(tree_spec), options);
 
   std::map<std::string, int> theta_of;  // joint name -> θ index
   for (int t = 0; t < m.n_theta(); ++t) theta_of[m.bodies[m.theta_joint[t]].joint.name] = t;

@@ -9,6 +9,7 @@
 #include <Eigen/Sparse>
 #include <array>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -96,6 +97,15 @@ enum class ForceRoute {
 enum class DynamicsRoute {
   Cholesky,    // q̈ = (M^s)⁻¹ (Q − h): evaluate, then dense or CHOLMOD Cholesky
   Articulated  // articulated-body recursion over the element-assembled Λ_b (core/articulated.hpp)
+};
+// Routes asked of compile() instead of those it would choose (CompileOptions::routes,
+// compile/compile.hpp): tests and benchmarks compare each route with its reference. A reference
+// route (Transform, Nodes, Cholesky) is exact on every model; a body-level one asked where it is
+// not exact is refused.
+struct RouteChoice {
+  std::optional<MassRoute> mass;
+  std::optional<ForceRoute> force;
+  std::optional<DynamicsRoute> dynamics;
 };
 // How the Cholesky route factorises M^s (core/mass_solver.hpp).
 enum class SolverKind {
