@@ -238,6 +238,9 @@ Model compile_tree(MechanismSpec spec, const CompileOptions& options) {
     m.bodies.push_back(std::move(b));
   }
   compile_coupling(spec, m);
+  // The passes below run kinematics on the model being built: its routes so far (the reference
+  // ones, no law) until choose_routes settles them.
+  m.routes = choose_equation_routes(m);
   build_node_level(spec, body_of_spec, m);
   condense_body_inertia(m);
   choose_routes(m, options.routes);

@@ -164,6 +164,7 @@ Model compile_with_coupling_level(MechanismSpec spec, const CompileOptions& opti
   m.dynamics_route = DynamicsRoute::Cholesky;
   m.coupling_level = std::move(level);
   m.tree = std::make_shared<const Model>(std::move(tree));
+  m.routes = choose_equation_routes(m);  // the law chain
   check_rigid_spans(m);
   return m;
 }

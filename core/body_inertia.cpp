@@ -116,6 +116,7 @@ void choose_routes(Model& m, const RouteChoice& asked) {
       refuse("articulated");
     m.dynamics_route = *asked.dynamics;
   }
+  m.routes = choose_equation_routes(m);
 }
 
 std::vector<MassProperties> body_mass_properties(const Model& m) {

@@ -16,6 +16,7 @@
 #include "core/coupling_level.hpp"
 #include "core/element.hpp"
 #include "core/joints/joint_type.hpp"
+#include "core/routes.hpp"
 #include "core/spatial.hpp"
 
 namespace femdyn {
@@ -170,6 +171,7 @@ struct Model {
   ForceRoute force_route = ForceRoute::Nodes;              // how h and τ are computed
   DynamicsRoute dynamics_route = DynamicsRoute::Cholesky;  // how forward_dynamics() finds q̈
   MassPattern mass_pattern;                                // the Cholesky route's solver
+  EquationRoutes routes;  // what each equations function calls, chosen once (core/routes.hpp)
 
   // A nonlinear coupling level θ = g(q) (core/coupling_level.hpp), or null. With one, C and θ0
   // above are only g's linearisation at compile time (its structure, for analyses and reports;
