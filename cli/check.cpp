@@ -1,4 +1,4 @@
-// femdyn check MODEL: the numerical diagnosis of a user's model (core/stability.hpp) over
+// femdyn check MODEL: the numerical diagnosis of a user's model (sim/stability.hpp) over
 // sampled states: conditioning of M^s, the modes of the linearised dynamics (the stiffest one
 // and the fastest motion, each labelled by kind), the largest stable step of each explicit
 // integrator, suspicious bodies, and advice on accuracy and stability: a recommended
@@ -15,8 +15,8 @@
 #include "cli/progress.hpp"
 #include "core/memory.hpp"
 #include "core/sampling.hpp"
-#include "core/stability.hpp"
 #include "io/output.hpp"
+#include "sim/stability.hpp"
 
 namespace femdyn::cli {
 namespace {

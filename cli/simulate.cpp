@@ -1,5 +1,5 @@
 // femdyn simulate: the motion of a model from an initial state under an actuation, by any of
-// the integrators of core/integrator.hpp, written as a trajectory CSV with the energy balance.
+// the integrators of sim/integrator.hpp, written as a trajectory CSV with the energy balance.
 #include <cmath>
 #include <csignal>
 #include <filesystem>
@@ -9,14 +9,14 @@
 
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
-#include "core/integrator.hpp"
 #include "core/memory.hpp"
 #include "core/names.hpp"
-#include "core/recorded_run.hpp"
 #include "io/actuation_table.hpp"
 #include "io/atomic_file.hpp"
 #include "io/output.hpp"
 #include "io/trajectory_csv.hpp"
+#include "sim/integrator.hpp"
+#include "sim/recorded_run.hpp"
 
 namespace femdyn::cli {
 namespace {

@@ -13,6 +13,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/stress_cases.hpp"
+#include "compile/compile.hpp"
 #include "core/errors.hpp"
 #include "core/names.hpp"
 #include "io/atomic_file.hpp"

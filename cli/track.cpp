@@ -6,10 +6,10 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
-#include "core/fixed_step.hpp"
-#include "core/quintic.hpp"
 #include "io/csv.hpp"
 #include "io/output.hpp"
+#include "sim/fixed_step.hpp"
+#include "sim/quintic.hpp"
 
 namespace femdyn::cli {
 namespace {

@@ -81,7 +81,7 @@ void condense_body_inertia(Model& m) {
   }
 }
 
-void choose_routes(Model& m) {
+void choose_routes(Model& m, const RouteChoice& asked) {
   // M^s by composite inertias wherever the body-level form is exact: measured faster than
   // Tᵀ (M T) on every model, from the 1-DOF pendulum up (docs/performance.md).
   m.mass_route = m.condensable ? MassRoute::Composite : MassRoute::Transform;
@@ -95,6 +95,28 @@ void choose_routes(Model& m) {
       m.condensable && m.velocity_forces_rigid && m.identity_coupling && one_rate_joints
           ? DynamicsRoute::Articulated
           : DynamicsRoute::Cholesky;
+  // A route asked for: any reference route, a body-level one only where it was chosen (exact).
+  const auto refuse = [&](const char* route) {
+    throw ModelError(m.where, std::string("the ") + route +
+                                  " route is not exact for this model (compile options)");
+  };
+  if (asked.mass) {
+    if (*asked.mass == MassRoute::Composite && m.mass_route != MassRoute::Composite)
+      refuse("composite mass");
+    m.mass_route = *asked.mass;
+  }
+  if (asked.force) {
+    if (*asked.force == ForceRoute::Bodies && m.force_route != ForceRoute::Bodies)
+      refuse("body-level force");
+    m.force_route = *asked.force;
+  }
+  if (asked.dynamics) {
+    if (*asked.dynamics == DynamicsRoute::Articulated &&
+        m.dynamics_route != DynamicsRoute::Articulated)
+      refuse("articulated");
+    m.dynamics_route = *asked.dynamics;
+  }
+  m.routes = choose_equation_routes(m);
 }
 
 std::vector<MassProperties> body_mass_properties(const Model& m) {

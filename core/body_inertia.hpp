@@ -30,8 +30,10 @@ namespace femdyn {
 
 void condense_body_inertia(Model& model);
 
-// Model::mass_route and Model::dynamics_route from the structure and an operation count.
-void choose_routes(Model& model);
+// Model::mass_route, force_route and dynamics_route from the structure and an operation count,
+// or those `asked` (throws ModelError for a body-level route where it is not exact); then
+// Model::routes, the table every equations function calls through (core/routes.hpp).
+void choose_routes(Model& model, const RouteChoice& asked = {});
 
 // The sum of the body's elements' mass properties (body frame); an element that spans bodies
 // (a rod) moves with no single body and is left out.

@@ -1,7 +1,7 @@
 // The constant external loads at the body level (core/articulated.hpp, core/newton_euler.hpp).
 //
 // Gravity: the nodal gravity forces are F = M G (every translation DOF accelerates by g,
-// core/correlation.cpp), so on each body they sum to Λ_b (0, g): exactly the wrench the
+// compile/correlation.cpp), so on each body they sum to Λ_b (0, g): exactly the wrench the
 // recursions produce from a base acceleration of −g (Featherstone's device). Point loads and
 // body torques, each a wrench on its body, are subtracted from the body's bias force. A
 // translation DOF left out of u never moves, so the loads on it do no work either way.

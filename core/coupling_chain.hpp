@@ -3,10 +3,10 @@
 //   M^s = Gᵀ M_θ G,   h = Gᵀ (h_θ + M_θ γ),   Q = Gᵀ Q_θ + τ,   τ = Gᵀ τ_θ(θ̈ = G q̈ + γ)
 //   T = T_θ G,   T'[x, y] = T'_θ[G x, G y] + T_θ g''[x, y]
 //   D_abc = Σ_i G_ia (Σ_jk D^θ_ijk G_jb G_kc + Σ_l M_θ,il H_lbc)
-// Called by the functions of core/equations.hpp and core/kinematics.hpp when
-// Model::coupling_level is set; linear couplings never come here. A state where a law is not
-// defined (a linkage that cannot assemble) throws ModelError from the void functions and is a
-// failed Status from forward_dynamics.
+// The route (Model::routes, core/routes.hpp) of every function of core/equations.hpp and of
+// propagate_bilinear for a model with Model::coupling_level; linear couplings never come here. A
+// state where a law is not defined (a linkage that cannot assemble) throws ModelError from the void
+// functions and is a failed Status from forward_dynamics.
 #pragma once
 #include <vector>
 

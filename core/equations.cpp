@@ -101,17 +101,16 @@ void form_mass_matrix(const Model& model, Workspace& ws) {
   mirror_upper(ws.Ms);
 }
 
-}  // namespace
-
-void mass_matrix(const Model& model, Workspace& ws, const VecX& q) {
-  if (model.coupling_level) return chain::mass_matrix(model, ws, q);
+// M^s alone: the body poses (composite) or T (transform), then form_mass_matrix.
+void mass_matrix_levels(const Model& model, Workspace& ws, const VecX& q) {
   const bool composite = model.mass_route == MassRoute::Composite;
   propagate(model, ws, q, q, {.jacobian = !composite, .bias = false, .rows = !composite});
   form_mass_matrix(model, ws);
 }
 
-void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau) {
-  if (model.coupling_level) return chain::evaluate(model, ws, q, qd, tau);
+// M^s, h and Q by the model's mass and force routes.
+void evaluate_levels(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+                     const VecX& tau) {
   const bool moving = !is_zero(qd);
   // The composite route needs only the body poses; the transform route the rows of T. The
   // body-level force route computes h by Newton–Euler, which leaves the poses.
@@ -136,14 +135,19 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
   assemble_forces(model, ws, tau, moving);
 }
 
-void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
-  if (model.coupling_level) return chain::evaluate_bias(model, ws, q, qd);
+// h by Newton–Euler over the body inertias (ForceRoute::Bodies).
+void bias_by_bodies(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
   if (is_zero(qd)) {
     ws.h.setZero();
     return;
   }
-  if (model.force_route == ForceRoute::Bodies) {
-    newton_euler(model, ws, q, qd, nullptr, false, ws.h);
+  newton_euler(model, ws, q, qd, nullptr, false, ws.h);
+}
+
+// h by the node-level sweeps (ForceRoute::Nodes).
+void bias_by_nodes(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
+  if (is_zero(qd)) {
+    ws.h.setZero();
     return;
   }
   propagate(model, ws, q, qd, {.jacobian = false, .bias = true});
@@ -152,45 +156,30 @@ void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX&
   apply_transpose(model, ws, ws.nodal, ws.h);  // h = Tᵀ (M T'[q̇,q̇] + g), T not formed
 }
 
-Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
-                        const VecX& tau) {
-  Status st;
-  if (model.coupling_level) {
-    st = chain::forward_dynamics(model, ws, q, qd, tau);
-  } else if (model.dynamics_route == DynamicsRoute::Articulated) {
-    st = articulated_forward_dynamics(model, ws, q, qd, tau);
-  } else if (model.force_route == ForceRoute::Bodies && model.mass_route == MassRoute::Composite) {
-    st = coupled_forward_dynamics(model, ws, q, qd, tau);
-  } else {
-    evaluate(model, ws, q, qd, tau);
-    st = ws.solver.factorize(ws.Ms);
-    if (st.ok) {
-      ws.qdd = ws.Q - ws.h;
-      ws.solver.solve_in_place(ws.qdd);
-    }
+// q̈ by evaluate(), then the Cholesky factorisation of M^s (DynamicsRoute::Cholesky).
+Status forward_by_cholesky(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+                           const VecX& tau) {
+  evaluate(model, ws, q, qd, tau);
+  Status st = ws.solver.factorize(ws.Ms);
+  if (st.ok) {
+    ws.qdd = ws.Q - ws.h;
+    ws.solver.solve_in_place(ws.qdd);
   }
-  if (!st.ok) return st;
-  // A result that overflowed is a failure naming the coordinate, never a NaN handed on.
-  for (Eigen::Index a = 0; a < ws.qdd.size(); ++a)
-    if (!std::isfinite(ws.qdd[a]))
-      return {false,
-              "q̈ of '" + model.coordinate_names[a] +
-                  "' is NaN or Inf (the forces or the state overflow double precision)",
-              static_cast<int>(a), true};
   return st;
 }
 
-void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+// τ by body-level Newton–Euler (ForceRoute::Bodies).
+void inverse_by_bodies(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+                       const VecX& qdd) {
+  newton_euler(model, ws, q, qd, &qdd, true, ws.tau);
+  add_joint_forces(model, ws, true, -1.0, ws.tau);
+}
+
+// τ = M^s q̈ + h − Q(τ = 0) = Tᵀ (M (T q̈ + T'[q̇,q̇]) + g(u̇,u̇) − F) − Cᵀ(spring + damper),
+// by two kinematic sweeps and one sweep of Tᵀ (ForceRoute::Nodes): O(N_u + bodies), neither T
+// nor M^s formed.
+void inverse_by_nodes(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                       const VecX& qdd) {
-  if (model.coupling_level) return chain::inverse_dynamics(model, ws, q, qd, qdd);
-  // τ = M^s q̈ + h − Q(τ = 0) = Tᵀ (M (T q̈ + T'[q̇,q̇]) + g(u̇,u̇) − F) − Cᵀ(spring + damper),
-  // by body-level Newton–Euler, or by two kinematic sweeps and one sweep of Tᵀ:
-  // O(N_u + bodies), neither T nor M^s formed.
-  if (model.force_route == ForceRoute::Bodies) {
-    newton_euler(model, ws, q, qd, &qdd, true, ws.tau);
-    add_joint_forces(model, ws, true, -1.0, ws.tau);
-    return;
-  }
   propagate(model, ws, q, qdd, {.jacobian = false, .bias = true});
   ws.u_acc = ws.u_dot;  // T q̈
   propagate(model, ws, q, qd, {.jacobian = false, .bias = true});
@@ -203,8 +192,7 @@ void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const Ve
   add_joint_forces(model, ws, true, -1.0, ws.tau);
 }
 
-std::vector<MatX> transform_hessian(const Model& model, Workspace& ws, const VecX& q) {
-  if (model.coupling_level) return chain::transform_hessian(model, ws, q);
+std::vector<MatX> transform_hessian_levels(const Model& model, Workspace& ws, const VecX& q) {
   // T'_{·bc} = ∂T_{·b}/∂q_c = T'[e_b, e_c]: one bilinear sweep per pair.
   const int n = model.n(), N = model.n_u();
   std::vector<MatX> H(N, MatX::Zero(n, n));
@@ -221,8 +209,7 @@ std::vector<MatX> transform_hessian(const Model& model, Workspace& ws, const Vec
   return H;
 }
 
-std::vector<MatX> third_order_tensor(const Model& model, Workspace& ws, const VecX& q) {
-  if (model.coupling_level) return chain::third_order_tensor(model, ws, q);
+std::vector<MatX> third_order_tensor_levels(const Model& model, Workspace& ws, const VecX& q) {
   const int n = model.n(), N = model.n_u();
   const std::vector<MatX> Tp = transform_hessian(model, ws, q);
   propagate(model, ws, q, VecX::Zero(n), {.jacobian = true, .bias = false});
@@ -241,14 +228,12 @@ std::vector<MatX> third_order_tensor(const Model& model, Workspace& ws, const Ve
   return D;
 }
 
-void joint_state(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
-  if (model.coupling_level) return chain::joint_state(model, ws, q, qd);
+void joint_state_levels(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
   coupling_apply(model, q, ws.theta, true);
   coupling_apply(model, qd, ws.theta_dot, false);
 }
 
-Energy energy(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
-  if (model.coupling_level) return chain::energy(model, ws, q, qd);
+Energy energy_levels(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
   Energy E;
   if (model.mass_route == MassRoute::Composite) {
     // Body by body, ½ Σ_b V_bᵀ Λ_b V_b with V_b = J_b q̇ the body's twist in its own axes: the
@@ -279,6 +264,91 @@ Energy energy(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) 
     E.potential += 0.5 * J.stiffness * (ws.theta[J.idx_q] - J.rest) * (ws.theta[J.idx_q] - J.rest);
   }
   return E;
+}
+
+}  // namespace
+
+EquationRoutes choose_equation_routes(const Model& model) {
+  EquationRoutes r;
+  if (model.coupling_level) {  // the law chain: the tree's equations reduced through θ = g(q)
+    r.evaluate = chain::evaluate;
+    r.mass_matrix = chain::mass_matrix;
+    r.evaluate_bias = chain::evaluate_bias;
+    r.forward_dynamics = chain::forward_dynamics;
+    r.inverse_dynamics = chain::inverse_dynamics;
+    r.transform_hessian = chain::transform_hessian;
+    r.third_order_tensor = chain::third_order_tensor;
+    r.energy = chain::energy;
+    r.joint_state = chain::joint_state;
+    r.propagate_bilinear = chain::propagate_bilinear;
+    return r;
+  }
+  r.evaluate = evaluate_levels;
+  r.mass_matrix = mass_matrix_levels;
+  r.transform_hessian = transform_hessian_levels;
+  r.third_order_tensor = third_order_tensor_levels;
+  r.energy = energy_levels;
+  r.joint_state = joint_state_levels;
+  r.propagate_bilinear = propagate_bilinear_levels;
+  const bool by_bodies = model.force_route == ForceRoute::Bodies;
+  r.evaluate_bias = by_bodies ? bias_by_bodies : bias_by_nodes;
+  r.inverse_dynamics = by_bodies ? inverse_by_bodies : inverse_by_nodes;
+  if (model.dynamics_route == DynamicsRoute::Articulated)
+    r.forward_dynamics = articulated_forward_dynamics;
+  else if (by_bodies && model.mass_route == MassRoute::Composite)
+    r.forward_dynamics = coupled_forward_dynamics;
+  else
+    r.forward_dynamics = forward_by_cholesky;
+  return r;
+}
+
+// Each function of equations.hpp: the model's route (Model::routes), chosen once by compile().
+
+void mass_matrix(const Model& model, Workspace& ws, const VecX& q) {
+  model.routes.mass_matrix(model, ws, q);
+}
+
+void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau) {
+  model.routes.evaluate(model, ws, q, qd, tau);
+}
+
+void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
+  model.routes.evaluate_bias(model, ws, q, qd);
+}
+
+Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+                        const VecX& tau) {
+  const Status st = model.routes.forward_dynamics(model, ws, q, qd, tau);
+  if (!st.ok) return st;
+  // A result that overflowed is a failure naming the coordinate, never a NaN handed on.
+  for (Eigen::Index a = 0; a < ws.qdd.size(); ++a)
+    if (!std::isfinite(ws.qdd[a]))
+      return {false,
+              "q̈ of '" + model.coordinate_names[a] +
+                  "' is NaN or Inf (the forces or the state overflow double precision)",
+              static_cast<int>(a), true};
+  return st;
+}
+
+void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+                      const VecX& qdd) {
+  model.routes.inverse_dynamics(model, ws, q, qd, qdd);
+}
+
+std::vector<MatX> transform_hessian(const Model& model, Workspace& ws, const VecX& q) {
+  return model.routes.transform_hessian(model, ws, q);
+}
+
+std::vector<MatX> third_order_tensor(const Model& model, Workspace& ws, const VecX& q) {
+  return model.routes.third_order_tensor(model, ws, q);
+}
+
+void joint_state(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
+  model.routes.joint_state(model, ws, q, qd);
+}
+
+Energy energy(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
+  return model.routes.energy(model, ws, q, qd);
 }
 
 }  // namespace femdyn

@@ -3,7 +3,6 @@
 #include <array>
 
 #include "core/coupling.hpp"
-#include "core/coupling_chain.hpp"
 #include "core/joints/kernel.hpp"
 
 namespace femdyn {
@@ -141,7 +140,11 @@ void propagate_nodes(const Model& model, Workspace& ws, KinematicsRequest req) {
 
 void propagate_bilinear(const Model& model, Workspace& ws, const VecX& q, const VecX& x,
                         const VecX& y, KinematicsRequest request) {
-  if (model.coupling_level) return chain::propagate_bilinear(model, ws, q, x, y, request);
+  model.routes.propagate_bilinear(model, ws, q, x, y, request);
+}
+
+void propagate_bilinear_levels(const Model& model, Workspace& ws, const VecX& q, const VecX& x,
+                               const VecX& y, KinematicsRequest request) {
   // Coupling level.
   coupling_apply(model, q, ws.theta, true);
   if (request.bias) {

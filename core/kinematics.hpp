@@ -35,9 +35,13 @@ struct KinematicsRequest {
 void propagate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                KinematicsRequest request);
 
-// The same with two rates: ws.bias = T'[x, y], ws.u_dot = T x.
+// The same with two rates: ws.bias = T'[x, y], ws.u_dot = T x. By the model's route
+// (Model::routes): the levels below, or through a nonlinear coupling level the law chain.
 void propagate_bilinear(const Model& model, Workspace& ws, const VecX& q, const VecX& x,
                         const VecX& y, KinematicsRequest request);
+// The route of every model without a nonlinear coupling law: θ = C q + θ0, the tree, the nodes.
+void propagate_bilinear_levels(const Model& model, Workspace& ws, const VecX& q, const VecX& x,
+                               const VecX& y, KinematicsRequest request);
 
 // y = Tᵀ f (+ the generalized force of body torques × torque_scale) without forming T, by the
 // principle of virtual work on the tree: each nodal force is gathered into its carrier body's

@@ -9,13 +9,15 @@
 #include <Eigen/Sparse>
 #include <array>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/coupling_level.hpp"
 #include "core/element.hpp"
+#include "core/joints/joint_type.hpp"
+#include "core/routes.hpp"
 #include "core/spatial.hpp"
-#include "core/spec.hpp"
 
 namespace femdyn {
 
@@ -100,6 +102,15 @@ enum class DynamicsRoute {
   Cholesky,    // q̈ = (M^s)⁻¹ (Q − h): evaluate, then dense or CHOLMOD Cholesky
   Articulated  // articulated-body recursion over the element-assembled Λ_b (core/articulated.hpp)
 };
+// Routes asked of compile() instead of those it would choose (CompileOptions::routes,
+// compile/compile.hpp): tests and benchmarks compare each route with its reference. A reference
+// route (Transform, Nodes, Cholesky) is exact on every model; a body-level one asked where it is
+// not exact is refused.
+struct RouteChoice {
+  std::optional<MassRoute> mass;
+  std::optional<ForceRoute> force;
+  std::optional<DynamicsRoute> dynamics;
+};
 // How the Cholesky route factorises M^s (core/mass_solver.hpp).
 enum class SolverKind {
   Dense,   // LLT
@@ -165,6 +176,7 @@ struct Model {
   ForceRoute force_route = ForceRoute::Nodes;              // how h and τ are computed
   DynamicsRoute dynamics_route = DynamicsRoute::Cholesky;  // how forward_dynamics() finds q̈
   MassPattern mass_pattern;                                // the Cholesky route's solver
+  EquationRoutes routes;  // what each equations function calls, chosen once (core/routes.hpp)
 
   // A nonlinear coupling level θ = g(q) (core/coupling_level.hpp), or null. With one, C and θ0
   // above are only g's linearisation at compile time (its structure, for analyses and reports;
@@ -184,8 +196,5 @@ struct Model {
   std::string dof_name(int i) const { return dof_name_of(dofs.at(i)); }
   std::string dof_name_of(const SystemDof& d) const;  // e.g. "link2/tip.x" or "link2.rz"
 };
-
-// Compiles a spec; throws ModelError naming spec `where` labels on bad input.
-Model compile(MechanismSpec spec);
 
 }  // namespace femdyn

@@ -10,7 +10,7 @@ struct Status {
   std::string message;
   int coordinate = -1;      // the coordinate a failure is attributed to, if any
   bool non_finite = false;  // the failure is a NaN or Inf (an overflow), not a singular matrix
-  bool diverged = false;    // the numerical solution blew up (core/divergence.hpp)
+  bool diverged = false;    // the numerical solution blew up (sim/divergence.hpp)
 };
 
 // The failure of a diagonal entry M^s(a, a) against the largest diagonal entry: no inertia at

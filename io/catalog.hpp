@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/spec.hpp"
+#include "compile/spec.hpp"
 #include "io/params.hpp"
 #include "io/registry.hpp"
 

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "compile/compile.hpp"
 #include "core/limits.hpp"
 #include "core/names.hpp"
 #include "io/catalog.hpp"
@@ -555,9 +556,9 @@ Model load_model(const std::string& path, const LoadOptions& options) {
     spec.gravity = *options.gravity;
     spec.gravity_where = spec.where + options.gravity_source;  // (where ends in ": ")
   }
-  if (!is_urdf_path(path)) return compile(std::move(spec));
+  if (!is_urdf_path(path)) return compile(std::move(spec), options.compile);
   try {
-    return compile(std::move(spec));
+    return compile(std::move(spec), options.compile);
   } catch (const ModelError& e) {
     rethrow_for_urdf(e, model_document(path, options), path);
   }

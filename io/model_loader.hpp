@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "compile/compile.hpp"
 #include "core/model.hpp"
 #include "io/catalog.hpp"
 #include "io/params.hpp"
@@ -16,6 +17,7 @@ struct LoadOptions {
   std::string gravity_source = "LoadOptions::gravity";  // names it in messages ("--gravity")
   std::function<void(const std::string&)> warn;  // non-fatal notes (e.g. URDF friction ignored)
   const Catalog* catalog = nullptr;  // element types and model plugins; null: default_catalog()
+  CompileOptions compile;            // e.g. the routes (compile/compile.hpp)
 };
 
 // A model file: femdyn JSON, or URDF by its extension .urdf (io/urdf_loader.hpp).

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "compile/compile.hpp"
 #include "core/errors.hpp"
 #include "core/inertia.hpp"
 #include "core/limits.hpp"

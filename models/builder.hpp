@@ -1,6 +1,6 @@
 // MechanismBuilder: a mechanism described in code, without JSON — bodies with their joints,
 // named nodes and elements, couplings (linear or a law), loads — into the plain MechanismSpec
-// (core/spec.hpp) that compile() turns into a Model. The same model as the JSON file that says
+// (compile/spec.hpp) that compile() turns into a Model. The same model as the JSON file that says
 // the same things (tests/test_builder.cpp, python/tests). Each call checks its arguments as the
 // JSON loader does and throws ModelError naming the place as a JSON path would:
 //   "arm (builder): /bodies/1/elements/0/mass: must be > 0, got -1".
@@ -14,8 +14,8 @@
 #include <variant>
 #include <vector>
 
+#include "compile/spec.hpp"
 #include "core/model.hpp"
-#include "core/spec.hpp"
 
 namespace femdyn {
 

@@ -6,11 +6,11 @@
 #include <limits>
 
 #include "core/equations.hpp"
-#include "core/integrator.hpp"
 #include "core/memory.hpp"
 #include "core/sampling.hpp"
 #include "python/parallel.hpp"
 #include "python/py_model.hpp"
+#include "sim/integrator.hpp"
 
 namespace femdyn::python {
 namespace {

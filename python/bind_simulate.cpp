@@ -1,17 +1,17 @@
 // femdyn.simulate: the motion from (q0, q̇0) under a constant τ by an integrator of
-// core/integrator.hpp, as `femdyn simulate` runs it (cli/simulate.cpp), into arrays.
+// sim/integrator.hpp, as `femdyn simulate` runs it (cli/simulate.cpp), into arrays.
 #include <pybind11/stl.h>
 
 #include <algorithm>
 #include <cmath>
 
-#include "core/integrator.hpp"
 #include "core/limits.hpp"
 #include "core/memory.hpp"
 #include "core/names.hpp"
-#include "core/recorded_run.hpp"
 #include "io/actuation_table.hpp"
 #include "python/py_model.hpp"
+#include "sim/integrator.hpp"
+#include "sim/recorded_run.hpp"
 
 namespace femdyn::python {
 namespace {

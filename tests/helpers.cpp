@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "compile/compile.hpp"
 #include "models/random_tree.hpp"
 
 namespace femdyn::test {
@@ -26,7 +27,9 @@ std::vector<std::string> bundled_models() {
   return out;
 }
 
-Model load_text(const std::string& json_text) { return compile(parse_spec(json_text, "test")); }
+Model load_text(const std::string& json_text, const CompileOptions& options) {
+  return compile(parse_spec(json_text, "test"), options);
+}
 
 std::string text_error(const std::string& json_text) {
   try {

@@ -15,7 +15,7 @@ namespace femdyn::test {
 
 std::string model_path(const std::string& name);  // FEMDYN_SOURCE_DIR/models/name
 std::vector<std::string> bundled_models();        // file names of models/*.json, sorted
-Model load_text(const std::string& json_text);
+Model load_text(const std::string& json_text, const CompileOptions& options = {});
 // The ModelError's message of load_text(json_text), or "(loaded)".
 std::string text_error(const std::string& json_text);
 

@@ -10,8 +10,8 @@
 #include <numbers>
 #include <sstream>
 
-#include "core/integrator.hpp"
-#include "core/stability.hpp"
+#include "sim/integrator.hpp"
+#include "sim/stability.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;

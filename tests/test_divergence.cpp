@@ -1,4 +1,4 @@
-// A run whose solution blows up fails as a divergence with its cause (core/divergence.hpp),
+// A run whose solution blows up fails as a divergence with its cause (sim/divergence.hpp),
 // never as "ok" and never blamed on the model; runs that are merely inaccurate, falling or
 // driven are not called diverged; fixed-step times lie on the grid t0 + k dt; a run that
 // cannot finish is refused before it starts (docs/simulation.md).
@@ -9,9 +9,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "core/integrator.hpp"
-#include "core/recorded_run.hpp"
-#include "core/stability.hpp"
+#include "sim/integrator.hpp"
+#include "sim/recorded_run.hpp"
+#include "sim/stability.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;

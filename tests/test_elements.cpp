@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 #include <sstream>
 
+#include "compile/compile.hpp"
 #include "core/equations.hpp"
 #include "core/inertia.hpp"
 #include "elements/lumped_point.hpp"

@@ -1,6 +1,7 @@
 // Every bad-input class gives a one-line error naming the file, the JSON path and the problem.
 #include <catch2/catch.hpp>
 
+#include "compile/compile.hpp"
 #include "core/errors.hpp"
 #include "tests/helpers.hpp"
 

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "compile/compile.hpp"
 #include "core/errors.hpp"
 #include "tests/helpers.hpp"
 

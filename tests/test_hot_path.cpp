@@ -5,7 +5,7 @@
 #include <catch2/catch.hpp>
 #include <cstdlib>
 
-#include "core/integrator.hpp"
+#include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
 #include "validation/alloc_counter.hpp"
 
@@ -82,8 +82,9 @@ TEST_CASE("the sparse (CHOLMOD) path allocates only CHOLMOD's own few work array
     return;
   }
   for (int bodies : {70, 140}) {
-    Model m = load_text(random_tree_json(4, bodies, 0.5, true));
-    m.dynamics_route = DynamicsRoute::Cholesky;  // (compile chooses the articulated route)
+    // (compile would choose the articulated route)
+    const Model m = load_text(random_tree_json(4, bodies, 0.5, true),
+                              {.routes = {.dynamics = DynamicsRoute::Cholesky}});
     Workspace ws(m);
     ws.solver = MassSolver(m, SolverKind::Sparse);  // (a tree would take the tree LTDL)
     std::mt19937 rng(3);

@@ -3,7 +3,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "core/fixed_step.hpp"
+#include "sim/fixed_step.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;

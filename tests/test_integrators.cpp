@@ -1,10 +1,10 @@
-// The integrators of core/integrator.hpp against independent references: convergence orders
+// The integrators of sim/integrator.hpp against independent references: convergence orders
 // measured against a much tighter run, the energy balance E(t) − E(0) = W(t), bounded energy
 // error of the symplectic method, a stiff spring against its closed form, failures reported.
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "core/integrator.hpp"
+#include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;

@@ -7,10 +7,10 @@
 #include <random>
 
 #include "core/equations.hpp"
-#include "core/integrator.hpp"
 #include "core/joints/kernel.hpp"
 #include "core/kinematics.hpp"
 #include "core/sampling.hpp"
+#include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;
@@ -176,9 +176,9 @@ TEST_CASE("a joint's bias c_J is the second derivative of the motion at constant
 }
 
 TEST_CASE("the node route and the body routes agree for every joint type") {
-  Model nodes = load_text(all_joints_json(9.81));
-  nodes.mass_route = MassRoute::Transform;
-  nodes.force_route = ForceRoute::Nodes;
+  const Model nodes =
+      load_text(all_joints_json(9.81),
+                {.routes = {.mass = MassRoute::Transform, .force = ForceRoute::Nodes}});
   const Model bodies = load_text(all_joints_json(9.81));
   REQUIRE(bodies.condensable);
   Workspace wn(nodes), wb(bodies);

@@ -10,9 +10,9 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "core/integrator.hpp"
 #include "core/memory.hpp"
 #include "io/actuation_table.hpp"
+#include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;

@@ -122,11 +122,10 @@ TEST_CASE("articulated route equals M^s + Cholesky on mixed random trees", "[rou
       INFO("seed " << seed << ", " << bodies << " bodies");
       const std::string text = mixed_tree_json(seed, bodies, seed % 2 ? 0.6 : 0.0, false);
       const Model art = load_text(text);
-      Model chol = load_text(text);
+      const Model chol = load_text(
+          text, {.routes = {.force = ForceRoute::Nodes, .dynamics = DynamicsRoute::Cholesky}});
       REQUIRE(art.dynamics_route == DynamicsRoute::Articulated);
       REQUIRE(art.force_route == ForceRoute::Bodies);
-      chol.dynamics_route = DynamicsRoute::Cholesky;
-      chol.force_route = ForceRoute::Nodes;
       check_same_equations(art, chol, seed, 1e-11);
     }
 }
@@ -136,13 +135,12 @@ TEST_CASE("coupled models: Cholesky route, both M^s routes and both force routes
   for (unsigned seed = 11; seed <= 16; ++seed) {
     INFO("seed " << seed);
     const std::string text = mixed_tree_json(seed, 24, 0.5, true);
-    Model composite = load_text(text), transform = load_text(text);
+    const Model composite = load_text(text, {.routes = {.mass = MassRoute::Composite}});
+    const Model transform =
+        load_text(text, {.routes = {.mass = MassRoute::Transform, .force = ForceRoute::Nodes}});
     REQUIRE(!composite.identity_coupling);
     CHECK(composite.dynamics_route == DynamicsRoute::Cholesky);
     CHECK(composite.force_route == ForceRoute::Bodies);
-    composite.mass_route = MassRoute::Composite;
-    transform.mass_route = MassRoute::Transform;
-    transform.force_route = ForceRoute::Nodes;
     check_same_equations(composite, transform, seed, 1e-11);
   }
 }
@@ -153,9 +151,8 @@ TEST_CASE("articulated route equals the tree LTDL and dense and CHOLMOD Cholesky
     INFO(bodies << " bodies");
     const std::string text = random_tree_json(bodies, bodies, 1.0, true);
     const Model art = load_text(text);
-    Model chol = load_text(text);
-    chol.dynamics_route = DynamicsRoute::Cholesky;
-    chol.force_route = ForceRoute::Nodes;
+    const Model chol = load_text(
+        text, {.routes = {.force = ForceRoute::Nodes, .dynamics = DynamicsRoute::Cholesky}});
     CHECK(Workspace(chol).solver.kind() == SolverKind::Tree);
     check_same_equations(art, chol, bodies, 1e-10);
     Workspace wa(art), wc(chol);
@@ -212,10 +209,10 @@ TEST_CASE("every bundled and test model: the chosen routes equal the reference r
   for (const std::string& path : texts) {
     INFO(path);
     const Model chosen = load_model(path);
-    Model reference = load_model(path);
-    reference.dynamics_route = DynamicsRoute::Cholesky;
-    reference.mass_route = MassRoute::Transform;
-    reference.force_route = ForceRoute::Nodes;
+    const Model reference =
+        load_model(path, {.compile = {.routes = {.mass = MassRoute::Transform,
+                                                 .force = ForceRoute::Nodes,
+                                                 .dynamics = DynamicsRoute::Cholesky}}});
     check_same_equations(chosen, reference, 5, 1e-11);
   }
 }
@@ -262,8 +259,8 @@ TEST_CASE("energy on the composite route is ½ q̇ᵀ M^s q̇ body by body, M^s 
       INFO("seed " << seed << " couplings " << couplings);
       CHECK(E.kinetic == Approx(kinetic).epsilon(1e-12));
       // The potential is as before: the same body poses.
-      Model transform = load_text(mixed_tree_json(seed, 25, 0.5, couplings));
-      transform.mass_route = MassRoute::Transform;
+      const Model transform = load_text(mixed_tree_json(seed, 25, 0.5, couplings),
+                                        {.routes = {.mass = MassRoute::Transform}});
       Workspace wt(transform);
       const Energy Et = energy(transform, wt, q, qd);
       CHECK(E.potential == Approx(Et.potential).epsilon(1e-12));

@@ -1,4 +1,4 @@
-// The stability diagnosis (core/stability.hpp) against closed forms, the backward error of q̈ on
+// The stability diagnosis (sim/stability.hpp) against closed forms, the backward error of q̈ on
 // an ill-conditioned M^s, femdyn check on a model with a culprit body, and every class of
 // femdyn stress with its verdicts (docs/stability.md).
 #include <catch2/catch.hpp>
@@ -7,7 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "core/stability.hpp"
+#include "sim/stability.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;
@@ -155,7 +155,7 @@ TEST_CASE("stress springs: 1e1 to 1e5 rad/s, RK4 unstable and BDF stable at 1e5"
 TEST_CASE("stress springs: measured stable steps within 5 % of the closed forms", "[stress]") {
   // Undamped: RK4 ω h ≤ 2√2, semi-implicit Euler ω h < 2. Damped (ζ = 100): the fast real mode
   // λ = −ω(ζ + √(ζ² − 1)) limits RK4 to |λ| h ≤ 2.785 and Euler to the spectral radius of its
-  // step, which the linear theory column holds (core/stability.cpp); both within 5 %.
+  // step, which the linear theory column holds (sim/stability.cpp); both within 5 %.
   for (const auto& c : stress_class("springs")) {
     INFO(c["case"]);
     const std::string name = c["case"];

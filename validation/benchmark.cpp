@@ -42,6 +42,7 @@
 #include <string>
 #include <vector>
 
+#include "compile/compile.hpp"
 #include "core/equations.hpp"
 #include "core/math.hpp"
 #include "core/sampling.hpp"
@@ -64,11 +65,11 @@ struct Case {
   VecX q, qd, tau, qdd, rest;  // rest: q̇ = 0
   // The same mechanism on the reference routes (Tᵀ M T, node-level sweeps, Cholesky), for the
   // crossovers in docs/performance.md; up to 128 coordinates (Tᵀ M T is O(N_u n²)).
-  std::unique_ptr<Model> reference;
+  std::unique_ptr<const Model> reference;
   std::unique_ptr<Workspace> ws_ref;
   // The same mechanism without gravity (when it has some): "leave out what the scene does not
   // need" measured, against evaluate() with gravity.
-  std::unique_ptr<Model> weightless;
+  std::unique_ptr<const Model> weightless;
   std::unique_ptr<Workspace> ws_weightless;
 };
 
@@ -90,20 +91,19 @@ template <class Spec>
 void add_case(std::string name, Spec spec) {
   auto c = std::make_unique<Case>();
   c->name = std::move(name);
-  const auto load = [&] { return compile(spec()); };
-  c->model = load();
+  c->model = compile(spec());
   const Model& m = c->model;
   if (!m.gravity.isZero()) {
     MechanismSpec s = spec();
     s.gravity = Vec3::Zero();
-    c->weightless = std::make_unique<Model>(compile(std::move(s)));
+    c->weightless = std::make_unique<const Model>(compile(std::move(s)));
     c->ws_weightless = std::make_unique<Workspace>(*c->weightless);
   }
   if (m.n() <= 128) {
-    c->reference = std::make_unique<Model>(load());
-    c->reference->mass_route = MassRoute::Transform;
-    c->reference->force_route = ForceRoute::Nodes;
-    c->reference->dynamics_route = DynamicsRoute::Cholesky;
+    c->reference = std::make_unique<const Model>(
+        compile(spec(), {.routes = {.mass = MassRoute::Transform,
+                                    .force = ForceRoute::Nodes,
+                                    .dynamics = DynamicsRoute::Cholesky}}));
     c->ws_ref = std::make_unique<Workspace>(*c->reference);
   }
   c->ws = std::make_unique<Workspace>(m);

@@ -5,8 +5,8 @@
 #include <numbers>
 #include <stdexcept>
 
-#include "core/integrator.hpp"
-#include "core/stability.hpp"
+#include "sim/integrator.hpp"
+#include "sim/stability.hpp"
 #include "validation/twin.hpp"
 #include "validation/validate.hpp"
 

@@ -5,9 +5,9 @@
 //     gives up (a stiff case), and its energy balance |E − E0 − W| relative to the energy;
 //   - for rk4 and euler the largest stable step, by bisection of real runs from the initial
 //     state: a step is stable when a run of at least kMinSteps steps and kPeriods periods of
-//     the stiffest mode (2π/|λ|) ends without diverging or failing (core/divergence.hpp), so
+//     the stiffest mode (2π/|λ|) ends without diverging or failing (sim/divergence.hpp), so
 //     a step longer than the scenario still gets its steps; beside it the linear theory's
-//     limit at the initial state (core/stability.hpp); for every integrator the error at the
+//     limit at the initial state (sim/stability.hpp); for every integrator the error at the
 //     scenario's step (rk4, euler) or at rtol 1e-6 (dopri, bdf);
 //   - agreement with Simbody's twin (RungeKuttaMerson at 1e-10) where Simbody can hold it;
 // and a verdict: stable; stable only with the implicit integrator; ill-conditioned (cond >

@@ -10,8 +10,8 @@
 #include <thread>
 
 #include "core/errors.hpp"
-#include "core/integrator.hpp"
 #include "core/joints/kernel.hpp"
+#include "sim/integrator.hpp"
 #include "validation/twin.hpp"
 #include "validation/validate.hpp"
 

@@ -1,9 +1,10 @@
 // SimbodyTwin: the same mechanism built in Simbody from a compiled femdyn Model, evaluated at
-// femdyn's coordinates q. This header does not include Simbody (the twin lives in twin.cpp,
-// the only translation unit that does), so callers may be compiled with any flags.
+// femdyn's coordinates q. This header does not include Simbody (the twin lives in twin*.cpp,
+// the only translation units that do, listed in twin_impl.hpp), so callers may be compiled with
+// any flags.
 //
-// twin.cpp is compiled as C++17 without NDEBUG (Simbody 3.7's headers do not compile as C++20,
-// and must see the NDEBUG setting the library was built with), so this header and what the
+// The twin's files are compiled as C++17 without NDEBUG (Simbody 3.7's headers do not compile as
+// C++20, and must see the NDEBUG setting the library was built with), so this header and what the
 // twin reads of a model (TwinModel) use Eigen and the standard library only.
 //
 // Mapping (docs/validation.md):

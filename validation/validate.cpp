@@ -10,17 +10,17 @@
 #include <random>
 #include <stdexcept>
 
+#include "compile/compile_level.hpp"
 #include "core/body_inertia.hpp"
-#include "core/compile_level.hpp"
 #include "core/equations.hpp"
 #include "core/errors.hpp"
-#include "core/fixed_step.hpp"
 #include "core/inertia.hpp"
 #include "core/joints/kernel.hpp"
 #include "core/kinematics.hpp"
 #include "core/math.hpp"
 #include "core/model.hpp"
 #include "core/sampling.hpp"
+#include "sim/fixed_step.hpp"
 #include "validation/twin.hpp"
 #include "validation/urdf_twin.hpp"
 
@@ -230,7 +230,7 @@ void accumulate(QuantityError& e, const MatX& femdyn, const MatX& simbody) {
   e.max_rel = std::max(e.max_rel, scale > 0 ? d / scale : d);
 }
 
-// femdyn's passive motion by RK4 (core/fixed_step.hpp) at step dt, sampled at `times`
+// femdyn's passive motion by RK4 (sim/fixed_step.hpp) at step dt, sampled at `times`
 // (multiples of dt): the joint states (θ, θ̇) and the states (q, q̇) at the samples.
 // Returns false if the integration failed (M^s singular on the way). An overflow along the
 // trajectory (NaN or Inf) is an error, never a skipped comparison.

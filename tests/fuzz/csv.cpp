@@ -10,6 +10,7 @@
 #include <cmath>
 #include <optional>
 
+#include "compile/compile.hpp"
 #include "core/limits.hpp"
 #include "io/actuation_table.hpp"
 #include "io/model_loader.hpp"

@@ -2,6 +2,7 @@
 // (parse_spec: JSON, plugins, the model document), compiled, and evaluated once.
 #include <optional>
 
+#include "compile/compile.hpp"
 #include "core/errors.hpp"
 #include "io/model_loader.hpp"
 #include "tests/fuzz/common.hpp"

@@ -3,17 +3,17 @@
 // start, then after every `every`-th step and at the last one — or, given `times`, a row at each
 // of those times (advance_to, dense output) — and the energy balance over the rows,
 //   max |E(t) − E(0) − W(t)|,  W the work of the non-conservative forces (τ, dampers, torques),
-// relative to the fixed scale S₀ + max |W| (core/divergence.hpp): the energy the motion started
+// relative to the fixed scale S₀ + max |W| (sim/divergence.hpp): the energy the motion started
 // with plus the work done, which does not grow with the error. The run is planned first
 // (Integrator::plan: a fixed-step run beyond max_steps is refused before any work), and a
-// solution that diverges fails as such (core/integrator.hpp). Joints that leave their declared
+// solution that diverges fails as such (sim/integrator.hpp). Joints that leave their declared
 // limits are recorded, once per joint, at the first step that finds them outside.
 #pragma once
 #include <functional>
 #include <vector>
 
 #include "core/equations.hpp"
-#include "core/integrator.hpp"
+#include "sim/integrator.hpp"
 
 namespace femdyn {
 

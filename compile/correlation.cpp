@@ -1,4 +1,4 @@
-#include "core/correlation.hpp"
+#include "compile/correlation.hpp"
 
 #include <algorithm>
 #include <array>

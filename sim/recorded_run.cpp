@@ -1,4 +1,4 @@
-#include "core/recorded_run.hpp"
+#include "sim/recorded_run.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -4,6 +4,7 @@
 #pragma once
 #include <vector>
 
+#include "compile/spec.hpp"
 #include "core/model.hpp"
 
 namespace femdyn {

@@ -1,5 +1,5 @@
 // The equations of motion as a first-order system, the right-hand side every integrator drives
-// (core/integrator.hpp):
+// (sim/integrator.hpp):
 //
 //   y = (q, q̇, W),   ẏ = f(t, y) = (q̇,  q̈ = (M^s)⁻¹ (Q(q, q̇, τ(t)) − h(q, q̇)),  P_nc),
 //

@@ -1,13 +1,13 @@
-#include "core/integrator.hpp"
+#include "sim/integrator.hpp"
 
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
 
-#include "core/fixed_step.hpp"
 #include "core/memory.hpp"
-#include "core/stability.hpp"
-#include "core/sundials_integrators.hpp"
+#include "sim/fixed_step.hpp"
+#include "sim/stability.hpp"
+#include "sim/sundials_integrators.hpp"
 
 namespace femdyn {
 namespace {

@@ -1,4 +1,4 @@
-#include "core/quintic.hpp"
+#include "sim/quintic.hpp"
 
 #include <algorithm>
 

@@ -2,15 +2,17 @@
 // of every joint is compiled twice from the spec (once as Model::tree, once as the model
 // itself), and the model's coordinates become the joints that no coupling sets.
 #pragma once
+#include "compile/compile.hpp"
+#include "compile/spec.hpp"
 #include "core/model.hpp"
 #include "core/workspace.hpp"
 
 namespace femdyn {
 
 bool has_coupling_law(const MechanismSpec& spec);
-Model compile_with_coupling_level(MechanismSpec spec);
+Model compile_with_coupling_level(MechanismSpec spec, const CompileOptions& options);
 // compile() without the check below (the tree of a model with a law moves its joints freely).
-Model compile_tree(MechanismSpec spec);
+Model compile_tree(MechanismSpec spec, const CompileOptions& options);
 // Each element that spans two bodies (a rod) must keep its length under the model's
 // kinematics: checked at the reference posture and 64 seeded postures within the limits;
 // otherwise ModelError naming the element, the posture and the change in length.

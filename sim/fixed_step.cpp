@@ -1,4 +1,4 @@
-#include "core/fixed_step.hpp"
+#include "sim/fixed_step.hpp"
 
 #include <chrono>
 #include <cmath>

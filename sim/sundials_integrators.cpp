@@ -1,4 +1,4 @@
-#include "core/sundials_integrators.hpp"
+#include "sim/sundials_integrators.hpp"
 
 #include <arkode/arkode_erkstep.h>
 #include <cvode/cvode.h>

@@ -1,4 +1,4 @@
-#include "core/compile_level.hpp"
+#include "compile/compile_level.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -102,11 +102,11 @@ void check_range(const CoupledJoint& j, const Model& m) {
 
 }  // namespace
 
-Model compile_with_coupling_level(MechanismSpec spec) {
+Model compile_with_coupling_level(MechanismSpec spec, const CompileOptions& options) {
   MechanismSpec tree_spec = spec;  // (elements are shared, immutable)
   tree_spec.couplings.clear();
-  Model tree = compile_tree(tree_spec);
-  Model m = compile_tree(std::move(tree_spec));
+  Model tree = compile_tree(tree_spec, options);
+  Model m = compile_tree(std::move(tree_spec), options);
   for (const Body& b : m.bodies)
     if (b.joint.nv > 1)
       throw ModelError(b.joint.where, "joint '" + b.joint.name + "' is " +
@@ -171,6 +171,7 @@ Model compile_with_coupling_level(MechanismSpec spec) {
   m.dynamics_route = DynamicsRoute::Cholesky;
   m.coupling_level = std::move(level);
   m.tree = std::make_shared<const Model>(std::move(tree));
+  m.routes = choose_equation_routes(m);  // the law chain
   check_rigid_spans(m);
   return m;
 }

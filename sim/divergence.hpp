@@ -1,5 +1,5 @@
 // A numerical solution that diverges (docs/simulation.md#divergence), told from the energy
-// balance E(t) − E(0) = W(t) that the exact motion keeps (core/motion.hpp). Dampers only take
+// balance E(t) − E(0) = W(t) that the exact motion keeps (sim/motion.hpp). Dampers only take
 // energy out, so the energy the state holds beyond what the forces supplied,
 //
 //   gain(t) = E(t) − E(0) − max(0, max_{s≤t} W(s)),

@@ -25,7 +25,7 @@
 
 #include "core/body_inertia.hpp"
 #include "core/equations.hpp"
-#include "core/integrator.hpp"
+#include "sim/integrator.hpp"
 
 namespace femdyn {
 

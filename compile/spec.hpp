@@ -1,5 +1,5 @@
 // MechanismSpec: a mechanism as described by the user, before compilation. Front ends (io/)
-// fill it; compile() (core/compile.cpp) turns it into an immutable Model. Every part carries
+// fill it; compile() (compile/compile.cpp) turns it into an immutable Model. Every part carries
 // `where`, the label of its place in the source file ("file.json: /bodies/3"), used in error
 // messages; compile appends JSON-pointer segments to it to name a field.
 #pragma once

@@ -1,4 +1,4 @@
-#include "core/divergence.hpp"
+#include "sim/divergence.hpp"
 
 namespace femdyn {
 

@@ -1,12 +1,14 @@
 // compile(): MechanismSpec -> Model. Tree order and joints, the coupling level θ = C q + θ0,
-// then the node level and the correlation table (core/correlation.cpp).
+// then the node level and the correlation table (compile/correlation.cpp).
+#include "compile/compile.hpp"
+
 #include <cmath>
 #include <map>
 #include <set>
 
+#include "compile/compile_level.hpp"
+#include "compile/correlation.hpp"
 #include "core/body_inertia.hpp"
-#include "core/compile_level.hpp"
-#include "core/correlation.hpp"
 #include "core/errors.hpp"
 #include "core/joints/kernel.hpp"
 #include "core/limits.hpp"
@@ -245,14 +247,14 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
 
 }  // namespace
 
-Model compile(MechanismSpec spec) {
-  if (has_coupling_law(spec)) return compile_with_coupling_level(std::move(spec));
-  Model m = compile_tree(std::move(spec));
+Model compile(MechanismSpec spec, const CompileOptions& options) {
+  if (has_coupling_law(spec)) return compile_with_coupling_level(std::move(spec), options);
+  Model m = compile_tree(std::move(spec), options);
   check_rigid_spans(m);
   return m;
 }
 
-Model compile_tree(MechanismSpec spec) {
+Model compile_tree(MechanismSpec spec, const CompileOptions& options) {
   Model m;
   m.name = spec.name;
   m.where = spec.where.size() >= 2 ? spec.where.substr(0, spec.where.size() - 2) : spec.where;
@@ -297,9 +299,12 @@ Model compile_tree(MechanismSpec spec) {
   }
   compile_coupling(spec, m);
   name_configuration(m);
+  // The passes below run kinematics on the model being built: its routes so far (the reference
+  // ones, no law) until choose_routes settles them.
+  m.routes = choose_equation_routes(m);
   build_node_level(spec, body_of_spec, m);
   condense_body_inertia(m);
-  choose_routes(m);
+  choose_routes(m, options.routes);
   analyse_mass_pattern(m);
   check_mass_matrix(m);
   return m;

@@ -1,4 +1,4 @@
-#include "core/motion.hpp"
+#include "sim/motion.hpp"
 
 #include <cmath>
 #include <cstdio>

@@ -1,4 +1,4 @@
-// Fixed-step integrators (core/integrator.hpp): steps on the grid t_k = t0 + k dt (times are
+// Fixed-step integrators (sim/integrator.hpp): steps on the grid t_k = t0 + k dt (times are
 // computed, never summed, so no round-off accumulates); an output time between two grid times
 // is landed on by a shortened step, and the next step returns to the grid. Buffers are sized
 // at construction; a step allocates nothing.
@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <array>
 
-#include "core/integrator.hpp"
+#include "sim/integrator.hpp"
 
 namespace femdyn {
 

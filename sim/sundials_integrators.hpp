@@ -1,4 +1,4 @@
-// Adaptive integrators from SUNDIALS 6.4 (core/integrator.hpp):
+// Adaptive integrators from SUNDIALS 6.4 (sim/integrator.hpp):
 //   DormandPrince  ARKODE ERKStep with the Dormand–Prince 7-stage 5(4) table (first same as
 //                  last), local error control on y, Hermite dense output at t_out.
 //   Bdf            CVODE variable-order BDF (1–5) with CVODE's Newton iteration and a dense
@@ -11,7 +11,7 @@
 #pragma once
 #include <string>
 
-#include "core/integrator.hpp"
+#include "sim/integrator.hpp"
 
 namespace femdyn {
 

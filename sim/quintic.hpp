@@ -1,5 +1,5 @@
 // The quintic (minimum-jerk) point-to-point reference used for computed-torque trajectories
-// (femdyn track). Time integration is in core/integrator.hpp.
+// (femdyn track). Time integration is in sim/integrator.hpp.
 #pragma once
 #include "core/math.hpp"
 

@@ -1,5 +1,5 @@
 // Integrators of M^s q̈ + h = Q in time (docs/simulation.md). Each is an object that owns its
-// buffers and its right-hand side (core/motion.hpp), takes a plain options struct with defaults
+// buffers and its right-hand side (sim/motion.hpp), takes a plain options struct with defaults
 // and a check that names the bad field, and after the first step allocates nothing per step.
 //
 //   Rk4             classical fixed-step Runge–Kutta, order 4, 4 evaluations a step
@@ -12,7 +12,7 @@
 // The state is y = (q, q̇, W), W the work of the non-conservative forces. A failure (step-size
 // underflow, NaN in the state, M^s losing definiteness, a Newton solver that does not converge)
 // is a failed Status naming the time, the quantity and the likely cause; the integrator keeps
-// its last good state. Divergence is looked for first (core/divergence.hpp): a run whose state
+// its last good state. Divergence is looked for first (sim/divergence.hpp): a run whose state
 // blows up fails as "the solution diverges" with the stiffest mode and the step it allows, even
 // where the blown-up state then makes M^s singular or overflows.
 #pragma once
@@ -21,8 +21,8 @@
 #include <string>
 #include <string_view>
 
-#include "core/divergence.hpp"
-#include "core/motion.hpp"
+#include "sim/divergence.hpp"
+#include "sim/motion.hpp"
 
 namespace femdyn {
 
@@ -110,7 +110,7 @@ class Integrator {
   virtual void start() = 0;  // after reset: (re)initialise the method at (t_, y_, t_stop_)
   virtual Status advance(double t_out) = 0;  // the method's own advance_to
   virtual Status one_step() = 0;             // the method's own step
-  // After an accepted step: the divergence test when the rates have grown (core/divergence.hpp).
+  // After an accepted step: the divergence test when the rates have grown (sim/divergence.hpp).
   Status watch();
   // A failure, unless the last good state shows the solution diverging: then that, first.
   Status explain(Status failure);

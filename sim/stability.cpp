@@ -1,4 +1,4 @@
-#include "core/stability.hpp"
+#include "sim/stability.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <cmath>

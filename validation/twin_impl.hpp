@@ -1,0 +1,92 @@
+// What the files of the Simbody twin share (twin.hpp): SimbodyTwin::Impl, the Simbody system
+// built from a TwinModel and the maps between femdyn's θ, q and Simbody's state. Includes
+// Simbody: read only by the twin's own files, compiled like twin.cpp (C++17, without NDEBUG).
+//   twin_mobilizers.cpp  femdyn bodies and joints as mobilized bodies, forces, the system
+//   twin_couplings.cpp   couplings θ = C q + θ0 as coordinate couplers
+//   twin_loops.cpp       the closed loops (laws and rods)
+//   twin_state.cpp       femdyn q, q̇ <-> Simbody's state; Cᵀ and C on Simbody's u layout
+//   twin.cpp             the equations, inverse dynamics and the timing entry points
+//   twin_simulate.cpp    Simbody's integrators and trajectories
+#pragma once
+#include <Simbody.h>
+
+#include <string>
+#include <vector>
+
+#include "validation/twin.hpp"
+
+namespace femdyn::validation {
+
+// A message on one line: its lines joined by spaces, without SimTK's "SimTK Exception thrown
+// at file:line:" headers. (The first line alone would often be such a header, or
+// "Integrator step failed at time 0 apparently because:", with the cause on the next lines.)
+std::string one_line(const std::string& text);
+
+constexpr bool kTiming = false;  // set_state's fit_rods in the timing entry points
+
+struct SimbodyTwin::Impl {
+  const TwinModel model;
+  SimTK::MultibodySystem system;
+  SimTK::SimbodyMatterSubsystem matter{system};
+  SimTK::GeneralForceSubsystem forces{system};
+  std::vector<SimTK::MobilizedBody> mobod;  // per femdyn body
+  std::vector<SimTK::MobilizedBody> rods;   // closed loop: per TwinModel::rods
+  VecX loop_theta, loop_theta_dot;          // closed loop: θ = g(q), θ̇ = G q̇
+  std::vector<int> theta_q, theta_u;        // θ index -> Simbody q / u index
+  std::vector<int> independent;             // q index -> θ index, -1 if none
+  bool couplers = true;
+  Eigen::SparseMatrix<double, Eigen::RowMajor> C_rows;  // C by rows: θ_j = Σ C_jk q_k + θ0_j
+  SimTK::State state;
+  SimTK::Matrix M_theta;
+  SimTK::Vector zero_mobility, residual, mobility, udot;
+  SimTK::Vector_<SimTK::SpatialVec> zero_body, A_GB;
+
+  explicit Impl(TwinModel tm);
+
+  // One femdyn body as a mobilized body with its mobilizer, spring and damper.
+  void add_body(const TwinBody& j);
+
+  // Gravity, loads and couplers, then the realized state.
+  void finish_system();
+
+  // Couplings θ_j = Σ_k C_jk q_k + θ0_j as constraints among the mobilities, for trajectories.
+  void add_linear_couplers();
+
+  // The realized state and the index maps.
+  void finish_state();
+
+  VecX reduce(const SimTK::Vector& f_theta) const;  // Cᵀ f_θ
+
+  // Buffers of the timing entry points (time_*).
+  SimTK::Vector bench_applied, bench_udot, bench_theta_ddot, bench_out;
+  SimTK::Vector_<SimTK::SpatialVec> bench_A_GB;
+  VecX bench_rest;                  // q̇ = 0
+  SimTK::Matrix bench_h1, bench_D;  // h(e_b) by columns; D_sym(·, b, c) in column b n + c
+
+  const VecX& rest();  // q̇ = 0, sized by the first call
+
+  // θ̇ = C (e_b + e_c) (c < 0: C e_b) written into the state; invalidates Velocity and above
+  // only, so the realized Position stage stays.
+  void set_unit_rates(int b, int c);
+
+  // Sets θ = C q + θ0, θ̇ = C q̇ (without temporaries: the timing entry points use it too) and
+  // realizes `stage`. Closed loop: θ = g(q), θ̇ = G q̇, and each rod fitted between its ends
+  // unless `fit_rods` is false (the timing entry points: a rod left as the last call set it
+  // changes none of the work Simbody does, only its constraint errors).
+  void set_state(const VecX& q, const VecX& qd, SimTK::Stage stage, bool fit_rods = true);
+
+  // θ, θ̇ and the energy of an integrator's state.
+  TwinSample sample(const SimTK::State& st) const;
+
+  // Closed loop: q̈ of the coordinates by Simbody's constrained forward dynamics under these
+  // applied forces.
+  VecX constrained_qdd(const SimTK::Vector& applied, const SimTK::Vector_<SimTK::SpatialVec>& body);
+
+  // Closed loop: M^s as the inverse of q̈'s response to a unit force on each coordinate,
+  // (M^s)⁻¹ e_k = q̈(e_k) − q̈(0), with a0 = q̈(no force).
+  MatX constrained_mass(const VecX& a0);
+
+  SimTK::Vector expand(const VecX& x) const;  // C x on Simbody's u layout
+};
+
+}  // namespace femdyn::validation

@@ -1,0 +1,107 @@
+// The twin's mechanism (twin_impl.hpp): each femdyn body on a Simbody mobilized body whose
+// mobilizer is its joint, the forces, and the system the constraints then close. Compiled like
+// twin.cpp (C++17, without NDEBUG).
+#include <Simbody.h>
+
+#include "core/names.hpp"
+#include "validation/twin_impl.hpp"
+#include "validation/twin_loops.hpp"
+
+namespace femdyn::validation {
+
+namespace {
+
+SimTK::Vec3 to_simtk(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+SimTK::Rotation to_simtk(const Mat3& R) {
+  SimTK::Mat33 m;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) m(i, j) = R(i, j);
+  return SimTK::Rotation(m, true);  // R is orthonormal (built from rpy)
+}
+
+SimTK::MassProperties mass_properties(const TwinBody& p) {
+  const Mat3& I = p.inertia_origin;  // Simbody wants the inertia about the body origin
+  return SimTK::MassProperties(
+      p.mass, to_simtk(p.com),
+      SimTK::Inertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)));
+}
+
+}  // namespace
+
+SimbodyTwin::Impl::Impl(TwinModel tm) : model(std::move(tm)), C_rows(model.C) {
+  using namespace SimTK;
+  const TwinModel& m = model;
+  const int nb = static_cast<int>(m.bodies.size());
+  mobod.reserve(nb);
+  for (int b = 0; b < nb; ++b) {
+    const TwinBody& j = m.bodies[b];
+    try {
+      add_body(j);
+    } catch (const std::exception& e) {
+      throw femdyn::Error("Simbody refuses body '" + escaped(j.name) + "': " + one_line(e.what()));
+    }
+  }
+  try {
+    rods = loops::add_rods(m, mobod);
+  } catch (const std::exception& e) {
+    throw femdyn::Error("Simbody refuses a rod: " + one_line(e.what()));
+  }
+  finish_system();
+}
+
+void SimbodyTwin::Impl::add_body(const TwinBody& j) {
+  using namespace SimTK;
+  {
+    MobilizedBody& parent =
+        j.parent < 0 ? static_cast<MobilizedBody&>(matter.updGround()) : mobod[j.parent];
+    const SimTK::Body::Rigid rigid(mass_properties(j));
+    const Rotation R_pj = to_simtk(j.R_pj);
+    const SimTK::Vec3 p_pj = to_simtk(j.p_pj);
+    switch (j.joint) {
+      case TwinBody::Joint::Revolute: {
+        const Rotation R_a(UnitVec3(to_simtk(j.axis)), ZAxis);  // Pin turns about z
+        mobod.push_back(MobilizedBody::Pin(parent, Transform(R_pj * R_a, p_pj), rigid,
+                                           Transform(R_a, SimTK::Vec3(0))));
+        break;
+      }
+      case TwinBody::Joint::Prismatic: {
+        const Rotation R_a(UnitVec3(to_simtk(j.axis)), XAxis);  // Slider moves along x
+        mobod.push_back(MobilizedBody::Slider(parent, Transform(R_pj * R_a, p_pj), rigid,
+                                              Transform(R_a, SimTK::Vec3(0))));
+        break;
+      }
+      case TwinBody::Joint::Fixed:
+        mobod.push_back(MobilizedBody::Weld(parent, Transform(R_pj, p_pj), rigid, Transform()));
+        break;
+    }
+    if (j.theta >= 0) {
+      if (j.stiffness != 0)
+        Force::MobilityLinearSpring(forces, mobod.back(), MobilizerQIndex(0), j.stiffness, j.rest);
+      if (j.damping != 0)
+        Force::MobilityLinearDamper(forces, mobod.back(), MobilizerUIndex(0), j.damping);
+    }
+  }
+}
+
+void SimbodyTwin::Impl::finish_system() {
+  using namespace SimTK;
+  const TwinModel& m = model;
+  if (m.gravity.norm() > 0)
+    Force::Gravity(forces, matter, UnitVec3(to_simtk(m.gravity)), m.gravity.norm());
+  for (const TwinModel::Load& l : m.loads) {
+    if (!l.force.isZero(0))
+      Force::ConstantForce(forces, mobod[l.body], to_simtk(l.point), to_simtk(l.force));
+    if (!l.torque.isZero(0)) Force::ConstantTorque(forces, mobod[l.body], to_simtk(l.torque));
+  }
+
+  if (m.closed_loop()) {  // the laws and rods as constraints, pointwise and for trajectories
+    independent = m.coordinate_theta;
+    loops::add_constraints(matter, m, mobod, rods);
+  } else {
+    add_linear_couplers();
+  }
+  finish_state();
+}
+
+}  // namespace femdyn::validation
