@@ -152,6 +152,7 @@ LoadOptions load_options(const Args& a) {
     opt.gravity = Vec3(g[0], g[1], g[2]);
     opt.gravity_source = "--gravity";
   }
+  opt.floating_base = a.has("floating-base");
   return opt;
 }
 
@@ -172,7 +173,8 @@ Args parse_args(int argc, char** argv, int first, const std::vector<std::string>
       value = key.substr(eq + 1);
       key = key.substr(0, eq);
     }
-    if (std::find(flags.begin(), flags.end(), key) != flags.end()) {
+    // --floating-base: every command that loads a model (load_options).
+    if (key == "floating-base" || std::find(flags.begin(), flags.end(), key) != flags.end()) {
       if (inline_value) throw CliError("--" + key + " takes no value");
       a.options[key] = "";
     } else if (std::find(valued.begin(), valued.end(), key) != valued.end()) {

@@ -526,7 +526,7 @@ std::string read_text(const std::string& path) { return read_input_file(path); }
 
 Json model_document(const std::string& path, const LoadOptions& options) {
   if (is_urdf_path(path)) {
-    UrdfResult r = read_urdf(path);
+    UrdfResult r = read_urdf(path, {.floating_base = options.floating_base});
     if (options.warn)
       for (const std::string& w : r.warnings) options.warn(w);
     return std::move(r.model);
@@ -541,6 +541,10 @@ Json model_document(const std::string& path, const LoadOptions& options) {
 
 MechanismSpec read_spec(const std::string& path, const LoadOptions& options) {
   const Catalog& catalog = options.catalog ? *options.catalog : default_catalog();
+  if (!is_urdf_path(path) && options.floating_base)
+    throw ModelError(path,
+                     "--floating-base is for URDF models: a JSON model gives its root body a "
+                     "free joint itself (\"joint\": {\"type\": \"free\"})");
   if (!is_urdf_path(path)) return parse_spec(read_text(path), path, catalog);
   const Json doc = model_document(path, options);
   try {

@@ -18,6 +18,7 @@ struct LoadOptions {
   std::function<void(const std::string&)> warn;  // non-fatal notes (e.g. URDF friction ignored)
   const Catalog* catalog = nullptr;  // element types and model plugins; null: default_catalog()
   CompileOptions compile;            // e.g. the routes (compile/compile.hpp)
+  bool floating_base = false;        // URDF: a free joint under the root link (io/urdf_loader.hpp)
 };
 
 // A model file: femdyn JSON, or URDF by its extension .urdf (io/urdf_loader.hpp).

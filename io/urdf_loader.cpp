@@ -105,7 +105,8 @@ bool is_urdf_path(const std::string& path) {
   return path.size() >= 5 && path.compare(path.size() - 5, 5, ".urdf") == 0;
 }
 
-UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
+UrdfResult urdf_to_model(const std::string& text, const std::string& source,
+                         const UrdfOptions& options) {
   const Ctx c{source};
   if (text.find("xmlns:xacro") != std::string::npos || text.find("<xacro:") != std::string::npos)
     throw ModelError(source,
@@ -195,17 +196,29 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
     const std::string who = "joint '" + ji.name + "'";
     const char* type_c = ji.e->Attribute("type");
     const std::string type = type_c ? type_c : "";
-    if (type == "floating" || type == "planar")
-      c.fail(who, "type " + quoted_text(type) +
-                      " is not supported (revolute, continuous, prismatic, fixed)");
-    if (type != "revolute" && type != "continuous" && type != "prismatic" && type != "fixed")
+    if (type != "revolute" && type != "continuous" && type != "prismatic" && type != "fixed" &&
+        type != "floating" && type != "planar")
       c.fail(who, "unknown type " + quoted_text(type));
     if (ji.child == "world") c.fail(who, "a link named 'world' can only be the root");
     const Origin o = origin_of(c, ji.e, who);
     Json joint = {{"name", ji.name},
-                  {"type", type == "continuous" ? "revolute" : type},
+                  {"type", type == "continuous" ? "revolute"
+                           : type == "floating" ? "free"
+                                                : type},
                   {"origin", {{"xyz", vec3_json(o.xyz)}, {"rpy", vec3_json(o.rpy)}}}};
-    if (type != "fixed") {
+    if (type == "floating" || type == "planar") {  // (no limits, dynamics or mimic: not used)
+      for (const char* unused : {"limit", "dynamics", "mimic"})
+        if (ji.e->FirstChildElement(unused))
+          out.warnings.push_back(source + ": " + who + ": <" + unused + "> ignored on a " + type +
+                                 " joint (femdyn models none on a joint of several coordinates)");
+      if (type == "planar") {  // the axis is the plane's normal
+        const Vec3 axis = vec_attr(c, ji.e->FirstChildElement("axis"), "xyz", Vec3::UnitZ(), who);
+        if (!(axis.norm() > 1e-12)) c.fail(who, "axis is zero");
+        joint["axis"] = vec3_json(axis.normalized());
+      } else if (ji.e->FirstChildElement("axis")) {
+        out.warnings.push_back(source + ": " + who + ": <axis> ignored on a floating joint");
+      }
+    } else if (type != "fixed") {
       const Vec3 axis = vec_attr(c, ji.e->FirstChildElement("axis"), "xyz", Vec3::UnitX(), who);
       if (!(axis.norm() > 1e-12)) c.fail(who, "axis is zero");
       joint["axis"] = vec3_json(axis.normalized());
@@ -235,24 +248,37 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source) {
                              {"offset", number_attr(c, mimic, "offset", 0.0, who)}});
       }
     }
+    const bool under_world = ji.parent == root && !options.floating_base;
     Json body = {
-        {"name", ji.child}, {"parent", ji.parent == root ? "world" : ji.parent}, {"joint", joint}};
+        {"name", ji.child}, {"parent", under_world ? "world" : ji.parent}, {"joint", joint}};
     const Json element = inertial_element(c, links.at(ji.child), "link '" + ji.child + "'");
     if (!element.is_null()) body["elements"] = Json::array({element});
     bodies.push_back(body);
   }
-  // The root link's own inertia never moves (it is welded to the world); still check it.
-  (void)inertial_element(c, links.at(root), "link '" + root + "'");
+  // The root link: welded to the world, its inertia never moves (still checked); or floating.
+  const Json root_element = inertial_element(c, links.at(root), "link '" + root + "'");
+  if (options.floating_base) {
+    if (root == "world")
+      c.fail("link 'world'", "the root link is the world itself, to which the robot is joined: "
+                             "--floating-base floats a root link that is a part of the robot");
+    Json base = {
+        {"name", root}, {"parent", "world"}, {"joint", {{"name", root}, {"type", "free"}}}};
+    if (!root_element.is_null()) base["elements"] = Json::array({root_element});
+    bodies.insert(bodies.begin(), base);
+  }
   const char* name = robot->Attribute("name");
-  out.model = {
-      {"name", name ? name : root},
-      {"description", "imported from " + source + "; root link '" + root + "' welded to the world"},
-      {"gravity", {0, 0, -9.81}},
-      {"bodies", bodies}};
+  out.model = {{"name", name ? name : root},
+               {"description", "imported from " + source + "; root link '" + root + "' " +
+                                   (options.floating_base ? "floating (a free joint to the world)"
+                                                          : "welded to the world")},
+               {"gravity", {0, 0, -9.81}},
+               {"bodies", bodies}};
   if (!couplings.empty()) out.model["couplings"] = couplings;
   return out;
 }
 
-UrdfResult read_urdf(const std::string& path) { return urdf_to_model(read_input_file(path), path); }
+UrdfResult read_urdf(const std::string& path, const UrdfOptions& options) {
+  return urdf_to_model(read_input_file(path), path, options);
+}
 
 }  // namespace femdyn

@@ -1,9 +1,11 @@
 // Reading URDF (plain URDF; xacro is refused) into a femdyn model document — the same JSON a
 // hand-written model would be — so that a robot loads, validates and exports like any model.
 //   links  -> bodies with one rigid_body element (inertia rotated out of the <inertial> frame)
-//   joints -> revolute / continuous / prismatic / fixed joints; <mimic> -> couplings;
+//   joints -> revolute / continuous / prismatic / fixed / planar joints, floating -> free;
+//             <mimic> -> couplings;
 //             <dynamics damping> -> joint dampers (friction is ignored, with a warning)
-//   the root link is welded to the world: its children hang from "world".
+//   the root link is welded to the world (its children hang from "world"), or with
+//   `floating_base` a body of its own on a free joint named after it (a floating base).
 // Errors: ModelError "file.urdf: joint 'elbow': axis is zero" (the element and the problem).
 #pragma once
 #include <string>
@@ -18,8 +20,12 @@ struct UrdfResult {
   std::vector<std::string> warnings;  // e.g. ignored friction
 };
 
-UrdfResult urdf_to_model(const std::string& xml_text, const std::string& source);
-UrdfResult read_urdf(const std::string& path);
+struct UrdfOptions {
+  bool floating_base = false;  // a free joint between the world and the root link
+};
+UrdfResult urdf_to_model(const std::string& xml_text, const std::string& source,
+                         const UrdfOptions& options = {});
+UrdfResult read_urdf(const std::string& path, const UrdfOptions& options = {});
 
 bool is_urdf_path(const std::string& path);  // by extension (.urdf)
 

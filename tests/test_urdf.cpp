@@ -8,8 +8,12 @@
 #include <fstream>
 #include <iterator>
 #include <numbers>
+#include <random>
 
+#include "core/equations.hpp"
 #include "core/errors.hpp"
+#include "core/sampling.hpp"
+#include "io/model_loader.hpp"
 #include "io/urdf_loader.hpp"
 #include "tests/helpers.hpp"
 #ifdef FEMDYN_WITH_SIMBODY
@@ -285,11 +289,10 @@ TEST_CASE("bad URDF: one line naming the file, the link or joint, and the proble
       Equals("bad.urdf: link 'l': value is NaN or Inf"));
   CHECK_THAT(error_of(one_link(ok_inertial, "", "0 0 0")),
              Equals("bad.urdf: joint 'j': axis is zero"));
-  CHECK_THAT(error_of(one_link(ok_inertial, "", "1 0 0", "floating")),
-             Equals("bad.urdf: joint 'j': type 'floating' is not supported (revolute, continuous, "
-                    "prismatic, fixed)"));
-  CHECK_THAT(error_of(one_link(ok_inertial, "", "1 0 0", "planar")),
-             Catch::StartsWith("bad.urdf: joint 'j': type 'planar' is not supported"));
+  CHECK_THAT(error_of(one_link(ok_inertial, "", "0 0 0", "planar")),
+             Equals("bad.urdf: joint 'j': axis is zero"));
+  CHECK_THAT(error_of(one_link(ok_inertial, "", "1 0 0", "hinge")),
+             Equals("bad.urdf: joint 'j': unknown type 'hinge'"));
   CHECK_THAT(
       error_of(
           R"(<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:macro name="m"/></robot>)"),
@@ -368,4 +371,40 @@ TEST_CASE("a URDF link with inertia but zero mass is a pure rotary inertia", "[u
   evaluate(m, ws, VecX::Constant(1, 0.7), VecX::Constant(1, 3.0), VecX());
   CHECK(ws.Ms(0, 0) == Approx(J(0, 0)).epsilon(1e-12));
   CHECK(std::abs(ws.h[0]) < 1e-15);  // spinning about a fixed axis: no velocity force on it
+}
+
+TEST_CASE("URDF floating and planar joints load as free and planar joints", "[urdf]") {
+  const std::string ok_inertial = inertial(2.0, "0 0.1 0", "0 0 0", 0.1, 0.2, 0.25);
+  const Model f = load_urdf_text(one_link(ok_inertial, "", "1 0 0", "floating"));
+  REQUIRE(f.bodies.size() == 1);
+  CHECK(f.bodies[0].joint.type == JointType::Free);
+  CHECK(f.n() == 6);
+  CHECK(f.n_q() == 7);
+  const Model p = load_urdf_text(one_link(ok_inertial, "", "0 0 2", "planar"));
+  CHECK(p.bodies[0].joint.type == JointType::Planar);
+  CHECK(p.bodies[0].joint.axis.isApprox(Vec3::UnitZ()));
+  CHECK(p.coordinate_names == std::vector<std::string>{"j.x", "j.y", "j.theta"});
+}
+
+TEST_CASE("--floating-base: a free root, in free fall every joint keeps still", "[urdf]") {
+  // Uniform gravity on a free mechanism at rest accelerates every body by g: the base's
+  // linear acceleration (in its own axes) is Rᵀg, and no joint accelerates.
+  for (const char* robot : {"atlas.urdf", "hyq.urdf"}) {
+    INFO(robot);
+    const std::string path = std::string(FEMDYN_SOURCE_DIR) + "/tests/robots/" + robot;
+    LoadOptions o;
+    o.floating_base = true;
+    const Model m = load_model(path, o);
+    REQUIRE(m.bodies[0].joint.type == JointType::Free);
+    REQUIRE(m.bodies[0].parent == -1);
+    CHECK(m.n_q() == m.n() + 1);
+    Workspace ws(m);
+    std::mt19937 rng(4);
+    const VecX q = random_posture(m, rng);
+    REQUIRE(forward_dynamics(m, ws, q, VecX::Zero(m.n()), VecX::Zero(m.n())).ok);
+    const Mat3 R = Eigen::Quaterniond(q[3], q[4], q[5], q[6]).toRotationMatrix();
+    CHECK((ws.qdd.head<3>() - R.transpose() * m.gravity).norm() < 1e-10 * m.gravity.norm());
+    CHECK(ws.qdd.segment<3>(3).norm() < 1e-10);
+    CHECK(ws.qdd.tail(m.n() - 6).cwiseAbs().maxCoeff() < 1e-9);
+  }
 }
