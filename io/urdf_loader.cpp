@@ -259,8 +259,9 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source,
   const Json root_element = inertial_element(c, links.at(root), "link '" + root + "'");
   if (options.floating_base) {
     if (root == "world")
-      c.fail("link 'world'", "the root link is the world itself, to which the robot is joined: "
-                             "--floating-base floats a root link that is a part of the robot");
+      c.fail("link 'world'",
+             "the root link is the world itself, to which the robot is joined: "
+             "--floating-base floats a root link that is a part of the robot");
     Json base = {
         {"name", root}, {"parent", "world"}, {"joint", {{"name", root}, {"type", "free"}}}};
     if (!root_element.is_null()) base["elements"] = Json::array({root_element});

@@ -386,7 +386,8 @@ TEST_CASE("URDF floating and planar joints load as free and planar joints", "[ur
   CHECK(p.coordinate_names == std::vector<std::string>{"j.x", "j.y", "j.theta"});
 }
 
-TEST_CASE("--floating-base: a free root, in free fall every joint keeps still", "[urdf]") {
+TEST_CASE("URDF with a floating base: a free root, in free fall every joint keeps still",
+          "[urdf]") {
   // Uniform gravity on a free mechanism at rest accelerates every body by g: the base's
   // linear acceleration (in its own axes) is Rᵀg, and no joint accelerates.
   for (const char* robot : {"atlas.urdf", "hyq.urdf"}) {
