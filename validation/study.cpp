@@ -48,7 +48,7 @@ Sampled femdyn_run(const Model& m, const IntegratorOptions& o, const StudyOption
   Workspace ws(m);
   const auto sample = [&] {
     joint_state(m, ws, integ->q(), integ->qd());
-    VecX x(2 * m.n_theta());
+    VecX x(ws.theta.size() + ws.theta_dot.size());
     x << ws.theta, ws.theta_dot;
     s.x.push_back(std::move(x));
     s.energy.push_back(integ->motion().energy_at(integ->y().data()).total());
