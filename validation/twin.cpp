@@ -70,13 +70,19 @@ TwinEquations SimbodyTwin::equations_unguarded(const VecX& q, const VecX& qd, co
     MatX Mt(nt, nt);
     for (int a = 0; a < nt; ++a)
       for (int b = 0; b < nt; ++b) Mt(a, b) = s.M_theta(s.theta_u[a], s.theta_u[b]);
+    for (std::size_t i = 0; i < s.rotated.size(); ++i) {  // M_v = Pᵀ M_u P
+      const int r = s.rotated[i].rate;
+      Mt.middleRows<3>(r) = s.rot[i].transpose() * Mt.middleRows<3>(r);
+      Mt.middleCols<3>(r) = Mt.middleCols<3>(r) * s.rot[i];
+    }
     const MatX MtC = Mt * m.C;
     out.M = m.C.transpose() * MtC;
   }
 
-  // h: residual with no applied force and θ̈ = 0 is the velocity (Coriolis, gyroscopic) term.
-  s.matter.calcResidualForceIgnoringConstraints(s.state, s.zero_mobility, s.zero_body,
-                                                s.zero_mobility, s.residual);
+  // h: residual with no applied force and θ̈ = 0 is the velocity (Coriolis, gyroscopic) term;
+  // with v̇ = 0 Simbody's u̇ is Ṗ v, so h_v = Pᵀ (h_u + M_u Ṗ v).
+  s.matter.calcResidualForceIgnoringConstraints(s.state, s.zero_mobility, s.zero_body, s.pdot_v,
+                                                s.residual);
   out.h = s.reduce(s.residual);
 
   // Q: what Simbody's force elements apply, as generalized forces, plus τ on q.
@@ -84,15 +90,14 @@ TwinEquations SimbodyTwin::equations_unguarded(const VecX& q, const VecX& qd, co
   const SimTK::Vector_<SimTK::SpatialVec>& body =
       s.system.getRigidBodyForces(s.state, SimTK::Stage::Dynamics);
   SimTK::Vector with_forces;
-  s.matter.calcResidualForceIgnoringConstraints(s.state, mob, body, s.zero_mobility, with_forces);
+  s.matter.calcResidualForceIgnoringConstraints(s.state, mob, body, s.pdot_v, with_forces);
   out.Q = s.reduce(s.residual - with_forces) + tau;
 
   if (plain) {
-    SimTK::Vector applied = mob;
-    for (int j = 0; j < nt; ++j) applied[s.theta_u[j]] += tau[j];
+    // τ on v is P τ on u (P orthogonal); v̇ = Pᵀ (u̇ − Ṗ v).
+    SimTK::Vector applied = mob + s.expand(tau);
     s.matter.calcAccelerationIgnoringConstraints(s.state, applied, body, s.udot, s.A_GB);
-    out.qdd.resize(n);
-    for (int j = 0; j < nt; ++j) out.qdd[j] = s.udot[s.theta_u[j]];
+    out.qdd = s.gather(s.udot - s.pdot_v, s.rot);
   } else {
     out.qdd = out.M.llt().solve(out.Q - out.h);
     if (V) out.MV = out.M * *V, out.M = MatX();
@@ -165,7 +170,9 @@ VecX SimbodyTwin::inverse_dynamics_unguarded(const VecX& q, const VecX& qd, cons
     return M * (qdd - a_forces);
   }
   // residual = M_θ θ̈ + h_θ − Q_θ with θ̈ = C q̈;  τ = Cᵀ residual
-  s.matter.calcResidualForceIgnoringConstraints(s.state, mob, body, s.expand(qdd), s.residual);
+  // u̇ = P C q̈ + Ṗ v
+  s.matter.calcResidualForceIgnoringConstraints(s.state, mob, body, s.expand(qdd) + s.pdot_v,
+                                                s.residual);
   return s.reduce(s.residual);
 }
 

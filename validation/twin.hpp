@@ -9,8 +9,15 @@
 //
 // Mapping (docs/validation.md):
 //   femdyn body b, joint (R_pj, p_pj, axis)  ->  MobilizedBody::Pin (revolute, turns about z),
-//       ::Slider (prismatic, moves along x) or ::Weld (fixed), with
-//       X_PF = (R_pj·R_a, p_pj), X_BM = (R_a, 0), R_a taking the mobilizer axis onto `axis`;
+//       ::Slider (prismatic, moves along x), ::Screw (helical, about and along z, the pitch),
+//       ::Universal (about x, then the new y), ::Planar (about z, along x, y) or ::Weld
+//       (fixed), with X_PF = (R_pj·R_a, p_pj), X_BM = (R_a, 0), R_a taking the mobilizer's axes
+//       onto the joint's (z onto `axis`; x, y onto a₁, a₂; x, y, z onto e₁, e₂, n);
+//       spherical -> ::Ball and free -> ::Free, with X_PF = (R_pj, p_pj), X_BM = 1 and
+//       quaternions. Their rates differ: femdyn's v is in B's axes, Simbody's u in F's
+//       (u = R_FM v per triple, the free joint's angular triple first), so u = P v with P
+//       orthogonal and u̇ = P v̇ + Ṗ v (Ṗ v = (0, R_FM (ω × v)) for a free joint, 0 else):
+//       M_v = Pᵀ M_u P, h_v = Pᵀ (h_u + M_u Ṗ v), Q_v = Pᵀ Q_u, forces in by P (P⁻ᵀ = P);
 //   body mass properties = Σ of the body's equivalent elements' Element::mass_properties();
 //   gravity -> Force::Gravity; springs/dampers -> MobilityLinearSpring / MobilityLinearDamper;
 //   point loads and torques -> Force::ConstantForce / ConstantTorque; τ -> applied mobility
@@ -45,11 +52,23 @@ using Vec3 = Eigen::Vector3d;
 struct TwinBody {
   std::string name;  // for messages ("Simbody refuses body 'x': …")
   int parent = -1;   // -1: the ground
-  enum class Joint { Revolute, Prismatic, Fixed } joint = Joint::Fixed;
+  enum class Joint {
+    Revolute,
+    Prismatic,
+    Fixed,
+    Helical,
+    Universal,
+    Planar,
+    Spherical,
+    Free
+  } joint = Joint::Fixed;
   Mat3 R_pj = Mat3::Identity();  // joint frame in the parent body frame
   Vec3 p_pj = Vec3::Zero();
-  Vec3 axis = Vec3::UnitZ();  // unit, joint frame
-  int theta = -1;             // index in θ
+  Vec3 axis = Vec3::UnitZ();   // unit, joint frame
+  Vec3 axis2 = Vec3::UnitX();  // universal: a₂ (B); planar: e₁ (joint frame, ⊥ axis)
+  double pitch = 0;            // helical, m/rad
+  int theta = -1;              // its first coordinate in θ (nq of them)
+  int rate = -1;               // its first rate in θ̇ (nv of them; = theta for nq = nv)
   double stiffness = 0, rest = 0, damping = 0;
   double mass = 0;                     // Σ of the body's equivalent elements:
   Vec3 com = Vec3::Zero();             //   centre of mass (body frame)
@@ -79,7 +98,8 @@ struct TwinRod {
 
 struct TwinModel {
   std::vector<TwinBody> bodies;  // parents first
-  std::vector<int> theta_body;   // θ index -> body
+  std::vector<int> theta_body;   // θ̇ index (a rate) -> body
+  int n_theta_q = 0;             // θ's entries (Σ nq; n_theta() without quaternions)
   SpMatX C;                      // θ = C q + θ0 (sparse: the identity is n entries, not n²)
   VecX theta0;
   Vec3 gravity = Vec3::Zero();
@@ -110,7 +130,7 @@ struct TwinEquations {
 
 struct TwinSample {
   double t = 0;
-  VecX theta, theta_dot;  // all joint coordinates θ and rates
+  VecX theta, theta_dot;  // all joint coordinates θ (n_theta_q) and rates (n_theta), femdyn's
   double energy = 0;      // Simbody's kinetic + potential energy
 };
 

@@ -32,8 +32,19 @@ struct SimbodyTwin::Impl {
   std::vector<SimTK::MobilizedBody> mobod;  // per femdyn body
   std::vector<SimTK::MobilizedBody> rods;   // closed loop: per TwinModel::rods
   VecX loop_theta, loop_theta_dot;          // closed loop: θ = g(q), θ̇ = G q̇
-  std::vector<int> theta_q, theta_u;        // θ index -> Simbody q / u index
-  std::vector<int> independent;             // q index -> θ index, -1 if none
+  std::vector<int> theta_q;                 // θ index (n_theta_q) -> Simbody q index
+  std::vector<int> theta_u;                 // θ̇ index (n_theta) -> Simbody u index
+  // A ball's or free joint's triple of rates: Simbody's u there is R_FM times femdyn's (B's
+  // axes to F's), R_FM from the quaternion at Simbody q index `quat`.
+  struct Rotated {
+    int quat = -1;
+    int rate = -1;             // its first θ̇ index
+    bool free_linear = false;  // a free joint's linear triple (its ω at rate + 3)
+  };
+  std::vector<Rotated> rotated;
+  std::vector<Eigen::Matrix3d> rot;  // R_FM of each, at the state set_state set
+  SimTK::Vector pdot_v;              // Ṗ v on Simbody's u layout at that state (0 without free)
+  std::vector<int> independent;      // q index -> θ index, -1 if none
   bool couplers = true;
   Eigen::SparseMatrix<double, Eigen::RowMajor> C_rows;  // C by rows: θ_j = Σ C_jk q_k + θ0_j
   SimTK::State state;
@@ -55,7 +66,13 @@ struct SimbodyTwin::Impl {
   // The realized state and the index maps.
   void finish_state();
 
-  VecX reduce(const SimTK::Vector& f_theta) const;  // Cᵀ f_θ
+  VecX reduce(const SimTK::Vector& f_theta) const;  // Cᵀ Pᵀ f_u
+
+  // R_FM of each rotated triple from Simbody's q.
+  std::vector<Eigen::Matrix3d> rotations(const SimTK::Vector& sq) const;
+  // Pᵀ f_u (femdyn's θ̇ layout) and P x (Simbody's u layout), with these rotations.
+  VecX gather(const SimTK::Vector& f_u, const std::vector<Eigen::Matrix3d>& R) const;
+  SimTK::Vector scatter(const VecX& x, const std::vector<Eigen::Matrix3d>& R) const;
 
   // Buffers of the timing entry points (time_*).
   SimTK::Vector bench_applied, bench_udot, bench_theta_ddot, bench_out;
@@ -86,7 +103,7 @@ struct SimbodyTwin::Impl {
   // (M^s)⁻¹ e_k = q̈(e_k) − q̈(0), with a0 = q̈(no force).
   MatX constrained_mass(const VecX& a0);
 
-  SimTK::Vector expand(const VecX& x) const;  // C x on Simbody's u layout
+  SimTK::Vector expand(const VecX& x) const;  // P C x on Simbody's u layout
 };
 
 }  // namespace femdyn::validation

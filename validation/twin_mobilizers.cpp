@@ -27,6 +27,13 @@ SimTK::MassProperties mass_properties(const TwinBody& p) {
       SimTK::Inertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)));
 }
 
+// The rotation whose x and y axes are the orthonormal x and y (z = x × y).
+SimTK::Rotation frame(const Vec3& x, const Vec3& y) {
+  Mat3 R;
+  R << x.normalized(), y.normalized(), x.normalized().cross(y.normalized());
+  return to_simtk(R);
+}
+
 }  // namespace
 
 SimbodyTwin::Impl::Impl(TwinModel tm) : model(std::move(tm)), C_rows(model.C) {
@@ -71,11 +78,39 @@ void SimbodyTwin::Impl::add_body(const TwinBody& j) {
                                               Transform(R_a, SimTK::Vec3(0))));
         break;
       }
+      case TwinBody::Joint::Helical: {
+        const Rotation R_a(UnitVec3(to_simtk(j.axis)), ZAxis);  // Screw: about and along z
+        mobod.push_back(MobilizedBody::Screw(parent, Transform(R_pj * R_a, p_pj), rigid,
+                                             Transform(R_a, SimTK::Vec3(0)), j.pitch));
+        break;
+      }
+      case TwinBody::Joint::Universal: {  // about x, then the new y: x -> a₁, y -> a₂
+        const Vec3 a2 = (j.axis2 - j.axis2.dot(j.axis) * j.axis).normalized();
+        const Rotation R_a = frame(j.axis, a2);
+        mobod.push_back(MobilizedBody::Universal(parent, Transform(R_pj * R_a, p_pj), rigid,
+                                                 Transform(R_a, SimTK::Vec3(0))));
+        break;
+      }
+      case TwinBody::Joint::Planar: {  // about z, along F's x and y: x, y, z -> e₁, e₂, n
+        const Rotation R_a = frame(j.axis2, j.axis.cross(j.axis2));
+        mobod.push_back(MobilizedBody::Planar(parent, Transform(R_pj * R_a, p_pj), rigid,
+                                              Transform(R_a, SimTK::Vec3(0))));
+        break;
+      }
+      case TwinBody::Joint::Spherical:
+        mobod.push_back(MobilizedBody::Ball(parent, Transform(R_pj, p_pj), rigid, Transform()));
+        break;
+      case TwinBody::Joint::Free:
+        mobod.push_back(MobilizedBody::Free(parent, Transform(R_pj, p_pj), rigid, Transform()));
+        break;
       case TwinBody::Joint::Fixed:
         mobod.push_back(MobilizedBody::Weld(parent, Transform(R_pj, p_pj), rigid, Transform()));
         break;
     }
-    if (j.theta >= 0) {
+    const bool one_rate = j.joint == TwinBody::Joint::Revolute ||
+                          j.joint == TwinBody::Joint::Prismatic ||
+                          j.joint == TwinBody::Joint::Helical;
+    if (j.theta >= 0 && one_rate) {
       if (j.stiffness != 0)
         Force::MobilityLinearSpring(forces, mobod.back(), MobilizerQIndex(0), j.stiffness, j.rest);
       if (j.damping != 0)

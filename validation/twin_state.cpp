@@ -3,39 +3,97 @@
 // (C++17, without NDEBUG).
 #include <Simbody.h>
 
+#include <algorithm>
+
 #include "validation/twin_impl.hpp"
 #include "validation/twin_loops.hpp"
 
 namespace femdyn::validation {
+
+namespace {
+
+// Where coordinate k (rate k) of a femdyn joint sits among its mobilizer's q (u): planar
+// (x, y, θ) against Simbody's (θ, x, y); free (p, quaternion), (v, ω) against (quaternion, p),
+// (ω, v); the others in the same order.
+int q_offset(TwinBody::Joint type, int k) {
+  if (type == TwinBody::Joint::Planar) return (k + 1) % 3;
+  if (type == TwinBody::Joint::Free) return k < 3 ? 4 + k : k - 3;
+  return k;
+}
+int u_offset(TwinBody::Joint type, int k) {
+  if (type == TwinBody::Joint::Planar) return (k + 1) % 3;
+  if (type == TwinBody::Joint::Free) return (k + 3) % 6;
+  return k;
+}
+
+}  // namespace
 
 void SimbodyTwin::Impl::finish_state() {
   using namespace SimTK;
   const TwinModel& m = model;
   state = system.realizeTopology();
   system.realizeModel(state);
-  theta_q.resize(m.n_theta());
-  theta_u.resize(m.n_theta());
-  for (int j = 0; j < m.n_theta(); ++j) {
-    theta_q[j] = mobod[m.theta_body[j]].getFirstQIndex(state);
-    theta_u[j] = mobod[m.theta_body[j]].getFirstUIndex(state);
+  theta_q.assign(std::max(m.n_theta_q, m.n_theta()), -1);
+  theta_u.assign(m.n_theta(), -1);
+  for (std::size_t b = 0; b < m.bodies.size(); ++b) {
+    const TwinBody& tb = m.bodies[b];
+    if (tb.theta < 0) continue;
+    const int rate = tb.rate >= 0 ? tb.rate : tb.theta;  // one index when nq = nv
+    const int q0 = mobod[b].getFirstQIndex(state), u0 = mobod[b].getFirstUIndex(state);
+    const int nq = mobod[b].getNumQ(state), nu = mobod[b].getNumU(state);
+    for (int k = 0; k < nq; ++k) theta_q[tb.theta + k] = q0 + q_offset(tb.joint, k);
+    for (int k = 0; k < nu; ++k) theta_u[rate + k] = u0 + u_offset(tb.joint, k);
+    if (tb.joint == TwinBody::Joint::Spherical) rotated.push_back({q0, rate, false});
+    if (tb.joint == TwinBody::Joint::Free)
+      rotated.push_back({q0, rate, true}), rotated.push_back({q0, rate + 3, false});
   }
+  theta_q.resize(m.n_theta_q > 0 ? m.n_theta_q : m.n_theta());
+  rot.assign(rotated.size(), Eigen::Matrix3d::Identity());
   const int nu = state.getNU();
   zero_mobility = Vector(nu, 0.0);
+  pdot_v = zero_mobility;
   zero_body =
       Vector_<SpatialVec>(matter.getNumBodies(), SpatialVec(SimTK::Vec3(0), SimTK::Vec3(0)));
 }
 
-VecX SimbodyTwin::Impl::reduce(const SimTK::Vector& f_theta) const {  // Cᵀ f_θ
-  VecX f(model.n_theta());
-  for (int j = 0; j < model.n_theta(); ++j) f[j] = f_theta[theta_u[j]];
-  return model.C.transpose() * f;
+std::vector<Eigen::Matrix3d> SimbodyTwin::Impl::rotations(const SimTK::Vector& sq) const {
+  std::vector<Eigen::Matrix3d> out;
+  for (const Rotated& r : rotated)
+    out.push_back(Eigen::Quaterniond(sq[r.quat], sq[r.quat + 1], sq[r.quat + 2], sq[r.quat + 3])
+                      .normalized()
+                      .toRotationMatrix());
+  return out;
 }
 
-SimTK::Vector SimbodyTwin::Impl::expand(const VecX& x) const {  // C x on Simbody's u layout
+VecX SimbodyTwin::Impl::gather(const SimTK::Vector& f_u,
+                               const std::vector<Eigen::Matrix3d>& R) const {  // Pᵀ f_u
+  VecX f(model.n_theta());
+  for (int j = 0; j < model.n_theta(); ++j) f[j] = f_u[theta_u[j]];
+  for (std::size_t i = 0; i < rotated.size(); ++i)
+    f.segment<3>(rotated[i].rate) = R[i].transpose() * f.segment<3>(rotated[i].rate);
+  return f;
+}
+
+SimTK::Vector SimbodyTwin::Impl::scatter(const VecX& x,
+                                         const std::vector<Eigen::Matrix3d>& R) const {  // P x
   SimTK::Vector out(state.getNU(), 0.0);
-  const VecX y = model.C * x;
+  if (rotated.empty()) {
+    for (int j = 0; j < model.n_theta(); ++j) out[theta_u[j]] = x[j];
+    return out;
+  }
+  VecX y = x;
+  for (std::size_t i = 0; i < rotated.size(); ++i)
+    y.segment<3>(rotated[i].rate) = R[i] * x.segment<3>(rotated[i].rate);
   for (int j = 0; j < model.n_theta(); ++j) out[theta_u[j]] = y[j];
   return out;
+}
+
+VecX SimbodyTwin::Impl::reduce(const SimTK::Vector& f_theta) const {  // Cᵀ Pᵀ f_u
+  return model.C.transpose() * gather(f_theta, rot);
+}
+
+SimTK::Vector SimbodyTwin::Impl::expand(const VecX& x) const {  // P C x on Simbody's u layout
+  return scatter(model.C * x, rot);
 }
 
 const VecX& SimbodyTwin::Impl::rest() {  // q̇ = 0, sized by the first call
@@ -65,6 +123,19 @@ void SimbodyTwin::Impl::set_state(const VecX& q, const VecX& qd, SimTK::Stage st
     system.realize(state, stage);
     return;
   }
+  if (!rotated.empty()) {  // a ball or free joint: no coupling (θ = q, θ̇ = v), u = P v
+    for (int i = 0; i < model.n_theta_q; ++i) sq[theta_q[i]] = q[i];
+    rot = rotations(sq);
+    su = scatter(qd, rot);
+    for (std::size_t i = 0; i < rotated.size(); ++i) {
+      if (!rotated[i].free_linear) continue;  // Ṗ v = R (ω × v) on a free joint's v
+      const int r = rotated[i].rate;
+      const Eigen::Vector3d d = rot[i] * qd.segment<3>(r + 3).cross(qd.segment<3>(r));
+      for (int k = 0; k < 3; ++k) pdot_v[theta_u[r + k]] = d[k];
+    }
+    system.realize(state, stage);
+    return;
+  }
   for (int j = 0; j < model.n_theta(); ++j) {
     double theta = model.theta0[j], theta_dot = 0;
     for (decltype(C_rows)::InnerIterator it(C_rows, j); it; ++it) {
@@ -79,15 +150,11 @@ void SimbodyTwin::Impl::set_state(const VecX& q, const VecX& qd, SimTK::Stage st
 
 TwinSample SimbodyTwin::Impl::sample(const SimTK::State& st) const {
   system.realize(st, SimTK::Stage::Dynamics);
-  const int nt = model.n_theta();
   TwinSample out;
   out.t = st.getTime();
-  out.theta.resize(nt);
-  out.theta_dot.resize(nt);
-  for (int j = 0; j < nt; ++j) {
-    out.theta[j] = st.getQ()[theta_q[j]];
-    out.theta_dot[j] = st.getU()[theta_u[j]];
-  }
+  out.theta.resize(static_cast<int>(theta_q.size()));
+  for (std::size_t i = 0; i < theta_q.size(); ++i) out.theta[i] = st.getQ()[theta_q[i]];
+  out.theta_dot = gather(st.getU(), rotations(st.getQ()));
   out.energy = system.calcEnergy(st);
   return out;
 }

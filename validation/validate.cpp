@@ -143,20 +143,39 @@ TwinModel twin_model(const Model& m) {
     TwinBody tb;
     tb.name = m.bodies[b].name;
     tb.parent = m.bodies[b].parent;
-    if (j.type != JointType::Revolute && j.type != JointType::Prismatic &&
-        j.type != JointType::Fixed)
-      throw ModelError(j.where, "joint '" + j.name + "' is " +
-                                    std::string(joint_type_name(j.type)) +
-                                    ": the Simbody twin maps revolute, prismatic and fixed joints "
-                                    "only (its Ball, Free, Universal, Planar and Screw mobilizers "
-                                    "are not mapped yet)");
-    tb.joint = j.type == JointType::Revolute    ? TwinBody::Joint::Revolute
-               : j.type == JointType::Prismatic ? TwinBody::Joint::Prismatic
-                                                : TwinBody::Joint::Fixed;
+    switch (j.type) {
+      case JointType::Revolute:
+        tb.joint = TwinBody::Joint::Revolute;
+        break;
+      case JointType::Prismatic:
+        tb.joint = TwinBody::Joint::Prismatic;
+        break;
+      case JointType::Helical:
+        tb.joint = TwinBody::Joint::Helical;
+        break;
+      case JointType::Universal:
+        tb.joint = TwinBody::Joint::Universal;
+        break;
+      case JointType::Planar:
+        tb.joint = TwinBody::Joint::Planar;
+        break;
+      case JointType::Spherical:
+        tb.joint = TwinBody::Joint::Spherical;
+        break;
+      case JointType::Free:
+        tb.joint = TwinBody::Joint::Free;
+        break;
+      case JointType::Fixed:
+        tb.joint = TwinBody::Joint::Fixed;
+        break;
+    }
     tb.R_pj = j.R_pj;
     tb.p_pj = j.p_pj;
     tb.axis = j.axis;
+    tb.axis2 = j.axis2;
+    tb.pitch = j.pitch;
     tb.theta = j.idx_q;
+    tb.rate = j.idx_v;
     tb.stiffness = j.stiffness;
     tb.rest = j.rest;
     tb.damping = j.damping;
@@ -167,6 +186,7 @@ TwinModel twin_model(const Model& m) {
     t.bodies.push_back(tb);
   }
   t.theta_body = m.theta_joint;
+  t.n_theta_q = m.n_theta_q;
   t.C = m.C;
   t.theta0 = m.theta0;
   t.gravity = m.gravity;
@@ -230,6 +250,17 @@ void accumulate(QuantityError& e, const MatX& femdyn, const MatX& simbody) {
   e.max_rel = std::max(e.max_rel, scale > 0 ? d / scale : d);
 }
 
+// q and −q are one rotation: each quaternion of x (a joint state θ, θ̇) takes the sign nearer
+// ref's (Simbody keeps the sign it starts with, femdyn's integrators keep w ≥ 0).
+void align_quaternions(const Model& m, const VecX& ref, VecX& x) {
+  for (const Body& b : m.bodies) {
+    const Joint& j = b.joint;
+    if (!moves(j) || is_flat(j)) continue;
+    const int at = j.idx_q + j.nq - 4;  // the quaternion is last
+    if (ref.segment<4>(at).dot(x.segment<4>(at)) < 0) x.segment<4>(at) *= -1;
+  }
+}
+
 // femdyn's passive motion by RK4 (sim/fixed_step.hpp) at step dt, sampled at `times`
 // (multiples of dt): the joint states (θ, θ̇) and the states (q, q̇) at the samples.
 // Returns false if the integration failed (M^s singular on the way). An overflow along the
@@ -250,7 +281,7 @@ bool integrate(const Model& m, Workspace& ws, const VecX& q0, const VecX& qd0,
     if (st.non_finite) throw femdyn::Error("along the trajectory: " + st.message);
     if (!st.ok) return false;
     joint_state(m, ws, rk4.q(), rk4.qd());
-    VecX x(2 * m.n_theta());
+    VecX x(ws.theta.size() + ws.theta_dot.size());
     x << ws.theta, ws.theta_dot;
     run.x.push_back(std::move(x));
     run.q.push_back(rk4.q());
@@ -518,6 +549,8 @@ struct Validator::Impl {
       VecX xs(fine.x[i].size()), xt(fine.x[i].size());
       xs << sim[i].theta, sim[i].theta_dot;
       xt << tight[i].theta, tight[i].theta_dot;
+      align_quaternions(m, fine.x[i], xs);
+      align_quaternions(m, fine.x[i], xt);
       simbody_estimate = std::max(simbody_estimate, max_abs(xs - xt));
       tight_scale = std::max(tight_scale, max_abs(xt));
     }
@@ -564,6 +597,8 @@ struct Validator::Impl {
       VecX xs(fine.x[i].size()), xt(fine.x[i].size());
       xs << sim[i].theta, sim[i].theta_dot;
       xt << tight[i].theta, tight[i].theta_dot;
+      align_quaternions(m, fine.x[i], xs);
+      align_quaternions(m, fine.x[i], xt);
       const double err = max_abs(fine.x[i] - xt);  // the finer runs of both
       const double e = energy(m, ws, fine.q[i], fine.qd[i]).total();
       tr.t.push_back(times[i]);
