@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "tests/helpers.hpp"
+#include "tests/validation_checks.hpp"
 #include "validation/twin.hpp"
 #include "validation/validate.hpp"
 
@@ -17,28 +18,6 @@ using validation::ValidationOptions;
 using validation::ValidationReport;
 
 namespace {
-
-ValidationOptions quick(int states, double t_end) {
-  ValidationOptions o;
-  o.states = states;
-  o.t_end = t_end;
-  return o;
-}
-
-void require_pass(const ValidationReport& r, const std::string& label) {
-  INFO(label << (r.failure.empty() ? "" : ": " + r.failure));
-  REQUIRE(r.failure.empty());
-  for (const auto& q : r.quantities) {
-    INFO(q.name << " max rel error " << q.max_rel);
-    CHECK(q.max_rel < 1e-10);
-  }
-  INFO("trajectory: " << r.trajectory.skipped << r.trajectory.stopped << " error "
-                      << r.trajectory.max_state_error << " tolerance " << r.trajectory.tolerance);
-  CHECK(r.trajectory.run);
-  CHECK(r.trajectory.resolved);
-  CHECK(r.trajectory.max_state_error <= r.trajectory.tolerance);
-  CHECK(r.pass());
-}
 
 // A body of full (asymmetric) inertia whose centre of mass is off its origin.
 std::string body(const std::string& name, const std::string& parent, const std::string& joint,

@@ -12,6 +12,7 @@
 #include "core/inertia.hpp"
 #include "elements/rotary_node.hpp"
 #include "tests/helpers.hpp"
+#include "tests/validation_checks.hpp"
 #include "validation/validate.hpp"
 
 using namespace femdyn;
@@ -20,28 +21,6 @@ using validation::ValidationOptions;
 using validation::ValidationReport;
 
 namespace {
-
-ValidationOptions quick(int states = 8, double t_end = 0.1) {
-  ValidationOptions o;
-  o.states = states;
-  o.t_end = t_end;
-  return o;
-}
-
-void require_pass(const ValidationReport& r, const std::string& label) {
-  INFO(label << (r.failure.empty() ? "" : ": " + r.failure));
-  REQUIRE(r.failure.empty());
-  for (const auto& q : r.quantities) {
-    INFO(q.name << " max rel error " << q.max_rel);
-    CHECK(q.max_rel < 1e-10);
-  }
-  INFO("trajectory: " << r.trajectory.skipped << " error " << r.trajectory.max_state_error
-                      << " tolerance " << r.trajectory.tolerance);
-  CHECK(r.trajectory.run);
-  CHECK(r.trajectory.resolved);
-  CHECK(r.trajectory.max_state_error <= r.trajectory.tolerance);
-  CHECK(r.pass());
-}
 
 // The middle body of a spatial 3-link chain, given by `elements`; loads, springs, dampers.
 std::string chain_with(const std::string& elements) {
