@@ -6,7 +6,8 @@
 
 namespace femdyn {
 
-Json dexterous_hand(const Params& p) {
+void append_hand(const Params& p, const std::string& parent, const Json& mount, Json& bodies,
+                 Json& couplings, Json& loads) {
   p.allow_only({"thumb", "wrist", "finger", "palm_mass"});
   const bool thumb = p.boolean_or("thumb", true);
   const bool wrist = p.boolean_or("wrist", true);
@@ -14,7 +15,6 @@ Json dexterous_hand(const Params& p) {
   const FingerParams f = p.has("finger") ? FingerParams::from(p.child("finger")) : FingerParams{};
   if (f.paper_lumping) p.fail("finger", "a hand uses the exact lumping");
 
-  Json bodies = Json::array(), couplings = Json::array(), loads = Json::array();
   // Palm: an aluminium plate 90 x 100 x 20 mm about its centre, 50 mm above the wrist.
   const double m = palm_mass, a = 0.09, b = 0.02, c = 0.10;
   const Json palm_body = {{"type", "rigid_body"},
@@ -24,17 +24,18 @@ Json dexterous_hand(const Params& p) {
                            {{"ixx", m * (b * b + c * c) / 12},
                             {"iyy", m * (a * a + c * c) / 12},
                             {"izz", m * (a * a + b * b) / 12}}}};
-  std::string palm_parent = "world";
+  std::string palm_parent = parent;
   if (wrist) {
     // Wrist: deviation about z then flexion about x; the carpal link is small.
     bodies.push_back(
         {{"name", "carpus"},
-         {"parent", "world"},
+         {"parent", parent},
          {"joint",
           {{"name", "wrist_deviation"},
            {"type", "revolute"},
            {"axis", {0, 0, 1}},
-           {"limits", {-0.4, 0.4}}}},
+           {"limits", {-0.4, 0.4}},
+           {"origin", mount}}},
          {"elements",
           Json::array({{{"type", "rigid_body"},
                         {"mass", 0.05},
@@ -42,15 +43,16 @@ Json dexterous_hand(const Params& p) {
                         {"inertia", {{"ixx", 1e-5}, {"iyy", 1e-5}, {"izz", 1e-5}}}}})}});
     palm_parent = "carpus";
   }
-  bodies.push_back({{"name", "palm"},
-                    {"parent", palm_parent},
-                    {"joint", wrist ? Json{{"name", "wrist_flexion"},
-                                           {"type", "revolute"},
-                                           {"axis", {1, 0, 0}},
-                                           {"limits", {-1.0, 1.0}},
-                                           {"origin", {{"xyz", {0, 0, 0.01}}}}}
-                                    : Json{{"name", "palm_mount"}, {"type", "fixed"}}},
-                    {"elements", Json::array({palm_body})}});
+  bodies.push_back(
+      {{"name", "palm"},
+       {"parent", palm_parent},
+       {"joint", wrist ? Json{{"name", "wrist_flexion"},
+                              {"type", "revolute"},
+                              {"axis", {1, 0, 0}},
+                              {"limits", {-1.0, 1.0}},
+                              {"origin", {{"xyz", {0, 0, 0.01}}}}}
+                       : Json{{"name", "palm_mount"}, {"type", "fixed"}, {"origin", mount}}},
+       {"elements", Json::array({palm_body})}});
   // Fingers along the top edge of the palm (z = 0.1), slightly splayed; the palm normal is y.
   const double half_pi = std::numbers::pi / 2;
   const char* names[] = {"index_", "middle_", "ring_", "little_"};
@@ -64,6 +66,11 @@ Json dexterous_hand(const Params& p) {
     // Thumb on the side of the palm, its abduction axis tilted towards the palm normal.
     append_finger(f, "thumb_", "palm", Vec3(0.045, 0.01, 0.03), Vec3(0, 0.9, half_pi - 0.6), bodies,
                   couplings, loads);
+}
+
+Json dexterous_hand(const Params& p) {
+  Json bodies = Json::array(), couplings = Json::array(), loads = Json::array();
+  append_hand(p, "world", {{"xyz", {0, 0, 0}}}, bodies, couplings, loads);
   Json model = {{"name", "dexterous hand"}, {"bodies", bodies}};
   if (!couplings.empty()) model["couplings"] = couplings;
   if (!loads.empty()) model["loads"] = loads;

@@ -8,4 +8,9 @@ namespace femdyn {
 
 Json dexterous_hand(const Params& params);
 
+// Appends the hand's bodies, couplings and loads, its first joint (the wrist's deviation, or the
+// palm's fixed mount) under `parent` at `mount` ({"xyz", "rpy"}, the joint's origin).
+void append_hand(const Params& params, const std::string& parent, const Json& mount, Json& bodies,
+                 Json& couplings, Json& loads);
+
 }  // namespace femdyn

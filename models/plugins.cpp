@@ -5,6 +5,7 @@
 #include "models/dexterous_finger.hpp"
 #include "models/hand.hpp"
 #include "models/random_tree.hpp"
+#include "models/space_robot.hpp"
 
 namespace femdyn {
 
@@ -16,6 +17,8 @@ static const std::array kPlugins = {
     ModelPlugin{"dexterous_hand", &dexterous_hand},
     // a seeded random tree or chain of rigid bodies (tests, studies, benchmarks)
     ModelPlugin{"random_tree", &random_tree},
+    // a free-floating satellite with a 7-DOF arm and the dexterous hand (zero gravity)
+    ModelPlugin{"space_robot", &space_robot},
 };
 
 const Registry<ModelPlugin>& model_plugins() {

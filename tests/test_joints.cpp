@@ -12,6 +12,7 @@
 #include "core/sampling.hpp"
 #include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
+#include "tests/momentum.hpp"
 
 using namespace femdyn;
 using namespace femdyn::test;
@@ -139,19 +140,6 @@ VecX along(const Model& m, const VecX& q, const VecX& v, double t) {
     xi += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
   }
   return integrate(m, q, xi);
-}
-
-// Σ_b Λ_b^O V_b: the spatial momentum about the world origin (angular, linear), world axes.
-Vec6 momentum(const Model& m, Workspace& ws, const VecX& q, const VecX& v) {
-  propagate(m, ws, q, v, {.jacobian = false, .bias = true, .rows = false});
-  Vec6 h = Vec6::Zero();
-  for (std::size_t b = 0; b < m.bodies.size(); ++b) {
-    const BodyState& B = ws.body[b];
-    Vec6 V;
-    V << B.w, B.v - B.w.cross(B.p);
-    h += inertia_at_origin(m.body_inertia[b], B.R, B.p) * V;
-  }
-  return h;
 }
 
 }  // namespace

@@ -119,7 +119,7 @@ TEST_CASE("O(n) inverse dynamics and bias (Tᵀ by a backward sweep) equal the m
     INFO(m.name);
     Workspace ws(m);
     for (int k = 0; k < 3; ++k) {
-      const VecX q = random_uniform(m.n(), 1.0, rng), qd = random_uniform(m.n(), 2.0, rng),
+      const VecX q = random_posture(m, rng), qd = random_uniform(m.n(), 2.0, rng),
                  qdd = random_uniform(m.n(), 3.0, rng);
       evaluate(m, ws, q, qd, VecX());
       const VecX h = ws.h, Q = ws.Q, expected = ws.Ms * qdd + ws.h - ws.Q;
@@ -151,7 +151,7 @@ TEST_CASE("M^s by composite inertias (composite route) equals Tᵀ M T", "[solve
     CHECK((m.mass_route == MassRoute::Composite) == m.condensable);
     condensed += m.mass_route == MassRoute::Composite;
     Workspace ws(m);
-    const VecX q = random_uniform(m.n(), 1.0, rng), qd = random_uniform(m.n(), 1.0, rng);
+    const VecX q = random_posture(m, rng), qd = random_uniform(m.n(), 1.0, rng);
     evaluate(m, ws, q, qd, VecX());
     const MatX Ms = ws.Ms;
     propagate(m, ws, q, qd, {.jacobian = true, .bias = false});  // forms T
