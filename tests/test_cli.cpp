@@ -184,6 +184,12 @@ TEST_CASE("validate: table and exit 0 on a good model, JSON, exit 1 when it cann
       run("validate " + model_path("urdf/arm7.urdf") + " --states 2 --t-end 0 --gravity 0,-9.81,0")
           .code == 0);
 
+  // A floating base: the import check floats the XML's root link too.
+  const Run hyq = run("validate " + std::string(FEMDYN_SOURCE_DIR) +
+                      "/tests/robots/hyq.urdf --floating-base --states 2 --t-end 0.02");
+  CHECK(hyq.code == 0);
+  CHECK_THAT(hyq.out, Catch::Contains("import ") && Catch::EndsWith("PASS\n"));
+
   const Run paper = run("validate " + model_path("finger_paper.json") + " --states 2");
   CHECK(paper.code == 1);
   CHECK_THAT(paper.out, Catch::Contains("its elements sum to no rigid body"));

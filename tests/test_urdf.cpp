@@ -237,6 +237,36 @@ TEST_CASE(
     }
   }
 }
+
+TEST_CASE(
+    "the import with a floating base: Atlas and HyQ equal an independent Simbody model whose "
+    "root link is on a Free mobilizer",
+    "[urdf][validation]") {
+  // The twin's Free mobilizer has u = (ω, v) in the world, femdyn's free joint (v, ω) in the
+  // base's axes: equal equations check that map, Ċ v in h included, as well as the import.
+  for (const char* robot : {"atlas.urdf", "hyq.urdf"}) {
+    INFO(robot);
+    const std::string path = std::string(FEMDYN_SOURCE_DIR) + "/tests/robots/" + robot;
+    const Model m = load_model(path, {.floating_base = true});
+    validation::UrdfTwin twin(path, m.gravity, true);
+    const std::vector<std::string> names(m.coordinate_names.begin() + 6, m.coordinate_names.end());
+    Workspace ws(m);
+    std::mt19937 rng(22);
+    for (int k = 0; k < 4; ++k) {
+      const VecX q = random_posture(m, rng), qd = random_uniform(m.n(), 2.0, rng);
+      evaluate(m, ws, q, qd, VecX());
+      const validation::UrdfTwinEquations s = twin.equations(names, q, qd);
+      CHECK(rel_error(ws.Ms, s.M) < 1e-10);
+      CHECK(rel_error(ws.h, s.h) < 1e-10);
+      CHECK(rel_error(ws.Q, s.Q) < 1e-10);
+    }
+    validation::ValidationOptions o;
+    o.states = 4;
+    std::string failure;
+    CHECK(validation::validate_urdf_import(m, path, o, failure).max_rel < 1e-10);
+    CHECK(failure.empty());
+  }
+}
 #endif
 
 TEST_CASE(

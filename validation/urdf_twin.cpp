@@ -66,12 +66,15 @@ struct UrdfTwin::Impl {
     double k, offset;
   };
   std::map<std::string, Mimic> mimic;
+  MobilizedBody base;  // the root's Free mobilizer, with a floating root
+  bool floating = false;
   State state;
 };
 
-UrdfTwin::UrdfTwin(const std::string& path, const Eigen::Vector3d& gravity)
+UrdfTwin::UrdfTwin(const std::string& path, const Eigen::Vector3d& gravity, bool floating)
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
+  s.floating = floating;
   tinyxml2::XMLDocument doc;
   if (doc.LoadFile(path.c_str()) != tinyxml2::XML_SUCCESS)
     throw femdyn::Error(path + ": cannot read");
@@ -88,8 +91,13 @@ UrdfTwin::UrdfTwin(const std::string& path, const Eigen::Vector3d& gravity)
   std::string root;
   for (const auto& [name, l] : links)
     if (!joint_to_child.count(name)) root = name;
-  // Build from the root outwards.
-  std::vector<std::pair<std::string, MobilizedBody>> todo{{root, s.matter.updGround()}};
+  // Build from the root outwards; a floating root carries its own <inertial>.
+  MobilizedBody root_body = s.matter.updGround();
+  if (floating)
+    root_body = s.base =
+        MobilizedBody::Free(s.matter.updGround(), Transform(),
+                            Body::Rigid(mass_properties(links.at(root))), Transform());
+  std::vector<std::pair<std::string, MobilizedBody>> todo{{root, root_body}};
   while (!todo.empty()) {
     auto [link, parent] = todo.back();
     todo.pop_back();
@@ -100,6 +108,9 @@ UrdfTwin::UrdfTwin(const std::string& path, const Eigen::Vector3d& gravity)
       const Transform X_PJ = origin(j);
       Vec3 axis = triple(j->FirstChildElement("axis"), "xyz", Vec3(1, 0, 0));
       MobilizedBody mb;
+      if (type == "floating" || type == "planar")  // (femdyn's own twin checks those joints)
+        throw femdyn::Error(path + ": joint '" + name + "': the independent URDF twin models no " +
+                            type + " joint");
       if (type == "fixed") {
         mb = MobilizedBody::Weld(parent, X_PJ, body, Transform());
       } else if (type == "prismatic") {
@@ -133,12 +144,29 @@ UrdfTwin::~UrdfTwin() = default;
 UrdfTwinEquations UrdfTwin::equations(const std::vector<std::string>& names,
                                       const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
   Impl& s = *impl_;
-  const int n = static_cast<int>(names.size()), nu = s.state.getNU();
-  // dθ/dq (nu x n) and θ(q): a coordinate drives its joint; a mimic joint follows its leader.
+  // nb rates of the floating root come first; then the named coordinates, at q index nb + 1 + a
+  // (after the quaternion's extra entry) and rate index nb + a.
+  const int nb = s.floating ? 6 : 0, nqb = s.floating ? 7 : 0;
+  const int n = nb + static_cast<int>(names.size()), nu = s.state.getNU();
+  // u = C v and θ(q): a coordinate drives its joint; a mimic joint follows its leader; the
+  // Free mobilizer's u = (ω, v) in the world is (R ω_b, R v_b) of femdyn's rates in body axes.
   Eigen::MatrixXd C = Eigen::MatrixXd::Zero(nu, n);
+  Eigen::VectorXd Cdot_v = Eigen::VectorXd::Zero(nu);  // Ċ v
+  const Eigen::VectorXd q_named = q.tail(q.size() - nqb);
+  if (s.floating) {
+    const Eigen::Quaterniond quat(q[3], q[4], q[5], q[6]);
+    const Eigen::Matrix3d R = quat.normalized().toRotationMatrix();
+    const int u0 = s.base.getFirstUIndex(s.state), q0 = s.base.getFirstQIndex(s.state);
+    for (int k = 0; k < 4; ++k) s.state.updQ()[q0 + k] = q[3 + k];  // Simbody: (quaternion, p)
+    for (int k = 0; k < 3; ++k) s.state.updQ()[q0 + 4 + k] = q[k];
+    C.block<3, 3>(u0, 3) = R;      // ω
+    C.block<3, 3>(u0 + 3, 0) = R;  // v
+    // d(R v_b)/dt = R v̇_b + R (ω_b × v_b); R ω_b has no such term (ω_b × ω_b = 0).
+    Cdot_v.segment<3>(u0 + 3) = R * qd.segment<3>(3).cross(qd.head<3>());
+  }
   Eigen::VectorXd theta0 = Eigen::VectorXd::Zero(nu);
   std::map<std::string, int> coordinate;
-  for (int a = 0; a < n; ++a) coordinate[names[a]] = a;
+  for (int a = nb; a < n; ++a) coordinate[names[a - nb]] = a;
   std::function<void(const std::string&, Eigen::RowVectorXd&, double&)> resolve =
       [&](const std::string& joint, Eigen::RowVectorXd& row, double& offset) {
         if (coordinate.count(joint)) {
@@ -159,8 +187,12 @@ UrdfTwinEquations UrdfTwin::equations(const std::vector<std::string>& names,
     const int u = mb.getFirstUIndex(s.state);
     C.row(u) = row;
     theta0[u] = offset;
-    s.state.updQ()[mb.getFirstQIndex(s.state)] = row.dot(q) + offset;  // Pin, Slider: q = θ
-    s.state.updU()[u] = row.dot(qd);
+    s.state.updQ()[mb.getFirstQIndex(s.state)] =
+        row.tail(n - nb).dot(q_named) + offset;  // Pin, Slider: q = θ
+  }
+  {
+    const Eigen::VectorXd u = C * qd;
+    for (int a = 0; a < nu; ++a) s.state.updU()[a] = u[a];
   }
   s.system.realize(s.state, Stage::Dynamics);
   Matrix M;
@@ -178,7 +210,8 @@ UrdfTwinEquations UrdfTwin::equations(const std::vector<std::string>& names,
     Qt[a] = bias[a] - with_forces[a];
     for (int b = 0; b < nu; ++b) Mt(a, b) = M(a, b);
   }
-  return {C.transpose() * Mt * C, C.transpose() * ht, C.transpose() * Qt};
+  // M_v = Cᵀ M C, h_v = Cᵀ (h + M Ċ v), Q_v = Cᵀ Q.
+  return {C.transpose() * Mt * C, C.transpose() * (ht + Mt * Cdot_v), C.transpose() * Qt};
 }
 
 }  // namespace femdyn::validation

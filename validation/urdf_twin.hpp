@@ -20,13 +20,19 @@ struct UrdfTwinEquations {
 
 class UrdfTwin {
  public:
-  UrdfTwin(const std::string& urdf_path, const Eigen::Vector3d& gravity);  // throws on bad XML
+  // With `floating`, the root link moves on a Free mobilizer (femdyn's --floating-base);
+  // otherwise it is welded to the ground. Throws on bad XML.
+  UrdfTwin(const std::string& urdf_path, const Eigen::Vector3d& gravity, bool floating = false);
   ~UrdfTwin();
   UrdfTwin(const UrdfTwin&) = delete;
   UrdfTwin& operator=(const UrdfTwin&) = delete;
 
   // The equations in the coordinates `names` (movable, non-mimic joints by name, in any order):
   // Simbody's over all joints, reduced by the mimic relations θ_j = k θ_leader + offset.
+  // With a floating root, q and q̇ start with the root's own 7 and 6 (q: x, y, z, qw, qx, qy, qz
+  // of the root link in the world; v: its origin's velocity and its ω, both in the root's axes,
+  // docs/notation.md), and the equations' first 6 rows and columns are those rates; `names`
+  // names the rest.
   UrdfTwinEquations equations(const std::vector<std::string>& names, const Eigen::VectorXd& q,
                               const Eigen::VectorXd& qd);
 

@@ -779,9 +779,14 @@ ValidationReport validate(const Model& m, const ValidationOptions& o) {
 QuantityError validate_urdf_import(const Model& m, const std::string& path,
                                    const ValidationOptions& o, std::string& failure) {
   QuantityError e{"import", 0, 0, o.tolerance > 0 ? o.tolerance : pointwise_tolerance(m)};
+  // --floating-base puts the root link first, on a free joint to the world named after it
+  // (io/urdf_loader.cpp); the twin then floats the root of the XML's tree.
+  const bool floating = !m.bodies.empty() && m.bodies[0].parent < 0 &&
+                        m.bodies[0].joint.type == JointType::Free &&
+                        m.bodies[0].joint.name == m.bodies[0].name;
   std::unique_ptr<UrdfTwin> twin;
   try {
-    twin = std::make_unique<UrdfTwin>(path, m.gravity);
+    twin = std::make_unique<UrdfTwin>(path, m.gravity, floating);
   } catch (const std::exception& ex) {
     failure = std::string("the independent URDF twin could not be built: ") + ex.what();
     return e;
@@ -792,7 +797,9 @@ QuantityError validate_urdf_import(const Model& m, const std::string& path,
     const VecX q = random_posture(m, rng);
     const VecX qd = random_uniform(m.n(), o.qd_scale, rng);
     evaluate(m, ws, q, qd, VecX());
-    const UrdfTwinEquations s = twin->equations(m.coordinate_names, q, qd);
+    const std::vector<std::string> names(m.coordinate_names.begin() + (floating ? 6 : 0),
+                                         m.coordinate_names.end());
+    const UrdfTwinEquations s = twin->equations(names, q, qd);
     accumulate(e, ws.Ms, s.M);
     accumulate(e, ws.h, s.h);
     accumulate(e, ws.Q, s.Q);
