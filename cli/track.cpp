@@ -44,6 +44,10 @@ int cmd_track(int argc, char** argv) {
       throw CliError("--csv " + out + ": exists (use --force to replace it)");
   }
   const Model m = load(a);
+  if (m.n_q() != m.n())  // q_ref(t) is a quintic in each coordinate; a quaternion is not one
+    throw CliError(a.positional.at(0) +
+                   ": track plans a quintic in each coordinate and takes no spherical or free "
+                   "joint yet");
   if (!a.has("to")) throw CliError("--to is required (try --help)");
   const VecX q1 = state_vector(a, "to", m), q0 = state_vector(a, "from", m);
   const double T = number_option(a, "duration", 1.0);

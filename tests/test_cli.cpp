@@ -184,6 +184,12 @@ TEST_CASE("validate: table and exit 0 on a good model, JSON, exit 1 when it cann
       run("validate " + model_path("urdf/arm7.urdf") + " --states 2 --t-end 0 --gravity 0,-9.81,0")
           .code == 0);
 
+  // track's quintic is per coordinate: a quaternion is refused in one line, not by an internal
+  // size check.
+  const Run track = run("track " + std::string(FEMDYN_SOURCE_DIR) +
+                        "/tests/robots/hyq.urdf --floating-base --to 0");
+  CHECK(track.code != 0);
+  CHECK_THAT(track.out, Catch::Contains("hyq.urdf: track plans a quintic in each coordinate"));
   // A floating base: the import check floats the XML's root link too.
   const Run hyq = run("validate " + std::string(FEMDYN_SOURCE_DIR) +
                       "/tests/robots/hyq.urdf --floating-base --states 2 --t-end 0.02");
