@@ -93,6 +93,30 @@ Eigen::Map<const RowMatX> batch_arg(const Array& a, const char* name, const Mode
   return {a.data(), a.shape(0), n};
 }
 
+RowMatX configuration_batch_arg(const Array& a, const char* name, const Model& model) {
+  const Eigen::Index nq = model.n_q();
+  if (a.ndim() != 2 || a.shape(1) != nq)
+    throw py::value_error(std::string(name) + ": expected shape (k, " + std::to_string(nq) +
+                          "), got " + shape_text(a));
+  RowMatX out = Eigen::Map<const RowMatX>(a.data(), a.shape(0), nq);
+  VecX q(nq);
+  for (Eigen::Index i = 0; i < out.rows(); ++i) {
+    const std::string row = std::string(name) + ": row " + std::to_string(i) + ", ";
+    for (Eigen::Index c = 0; c < nq; ++c) {
+      const double x = out(i, c);
+      if (std::isfinite(x) && std::abs(x) <= kMaxMagnitude) continue;
+      throw py::value_error(row + "entry " + std::to_string(c) + " ('" +
+                            model.configuration_names[c] + "') " +
+                            (std::isfinite(x) ? out_of_range_text(x) : "is NaN or Inf"));
+    }
+    q = out.row(i).transpose();
+    if (const std::string bad = normalize_quaternions(model, q); !bad.empty())
+      throw py::value_error(row + bad);
+    out.row(i) = q.transpose();
+  }
+  return out;
+}
+
 py::array_t<double> new_array(std::initializer_list<py::ssize_t> shape) {
   return py::array_t<double>(std::vector<py::ssize_t>(shape));
 }

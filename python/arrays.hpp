@@ -50,6 +50,11 @@ VecX configuration_arg(const std::optional<Array>& a, const char* name, const Mo
 Eigen::Map<const RowMatX> batch_arg(const Array& a, const char* name, const Model& model,
                                     Eigen::Index k, Entries entries = Entries::Bounded);
 
+// A batch of configurations of a model with a spherical or free joint: shape (k, n_q), each row
+// checked as configuration_arg checks q (the message names the row), copied with its
+// quaternions normalised.
+RowMatX configuration_batch_arg(const Array& a, const char* name, const Model& model);
+
 // A str argument (a path, a name, a choice), refused with ValueError if it holds a NUL character,
 // as Python's open() refuses it: the system, and C++ code that takes C strings, would see only
 // the part before it ("a\0b.json" would open "a").

@@ -20,18 +20,22 @@ using OptArray = std::optional<Array>;
 // The k states of a batch, row i of each a state: q sets k; q̇ and the third argument (τ or
 // q̈) default to zero rows. The arrays are read in place (numpy's memory). Every entry is bounded
 // as a physical input (|x| ≤ 1e100, arrays.hpp).
+// With a spherical or free joint, q's rows have n_q entries and are a checked, normalised copy
+// (python/arrays.hpp, configuration_batch_arg).
 struct Batch {
-  Eigen::Index k = 0, n = 0;
+  Eigen::Index k = 0, n = 0, nq = 0;
   const double *q = nullptr, *qd = nullptr, *third = nullptr;
-  VecX zeros;  // one zero row for an absent argument
+  VecX zeros;          // one zero row for an absent argument
+  RowMatX q_manifold;  // the normalised configurations of a non-flat model
   Batch(const Model& m, const Array& q_in, const OptArray& qd_in, const OptArray& third_in,
         const char* third_name, Entries third_entries)
-      : n(m.n()), zeros(VecX::Zero(m.n())) {
-    if (!flat_model(m))
-      throw py::value_error(
-          "q: batches of configurations with a spherical or free joint are not "
-          "supported yet (call the model once per state)");
-    q = batch_arg(q_in, "q", m, -1).data();
+      : n(m.n()), nq(m.n_q()), zeros(VecX::Zero(m.n())) {
+    if (flat_model(m)) {
+      q = batch_arg(q_in, "q", m, -1).data();
+    } else {
+      q_manifold = configuration_batch_arg(q_in, "q", m);
+      q = q_manifold.data();
+    }
     k = q_in.shape(0);
     if (qd_in) qd = batch_arg(*qd_in, "qd", m, k).data();
     if (third_in) third = batch_arg(*third_in, third_name, m, k, third_entries).data();
@@ -39,13 +43,14 @@ struct Batch {
   Eigen::Map<const VecX> row(const double* x, Eigen::Index i) const {
     return {x ? x + i * n : zeros.data(), n};
   }
+  Eigen::Map<const VecX> configuration(Eigen::Index i) const { return {q + i * nq, nq}; }
 };
 
 // One row's buffers (the core takes VecX).
 struct RowState {
   VecX q, qd, x;
   void load(const Batch& b, Eigen::Index i) {
-    q = b.row(b.q, i);
+    q = b.configuration(i);
     qd = b.row(b.qd, i);
     x = b.row(b.third, i);
   }

@@ -5,6 +5,7 @@ import csv
 import json
 
 import numpy as np
+import pytest
 
 import femdyn
 from conftest import cli_json, numbers
@@ -40,3 +41,32 @@ def test_floating_base_from_python_equals_cli(tmp_path):
     assert rows[0][1:5] == ["q_base.x", "q_base.y", "q_base.z", "q_base.qw"]
     last = np.array([float(x) for x in rows[-1][1:12]])
     assert np.allclose(last, q[-1], rtol=0, atol=1e-12)
+
+
+def test_batches_take_configurations_of_n_q_entries(tmp_path):
+    # Rows of q have n_q entries; each row equals the single-state call, quaternions are
+    # normalised as there, and a row's bad quaternion is named by its row.
+    path = tmp_path / "floating.json"
+    path.write_text(json.dumps(FLOATING))
+    model = femdyn.load(str(path))
+    rng = np.random.default_rng(3)
+    k = 5
+    q = rng.uniform(-1, 1, (k, 11))
+    for cols in (slice(3, 7), slice(7, 11)):
+        q[:, cols] /= np.linalg.norm(q[:, cols], axis=1, keepdims=True)
+    qd, tau = rng.uniform(-1, 1, (k, 9)), rng.uniform(-1, 1, (k, 9))
+    qdd = model.forward_dynamics_batch(q, qd, tau)
+    eq = model.equations_batch(q, qd, tau)
+    assert qdd.shape == (k, 9) and eq["M"].shape == (k, 9, 9)
+    for i in range(k):
+        one = model.forward_dynamics(q[i], qd[i], tau[i])
+        assert np.array_equal(qdd[i], one)
+        assert np.array_equal(eq["qdd"][i], one)
+    back = model.inverse_dynamics_batch(q, qd, qdd)
+    assert np.allclose(back, tau, rtol=0, atol=1e-12)
+    bad = q.copy()
+    bad[2, 3:7] *= 1.1
+    with pytest.raises(ValueError, match=r"^q: row 2, "):
+        model.forward_dynamics_batch(bad)
+    with pytest.raises(ValueError, match=r"expected shape \(k, 11\), got \(5, 9\)"):
+        model.forward_dynamics_batch(q[:, :9])
