@@ -81,12 +81,12 @@ JointSpec joint_arg(const std::optional<std::string>& type_in,
                     const std::optional<std::string>& name, const OptArray& axis,
                     const OptArray& xyz, const OptArray& rpy,
                     const std::optional<std::pair<double, double>>& limits, OptNumber stiffness,
-                    OptNumber rest, OptNumber damping) {
-  const std::pair<const char*, bool> motion[] = {{"axis", axis.has_value()},
-                                                 {"limits", limits.has_value()},
-                                                 {"stiffness", stiffness.has_value()},
-                                                 {"rest", rest.has_value()},
-                                                 {"damping", damping.has_value()}};
+                    OptNumber rest, OptNumber damping, const OptArray& axis2, OptNumber pitch) {
+  const std::pair<const char*, bool> motion[] = {
+      {"axis", axis.has_value()},           {"axis2", axis2.has_value()},
+      {"pitch", pitch.has_value()},         {"limits", limits.has_value()},
+      {"stiffness", stiffness.has_value()}, {"rest", rest.has_value()},
+      {"damping", damping.has_value()}};
   if (!type_in) {
     for (const auto& [arg, given] :
          {std::pair{"joint", name.has_value()}, {"xyz", xyz.has_value()}, {"rpy", rpy.has_value()}})
@@ -115,6 +115,13 @@ JointSpec joint_arg(const std::optional<std::string>& type_in,
                               ": a fixed joint has no motion: no axis, limits, spring or damping");
   if (name) j.name = *name;
   if (axis) j.axis = vec3_arg(*axis, "axis");
+  if (axis2) j.axis2 = vec3_arg(*axis2, "axis2");  // (compile: universal only)
+  if (pitch) {
+    if (j.type != JointType::Helical)
+      throw py::value_error("pitch: only a helical joint has a pitch");
+    if (!std::isfinite(*pitch)) throw py::value_error("pitch: NaN or Inf");
+    j.pitch = *pitch;
+  }
   if (xyz) j.xyz = vec3_arg(*xyz, "xyz");
   if (rpy) j.rpy = vec3_arg(*rpy, "rpy");
   if (limits) {
@@ -144,22 +151,24 @@ void bind_builder(py::module_& m) {
              const std::optional<std::string>& type, const std::optional<std::string>& joint,
              const OptArray& axis, const OptArray& xyz, const OptArray& rpy,
              const std::optional<std::pair<double, double>>& limits, OptNumber stiffness,
-             OptNumber rest, OptNumber damping) {
+             OptNumber rest, OptNumber damping, const OptArray& axis2, OptNumber pitch) {
             b.body(text_arg(name, "name"), text_arg(parent, "parent"),
                    joint_arg(text_arg(type, "type"), text_arg(joint, "joint"), axis, xyz, rpy,
-                             limits, stiffness, rest, damping));
+                             limits, stiffness, rest, damping, axis2, pitch));
           },
           py::arg("name"), py::arg("parent") = "world", py::arg("type") = py::none(),
           py::arg("joint") = py::none(), py::arg("axis") = py::none(), py::arg("xyz") = py::none(),
           py::arg("rpy") = py::none(), py::arg("limits") = py::none(),
           py::arg("stiffness") = py::none(), py::arg("rest") = py::none(),
-          py::arg("damping") = py::none(),
+          py::arg("damping") = py::none(), py::arg("axis2") = py::none(),
+          py::arg("pitch") = py::none(),
           "A body on `parent` ('world': the ground) by a joint of `type` (revolute, prismatic, "
-          "fixed) named `joint` (default: the body's name), at xyz, rpy (default 0), about axis "
-          "(default (0, 0, 1)), with limits (lower, upper), a spring (stiffness, rest) and a "
-          "damper. Without type the body is welded to its parent's origin and no other joint "
-          "argument may be given (ValueError naming it); a fixed joint takes no axis, limits, "
-          "spring or damper.")
+          "fixed, helical, universal, planar, spherical, free; docs/notation.md) named `joint` "
+          "(default: the body's name), at xyz, rpy (default 0), about axis (default (0, 0, 1)), "
+          "with limits (lower, upper), a spring (stiffness, rest) and a damper; a universal "
+          "joint's second axis `axis2`, a helical joint's `pitch` (m/rad). Without type the body "
+          "is welded to its parent's origin and no other joint argument may be given (ValueError "
+          "naming it); a fixed joint takes no axis, limits, spring or damper.")
       .def(
           "node",
           [](MechanismBuilder& b, const std::string& body, const std::string& name,

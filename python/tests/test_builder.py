@@ -198,3 +198,54 @@ def test_a_weld_is_said_with_type_fixed():
         assert model.coordinates == ["link"]
         masses.append(model.mass_matrix([0.0])[0, 0])
     assert masses[0] == pytest.approx(0.25) and masses[1] == pytest.approx(0.25)
+
+
+JOINTS = {
+    "name": "every joint", "gravity": [0, -9.81, 0],
+    "bodies": [
+        {"name": "base", "parent": "world", "joint": {"name": "base", "type": "free"},
+         "elements": [{"type": "rigid_body", "mass": 3, "com": [0, 0, 0],
+                       "inertia": {"ixx": 0.1, "iyy": 0.12, "izz": 0.08}}]},
+        {"name": "cardan", "parent": "base",
+         "joint": {"name": "u", "type": "universal", "axis": [0, 0, 1], "axis2": [1, 0, 0],
+                   "origin": {"xyz": [0.2, 0, 0]}},
+         "elements": [{"type": "rigid_body", "mass": 1, "com": [0.1, 0, 0],
+                       "inertia": {"ixx": 0.01, "iyy": 0.02, "izz": 0.02}}]},
+        {"name": "screw", "parent": "cardan",
+         "joint": {"name": "s", "type": "helical", "axis": [1, 0, 0], "pitch": 0.01,
+                   "origin": {"xyz": [0.2, 0, 0]}},
+         "elements": [{"type": "rigid_body", "mass": 0.5, "com": [0.05, 0.02, 0],
+                       "inertia": {"ixx": 0.002, "iyy": 0.003, "izz": 0.003}}]}]}
+
+
+def test_builder_takes_every_joint_type_with_axis2_and_pitch(tmp_path):
+    b = femdyn.Builder("every joint", gravity=[0, -9.81, 0])
+    b.body("base", "world", type="free")
+    b.rigid_body("base", 3, [0, 0, 0], np.diag([0.1, 0.12, 0.08]))
+    b.body("cardan", "base", type="universal", joint="u", axis=[0, 0, 1], axis2=[1, 0, 0],
+           xyz=[0.2, 0, 0])
+    b.rigid_body("cardan", 1, [0.1, 0, 0], np.diag([0.01, 0.02, 0.02]))
+    b.body("screw", "cardan", type="helical", joint="s", axis=[1, 0, 0], pitch=0.01,
+           xyz=[0.2, 0, 0])
+    b.rigid_body("screw", 0.5, [0.05, 0.02, 0], np.diag([0.002, 0.003, 0.003]))
+    a = b.build()
+    path = tmp_path / "joints.json"
+    path.write_text(json.dumps(JOINTS))
+    j = femdyn.load(str(path))
+    assert a.coordinates == j.coordinates and a.n == 9
+    rng = np.random.default_rng(5)
+    q = rng.uniform(-1, 1, 10)
+    q[3:7] /= np.linalg.norm(q[3:7])
+    qd, tau = rng.uniform(-1, 1, 9), rng.uniform(-1, 1, 9)
+    ea, ej = a.equations(q, qd, tau), j.equations(q, qd, tau)
+    for key in ("M", "h", "Q", "qdd"):
+        assert np.array_equal(ea[key], ej[key]), key
+    with pytest.raises(ValueError, match="pitch: only a helical joint has a pitch"):
+        femdyn.Builder("x").body("a", type="revolute", pitch=0.1)
+    with pytest.raises(ValueError, match="axis2: given without a joint type"):
+        femdyn.Builder("x").body("a", axis2=[1, 0, 0])
+    b2 = femdyn.Builder("x")
+    b2.body("a", type="universal", axis=[0, 0, 1])
+    b2.lumped_point("a", [0.1, 0, 0], 1)
+    with pytest.raises(femdyn.ModelError, match="a universal joint needs its second axis"):
+        b2.build()
