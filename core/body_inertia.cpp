@@ -88,13 +88,11 @@ void choose_routes(Model& m, const RouteChoice& asked) {
   // h and τ: the body-level recursion is exact under the same conditions (couplings are
   // linear), and it is O(bodies) instead of O(N_u) (measured faster on every model).
   m.force_route = m.condensable && m.velocity_forces_rigid ? ForceRoute::Bodies : ForceRoute::Nodes;
-  // The articulated recursion pivots on one rate per body (core/articulated.cpp).
-  const bool one_rate_joints =
-      std::all_of(m.bodies.begin(), m.bodies.end(), [](const Body& b) { return b.joint.nv <= 1; });
-  m.dynamics_route =
-      m.condensable && m.velocity_forces_rigid && m.identity_coupling && one_rate_joints
-          ? DynamicsRoute::Articulated
-          : DynamicsRoute::Cholesky;
+  // The articulated recursion pivots on each joint's block of rates (core/articulated.hpp);
+  // couplings (C ≠ I) it cannot eliminate joint by joint.
+  m.dynamics_route = m.condensable && m.velocity_forces_rigid && m.identity_coupling
+                         ? DynamicsRoute::Articulated
+                         : DynamicsRoute::Cholesky;
   // A route asked for: any reference route, a body-level one only where it was chosen (exact).
   const auto refuse = [&](const char* route) {
     throw ModelError(m.where, std::string("the ") + route +

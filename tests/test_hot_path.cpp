@@ -44,6 +44,30 @@ TEST_CASE("no heap allocation in evaluate, forward and inverse dynamics", "[hot-
   }
 }
 
+TEST_CASE("no heap allocation in the articulated route over joints of several rates",
+          "[hot-path]") {
+  if (!kAvailable) {
+    WARN(kSkipped);
+    return;
+  }
+  // A floating base (free joint, 6 rates) carrying a tree of revolute joints.
+  LoadOptions o;
+  o.floating_base = true;
+  const Model m = load_model(std::string(FEMDYN_SOURCE_DIR) + "/tests/robots/atlas.urdf", o);
+  REQUIRE(m.dynamics_route == DynamicsRoute::Articulated);
+  REQUIRE(m.bodies[0].joint.nv == 6);
+  Workspace ws(m);
+  std::mt19937 rng(3);
+  const VecX q = random_posture(m, rng), qd = random_uniform(m.n(), 1, rng),
+             tau = random_uniform(m.n(), 1, rng);
+  REQUIRE(forward_dynamics(m, ws, q, qd, tau).ok);  // warm-up
+  alloc_counter::start();
+  const bool ok = forward_dynamics(m, ws, q, qd, tau).ok;
+  const long mallocs = alloc_counter::stop();
+  CHECK(ok);
+  CHECK(mallocs == 0);
+}
+
 TEST_CASE("no heap allocation per step after the first, for every integrator", "[hot-path]") {
   if (!kAvailable) {
     WARN(kSkipped);

@@ -2,6 +2,7 @@
 // give the same equations: each new route is checked against the one it replaces, on random trees
 // of every element type, with fixed joints, springs, dampers, loads and couplings, and at the sizes
 // where the choice switches.
+#include <array>
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
@@ -15,8 +16,11 @@ using Json = nlohmann::json;
 namespace {
 
 // A random tree with every element type, fixed joints, springs, dampers, point loads and
-// torques, and (with `couplings`) joints that follow others linearly.
-std::string mixed_tree_json(unsigned seed, int bodies, double branching, bool couplings) {
+// torques, and (with `couplings`) joints that follow others linearly; with `several_rates`,
+// universal, planar, spherical and free joints in place of half the plain revolute ones, and a
+// free-floating base for odd seeds.
+std::string mixed_tree_json(unsigned seed, int bodies, double branching, bool couplings,
+                            bool several_rates = false) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0), pos(0.2, 1.0);
   const auto v3 = [&](double s) { return Json::array({s * u(rng), s * u(rng), s * u(rng)}); };
@@ -28,7 +32,16 @@ std::string mixed_tree_json(unsigned seed, int bodies, double branching, bool co
     const int kind = static_cast<int>(rng() % 8);
     Json joint = {{"name", "j" + std::to_string(b)},
                   {"origin", {{"xyz", v3(0.4)}, {"rpy", v3(2.0)}}}};
-    if (kind == 0 && b > 0) {
+    if (several_rates && (kind >= 4 || (b == 0 && seed % 2))) {
+      static constexpr const char* kTypes[] = {"universal", "planar", "spherical", "free"};
+      joint["type"] = b == 0 && seed % 2 ? "free" : kTypes[kind - 4];
+      if (joint["type"] == "universal") {
+        joint["axis"] = {1, 0, 0};
+        joint["axis2"] = {0, 0.6, 0.8};
+      }
+      if (joint["type"] == "planar") joint["axis"] = v3(1.0);
+      movable.push_back(b);
+    } else if (kind == 0 && b > 0) {
       joint["type"] = "fixed";
     } else {
       joint["type"] = kind == 1 ? "prismatic" : "revolute";
@@ -114,6 +127,25 @@ void check_same_equations(const Model& a, const Model& b, unsigned seed, double 
   }
 }
 
+// q̈ of `a` and `b` (the same mechanism on different routes) at random postures (any joint
+// types), with M^s q̈ + h = Q on `b`'s equations and τ back from `a`'s inverse dynamics.
+void check_same_accelerations(const Model& a, const Model& b, unsigned seed, double tol) {
+  Workspace wa(a), wb(b);
+  std::mt19937 rng(seed);
+  for (int k = 0; k < 3; ++k) {
+    const VecX q = random_posture(a, rng), qd = random_uniform(a.n(), 2, rng),
+               tau = random_uniform(a.n(), 3, rng);
+    REQUIRE(forward_dynamics(a, wa, q, qd, tau).ok);
+    REQUIRE(forward_dynamics(b, wb, q, qd, tau).ok);
+    CHECK(rel_error(wa.qdd, wb.qdd) < tol);
+    evaluate(b, wb, q, qd, tau);
+    CHECK(rel_error(wb.Ms * wa.qdd + wb.h, wb.Q) < tol);
+    const VecX qdd = wa.qdd;
+    inverse_dynamics(a, wa, q, qd, qdd);
+    CHECK(rel_error(wa.tau, tau, wb.Ms.cwiseAbs().maxCoeff() * qdd.cwiseAbs().maxCoeff()) < tol);
+  }
+}
+
 }  // namespace
 
 TEST_CASE("articulated route equals M^s + Cholesky on mixed random trees", "[routes]") {
@@ -128,6 +160,80 @@ TEST_CASE("articulated route equals M^s + Cholesky on mixed random trees", "[rou
       REQUIRE(art.force_route == ForceRoute::Bodies);
       check_same_equations(art, chol, seed, 1e-11);
     }
+}
+
+TEST_CASE("articulated route equals M^s + Cholesky with joints of several rates", "[routes]") {
+  // Universal, planar, spherical and free joints among revolute (springs, dampers), prismatic
+  // and fixed ones, point loads and torques, gravity; a free-floating base for odd seeds.
+  std::array<int, 8> seen{};
+  for (unsigned seed = 1; seed <= 8; ++seed)
+    for (const int bodies : {1, 2, 5, 12, 30}) {
+      INFO("seed " << seed << ", " << bodies << " bodies");
+      const std::string text = mixed_tree_json(seed, bodies, seed % 2 ? 0.6 : 0.0, false, true);
+      const Model art = load_text(text);
+      const Model chol = load_text(
+          text, {.routes = {.force = ForceRoute::Nodes, .dynamics = DynamicsRoute::Cholesky}});
+      REQUIRE(art.dynamics_route == DynamicsRoute::Articulated);
+      for (const Body& b : art.bodies) ++seen[static_cast<int>(b.joint.type)];
+      check_same_accelerations(art, chol, seed, 1e-10);
+    }
+  for (const JointType t : {JointType::Universal, JointType::Planar, JointType::Spherical,
+                            JointType::Free, JointType::Revolute, JointType::Fixed})
+    CHECK(seen[static_cast<int>(t)] > 3);
+}
+
+TEST_CASE("floating-base robots: the articulated route equals M^s + Cholesky", "[routes]") {
+  std::vector<std::string> paths;
+  for (const char* robot : {"atlas.urdf", "hyq.urdf"})  // (iiwa's root link is the world)
+    paths.push_back(std::string(FEMDYN_SOURCE_DIR) + "/tests/robots/" + robot);
+  // (hand16's couplings take no free joint: it does not float.)
+  for (const char* name : {"urdf/arm7.urdf", "urdf/gantry.urdf"}) paths.push_back(model_path(name));
+  for (const std::string& path : paths) {
+    INFO(path);
+    LoadOptions o;
+    o.floating_base = true;
+    const Model chosen = load_model(path, o);
+    o.compile.routes = {.force = ForceRoute::Nodes, .dynamics = DynamicsRoute::Cholesky};
+    const Model reference = load_model(path, o);
+    REQUIRE(chosen.bodies[0].joint.type == JointType::Free);
+    CHECK(chosen.dynamics_route == DynamicsRoute::Articulated);
+    check_same_accelerations(chosen, reference, 7, 1e-10);
+  }
+}
+
+TEST_CASE("a singular block of several rates fails on the articulated route as on Cholesky",
+          "[routes]") {
+  // A point mass on a free or spherical joint: its rotation about the line through the joint
+  // and the point moves no inertia. Off that line every diagonal entry of M^s is non-zero, so
+  // only the block's pivots can tell; compile's check at the reference posture refuses it on
+  // either route, naming the same coordinate (the last rate left when the block is eliminated
+  // last rate first). A rigid body in its place runs, both routes agreeing.
+  for (const char* type : {"free", "spherical"}) {
+    for (const bool rigid : {false, true}) {
+      INFO(type << (rigid ? ", rigid body" : ", point mass"));
+      const std::string element =
+          rigid ? R"({"type": "rigid_body", "mass": 1.0, "com": [0.1, 0.2, 0.3],
+                      "inertia": {"ixx": 0.01, "iyy": 0.02, "izz": 0.03}})"
+                : R"({"type": "lumped_point", "node": [0.1, 0.2, 0.3], "mass": 1.0})";
+      const std::string text =
+          std::string(R"({"name": "block", "gravity": [0, 0, -9.81], "bodies": [)") +
+          R"({"name": "a", "parent": "world", "joint": {"name": "j", "type": ")" + type +
+          R"("}, "elements": [)" + element + "]}]}";
+      const CompileOptions cholesky{.routes = {.dynamics = DynamicsRoute::Cholesky}};
+      if (!rigid) {
+        CHECK_THROWS_WITH(load_text(text),
+                          Catch::Contains("singular: coordinate 'j.wx' moves no inertia "
+                                          "independently of the joints beyond it"));
+        CHECK_THROWS_WITH(load_text(text, cholesky),
+                          Catch::Contains("singular: coordinate 'j.wx' moves no inertia "
+                                          "independently of the coordinates"));
+        continue;
+      }
+      const Model art = load_text(text), chol = load_text(text, cholesky);
+      REQUIRE(art.dynamics_route == DynamicsRoute::Articulated);
+      check_same_accelerations(art, chol, 2, 1e-10);
+    }
+  }
 }
 
 TEST_CASE("coupled models: Cholesky route, both M^s routes and both force routes agree",
