@@ -71,7 +71,7 @@ TEST_CASE("mutated models load or fail with a ModelError, never anything else", 
       try {
         const Model m = compile(parse_spec(j.dump(), "fuzz.json"));
         Workspace ws(m);
-        evaluate(m, ws, VecX::Zero(m.n()), VecX::Ones(m.n()), VecX());
+        evaluate(m, ws, neutral_posture(m), VecX::Ones(m.n()), VecX());
         ++loaded;
       } catch (const ModelError& e) {
         ++errors;

@@ -4,9 +4,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <random>
 #include <typeinfo>
 
 #include "core/equations.hpp"
+#include "core/sampling.hpp"
 
 #ifndef FEMDYN_FUZZ_NAN_CHECK
 #define FEMDYN_FUZZ_NAN_CHECK 1
@@ -87,6 +89,10 @@ void evaluate_once(const Model& model, std::uint64_t seed, bool inputs_finite) {
     q[i] = 0.5 * uniform(seed);
     qd[i] = uniform(seed);
     tau[i] = uniform(seed);
+  }
+  if (model.n_q() != n) {  // a quaternion: q has n_q entries, each quaternion of norm 1
+    std::mt19937 rng(static_cast<std::mt19937::result_type>(seed));
+    q = random_posture(model, rng);
   }
   Workspace ws(model);
   const Status st = forward_dynamics(model, ws, q, qd, tau);
