@@ -45,6 +45,18 @@ void check_entries(const double* data, Eigen::Index rows, const char* name, cons
     }
 }
 
+// q (n_q entries): each entry bounded, each quaternion within 1e-6 of norm 1, then normalised;
+// a ValueError starting with `prefix` ("q: " or "q: row 3, ") otherwise.
+void check_configuration(VecX& q, const std::string& prefix, const Model& model) {
+  for (Eigen::Index i = 0; i < q.size(); ++i)
+    if (!std::isfinite(q[i]) || std::abs(q[i]) > kMaxMagnitude)
+      throw py::value_error(prefix + "entry " + std::to_string(i) + " ('" +
+                            model.configuration_names[i] + "') " +
+                            (std::isfinite(q[i]) ? out_of_range_text(q[i]) : "is NaN or Inf"));
+  if (const std::string bad = normalize_quaternions(model, q); !bad.empty())
+    throw py::value_error(prefix + bad);
+}
+
 }  // namespace
 
 VecX vector_arg(const Array& a, const char* name, const Model& model, Entries entries) {
@@ -68,13 +80,7 @@ VecX configuration_arg(const Array& a, const char* name, const Model& model) {
     throw py::value_error(std::string(name) + ": expected shape (" + std::to_string(nq) +
                           ",), got " + shape_text(a));
   VecX q = Eigen::Map<const VecX>(a.data(), nq);
-  for (Eigen::Index i = 0; i < nq; ++i)
-    if (!std::isfinite(q[i]) || std::abs(q[i]) > kMaxMagnitude)
-      throw py::value_error(std::string(name) + ": entry " + std::to_string(i) + " ('" +
-                            model.configuration_names[i] + "') " +
-                            (std::isfinite(q[i]) ? out_of_range_text(q[i]) : "is NaN or Inf"));
-  if (const std::string bad = normalize_quaternions(model, q); !bad.empty())
-    throw py::value_error(std::string(name) + ": " + bad);
+  check_configuration(q, std::string(name) + ": ", model);
   return q;
 }
 
@@ -101,17 +107,8 @@ RowMatX configuration_batch_arg(const Array& a, const char* name, const Model& m
   RowMatX out = Eigen::Map<const RowMatX>(a.data(), a.shape(0), nq);
   VecX q(nq);
   for (Eigen::Index i = 0; i < out.rows(); ++i) {
-    const std::string row = std::string(name) + ": row " + std::to_string(i) + ", ";
-    for (Eigen::Index c = 0; c < nq; ++c) {
-      const double x = out(i, c);
-      if (std::isfinite(x) && std::abs(x) <= kMaxMagnitude) continue;
-      throw py::value_error(row + "entry " + std::to_string(c) + " ('" +
-                            model.configuration_names[c] + "') " +
-                            (std::isfinite(x) ? out_of_range_text(x) : "is NaN or Inf"));
-    }
     q = out.row(i).transpose();
-    if (const std::string bad = normalize_quaternions(model, q); !bad.empty())
-      throw py::value_error(row + bad);
+    check_configuration(q, std::string(name) + ": row " + std::to_string(i) + ", ", model);
     out.row(i) = q.transpose();
   }
   return out;
