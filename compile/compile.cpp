@@ -132,26 +132,6 @@ void check_one_rate(const Model& m, int t, const std::string& where) {
                                 " rates): couplings join joints of one coordinate");
 }
 
-// The names of the entries of q: the rates' names while θ and θ̇ have the same layout, else
-// (a joint with nq ≠ nv, allowed only without couplings) each joint's coordinates in tree order.
-void name_configuration(Model& m) {
-  bool flat = true;
-  for (const Body& b : m.bodies) flat = flat && is_flat(b.joint);
-  if (flat) {
-    m.configuration_names = m.coordinate_names;
-    return;
-  }
-  if (!m.identity_coupling)
-    throw ModelError(m.where,
-                     "couplings in a model with a spherical or free joint are not "
-                     "supported yet (couplings join one-coordinate joints of a model "
-                     "whose joints all have nq = nv)");
-  for (const Body& b : m.bodies)
-    for (int k = 0; k < b.joint.nq; ++k)
-      m.configuration_names.push_back(
-          b.joint.nq == 1 ? b.joint.name : b.joint.name + "." + coordinate_name(b.joint, k));
-}
-
 // The coupling level: C (nθ x n) and θ0 from the couplings; the remaining movable joints,
 // in tree order, are the generalized coordinates q.
 void compile_coupling(const MechanismSpec& spec, Model& m) {
@@ -182,6 +162,7 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
     if (!coupled.count(t)) {
       q_of[t] = static_cast<int>(m.coordinate_names.size());
       const Joint& j = m.bodies[m.theta_joint[t]].joint;
+      if (t == j.idx_v) m.coordinate_joints.push_back({m.theta_joint[t], 0, q_of[t]});
       m.coordinate_names.push_back(j.nv == 1 ? j.name : j.name + "." + rate_name(j, t - j.idx_v));
     }
   const int n = static_cast<int>(m.coordinate_names.size());
@@ -247,6 +228,47 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
 
 }  // namespace
 
+// Each coordinate joint's address in q (its address in v is set with C), and the names of q's
+// entries: a joint's name for one coordinate, else "name.coordinate".
+void lay_out_coordinates(Model& m) {
+  for (CoordinateJoint& c : m.coordinate_joints) {
+    const Joint& J = m.bodies[c.body].joint;
+    c.q = m.n_q();
+    for (int k = 0; k < J.nq; ++k)
+      m.configuration_names.push_back(J.nq == 1 ? J.name : J.name + "." + coordinate_name(J, k));
+  }
+}
+
+// θ = C_q q + θ0_q (Model::C_configuration): C's rows with each coordinate's column moved to its
+// entry of q (a one-rate joint's coordinate), and a joint with nq ≠ nv the identity on its own.
+void configuration_coupling(Model& m) {
+  std::vector<int> q_of_v(m.n(), -1);  // a flat joint's rate -> its coordinate in q
+  std::vector<int> owner(m.bodies.size(), -1);
+  for (const CoordinateJoint& c : m.coordinate_joints) {
+    const Joint& J = m.bodies[c.body].joint;
+    owner[c.body] = c.q;
+    if (is_flat(J))
+      for (int k = 0; k < J.nv; ++k) q_of_v[c.v + k] = c.q + k;
+  }
+  std::vector<Eigen::Triplet<double>> entries;
+  m.theta0_configuration = VecX::Zero(m.n_theta_q);
+  for (std::size_t b = 0; b < m.bodies.size(); ++b) {
+    const Joint& J = m.bodies[b].joint;
+    if (!moves(J)) continue;
+    if (owner[b] >= 0 && !is_flat(J)) {
+      for (int k = 0; k < J.nq; ++k) entries.emplace_back(J.idx_q + k, owner[b] + k, 1.0);
+      continue;
+    }
+    for (int k = 0; k < J.nv; ++k) {  // flat: θ_q = θ, row by row
+      m.theta0_configuration[J.idx_q + k] = m.theta0[J.idx_v + k];
+      for (SpRowMat::InnerIterator it(m.C_sparse, J.idx_v + k); it; ++it)
+        entries.emplace_back(J.idx_q + k, q_of_v[it.col()], it.value());
+    }
+  }
+  m.C_configuration.resize(m.n_theta_q, m.n_q());
+  m.C_configuration.setFromTriplets(entries.begin(), entries.end());
+}
+
 Model compile(MechanismSpec spec, const CompileOptions& options) {
   if (has_coupling_law(spec)) return compile_with_coupling_level(std::move(spec), options);
   Model m = compile_tree(std::move(spec), options);
@@ -298,7 +320,8 @@ Model compile_tree(MechanismSpec spec, const CompileOptions& options) {
     m.bodies.push_back(std::move(b));
   }
   compile_coupling(spec, m);
-  name_configuration(m);
+  lay_out_coordinates(m);
+  configuration_coupling(m);
   // The passes below run kinematics on the model being built: its routes so far (the reference
   // ones, no law) until choose_routes settles them.
   m.routes = choose_equation_routes(m);

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "core/errors.hpp"
+#include "core/joints/kernel.hpp"
 #include "core/kinematics.hpp"
 #include "core/names.hpp"
 #include "core/sampling.hpp"
@@ -107,12 +108,6 @@ Model compile_with_coupling_level(MechanismSpec spec, const CompileOptions& opti
   tree_spec.couplings.clear();
   Model tree = compile_tree(tree_spec, options);
   Model m = compile_tree(std::move(tree_spec), options);
-  for (const Body& b : m.bodies)
-    if (b.joint.nv > 1)
-      throw ModelError(b.joint.where, "joint '" + b.joint.name + "' is " +
-                                          std::string(joint_type_name(b.joint.type)) +
-                                          ": a model with coupling laws takes joints of one "
-                                          "coordinate only (not supported yet)");
 
   std::map<std::string, int> theta_of;  // joint name -> θ index
   for (int t = 0; t < m.n_theta(); ++t) theta_of[m.bodies[m.theta_joint[t]].joint.name] = t;
@@ -127,13 +122,24 @@ Model compile_with_coupling_level(MechanismSpec spec, const CompileOptions& opti
   }
   auto level = std::make_shared<CouplingLevel>();
   level->n_theta = m.n_theta();
+  level->n_theta_q = m.n_theta_q;
   m.coordinate_names.clear();
-  for (int t = 0; t < m.n_theta(); ++t)
-    if (!coupled.count(t)) {
-      level->coordinate_theta.push_back(t);
-      m.coordinate_names.push_back(m.bodies[m.theta_joint[t]].joint.name);
-    }
-  level->n = static_cast<int>(level->coordinate_theta.size());
+  m.coordinate_joints.clear();
+  m.configuration_names.clear();
+  level->theta_q.assign(m.n_theta(), -1);
+  for (int t = 0; t < m.n_theta(); ++t) {
+    const Joint& J = m.bodies[m.theta_joint[t]].joint;
+    if (is_flat(J)) level->theta_q[t] = J.idx_q + (t - J.idx_v);
+    if (coupled.count(t)) continue;
+    if (t == J.idx_v) m.coordinate_joints.push_back({m.theta_joint[t], 0, level->n});
+    level->coordinate_theta.push_back(t);
+    m.coordinate_names.push_back(J.nv == 1 ? J.name : J.name + "." + rate_name(J, t - J.idx_v));
+    ++level->n;
+  }
+  lay_out_coordinates(m);
+  for (const CoordinateJoint& c : m.coordinate_joints)
+    for (int k = 0; k < m.bodies[c.body].joint.nq; ++k)
+      level->configuration_theta.push_back(m.bodies[c.body].joint.idx_q + k);
   level->coupled = dependency_order(std::move(coupled), m);
   if (level->n == 0) throw ModelError(m.where, "every joint is coupled: there is no coordinate");
   for (const CoupledJoint& j : level->coupled) {
@@ -144,7 +150,7 @@ Model compile_with_coupling_level(MechanismSpec spec, const CompileOptions& opti
   // C and θ0: g's linearisation at q_ref (each coordinate at 0, or its nearest limit), for the
   // reports and structure analyses only; a dependence with zero slope there is stored as 1.
   const int n = level->n, nt = level->n_theta;
-  const VecX q_ref = reference_posture(m);  // (by m.coordinate_names, already the level's)
+  const VecX q_ref = reference_posture(m);  // (by m.coordinate_joints, already the level's)
   CouplingLevelState s(*level);
   const VecX zero = VecX::Zero(n);
   if (!evaluate_level(*level, q_ref, zero, zero, s))
@@ -164,9 +170,16 @@ Model compile_with_coupling_level(MechanismSpec spec, const CompileOptions& opti
   m.C.resize(nt, n);
   m.C.setFromTriplets(entries.begin(), entries.end());
   m.C_sparse = m.C;
-  m.theta0 = s.theta - s.G * q_ref;
+  m.theta0 = VecX::Zero(nt);  // θ0 = g(q_ref) − G q_ref on the one-coordinate joints
+  for (int t = 0; t < nt; ++t)
+    if (level->theta_q[t] >= 0) {
+      m.theta0[t] = s.theta[level->theta_q[t]];
+      for (int a = 0; a < n; ++a)
+        if (const int i = level->theta_q[level->coordinate_theta[a]]; i >= 0 && s.G(t, a) != 0)
+          m.theta0[t] -= s.G(t, a) * s.theta[i];
+    }
   m.identity_coupling = false;
-  m.configuration_names = m.coordinate_names;
+  configuration_coupling(m);
   m.mass_pattern = MassPattern{};  // (M^s is reduced and factorised densely: coupling_chain)
   m.dynamics_route = DynamicsRoute::Cholesky;
   m.coupling_level = std::move(level);
@@ -190,7 +203,7 @@ void check_rigid_spans(const Model& m) {
                                [](const ElementEntry& e) { return e.spans; });
   if (!any) return;
   Workspace ws(m);
-  VecX q(m.n());
+  VecX q(m.n_q());
   std::mt19937 rng(12345);
   const VecX zero = VecX::Zero(m.n());
   std::vector<double> L0;
@@ -208,8 +221,8 @@ void check_rigid_spans(const Model& m) {
       const double change = L - L0[s++];
       if (std::abs(change) > 1e-9 * L0[s - 1] + 1e-12) {
         std::string at;
-        for (int a = 0; a < m.n(); ++a)
-          at += (a ? ", " : "") + m.coordinate_names[a] + " = " + format_number(q[a]);
+        for (int a = 0; a < m.n_q(); ++a)
+          at += (a ? ", " : "") + m.configuration_names[a] + " = " + format_number(q[a]);
         throw ModelError(e.where, std::string(e.element->type_name()) +
                                       " spanning two bodies does not keep its length: " +
                                       format_number(L0[s - 1]) + " m at the reference posture, " +

@@ -13,6 +13,11 @@ bool has_coupling_law(const MechanismSpec& spec);
 Model compile_with_coupling_level(MechanismSpec spec, const CompileOptions& options);
 // compile() without the check below (the tree of a model with a law moves its joints freely).
 Model compile_tree(MechanismSpec spec, const CompileOptions& options);
+// Passes shared with compile_tree (compile/compile.cpp), run again once the coordinates change:
+// the coordinate joints' addresses in q and the names of q's entries (Model::coordinate_joints
+// must hold the joints and their v addresses), then C_q and θ0_q from C and θ0.
+void lay_out_coordinates(Model& m);
+void configuration_coupling(Model& m);
 // Each element that spans two bodies (a rod) must keep its length under the model's
 // kinematics: checked at the reference posture and 64 seeded postures within the limits;
 // otherwise ModelError naming the element, the posture and the change in length.

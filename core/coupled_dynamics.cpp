@@ -12,7 +12,7 @@ Status coupled_forward_dynamics(const Model& model, Workspace& ws, const VecX& q
                                 const VecX& tau) {
   const int nb = static_cast<int>(model.bodies.size());
   propagate(model, ws, q, qd, {.jacobian = false, .bias = false, .rows = false});  // poses, θ
-  coupling_apply(model, qd, ws.theta_dot, false);
+  coupling_apply(model, qd, ws.theta_dot);
 
   // Root to leaves: V_b, a_b (q̈ = 0), I_b and the force f_b (kept in pA) the body needs.
   for (int b = 0; b < nb; ++b) {

@@ -1,4 +1,4 @@
-// The coupling level θ = C q + θ0 applied in the hot path: through the sparse copy of C
+// The coupling level θ = C q + θ0 (θ̇ = C v) applied in the hot path: through the sparse copy of C
 // (Model::C_sparse, O(non-zeros)), or, for the identity (no couplings), as nothing at all.
 // Model::C (column-major, for M^s = Cᵀ M_θ C and reports) and C_sparse (row-major) hold
 // the same entries.
@@ -7,14 +7,23 @@
 
 namespace femdyn {
 
-// θ = C x (+ θ0 when `offset`).
-inline void coupling_apply(const Model& m, const VecX& x, VecX& theta, bool offset) {
+// The joints' coordinates θ = C_q q + θ0_q of the configuration q (n_q entries).
+inline void coupling_configuration(const Model& m, const VecX& q, VecX& theta) {
   if (m.identity_coupling) {
-    theta = x;
+    theta = q;
     return;
   }
-  theta.noalias() = m.C_sparse * x;
-  if (offset) theta += m.theta0;
+  theta.noalias() = m.C_configuration * q;
+  theta += m.theta0_configuration;
+}
+
+// The joints' rates θ̇ = C x of the generalized rates x (n entries).
+inline void coupling_apply(const Model& m, const VecX& x, VecX& theta_dot) {
+  if (m.identity_coupling) {
+    theta_dot = x;
+    return;
+  }
+  theta_dot.noalias() = m.C_sparse * x;
 }
 
 // y = Cᵀ f.

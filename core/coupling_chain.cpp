@@ -17,7 +17,7 @@ CouplingLevelState& level_at(const Model& m, Workspace& ws, const VecX& q, const
     std::string at;
     for (int k : j.sources)
       at += (at.empty() ? "" : ", ") + m.bodies[m.theta_joint[k]].joint.name + " = " +
-            format_number(s.theta[k]);
+            format_number(s.theta[m.coupling_level->theta_q[k]]);
     throw ModelError(j.where, "the law of joint '" + j.name + "' is not defined at " + at +
                                   " (a linkage that cannot assemble or is at its dead point)");
   }

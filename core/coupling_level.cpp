@@ -3,7 +3,7 @@
 namespace femdyn {
 
 CouplingLevelState::CouplingLevelState(const CouplingLevel& level)
-    : theta(VecX::Zero(level.n_theta)),
+    : theta(VecX::Zero(level.n_theta_q)),
       theta_dot(VecX::Zero(level.n_theta)),
       theta_dot_y(VecX::Zero(level.n_theta)),
       gamma(VecX::Zero(level.n_theta)),
@@ -20,9 +20,10 @@ bool evaluate_level(const CouplingLevel& level, const VecX& q, const VecX& x, co
   if (hessian && s.H.size() != static_cast<std::size_t>(level.n_theta))
     s.H.assign(level.n_theta, MatX::Zero(level.n, level.n));  // first request only
   s.failed = -1;
-  for (int a = 0; a < level.n; ++a) {  // the coordinates: θ_t = q_a
+  for (std::size_t i = 0; i < level.configuration_theta.size(); ++i)
+    s.theta[level.configuration_theta[i]] = q[i];  // the coordinates' own joints: θ = q
+  for (int a = 0; a < level.n; ++a) {              // and their rates: θ̇_t = x_a
     const int t = level.coordinate_theta[a];
-    s.theta[t] = q[a];
     s.theta_dot[t] = x[a];
     s.theta_dot_y[t] = y[a];
     s.gamma[t] = 0;
@@ -33,7 +34,7 @@ bool evaluate_level(const CouplingLevel& level, const VecX& q, const VecX& x, co
   for (std::size_t c = 0; c < level.coupled.size(); ++c) {
     const CoupledJoint& j = level.coupled[c];
     const int k = static_cast<int>(j.sources.size());
-    for (int i = 0; i < k; ++i) s.x[i] = s.theta[j.sources[i]];
+    for (int i = 0; i < k; ++i) s.x[i] = s.theta[level.theta_q[j.sources[i]]];
     double f = 0;
     if (!j.law->evaluate({s.x.data(), static_cast<std::size_t>(k)}, f,
                          {s.df.data(), static_cast<std::size_t>(k)},
@@ -42,7 +43,7 @@ bool evaluate_level(const CouplingLevel& level, const VecX& q, const VecX& x, co
       return false;
     }
     const int t = j.theta;
-    s.theta[t] = f;
+    s.theta[level.theta_q[t]] = f;
     s.G.row(t).setZero();
     s.theta_dot[t] = s.theta_dot_y[t] = s.gamma[t] = 0;
     if (hessian) s.H[t].setZero();

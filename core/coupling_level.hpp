@@ -24,8 +24,10 @@ struct CoupledJoint {
 };
 
 struct CouplingLevel {
-  int n = 0, n_theta = 0;
-  std::vector<int> coordinate_theta;  // q index -> θ index
+  int n = 0, n_theta = 0, n_theta_q = 0;  // rates v, joint rates θ̇, joint coordinates θ
+  std::vector<int> coordinate_theta;      // v index -> θ̇ index
+  std::vector<int> configuration_theta;   // q index (n_q) -> θ index: the coordinates' own joints
+  std::vector<int> theta_q;  // θ̇ index -> its θ index on a flat joint, -1 on a quaternion joint
   std::vector<CoupledJoint> coupled;  // in dependency order
   int largest_arity = 0;
 };
@@ -33,7 +35,7 @@ struct CouplingLevel {
 // One evaluation's results and scratch (held by the Workspace: no allocation per call).
 struct CouplingLevelState {
   explicit CouplingLevelState(const CouplingLevel& level);
-  VecX theta, theta_dot, theta_dot_y, gamma;  // θ, G x, G y, g''[x, y]
+  VecX theta, theta_dot, theta_dot_y, gamma;  // θ (n_θq), G x, G y, g''[x, y] (nθ)
   MatX G;                                     // ∂θ/∂q, nθ × n
   std::vector<MatX> H;                        // ∂²θ_t/∂q², sized on the first request
   std::vector<double> x, df, d2f;             // one law's arguments and derivatives
@@ -42,8 +44,8 @@ struct CouplingLevelState {
   int failed = -1;                            // index into coupled[] where a law is undefined
 };
 
-// θ = g(q), G, θ̇ = G x, θ̇_y = G y, γ = g''[x, y] (and H with `hessian`). False when a law is
-// not defined at this q (s.failed names it).
+// θ = g(q) (q of n_q entries; laws act on joints of one coordinate), G, θ̇ = G x, θ̇_y = G y, γ =
+// g''[x, y] (and H with `hessian`). False when a law is not defined at this q (s.failed names it).
 bool evaluate_level(const CouplingLevel& level, const VecX& q, const VecX& x, const VecX& y,
                     CouplingLevelState& s, bool hessian = false);
 

@@ -229,8 +229,8 @@ std::vector<MatX> third_order_tensor_levels(const Model& model, Workspace& ws, c
 }
 
 void joint_state_levels(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
-  coupling_apply(model, q, ws.theta, true);
-  coupling_apply(model, qd, ws.theta_dot, false);
+  coupling_configuration(model, q, ws.theta);
+  coupling_apply(model, qd, ws.theta_dot);
 }
 
 Energy energy_levels(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {

@@ -146,10 +146,10 @@ void propagate_bilinear(const Model& model, Workspace& ws, const VecX& q, const 
 void propagate_bilinear_levels(const Model& model, Workspace& ws, const VecX& q, const VecX& x,
                                const VecX& y, KinematicsRequest request) {
   // Coupling level.
-  coupling_apply(model, q, ws.theta, true);
+  coupling_configuration(model, q, ws.theta);
   if (request.bias) {
-    coupling_apply(model, x, ws.theta_dot, false);
-    coupling_apply(model, y, ws.theta_dot_y, false);
+    coupling_apply(model, x, ws.theta_dot);
+    coupling_apply(model, y, ws.theta_dot_y);
   }
   propagate_tree(model, ws, request);
   propagate_nodes(model, ws, request);

@@ -57,6 +57,14 @@ struct SystemNode {
   std::string label;
 };
 
+// A joint that owns generalized coordinates (no coupling sets it), with its first entry in q
+// (n_q) and in v (n): MuJoCo's jnt_qposadr/jnt_dofadr, one level up past the couplings. Without
+// couplings these are the joint's own idx_q and idx_v.
+struct CoordinateJoint {
+  int body = -1;
+  int q = 0, v = 0;
+};
+
 enum class DofKind : unsigned char { Translation, Rotation };
 
 // One transition coordinate u_i: a translation of a node or a rotation rate of a body.
@@ -147,8 +155,9 @@ struct Model {
   SpMat C;
   VecX theta0;
   std::vector<std::string> coordinate_names;  // n: the independent rates v (q̇ for 1-DOF joints)
-  std::vector<std::string> configuration_names;  // n_q: the entries of q (e.g. base.qw)
-  int n_theta_q = 0;                             // the joints' coordinates θ (Σ nq)
+  std::vector<std::string> configuration_names;    // n_q: the entries of q (e.g. base.qw)
+  int n_theta_q = 0;                               // the joints' coordinates θ (Σ nq)
+  std::vector<CoordinateJoint> coordinate_joints;  // tree order: q and v joint by joint
 
   // Node level.
   std::vector<SystemNode> nodes;
@@ -170,8 +179,13 @@ struct Model {
   std::vector<RigidInertia> body_inertia;  // Λ_b = Σ X_eᵀ m_e X_e, body axes (core/spatial.hpp)
   bool identity_coupling = false;          // C = I and θ0 = 0: the coupling level is nothing
   SpRowMat C_sparse;                       // C for the hot path (core/coupling.hpp)
-  bool condensable = false;                // the body-level form is exact for this model
-  bool velocity_forces_rigid = false;      // every g_e is its element's gyroscopic term (checked)
+  // The configuration's form of C and θ0: θ (n_θq) = C_q q + θ0_q (q of n_q entries). A joint
+  // with nq ≠ nv is never coupled: its nq rows are the identity on its own entries of q. Equal to
+  // C and θ0 when every joint is flat; unused with the identity.
+  SpRowMat C_configuration;
+  VecX theta0_configuration;
+  bool condensable = false;            // the body-level form is exact for this model
+  bool velocity_forces_rigid = false;  // every g_e is its element's gyroscopic term (checked)
   MassRoute mass_route = MassRoute::Transform;             // how evaluate() forms M^s
   ForceRoute force_route = ForceRoute::Nodes;              // how h and τ are computed
   DynamicsRoute dynamics_route = DynamicsRoute::Cholesky;  // how forward_dynamics() finds q̈

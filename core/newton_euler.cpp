@@ -41,8 +41,8 @@ void newton_euler(const Model& model, Workspace& ws, const VecX& q, const VecX& 
                   bool with_external, VecX& y) {
   const int nb = static_cast<int>(model.bodies.size());
   propagate(model, ws, q, qd, {.jacobian = false, .bias = false, .rows = false});  // poses, θ
-  coupling_apply(model, qd, ws.theta_dot, false);
-  if (qdd) coupling_apply(model, *qdd, ws.theta_dot_y, false);  // θ̈ = C q̈ (buffer reused)
+  coupling_apply(model, qd, ws.theta_dot);
+  if (qdd) coupling_apply(model, *qdd, ws.theta_dot_y);  // θ̈ = C q̈ (buffer reused)
   const Vec6 a_base = with_external ? gravity_base_acceleration(model) : Vec6::Zero();
 
   // Root to leaves: V_b, a_b, and the force f_b (kept in pA) the body needs.

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <numbers>
 #include <string>
 
@@ -11,19 +10,6 @@
 namespace femdyn {
 
 namespace {
-
-// Coordinate -> its joint (by name).
-// (By the coordinates' names, so that compile may call it before C has its final width.)
-std::vector<const Joint*> coordinate_joints(const Model& m) {
-  const int n = static_cast<int>(m.coordinate_names.size());
-  std::vector<const Joint*> joint_of(n, nullptr);
-  std::map<std::string, int> coordinate;
-  for (int a = 0; a < n; ++a) coordinate.emplace(m.coordinate_names[a], a);
-  for (const Body& b : m.bodies)
-    if (const auto it = coordinate.find(b.joint.name); it != coordinate.end())
-      joint_of[it->second] = &b.joint;
-  return joint_of;
-}
 
 // One coordinate of a one-coordinate joint (or of none: ±π).
 double random_within_limits(const Joint* joint, std::mt19937& rng) {
@@ -43,18 +29,18 @@ double random_within_limits(const Joint* joint, std::mt19937& rng) {
   return std::uniform_real_distribution<double>(lo, hi)(rng);
 }
 
-// With a spherical or free joint (no couplings then: θ = q): each joint's configuration in turn,
-// a one-coordinate joint's by `one`, any other's by `many`.
+// q joint by joint over the coordinate joints: a one-coordinate joint's entry by `one`, any
+// other's nq entries by `many`.
 template <class One, class Many>
 VecX per_joint(const Model& m, One&& one, Many&& many) {
   VecX q(m.n_q());
-  for (const Body& b : m.bodies)
-    if (const Joint& J = b.joint; moves(J)) {
-      if (J.nq == 1)
-        q[J.idx_q] = one(J);
-      else
-        many(J, q.data() + J.idx_q);
-    }
+  for (const CoordinateJoint& c : m.coordinate_joints) {
+    const Joint& J = m.bodies[c.body].joint;
+    if (J.nq == 1)
+      q[c.q] = one(J);
+    else
+      many(J, q.data() + c.q);
+  }
   return q;
 }
 
@@ -66,29 +52,15 @@ bool flat_model(const Model& m) {
 }
 
 VecX reference_posture(const Model& m) {
-  if (!flat_model(m))
-    return per_joint(
-        m, [](const Joint& J) { return std::clamp(0.0, J.lower, J.upper); },
-        [](const Joint& J, double* q) { neutral_configuration(J, q); });
-  const std::vector<const Joint*> joint_of = coordinate_joints(m);
-  const int n = static_cast<int>(joint_of.size());
-  VecX q(n);
-  for (int a = 0; a < n; ++a)
-    q[a] = joint_of[a] ? std::clamp(0.0, joint_of[a]->lower, joint_of[a]->upper) : 0.0;
-  return q;
+  return per_joint(
+      m, [](const Joint& J) { return std::clamp(0.0, J.lower, J.upper); },
+      [](const Joint& J, double* q) { neutral_configuration(J, q); });
 }
 
 VecX random_posture(const Model& m, std::mt19937& rng) {
-  if (!flat_model(m))
-    return per_joint(
-        m, [&](const Joint& J) { return random_within_limits(&J, rng); },
-        [&](const Joint& J, double* q) { random_configuration(J, rng, q); });
-  const std::vector<const Joint*> joint_of = coordinate_joints(m);
-  VecX q(m.n());
-  for (int a = 0; a < m.n(); ++a) {
-    q[a] = random_within_limits(joint_of[a], rng);
-  }
-  return q;
+  return per_joint(
+      m, [&](const Joint& J) { return random_within_limits(&J, rng); },
+      [&](const Joint& J, double* q) { random_configuration(J, rng, q); });
 }
 
 VecX neutral_posture(const Model& m) {
@@ -101,26 +73,25 @@ VecX neutral_posture(const Model& m) {
 VecX integrate_posture(const Model& m, const VecX& q, const VecX& xi) {
   if (flat_model(m)) return q + xi;
   VecX out(m.n_q());
-  for (const Body& b : m.bodies)
-    if (const Joint& J = b.joint; moves(J))
-      integrate_configuration(J, q.data() + J.idx_q, xi.data() + J.idx_v, out.data() + J.idx_q);
+  for (const CoordinateJoint& c : m.coordinate_joints)
+    integrate_configuration(m.bodies[c.body].joint, q.data() + c.q, xi.data() + c.v,
+                            out.data() + c.q);
   return out;
 }
 
 VecX chart_rates(const Model& m, const VecX& q, const VecX& xi, const VecX& v) {
   if (flat_model(m)) return v;
   VecX out(m.n());
-  for (const Body& b : m.bodies)
-    if (const Joint& J = b.joint; moves(J))
-      chart_rate(J, q.data() + J.idx_q, xi.data() + J.idx_v, v.data() + J.idx_v,
-                 out.data() + J.idx_v);
+  for (const CoordinateJoint& c : m.coordinate_joints)
+    chart_rate(m.bodies[c.body].joint, q.data() + c.q, xi.data() + c.v, v.data() + c.v,
+               out.data() + c.v);
   return out;
 }
 
 std::string normalize_quaternions(const Model& m, VecX& q) {
-  for (const Body& b : m.bodies)
-    if (const Joint& J = b.joint; moves(J) && !is_flat(J)) {
-      auto quat = q.segment<4>(J.idx_q + J.nq - 4);  // (the quaternion is last)
+  for (const CoordinateJoint& c : m.coordinate_joints)
+    if (const Joint& J = m.bodies[c.body].joint; !is_flat(J)) {
+      auto quat = q.segment<4>(c.q + J.nq - 4);  // (the quaternion is last)
       const double norm = quat.norm();
       if (!(std::abs(norm - 1) <= 1e-6))
         return "the quaternion of joint '" + J.name + "' has norm " + std::to_string(norm) +

@@ -13,8 +13,7 @@ VecX reference_posture(const Model& model);
 VecX random_uniform(int n, double scale, std::mt19937& rng);
 // Every joint at its neutral configuration (0, the identity rotation): q of size n_q.
 VecX neutral_posture(const Model& model);
-// q ⊕ ξ joint by joint (ξ of size n, in each joint's chart around its q; no couplings if a
-// joint is not flat).
+// q ⊕ ξ over the coordinate joints (ξ of size n, in each joint's chart around its q).
 VecX integrate_posture(const Model& model, const VecX& q, const VecX& xi);
 // ξ̇ = the chart rates at (q ⊕ ξ) for the rates v, joint by joint (v when flat).
 VecX chart_rates(const Model& model, const VecX& q, const VecX& xi, const VecX& v);

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "core/joints/kernel.hpp"
+#include "core/sampling.hpp"
 
 namespace femdyn {
 
@@ -28,16 +29,11 @@ double nonconservative_power(const Model& model, const Workspace& ws, const VecX
 Motion::Motion(const Model& model, Actuation tau)
     : model_(model), tau_(std::move(tau)), ws_(model) {
   q_ = qd_ = u_ = VecX::Zero(model.n());
-  for (const Body& b : model.bodies) flat_ = flat_ && is_flat(b.joint);
-  if (!flat_) {
-    q_c_ = q_ = VecX::Zero(model.n_q());
-    for (const Body& b : model.bodies)
-      if (moves(b.joint)) neutral_configuration(b.joint, q_c_.data() + b.joint.idx_q);
-  }
+  flat_ = flat_model(model);
+  if (!flat_) q_c_ = q_ = neutral_posture(model);
 }
 
-// (Without couplings, as compile requires of a non-flat model: θ = q, θ̇ = v, and each joint's
-// addresses idx_q, idx_v are its places in q and v.)
+// (Joint by joint over Model::coordinate_joints, whose addresses are their places in q and v.)
 void Motion::start_chart(const VecX& q, double* y) {
   if (flat_) {
     Eigen::Map<VecX>(y, n()) = q;
@@ -53,9 +49,9 @@ void Motion::configuration(const double* y, VecX& q) const {
     return;
   }
   q.resize(model_.n_q());
-  for (const Body& b : model_.bodies)
-    if (const Joint& J = b.joint; moves(J))
-      integrate_configuration(J, q_c_.data() + J.idx_q, y + J.idx_v, q.data() + J.idx_q);
+  for (const CoordinateJoint& c : model_.coordinate_joints)
+    integrate_configuration(model_.bodies[c.body].joint, q_c_.data() + c.q, y + c.v,
+                            q.data() + c.q);
 }
 
 void Motion::recenter(double* y) {
@@ -69,9 +65,9 @@ void Motion::recenter(double* y) {
 double Motion::chart_extent(const double* y) const {
   double extent = 0;
   if (flat_) return extent;
-  for (const Body& b : model_.bodies)
-    if (const Joint& J = b.joint; !is_flat(J))  // the rotation is a non-flat joint's last 3 rates
-      extent = std::max(extent, Eigen::Map<const Vec3>(y + J.idx_v + J.nv - 3).norm());
+  for (const CoordinateJoint& c : model_.coordinate_joints)
+    if (const Joint& J = model_.bodies[c.body].joint; !is_flat(J))  // its rotation: last 3 rates
+      extent = std::max(extent, Eigen::Map<const Vec3>(y + c.v + J.nv - 3).norm());
   return extent;
 }
 
@@ -80,9 +76,8 @@ void Motion::chart_rates(const double* xi, const double* v, double* xi_dot) cons
     std::copy(v, v + n(), xi_dot);
     return;
   }
-  for (const Body& b : model_.bodies)
-    if (const Joint& J = b.joint; moves(J))
-      chart_rate(J, q_c_.data() + J.idx_q, xi + J.idx_v, v + J.idx_v, xi_dot + J.idx_v);
+  for (const CoordinateJoint& c : model_.coordinate_joints)
+    chart_rate(model_.bodies[c.body].joint, q_c_.data() + c.q, xi + c.v, v + c.v, xi_dot + c.v);
 }
 
 Status Motion::check_state(double t, const double* y) const {

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 #include <fstream>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
 
@@ -122,6 +123,28 @@ std::string mixed_tree_json(unsigned seed, int bodies) {
   return out + "]}";
 }
 
+// The mixed tree with couplings among its one-coordinate joints (revolute, prismatic, helical),
+// each after the first coupled to the one before it, alternately linearly and by a polynomial
+// law: θ and q then differ in layout as well as in value (a quaternion before a coupled joint).
+std::string coupled_mixed_tree_json(unsigned seed, int bodies) {
+  nlohmann::json m = nlohmann::json::parse(mixed_tree_json(seed, bodies));
+  std::vector<std::string> one;
+  for (const auto& b : m["bodies"])
+    if (const std::string t = b["joint"]["type"];
+        t == "revolute" || t == "prismatic" || t == "helical")
+      one.push_back(b["name"]);
+  m["couplings"] = nlohmann::json::array();
+  for (std::size_t k = 1; k < one.size(); k += 2)
+    if (k % 4 == 1)
+      m["couplings"].push_back(
+          {{"joint", one[k]}, {"follows", one[k - 1]}, {"ratio", 0.7}, {"offset", 0.1}});
+    else
+      m["couplings"].push_back({{"joint", one[k]},
+                                {"follows", one[k - 1]},
+                                {"polynomial", {{0.1, 0}, {0.6, 1}, {0.2, 2}}}});
+  return m.dump();
+}
+
 }  // namespace
 
 TEST_CASE("each new joint type alone matches its Simbody mobilizer", "[validation][joints]") {
@@ -144,6 +167,31 @@ TEST_CASE("seeded random trees of mixed joint types match Simbody", "[validation
     require_pass(validation::validate(m, quick(5, 0.1)),
                  "seed " + std::to_string(seed) + ", " + std::to_string(bodies) + " bodies");
   }
+}
+
+TEST_CASE("random mixed trees with linear and law couplings beside quaternions match Simbody",
+          "[validation][joints][couplings]") {
+  int linear = 0, laws = 0;
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    const int bodies = 6 + static_cast<int>(seed * 2);
+    for (const bool with_laws : {false, true}) {
+      std::string text = coupled_mixed_tree_json(seed, bodies);
+      if (!with_laws) {  // the same couplings, every one linear
+        nlohmann::json j = nlohmann::json::parse(text);
+        for (auto& c : j["couplings"])
+          if (c.contains("polynomial")) c.erase("polynomial"), c["ratio"] = -0.5;
+        text = j.dump();
+      }
+      const Model m = load_text(text);
+      if (m.n() == m.n_theta()) continue;  // no coupling drawn
+      REQUIRE(m.n_q() != m.n());
+      ++(m.coupling_level ? laws : linear);
+      require_pass(validation::validate(m, quick(4, 0.1)),
+                   "seed " + std::to_string(seed) + (with_laws ? ", laws" : ", linear"));
+    }
+  }
+  CHECK(linear >= 3);
+  CHECK(laws >= 3);
 }
 
 TEST_CASE("femdyn validate passes on a model of every joint type", "[validation][joints][cli]") {

@@ -32,6 +32,21 @@ Model held_space_robot() {
                        {"stiffness": 1e-4, "damping": 1e-5}}}})");
 }
 
+// The robot whose fingers' distal joints follow their middle ones: linearly (θ_dip = 0.8 θ_pip)
+// or through hand_fourbar.json's four-bar with its coupler rod.
+Model coupled_space_robot() {
+  return load_text(R"({"model": "space_robot", "params": {"hand": {"finger":
+                       {"coupling": {"ratio": 0.8}}}}})");
+}
+// (Without the coupler rod the law alone: tests/momentum.hpp sums body momenta, and a rod
+// spanning two bodies is not a body.)
+Model fourbar_space_robot(bool coupler_rod = true) {
+  return load_text(std::string(R"({"model": "space_robot", "params": {"hand": {"finger": {
+    "coupling": {"four_bar": {"ground": 0.03, "input": 0.005, "coupler": 0.0285, "output": 0.007,
+                 "branch": 1, "input_offset": 2.0264, "input_sign": -1})") +
+                   (coupler_rod ? R"(, "coupler_mass": 0.0005)" : "") + "}}}}}");
+}
+
 // Smooth joint torques on the arm and the fingers, none on the satellite's six rates (they would
 // be external forces): τ_i(t) = a_i sin(ω_i t + φ_i), a_i = M^s_ii (0.5 … 1.5 rad/s²) at the
 // reference posture, so that every joint, from the shoulder to a fingertip, moves about as fast.
@@ -86,6 +101,27 @@ TEST_CASE("the space robot is a free-floating satellite with a 7-DOF arm and a 2
   CHECK(mass < 200 + 17.5 + 1);
 }
 
+// The momentum about the COM over `seconds` under joint torques, relative drift (angular, linear).
+std::pair<double, double> momentum_drift(const Model& m, double seconds) {
+  Workspace ws(m);
+  std::mt19937 rng(17);
+  const VecX q0 = random_posture(m, rng), v0 = random_uniform(m.n(), 0.5, rng);
+  const Vec6 h0 = momentum_about_com(m, ws, q0, v0);
+  REQUIRE(h0.head<3>().norm() > 1);
+  REQUIRE(h0.tail<3>().norm() > 1);
+  auto integrator = dopri(m, joint_torques(m, 3));
+  integrator->reset(0, q0, v0);
+  double worst_L = 0, worst_p = 0;
+  for (int k = 1; k <= 20; ++k) {
+    REQUIRE(integrator->advance_to(seconds * k / 20).ok);
+    const Vec6 h = momentum_about_com(m, ws, integrator->q(), integrator->qd());
+    worst_L = std::max(worst_L, (h - h0).head<3>().norm() / h0.head<3>().norm());
+    worst_p = std::max(worst_p, (h - h0).tail<3>().norm() / h0.tail<3>().norm());
+  }
+  INFO(integrator->stats().steps << " steps");
+  return {worst_L, worst_p};
+}
+
 TEST_CASE("in free float dopri conserves the space robot's momentum about its centre of mass") {
   const Model m = held_space_robot();
   Workspace ws(m);
@@ -107,6 +143,18 @@ TEST_CASE("in free float dopri conserves the space robot's momentum about its ce
                                             << integrator->stats().steps << " steps");
   CHECK(worst_L <= 1e-9);
   CHECK(worst_p <= 1e-9);
+}
+
+TEST_CASE("with coupled or four-bar fingers the floating robot still conserves its momentum") {
+  for (const Model& m : {coupled_space_robot(), fourbar_space_robot(false)}) {
+    REQUIRE(m.n() == 6 + 7 + 15);  // each finger and the thumb: 3 coordinates
+    REQUIRE(m.n_q() == m.n() + 1);
+    const auto [L, p] = momentum_drift(m, 2.0);
+    INFO(m.name << (m.coupling_level ? " (four-bar)" : " (linear)") << ": angular " << L
+                << ", linear " << p);
+    CHECK(L <= 1e-9);
+    CHECK(p <= 1e-9);
+  }
 }
 
 TEST_CASE(
@@ -150,5 +198,8 @@ TEST_CASE("the space robot's M^s, h, q̈ and τ and a trajectory match Simbody, 
   require_pass(validation::validate(space_robot(), quick(4, 0.1)), "space robot");
   // Springs and dampers on joints whose q and v addresses differ (after the quaternion).
   require_pass(validation::validate(held_space_robot(), quick(4, 0.1)), "held space robot");
+  // Couplings after the quaternion: θ = C_q q + θ0_q, and the four-bar's law and rods.
+  require_pass(validation::validate(coupled_space_robot(), quick(4, 0.1)), "coupled fingers");
+  require_pass(validation::validate(fourbar_space_robot(), quick(4, 0.1)), "four-bar fingers");
 }
 #endif

@@ -105,24 +105,28 @@ TwinEquations SimbodyTwin::equations_unguarded(const VecX& q, const VecX& qd, co
   return out;
 }
 
+// v̇ = Pᵀ (u̇ − Ṗ v) on the coordinates' rates.
 VecX SimbodyTwin::Impl::constrained_qdd(const SimTK::Vector& applied,
                                         const SimTK::Vector_<SimTK::SpatialVec>& body) {
   matter.calcAcceleration(state, applied, body, udot, A_GB);
+  const VecX theta_ddot = gather(udot - pdot_v, rot);
   VecX out(model.n());
-  for (int k = 0; k < model.n(); ++k) out[k] = udot[theta_u[model.coordinate_theta[k]]];
+  for (int k = 0; k < model.n(); ++k) out[k] = theta_ddot[model.coordinate_theta[k]];
   return out;
+}
+
+// A force f on the coordinates' rates as Simbody's mobility forces: P f.
+SimTK::Vector SimbodyTwin::Impl::coordinate_forces(const VecX& f) const {
+  VecX f_theta = VecX::Zero(model.n_theta());
+  for (int k = 0; k < model.n(); ++k) f_theta[model.coordinate_theta[k]] = f[k];
+  return scatter(f_theta, rot);
 }
 
 MatX SimbodyTwin::Impl::constrained_mass(const VecX& a0) {
   const int n = model.n();
   MatX response(n, n);
-  SimTK::Vector unit = zero_mobility;
-  for (int k = 0; k < n; ++k) {
-    const int u = theta_u[model.coordinate_theta[k]];
-    unit[u] = 1;
-    response.col(k) = constrained_qdd(unit, zero_body) - a0;
-    unit[u] = 0;
-  }
+  for (int k = 0; k < n; ++k)
+    response.col(k) = constrained_qdd(coordinate_forces(VecX::Unit(n, k)), zero_body) - a0;
   return response.partialPivLu().inverse();
 }
 
@@ -130,7 +134,6 @@ MatX SimbodyTwin::Impl::constrained_mass(const VecX& a0) {
 // constrained forward dynamics alone (twin.hpp).
 TwinEquations SimbodyTwin::closed_loop_equations(const VecX& tau) {
   Impl& s = *impl_;
-  const TwinModel& m = s.model;
   TwinEquations out;
   for (int i = 0; i < s.state.getNQErr(); ++i)
     out.loop_position_error = std::max(out.loop_position_error, std::abs(s.state.getQErr()[i]));
@@ -144,9 +147,7 @@ TwinEquations SimbodyTwin::closed_loop_equations(const VecX& tau) {
   out.M = s.constrained_mass(a0);
   out.h = -out.M * a0;
   out.Q = out.M * (a_forces - a0) + tau;
-  SimTK::Vector applied = mob;
-  for (int k = 0; k < m.n(); ++k) applied[s.theta_u[m.coordinate_theta[k]]] += tau[k];
-  out.qdd = s.constrained_qdd(applied, body);
+  out.qdd = s.constrained_qdd(mob + s.coordinate_forces(tau), body);
   return out;
 }
 

@@ -116,7 +116,16 @@ struct TwinModel {
   bool closed_loop() const { return !laws.empty() || !rods.empty(); }
   int n() const { return static_cast<int>(closed_loop() ? coordinate_theta.size() : C.cols()); }
   int n_theta() const { return static_cast<int>(theta_body.size()); }
+  // θ's index of rate j (θ̇ index) on a joint with nq = nv.
+  int theta_of_rate(int j) const;
+  // femdyn's q lists the joints of the coordinates in order (coordinate k's joint has rate
+  // own_rate[k]), each with its nq entries: each body's first entry in q (-1 for a body that
+  // owns no coordinate), and n_q in `n_q`.
+  std::vector<int> configuration_layout(const std::vector<int>& own_rate, int& n_q) const;
 };
+
+// A joint type's coordinates nq (4 for a ball's quaternion, 7 for a free joint).
+int coordinates_of(TwinBody::Joint type);
 
 // Simbody's equations reduced to q: M = Cᵀ M_θ C, h = Cᵀ h_θ(C q̇), Q = Cᵀ Q_θ + τ.
 struct TwinEquations {

@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/errors.hpp"
 #include "validation/twin_impl.hpp"
 
 namespace femdyn::validation {
@@ -26,6 +27,40 @@ std::vector<int> independent_thetas(const TwinModel& model) {
     if (model.theta0[j] == 0 && nonzeros[j] == 1 && value[j] == 1.0 && out[column[j]] < 0)
       out[column[j]] = j;
   return out;
+}
+
+int coordinates_of(TwinBody::Joint type) {
+  switch (type) {
+    case TwinBody::Joint::Fixed:
+      return 0;
+    case TwinBody::Joint::Spherical:
+      return 4;
+    case TwinBody::Joint::Free:
+      return 7;
+    case TwinBody::Joint::Universal:
+      return 2;
+    case TwinBody::Joint::Planar:
+      return 3;
+    default:
+      return 1;
+  }
+}
+
+int TwinModel::theta_of_rate(int j) const {
+  const TwinBody& tb = bodies[theta_body[j]];
+  return tb.theta + (j - (tb.rate >= 0 ? tb.rate : tb.theta));
+}
+
+std::vector<int> TwinModel::configuration_layout(const std::vector<int>& own_rate, int& n_q) const {
+  std::vector<int> first(bodies.size(), -1);
+  n_q = 0;
+  for (const int j : own_rate) {
+    if (j < 0) throw femdyn::Error("a coordinate drives no joint directly");
+    const TwinBody& tb = bodies[theta_body[j]];
+    if (j == (tb.rate >= 0 ? tb.rate : tb.theta))
+      first[theta_body[j]] = n_q, n_q += coordinates_of(tb.joint);
+  }
+  return first;
 }
 
 int independent_theta(const TwinModel& model, int k) { return independent_thetas(model).at(k); }

@@ -47,6 +47,11 @@ struct SimbodyTwin::Impl {
   std::vector<int> independent;      // q index -> θ index, -1 if none
   bool couplers = true;
   Eigen::SparseMatrix<double, Eigen::RowMajor> C_rows;  // C by rows: θ_j = Σ C_jk q_k + θ0_j
+  // With a ball or free joint, θ (n_theta_q) = C_q q + θ0_q for q of the coordinate joints'
+  // entries in turn (configuration_coupling(): C's rows on q's layout, a quaternion copied).
+  Eigen::SparseMatrix<double, Eigen::RowMajor> C_configuration;
+  VecX theta0_configuration;
+  void configuration_coupling();
   SimTK::State state;
   SimTK::Matrix M_theta;
   SimTK::Vector zero_mobility, residual, mobility, udot;
@@ -98,6 +103,8 @@ struct SimbodyTwin::Impl {
   // Closed loop: q̈ of the coordinates by Simbody's constrained forward dynamics under these
   // applied forces.
   VecX constrained_qdd(const SimTK::Vector& applied, const SimTK::Vector_<SimTK::SpatialVec>& body);
+  // Closed loop: a force on the coordinates as mobility forces (P f on their joints' rates).
+  SimTK::Vector coordinate_forces(const VecX& f) const;
 
   // Closed loop: M^s as the inverse of q̈'s response to a unit force on each coordinate,
   // (M^s)⁻¹ e_k = q̈(e_k) − q̈(0), with a0 = q̈(no force).

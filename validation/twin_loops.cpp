@@ -53,22 +53,24 @@ class LawConstraint final : public SimTK::Function {
 }  // namespace
 
 void joint_state(const TwinModel& m, const VecX& q, const VecX& qd, VecX& theta, VecX& theta_dot) {
-  theta = VecX::Zero(m.n_theta());
+  theta = VecX::Zero(std::max(m.n_theta_q, m.n_theta()));
   theta_dot = VecX::Zero(m.n_theta());
-  for (int k = 0; k < m.n(); ++k) {
-    theta[m.coordinate_theta[k]] = q[k];
-    theta_dot[m.coordinate_theta[k]] = qd[k];
-  }
+  int n_q = 0;
+  const std::vector<int> first = m.configuration_layout(m.coordinate_theta, n_q);
+  for (std::size_t b = 0; b < m.bodies.size(); ++b)  // the coordinates' joints: θ = q
+    for (int k = 0; first[b] >= 0 && k < coordinates_of(m.bodies[b].joint); ++k)
+      theta[m.bodies[b].theta + k] = q[first[b] + k];
+  for (int k = 0; k < m.n(); ++k) theta_dot[m.coordinate_theta[k]] = qd[k];
   std::vector<double> x, df, d2f;
-  for (const TwinLaw& law : m.laws) {
+  for (const TwinLaw& law : m.laws) {  // (laws act on joints of one coordinate)
     const std::size_t k = law.sources.size();
     x.resize(k), df.resize(k), d2f.resize(k * k);
-    for (std::size_t i = 0; i < k; ++i) x[i] = theta[law.sources[i]];
+    for (std::size_t i = 0; i < k; ++i) x[i] = theta[m.theta_of_rate(law.sources[i])];
     double f = 0;
     if (!law.law(x.data(), f, df.data(), d2f.data()))
       throw femdyn::Error("the coupling law of joint '" + escaped(law.name) +
                           "' is not defined at this state");
-    theta[law.theta] = f;
+    theta[m.theta_of_rate(law.theta)] = f;
     double rate = 0;
     for (std::size_t i = 0; i < k; ++i) rate += df[i] * theta_dot[law.sources[i]];
     theta_dot[law.theta] = rate;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 
+#include "core/errors.hpp"
 #include "validation/twin_impl.hpp"
 #include "validation/twin_loops.hpp"
 
@@ -49,11 +50,44 @@ void SimbodyTwin::Impl::finish_state() {
   }
   theta_q.resize(m.n_theta_q > 0 ? m.n_theta_q : m.n_theta());
   rot.assign(rotated.size(), Eigen::Matrix3d::Identity());
+  if (!rotated.empty() && !m.closed_loop()) configuration_coupling();
   const int nu = state.getNU();
   zero_mobility = Vector(nu, 0.0);
   pdot_v = zero_mobility;
   zero_body =
       Vector_<SpatialVec>(matter.getNumBodies(), SpatialVec(SimTK::Vec3(0), SimTK::Vec3(0)));
+}
+
+// θ = C_q q + θ0_q: a ball's or free joint's entries copied from q, every other joint's θ from
+// C's row on the entries of q its coordinates sit at.
+void SimbodyTwin::Impl::configuration_coupling() {
+  const TwinModel& m = model;
+  const std::vector<int> own = independent_thetas(m);  // coordinate k -> its joint's rate
+  int n_q = 0;
+  const std::vector<int> first = m.configuration_layout(own, n_q);
+  const auto q_at = [&](int k) {  // coordinate k's entry of q (on a joint with nq = nv)
+    const TwinBody& tb = m.bodies[m.theta_body[own[k]]];
+    return first[m.theta_body[own[k]]] + (own[k] - (tb.rate >= 0 ? tb.rate : tb.theta));
+  };
+  std::vector<Eigen::Triplet<double>> entries;
+  theta0_configuration = VecX::Zero(m.n_theta_q);
+  for (std::size_t b = 0; b < m.bodies.size(); ++b) {
+    const TwinBody& tb = m.bodies[b];
+    if (tb.theta < 0) continue;
+    if (tb.joint == TwinBody::Joint::Spherical || tb.joint == TwinBody::Joint::Free) {
+      for (int k = 0; k < coordinates_of(tb.joint); ++k)
+        entries.emplace_back(tb.theta + k, first[b] + k, 1.0);
+      continue;
+    }
+    const int rate = tb.rate >= 0 ? tb.rate : tb.theta;
+    for (int k = 0; k < coordinates_of(tb.joint); ++k) {
+      theta0_configuration[tb.theta + k] = m.theta0[rate + k];
+      for (decltype(C_rows)::InnerIterator it(C_rows, rate + k); it; ++it)
+        entries.emplace_back(tb.theta + k, q_at(static_cast<int>(it.col())), it.value());
+    }
+  }
+  C_configuration.resize(m.n_theta_q, n_q);
+  C_configuration.setFromTriplets(entries.begin(), entries.end());
 }
 
 std::vector<Eigen::Matrix3d> SimbodyTwin::Impl::rotations(const SimTK::Vector& sq) const {
@@ -113,26 +147,24 @@ void SimbodyTwin::Impl::set_state(const VecX& q, const VecX& qd, SimTK::Stage st
                                   bool fit_rods) {
   SimTK::Vector& sq = state.updQ();
   SimTK::Vector& su = state.updU();
-  if (model.closed_loop()) {  // θ = g(q), θ̇ = G q̇, then the rods between their ends
-    loops::joint_state(model, q, qd, loop_theta, loop_theta_dot);
-    for (int j = 0; j < model.n_theta(); ++j) {
-      sq[theta_q[j]] = loop_theta[j];
-      su[theta_u[j]] = loop_theta_dot[j];
+  if (model.closed_loop() || !rotated.empty()) {
+    if (model.closed_loop())  // θ = g(q), θ̇ = G q̇, then the rods between their ends
+      loops::joint_state(model, q, qd, loop_theta, loop_theta_dot);
+    else {  // a ball or free joint: θ = C_q q + θ0_q, θ̇ = C q̇
+      loop_theta = C_configuration * q + theta0_configuration;
+      loop_theta_dot = model.C * qd;
     }
-    if (fit_rods) loops::fit_rods(system, state, model, mobod, rods);
-    system.realize(state, stage);
-    return;
-  }
-  if (!rotated.empty()) {  // a ball or free joint: no coupling (θ = q, θ̇ = v), u = P v
-    for (int i = 0; i < model.n_theta_q; ++i) sq[theta_q[i]] = q[i];
+    for (std::size_t i = 0; i < theta_q.size(); ++i) sq[theta_q[i]] = loop_theta[i];
     rot = rotations(sq);
-    su = scatter(qd, rot);
+    su = scatter(loop_theta_dot, rot);  // u = P θ̇
     for (std::size_t i = 0; i < rotated.size(); ++i) {
-      if (!rotated[i].free_linear) continue;  // Ṗ v = R (ω × v) on a free joint's v
+      if (!rotated[i].free_linear) continue;  // Ṗ θ̇ = R (ω × v) on a free joint's v
       const int r = rotated[i].rate;
-      const Eigen::Vector3d d = rot[i] * qd.segment<3>(r + 3).cross(qd.segment<3>(r));
+      const Eigen::Vector3d d =
+          rot[i] * loop_theta_dot.segment<3>(r + 3).cross(loop_theta_dot.segment<3>(r));
       for (int k = 0; k < 3; ++k) pdot_v[theta_u[r + k]] = d[k];
     }
+    if (model.closed_loop() && fit_rods) loops::fit_rods(system, state, model, mobod, rods);
     system.realize(state, stage);
     return;
   }
