@@ -195,6 +195,11 @@ TEST_CASE("validate: table and exit 0 on a good model, JSON, exit 1 when it cann
                       "/tests/robots/hyq.urdf --floating-base --states 2 --t-end 0.02");
   CHECK(hyq.code == 0);
   CHECK_THAT(hyq.out, Catch::Contains("import ") && Catch::EndsWith("PASS\n"));
+  // Floating, with <mimic> couplings after the quaternion (θ = C_q q + θ0_q).
+  const Run hand = run("validate " + model_path("urdf/hand16.urdf") +
+                       " --floating-base --states 2 --t-end 0.02");
+  CHECK(hand.code == 0);
+  CHECK_THAT(hand.out, Catch::Contains("import ") && Catch::EndsWith("PASS\n"));
 
   const Run paper = run("validate " + model_path("finger_paper.json") + " --states 2");
   CHECK(paper.code == 1);

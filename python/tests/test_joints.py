@@ -70,3 +70,47 @@ def test_batches_take_configurations_of_n_q_entries(tmp_path):
         model.forward_dynamics_batch(bad)
     with pytest.raises(ValueError, match=r"expected shape \(k, 11\), got \(5, 9\)"):
         model.forward_dynamics_batch(q[:, :9])
+
+
+COUPLED_FLOATING = {
+    "name": "floating coupled chain", "gravity": [0, 0, 0],
+    "bodies": FLOATING["bodies"] + [
+        {"name": "l1", "parent": "arm",
+         "joint": {"type": "revolute", "axis": [0, 1, 0], "origin": {"xyz": [0.6, 0, 0]}},
+         "elements": [{"type": "rigid_body", "mass": 1, "com": [0.2, 0, 0],
+                       "inertia": {"ixx": 0.01, "iyy": 0.02, "izz": 0.02}}]},
+        {"name": "l2", "parent": "l1",
+         "joint": {"type": "revolute", "axis": [0, 1, 0], "origin": {"xyz": [0.4, 0, 0]}},
+         "elements": [{"type": "rigid_body", "mass": 0.5, "com": [0.1, 0, 0],
+                       "inertia": {"ixx": 0.005, "iyy": 0.01, "izz": 0.01}}]}],
+    "couplings": [{"joint": "l2", "follows": "l1", "ratio": 0.5, "offset": 0.2}]}
+
+
+@pytest.mark.parametrize("law", [False, True])
+def test_couplings_beside_quaternions_from_python(tmp_path, law):
+    # q: base (7), arm (4), l1 (1); l2 follows l1 linearly or by a polynomial law.
+    spec = json.loads(json.dumps(COUPLED_FLOATING))
+    if law:
+        c = spec["couplings"][0]
+        del c["ratio"], c["offset"]
+        c["polynomial"] = [[0.2, 0], [0.5, 1], [0.1, 2]]
+    path = tmp_path / "coupled.json"
+    path.write_text(json.dumps(spec))
+    model = femdyn.load(str(path))
+    assert model.n == 6 + 3 + 1
+    qd0 = np.array([0.1, 0, 0.2, 0, 0.3, 1, 0, 2, 0, 3])
+    r = femdyn.simulate(model, 1.0, qd0=qd0, integrator="rk4", dt=1e-3)
+    q = r["q"]
+    assert q.shape[1] == 12
+    for cols in (slice(3, 7), slice(7, 11)):
+        assert abs(np.linalg.norm(q[-1, cols]) - 1) < 1e-14
+    assert abs(r["total"][-1] - r["total"][0]) < 1e-8 * r["total"][0]
+    # A batch row equals the single call at the same (q, v).
+    rng = np.random.default_rng(5)
+    qs = q[::250]
+    vs = rng.uniform(-1, 1, (len(qs), model.n))
+    taus = rng.uniform(-1, 1, (len(qs), model.n))
+    batch = model.forward_dynamics_batch(qs, vs, taus)
+    for k in range(len(qs)):
+        assert np.allclose(batch[k], model.forward_dynamics(qs[k], vs[k], taus[k]),
+                           rtol=1e-13, atol=1e-13)
