@@ -18,10 +18,12 @@ constexpr const char* kHelp =
     R"(usage: femdyn track MODEL --to a,b,… [--from …] [--duration T] [--steps N] [--csv FILE [--force]] [--json]
                      [--gravity gx,gy,gz]
 
-Plans the quintic (minimum-jerk) motion q_ref(t) from --from (default 0) to --to in T seconds
-(default 1), computes the joint torques τ(t) = M^s q̈_ref + h − Q(τ = 0) by inverse dynamics,
+Plans the quintic (minimum-jerk) motion q_ref(t) from --from (default 0, the identity rotation
+for a ball or free joint) to --to in T seconds (default 1), along each joint's geodesic
+(q_ref = q_from ⊕ s(t/T)(q_to ⊖ q_from); n_q values each, quaternions (w, x, y, z)), computes the joint torques τ(t) = M^s q̈_ref + h − Q(τ = 0) by inverse dynamics,
 then simulates the model under τ(t) alone (RK4, N steps, default 1000) and reports how closely
-the simulated motion follows q_ref. --csv writes t, q_ref, τ and q_sim per step (atomically; an
+the simulated motion follows q_ref (max |q_sim ⊖ q_ref|: rad or m; a rotation by the rotation
+vector between the two quaternions). --csv writes t, q_ref, τ and q_sim per step (atomically; an
 existing FILE is replaced only with --force, and never when it is MODEL). --json prints
 {"model", "n", "coordinates", "duration", "steps", "max_tracking_error", "max_abs_tau"}.
 )";
@@ -44,21 +46,19 @@ int cmd_track(int argc, char** argv) {
       throw CliError("--csv " + out + ": exists (use --force to replace it)");
   }
   const Model m = load(a);
-  if (m.n_q() != m.n())  // q_ref(t) is a quintic in each coordinate; a quaternion is not one
-    throw CliError(a.positional.at(0) +
-                   ": track plans a quintic in each coordinate and takes no spherical or free "
-                   "joint yet");
   if (!a.has("to")) throw CliError("--to is required (try --help)");
-  const VecX q1 = state_vector(a, "to", m), q0 = state_vector(a, "from", m);
+  const VecX q1 = configuration_vector(a, "to", m);
+  const VecX q0 = configuration_vector(a, "from", m);      // (the neutral configuration)
+  const VecX delta = configuration_difference(m, q0, q1);  // q1 ⊖ q0, joint by joint
   const double T = number_option(a, "duration", 1.0);
   if (!(T > 0)) throw CliError("--duration expects one positive number");
   const int N = static_cast<int>(integer_option(a, "steps", 1000, 1, 1e7));
   const int n = m.n();
   Workspace wref(m);
-  VecX qr(n), qdr(n), qddr(n);
+  VecX qr(m.n_q()), qdr(n), qddr(n);
   // τ(t) by inverse dynamics of the reference.
   const Actuation tau = [&](double t, VecX& out) {
-    quintic(q0, q1, T, t, qr, qdr, qddr);
+    quintic(m, q0, delta, T, t, qr, qdr, qddr);
     inverse_dynamics(m, wref, qr, qdr, qddr);
     out = wref.tau;
   };
@@ -71,19 +71,20 @@ int cmd_track(int argc, char** argv) {
   csv.precision(12);
   csv << "t";
   // Names quoted where they need it (RFC 4180): a coordinate "a,b" stays one column.
-  for (const auto& c : m.coordinate_names) csv << ',' << csv_field("q_ref_" + c);
+  for (const auto& c : m.configuration_names) csv << ',' << csv_field("q_ref_" + c);
   for (const auto& c : m.coordinate_names) csv << ',' << csv_field("tau_" + c);
-  for (const auto& c : m.coordinate_names) csv << ',' << csv_field("q_sim_" + c);
+  for (const auto& c : m.configuration_names) csv << ',' << csv_field("q_sim_" + c);
   csv << "\n";
   for (int k = 0; k <= N; ++k) {
     const double t = k * dt;
     tau(t, u);
-    max_err = std::max(max_err, (rk4.q() - qr).cwiseAbs().maxCoeff());
+    // |q_sim ⊖ q_ref|: rad or m (a ball's rotation: the angle of the rotation vector's entries)
+    max_err = std::max(max_err, configuration_difference(m, qr, rk4.q()).cwiseAbs().maxCoeff());
     max_tau = std::max(max_tau, u.cwiseAbs().maxCoeff());
     csv << t;
-    for (int i = 0; i < n; ++i) csv << "," << qr[i];
+    for (int i = 0; i < m.n_q(); ++i) csv << "," << qr[i];
     for (int i = 0; i < n; ++i) csv << "," << u[i];
-    for (int i = 0; i < n; ++i) csv << "," << rk4.q()[i];
+    for (int i = 0; i < m.n_q(); ++i) csv << "," << rk4.q()[i];
     csv << "\n";
     if (k == N) break;
     const Status st = rk4.advance_to((k + 1) * dt);

@@ -11,6 +11,7 @@
 #include "core/kinematics.hpp"
 #include "core/sampling.hpp"
 #include "sim/integrator.hpp"
+#include "sim/quintic.hpp"
 #include "tests/helpers.hpp"
 #include "tests/momentum.hpp"
 
@@ -186,6 +187,30 @@ TEST_CASE("the node route and the body routes agree for every joint type") {
     CHECK(rel_error(wn.Ms * qdd + wn.h, wn.Q) < 1e-11);
     inverse_dynamics(bodies, wb, q, v, qdd);
     CHECK(rel_error(wb.tau, tau) < 1e-10);
+  }
+}
+
+TEST_CASE("the quintic reference's v and v̇ are its derivatives on every joint's manifold") {
+  // q(t) = q0 ⊕ s(t)Δ: v is the rate of the chart around q(t) (whose ξ̇ at ξ = 0 is v), and v̇
+  // the rate of v, both against central differences (O(h²)).
+  const Model m = load_text(all_joints_json(9.81));
+  std::mt19937 rng(11);
+  const VecX q0 = random_configuration(m, rng), q1 = random_configuration(m, rng);
+  const VecX delta = configuration_difference(m, q0, q1);
+  VecX q, v, vdot, qa, va, ad, qb, vb, bd;
+  const double T = 0.8, h = 1e-5;
+  quintic(m, q0, delta, T, T, q, v, vdot);
+  CHECK(configuration_difference(m, q, q1).norm() < 1e-12);  // it ends at q1
+  for (const double t : {0.13, 0.4, 0.71}) {
+    quintic(m, q0, delta, T, t, q, v, vdot);
+    quintic(m, q0, delta, T, t + h, qa, va, ad);
+    quintic(m, q0, delta, T, t - h, qb, vb, bd);
+    const VecX v_fd =
+        (configuration_difference(m, q, qa) - configuration_difference(m, q, qb)) / (2 * h);
+    const VecX vdot_fd = (va - vb) / (2 * h);
+    INFO("t = " << t);
+    CHECK((v - v_fd).cwiseAbs().maxCoeff() < 1e-8 * (1 + v.cwiseAbs().maxCoeff()));
+    CHECK((vdot - vdot_fd).cwiseAbs().maxCoeff() < 1e-7 * (1 + vdot.cwiseAbs().maxCoeff()));
   }
 }
 

@@ -249,3 +249,41 @@ TEST_CASE("the twin samples a trajectory by landing on each sample or by interpo
     last_error = error(free);
   }
 }
+
+TEST_CASE("study on a floating base measures quaternions on their manifold", "[study][joints]") {
+#ifndef NDEBUG
+  return;  // (study refuses to time a build with asserts; see above)
+#endif
+  // A free base carrying a ball-jointed arm: the error of a quaternion is the rotation vector
+  // between the two, so rk4's error falls as dt⁴ (16x per halving, here at least 10x) and
+  // Simbody's twin (Free and Ball mobilizers, its own quaternions) is measured the same way.
+  Scratch s("study_floating");
+  std::ofstream(s / "floating.json") << R"({"name": "floating two-link", "gravity": [0, 0, 0],
+    "bodies": [{"name": "base", "parent": "world", "joint": {"type": "free"},
+      "elements": [{"type": "rigid_body", "mass": 10, "com": [0, 0, 0],
+                    "inertia": {"ixx": 1, "iyy": 1.2, "izz": 0.8}}]},
+     {"name": "arm", "parent": "base",
+      "joint": {"type": "spherical", "origin": {"xyz": [0.5, 0, 0]}},
+      "elements": [{"type": "rigid_body", "mass": 2, "com": [0.3, 0, 0],
+                    "inertia": {"ixx": 0.01, "iyy": 0.05, "izz": 0.05}}]}]})";
+  const Run r = study(s / "floating.json" + " --quick --json --out " + (s / "out"));
+  INFO(r.out.substr(0, 2000));
+  REQUIRE(r.code == 0);
+  const Json j = Json::parse(r.out);
+  std::set<std::string> units;
+  for (const Json& scale : j["error"]["scales"]) units.insert(scale["unit"]);
+  CHECK(units == std::set<std::string>{"rad", "rad/s", "m", "m/s"});
+  std::map<double, double> rk4;  // dt -> error
+  double simbody_best = INFINITY;
+  for (const Json& run : j["runs"]) {
+    if (!run["ok"].get<bool>()) continue;
+    if (run["integrator"] == "rk4") rk4[run["value"].get<double>()] = run["error"];
+    if (run["engine"] == "Simbody")
+      simbody_best = std::min(simbody_best, run["error"].get<double>());
+  }
+  REQUIRE(rk4.size() >= 3);
+  auto it = rk4.rbegin();  // the two largest steps (the finest reach round-off)
+  const double coarsest = it->second, next = (++it)->second;
+  CHECK(coarsest > 10 * next);
+  CHECK(simbody_best < 1e-6);  // Simbody's tightest accuracy tracks the same reference
+}

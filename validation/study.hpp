@@ -3,12 +3,15 @@
 // run's error against a reference solution and its wall time.
 //
 //   error(run) = max over the sample times t_k (t_0 = 0 included) and the groups g of
-//                max_{j∈g} |x_run,j(t_k) − x_ref,j(t_k)| / S_g,
-//   S_g = max over the samples of max_{j∈g} |x_ref,j(t_k)|,
+//                max_{j∈g} |(x_run(t_k) ⊖ x_ref(t_k))_j| / S_g,
+//   S_g = max over the samples of max_{j∈g} |(x_ref(t_k) ⊖ x_0)_j|,
 // a dimensionless relative state error: x = (θ, θ̇), the joint coordinates (θ = C q + θ0, or the
-// coupling laws' θ = g(q)) and rates, so both engines are measured alike; the groups are the
-// angles (rad), the angular rates (rad/s), and for prismatic joints the positions (m) and
-// speeds (m/s), so no error is divided by a size of another unit. The absolute errors (the
+// coupling laws' θ = g(q)) and rates, so both engines are measured alike. ⊖ is the difference on
+// each joint's manifold, one component per rate: θ − θ_ref on a flat joint, the rotation vector
+// log(R_refᵀ R) of a ball's or free joint's quaternion (so q and −q are one), and θ̇ − θ̇_ref;
+// x_0 is the neutral configuration at rest. The groups are the angles (rad), the angular rates
+// (rad/s), and the translations (m) and speeds (m/s) of prismatic, planar and free joints, so no
+// error is divided by a size of another unit. The absolute errors (the
 // largest |Δθ| and |Δθ̇|) are kept beside it. The reference is Dormand–Prince landing on each
 // sample at rtol 1e-14, its own error estimated by the same measure against the run at rtol
 // 1e-13 (an upper estimate). A run whose error is below 100x that estimate is "unresolved" and
@@ -38,7 +41,7 @@ namespace femdyn::validation {
 struct StudyOptions {
   double t_end = 1.0;
   int samples = 20;            // sample times t_end·k/samples, k = 1..samples
-  VecX q0, qd0;                // initial state (sizes n)
+  VecX q0, qd0;                // initial state (sizes n_q and n)
   bool interpolate = true;     // both engines interpolate at the samples, or both land on them
   int repeats = 5;             // timed runs after the warm-up, for a run under repeat_below
   int long_repeats = 3;        // timed runs after the warm-up, for a longer run

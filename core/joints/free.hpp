@@ -54,6 +54,15 @@ struct FreeJoint {
     const Vec3 p = E * Vec3(v[0], v[1], v[2]), a = inverse_right_jacobian_times(r, w);
     for (int k = 0; k < 3; ++k) xi_dot[k] = p[k], xi_dot[3 + k] = a[k];
   }
+  // Along the ray q(s) = q_c ⊕ sΔ: p = p_c + R_c s Δ_p turns into B's axes as B turns by
+  // exp(sΔ_r), so the rates per unit s are w = (exp(sΔ_r)ᵀ Δ_p, Δ_r), dw/ds = (−Δ_r × w_p, 0).
+  static void ray_rates(const Joint&, const double* delta, double s, double* w, double* dw) {
+    const Vec3 r(delta[3], delta[4], delta[5]);
+    const double angle = s * r.norm();
+    const Mat3 E = angle != 0 ? axis_rotation(r.normalized(), angle) : Mat3::Identity();
+    const Vec3 wp = E.transpose() * Vec3(delta[0], delta[1], delta[2]), dwp = -r.cross(wp);
+    for (int k = 0; k < 3; ++k) w[k] = wp[k], dw[k] = dwp[k], w[3 + k] = r[k], dw[3 + k] = 0;
+  }
   static void neutral(double* q) {
     for (int k = 0; k < 7; ++k) q[k] = 0;
     q[3] = 1;

@@ -221,6 +221,19 @@ inline void random_configuration(const Joint& j, std::mt19937& rng, double* q) {
   });
 }
 
+// The rates w that move q(s) = q_c ⊕ sΔ at unit ds, and dw/ds (nv each): along q(s(t)) the
+// joint's v = ṡ w and v̇ = s̈ w + ṡ² dw/ds. By default w = Δ, dw/ds = 0: true of a flat joint
+// (θ = θ_c + sΔ) and of a ball (R = R_c exp(sΔ), ω = ṡ Δ in B); a type whose rates turn along
+// the ray says so by J::ray_rates (the free joint: its v is in B's axes).
+inline void ray_rates(const Joint& j, const double* delta, double s, double* w, double* dw) {
+  visit_joint(j.type, [&]<class J>(J) {
+    if constexpr (requires { J::ray_rates(j, delta, s, w, dw); })
+      J::ray_rates(j, delta, s, w, dw);
+    else
+      for (int k = 0; k < J::nv; ++k) w[k] = delta[k], dw[k] = 0;
+  });
+}
+
 // Whether rate k moves B by translation alone (a length, m), not by a turn (an angle, rad).
 inline bool is_translation(const Joint& j, int k) {
   return visit_joint(j.type,
