@@ -104,7 +104,7 @@ int cmd_stress(int argc, char** argv) {
       s.dt = c.dt;
       s.large = c.large;
       r = validation::run_stress(m, s);
-    } catch (const ModelError& e) {
+    } catch (const Error& e) {
       r = validation::refused_case(e.what());
     }
     const double seconds =

@@ -18,8 +18,8 @@ CouplingLevelState& level_at(const Model& m, Workspace& ws, const VecX& q, const
     for (int k : j.sources)
       at += (at.empty() ? "" : ", ") + m.bodies[m.theta_joint[k]].joint.name + " = " +
             format_number(s.theta[m.coupling_level->theta_q[k]]);
-    throw ModelError(j.where, "the law of joint '" + j.name + "' is not defined at " + at +
-                                  " (a linkage that cannot assemble or is at its dead point)");
+    throw StateError(j.where + ": the law of joint '" + j.name + "' is not defined at " + at +
+                     " (a linkage that cannot assemble or is at its dead point)");
   }
   ws.theta = s.theta;
   ws.theta_dot = s.theta_dot;
@@ -73,7 +73,7 @@ Status forward_dynamics(const Model& m, Workspace& ws, const VecX& q, const VecX
                         const VecX& tau) {
   try {
     chain::evaluate(m, ws, q, qd, tau);
-  } catch (const ModelError& e) {
+  } catch (const StateError& e) {
     return {false, e.what()};
   }
   ws.reduced.compute(ws.Ms);

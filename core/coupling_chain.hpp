@@ -5,7 +5,7 @@
 //   D_abc = Σ_i G_ia (Σ_jk D^θ_ijk G_jb G_kc + Σ_l M_θ,il H_lbc)
 // The route (Model::routes, core/routes.hpp) of every function of core/equations.hpp and of
 // propagate_bilinear for a model with Model::coupling_level; linear couplings never come here. A
-// state where a law is not defined (a linkage that cannot assemble) throws ModelError from the void
+// state where a law is not defined (a linkage that cannot assemble) throws StateError from the void
 // functions and is a failed Status from forward_dynamics.
 #pragma once
 #include <vector>

@@ -53,7 +53,7 @@ struct Energy {
 Energy energy(const Model& model, Workspace& ws, const VecX& q, const VecX& qd);
 
 // The joint coordinates and rates of the state into ws.theta, ws.theta_dot: θ = C q + θ0,
-// θ̇ = C q̇, or through a nonlinear coupling level θ = g(q), θ̇ = G q̇ (throws ModelError where a
+// θ̇ = C q̇, or through a nonlinear coupling level θ = g(q), θ̇ = G q̇ (throws StateError where a
 // law is not defined). For reports and comparisons joint by joint (validation, studies).
 void joint_state(const Model& model, Workspace& ws, const VecX& q, const VecX& qd);
 

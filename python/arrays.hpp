@@ -20,11 +20,9 @@ namespace py = pybind11;
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 using RowMatX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
-// A numerical failure at a state (a singular M^s, a q̈ that overflows): femdyn.NumericalError.
-class NumericalError : public Error {
- public:
-  using Error::Error;
-};
+// A numerical failure at a state (a singular M^s, a q̈ that overflows, a coupling law undefined
+// there; core's StateError): femdyn.NumericalError.
+using NumericalError = StateError;
 
 // "(3,)", "(5, 4)".
 std::string shape_text(const py::array& a);
