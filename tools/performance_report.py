@@ -341,8 +341,9 @@ targets = [("finger", "forward", 800), ("finger", "mass", 250), ("hand16", "forw
 P("## Targets")
 P("")
 P("The targets of issue 11: the fastest of Simbody, MuJoCo 2.2 and Pinocchio 3.7 measured on this "
-  "kind of machine (those two engines' figures were measured elsewhere, in the issue; they are "
-  "not rerun here).")
+  "kind of machine (Pinocchio's and MuJoCo's figures for these targets were measured elsewhere, "
+  "in the issue, and are not rerun here; MuJoCo is measured in this run on the URDF robots only, "
+  "in the section above and the table below).")
 P("")
 P("| model | quantity | target | femdyn | met |")
 P("|---|---|---:|---:|---|")
