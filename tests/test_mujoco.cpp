@@ -77,7 +77,10 @@ TEST_CASE("MuJoCo peer: a URDF it cannot load or map is one line naming the file
     return path;
   };
   const std::string junk = write("junk.urdf", "<robot name=\"r\"><link name=\"a\">");
-  CHECK_THAT(peer_error(junk, false), Catch::StartsWith(junk + ": MuJoCo peer: "));
+  CHECK_THAT(peer_error(junk, false),
+             Catch::StartsWith(junk + ": MuJoCo peer: malformed XML at line 1 ("));
+  CHECK(peer_error(scratch / "none.urdf", false) ==
+        scratch / "none.urdf" + ": MuJoCo peer: cannot open file");
   const std::string orphan = write("orphan.urdf", R"(<robot name="r"><link name="a"/>
       <joint name="j" type="revolute"><parent link="a"/><child link="b"/>
       <axis xyz="0 0 1"/></joint></robot>)");

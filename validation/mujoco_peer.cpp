@@ -115,8 +115,13 @@ void write_principal_axes(tinyxml2::XMLElement* inertial) {
 // `floating` a free joint above the root link.
 std::string prepared_urdf(const std::string& path, bool floating) {
   tinyxml2::XMLDocument doc;
-  if (doc.LoadFile(path.c_str()) != tinyxml2::XML_SUCCESS)
-    throw std::runtime_error(path + ": MuJoCo peer: " + one_line(doc.ErrorStr()));
+  const tinyxml2::XMLError status = doc.LoadFile(path.c_str());
+  if (status == tinyxml2::XML_ERROR_FILE_NOT_FOUND ||
+      status == tinyxml2::XML_ERROR_FILE_COULD_NOT_BE_OPENED)
+    throw std::runtime_error(path + ": MuJoCo peer: cannot open file");
+  if (status != tinyxml2::XML_SUCCESS)
+    throw std::runtime_error(path + ": MuJoCo peer: malformed XML at line " +
+                             std::to_string(doc.ErrorLineNum()) + " (" + doc.ErrorName() + ")");
   tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
   if (!robot) throw std::runtime_error(path + ": MuJoCo peer: no <robot> element");
   std::set<std::string> links, children;
@@ -251,7 +256,7 @@ MujocoPeer::MujocoPeer(const std::string& urdf_path, const Eigen::Vector3d& grav
   };
   if (m.nv != s.n)
     refuse("MuJoCo has " + std::to_string(m.nv) + " dofs, femdyn " + std::to_string(s.n) +
-           " coordinates (a <mimic> joint?)");
+           " coordinates" + (m.nv > s.n ? " (a <mimic> joint?)" : ""));
   const int base = floating ? 6 : 0;
   bool found_free = false;
   for (int j = 0; j < m.njnt; ++j) {
