@@ -94,3 +94,48 @@ TEST_CASE("MuJoCo peer: a URDF it cannot load or map is one line naming the file
   CHECK_THAT(peer_error(robot_path("iiwa"), false, {"a", "b", "c", "d", "e", "f", "g"}),
              Catch::Contains("no hinge or slide joint named 'a'"));
 }
+
+TEST_CASE(
+    "MuJoCo peer: a floating robot with a prismatic, a continuous and a fixed joint, tilted "
+    "frames and full inertia tensors equals MuJoCo's",
+    "[mujoco][validation]") {
+  Scratch scratch("mujoco_peer_joints");
+  const std::string path = scratch / "joints.urdf";
+  const auto inertial = [](const char* rpy, const char* m, const char* tensor) {
+    return std::string("<inertial><origin xyz=\"0.02 -0.03 0.05\" rpy=\"") + rpy +
+           "\"/><mass value=\"" + m + "\"/><inertia " + tensor + "/></inertial>";
+  };
+  const char* full = R"(ixx="0.3" ixy="0.02" ixz="-0.04" iyy="0.25" iyz="0.01" izz="0.2")";
+  std::ofstream(path) << "<robot name=\"r\"><link name=\"base\">" +
+                             inertial("0.3 -0.7 1.1", "5", full) + "</link><link name=\"slider\">" +
+                             inertial("0 0 0", "1.5", full) + "</link><link name=\"wheel\">" +
+                             inertial("-1.2 0.4 2.0", "0.7", full) + "</link><link name=\"tool\">" +
+                             inertial("0.1 0.2 0.3", "0.4", full) + "</link>" + R"(
+      <joint name="slide" type="prismatic"><parent link="base"/><child link="slider"/>
+        <origin xyz="0.1 0.2 -0.1" rpy="0.2 0.1 -0.3"/><axis xyz="0.6 0 0.8"/>
+        <limit lower="-0.5" upper="0.5" effort="1" velocity="1"/></joint>
+      <joint name="spin" type="continuous"><parent link="slider"/><child link="wheel"/>
+        <origin xyz="0 0.3 0" rpy="1.0 0 0.5"/><axis xyz="0 1 0"/></joint>
+      <joint name="weld" type="fixed"><parent link="wheel"/><child link="tool"/>
+        <origin xyz="0.2 0 0.1" rpy="0 0.4 0"/></joint></robot>)";
+  for (const bool floating : {false, true}) {
+    INFO((floating ? "floating base" : "welded"));
+    const Model m = load_model(path, {.floating_base = floating});
+    validation::MujocoPeer peer(path, m.gravity, floating, m.coordinate_names);
+    Workspace ws(m);
+    std::mt19937 rng(3);
+    for (int k = 0; k < 3; ++k) {
+      const VecX q = random_posture(m, rng), qd = random_uniform(m.n(), 2, rng);
+      const VecX qdd = random_uniform(m.n(), 5, rng), tau = random_uniform(m.n(), 1, rng);
+      mass_matrix(m, ws, q);
+      const double e_mass = rel_error(ws.Ms, peer.mass(q));
+      inverse_dynamics(m, ws, q, qd, qdd);
+      const double e_inverse = rel_error(ws.tau, peer.inverse(q, qd, qdd));
+      REQUIRE(forward_dynamics(m, ws, q, qd, tau).ok);
+      const double e_forward = rel_error(ws.qdd, peer.forward(q, qd, tau));
+      CHECK(e_mass < 1e-10);
+      CHECK(e_inverse < 1e-10);
+      CHECK(e_forward < 1e-10);
+    }
+  }
+}

@@ -124,7 +124,7 @@ std::string prepared_urdf(const std::string& path, bool floating) {
                              std::to_string(doc.ErrorLineNum()) + " (" + doc.ErrorName() + ")");
   tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
   if (!robot) throw std::runtime_error(path + ": MuJoCo peer: no <robot> element");
-  std::set<std::string> links, children;
+  std::set<std::string> links, children, joints;
   for (tinyxml2::XMLElement* link = robot->FirstChildElement("link"); link;
        link = link->NextSiblingElement("link")) {
     if (const char* name = link->Attribute("name")) links.insert(name);
@@ -134,14 +134,27 @@ std::string prepared_urdf(const std::string& path, bool floating) {
       write_principal_axes(inertial);
   }
   for (tinyxml2::XMLElement* joint = robot->FirstChildElement("joint"); joint;
-       joint = joint->NextSiblingElement("joint"))
+       joint = joint->NextSiblingElement("joint")) {
+    if (const char* name = joint->Attribute("name")) joints.insert(name);
     if (const tinyxml2::XMLElement* child = joint->FirstChildElement("child"))
       if (const char* name = child->Attribute("link")) children.insert(name);
+  }
+  std::vector<std::string> roots;
+  for (const std::string& l : links)
+    if (!children.count(l)) roots.push_back(l);
+  const auto refuse = [&](const std::string& why) {
+    throw std::runtime_error(path + ": MuJoCo peer: " + why);
+  };
+  if (roots.size() != 1) refuse("one root link expected, not " + std::to_string(roots.size()));
+  const std::string& root = roots[0];
+  if (links.count("world") && root != "world") refuse("a link other than the root is 'world'");
+  if (floating && root == "world") refuse("the root link is the world: no floating base");
   while (tinyxml2::XMLElement* old = robot->FirstChildElement("mujoco")) robot->DeleteChild(old);
 
+  // No fusing (fusestatic="false"): MuJoCo would diagonalise a fused inertia again, roughly.
   tinyxml2::XMLElement* extension = doc.NewElement("mujoco");
   tinyxml2::XMLElement* compiler = extension->InsertNewChildElement("compiler");
-  compiler->SetAttribute("fusestatic", "true");
+  compiler->SetAttribute("fusestatic", "false");
   compiler->SetAttribute("discardvisual", "true");
   compiler->SetAttribute("inertiafromgeom", "false");
   compiler->SetAttribute("balanceinertia", "false");
@@ -149,24 +162,29 @@ std::string prepared_urdf(const std::string& path, bool floating) {
   compiler->SetAttribute("boundinertia", "0");
   robot->InsertFirstChild(extension);
 
+  // MuJoCo's importer makes a root link named "world" its world body. Welded, the root link is
+  // renamed so (its inertia never moves); floating, a link "world" is added above it, joined by
+  // a URDF "floating" joint, which MuJoCo makes a free joint.
   if (floating) {
-    std::vector<std::string> roots;
-    for (const std::string& l : links)
-      if (!children.count(l)) roots.push_back(l);
-    if (roots.size() != 1)
-      throw std::runtime_error(path + ": MuJoCo peer: a floating base needs one root link, not " +
-                               std::to_string(roots.size()));
-    std::string ground = "mujoco_peer_world";
-    while (links.count(ground)) ground += "_";
+    std::string name = "mujoco_peer_free";
+    while (joints.count(name)) name += "_";
     tinyxml2::XMLElement* link = doc.NewElement("link");
-    link->SetAttribute("name", ground.c_str());
+    link->SetAttribute("name", "world");
     robot->InsertAfterChild(extension, link);
     tinyxml2::XMLElement* joint = doc.NewElement("joint");
-    joint->SetAttribute("name", (ground + "_free").c_str());
+    joint->SetAttribute("name", name.c_str());
     joint->SetAttribute("type", "floating");
-    joint->InsertNewChildElement("parent")->SetAttribute("link", ground.c_str());
-    joint->InsertNewChildElement("child")->SetAttribute("link", roots[0].c_str());
+    joint->InsertNewChildElement("parent")->SetAttribute("link", "world");
+    joint->InsertNewChildElement("child")->SetAttribute("link", root.c_str());
     robot->InsertAfterChild(link, joint);
+  } else if (root != "world") {
+    for (tinyxml2::XMLElement* link = robot->FirstChildElement("link"); link;
+         link = link->NextSiblingElement("link"))
+      if (link->Attribute("name", root.c_str())) link->SetAttribute("name", "world");
+    for (tinyxml2::XMLElement* joint = robot->FirstChildElement("joint"); joint;
+         joint = joint->NextSiblingElement("joint"))
+      if (tinyxml2::XMLElement* parent = joint->FirstChildElement("parent"))
+        if (parent->Attribute("link", root.c_str())) parent->SetAttribute("link", "world");
   }
   tinyxml2::XMLPrinter printer;
   doc.Print(&printer);

@@ -4,13 +4,14 @@
 // includes MuJoCo (built when CMake finds it: FEMDYN_WITH_MUJOCO).
 //
 // Loading (docs/validation.md, "MuJoCo"): a copy of the URDF, with <visual> and <collision>
-// removed and a <mujoco><compiler …/></mujoco> that keeps every <inertial> as written
-// (inertiafromgeom="false", balanceinertia="false", no bound on mass or inertia); with
-// `floating`, a massless link and a "floating" URDF joint above the root link, which MuJoCo
-// turns into a free joint of the root (the massless link is fused into the world). After
-// compiling: gravity as given, the constraint solver and contacts off (joint limits and
-// frictionloss are constraints in MuJoCo, none in femdyn), armature 0; joint damping stays a
-// passive force in both.
+// removed, each <inertial> rewritten in exact principal axes (MuJoCo's compiler finds them only
+// roughly), and a <mujoco><compiler …/></mujoco> that keeps the inertias as given
+// (inertiafromgeom="false", balanceinertia="false", no bound on mass or inertia, no fusing of
+// static bodies). The root link becomes MuJoCo's world body (renamed "world"); with `floating`,
+// a link "world" and a "floating" URDF joint are added above it instead, which MuJoCo turns
+// into a free joint of the root. After compiling: gravity as given, the constraint solver and
+// contacts off (joint limits and frictionloss are constraints in MuJoCo, none in femdyn),
+// armature 0; joint damping stays a passive force in both.
 //
 // Quantities: M = mj_fullM after mj_crb; τ = mj_inverse (qfrc_inverse); q̈ = mj_forward with the
 // constraint solver disabled, so qacc is its smooth part, qacc_smooth.
