@@ -1,14 +1,17 @@
 // femdyn bench MODEL: femdyn's equations of motion timed against the model's Simbody twin
 // (validation/twin.hpp, the twin femdyn validate checks against) in the same run: the median
 // ns per call of M^s, h, the forces at rest, the whole equations, q̈, τ and D, femdyn and
-// Simbody batch by batch in turn (docs/benchmarks.md).
+// Simbody batch by batch in turn (docs/benchmarks.md). A URDF robot is also timed on MuJoCo's
+// own import of the file (M, q̈, τ) when femdyn is built with MuJoCo (validation/mujoco_peer.hpp).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string_view>
@@ -19,6 +22,10 @@
 #include "core/math.hpp"
 #include "core/sampling.hpp"
 #include "io/output.hpp"
+#include "io/urdf_loader.hpp"
+#ifdef FEMDYN_WITH_MUJOCO
+#include "validation/mujoco_peer.hpp"
+#endif
 #include "validation/twin.hpp"
 #include "validation/validate.hpp"
 
@@ -60,9 +67,15 @@ q̈ in ±5), cycled; per engine and quantity a warm-up, then 15 batches of about
 per call, the report is the median, min and max over the batches. Both engines are first
 checked to agree on M^s, h and q̈ at the first state (relative 1e-8; a warning if not).
 A Debug build refuses to time anything.
---json: {"model", "n", "coordinates", "build", "results": [{"engine": "femdyn" | "simbody",
-"quantity", "median_ns", "min_ns", "max_ns"}]} (n the number of coordinates, "coordinates"
-their names).
+MuJoCo: a URDF robot (with --floating-base too) is also timed on MuJoCo's own import of the
+file, when femdyn was built with MuJoCo: M (mj_crb, mj_fullM), qdd (mj_forward with the
+constraint solver off: its smooth part qacc_smooth) and tau (mj_inverse), in a third column
+MuJoCo and the ratio MuJoCo / femdyn; its batches alternate with the other two. Checked first
+against femdyn at the first state like Simbody; a file MuJoCo cannot map (a <mimic> joint) is
+a warning, and MuJoCo is left out.
+--json: {"model", "n", "coordinates", "build", "results": [{"engine": "femdyn" | "simbody" |
+"mujoco", "quantity", "median_ns", "min_ns", "max_ns"}]} (n the number of coordinates,
+"coordinates" their names).
 )";
 
 constexpr int kTensorMaxN = 40;  // D above this many coordinates takes too long to time
@@ -116,6 +129,26 @@ void check_agreement(const std::string& path, const Model& m, Workspace& ws, fv:
             << "); the timings compare different computations\n";
 }
 
+#ifdef FEMDYN_WITH_MUJOCO
+// The same for MuJoCo: M^s, q̈ and τ at the first state.
+void check_mujoco_agreement(const std::string& path, const Model& m, Workspace& ws,
+                            fv::MujocoPeer& peer, const States& s) {
+  const Status st = forward_dynamics(m, ws, s.q[0], s.qd[0], s.tau[0]);
+  const double dqdd =
+      st.ok ? relative_error(peer.forward(s.q[0], s.qd[0], s.tau[0]), ws.qdd, 1e-6) : INFINITY;
+  inverse_dynamics(m, ws, s.q[0], s.qd[0], s.qdd[0]);
+  const double dtau = relative_error(peer.inverse(s.q[0], s.qd[0], s.qdd[0]), ws.tau, 1e-6);
+  mass_matrix(m, ws, s.q[0]);
+  const double dM = relative_error(peer.mass(s.q[0]), ws.Ms, 1e-6);
+  if (dM < 1e-8 && dtau < 1e-8 && dqdd < 1e-8) return;
+  std::cerr << "femdyn bench: warning: " << escaped(path)
+            << ": femdyn and MuJoCo differ at the first state (relative M^s " << format_short(dM)
+            << ", τ " << format_short(dtau) << ", q̈ "
+            << (st.ok ? format_short(dqdd) : "not computed: " + st.message)
+            << "); the timings compare different computations\n";
+}
+#endif
+
 // Keeps the compiler from dropping work whose result it could prove unused.
 inline void keep(const void* p) { asm volatile("" : : "g"(p) : "memory"); }
 
@@ -166,21 +199,27 @@ struct Method {
 struct Row {
   std::string quantity;
   Timing femdyn, simbody;
+  std::optional<Timing> mujoco;  // M, qdd and tau of a URDF robot, built with MuJoCo
 };
 
-// One quantity on both engines: each calibrated, then `batches` rounds of a femdyn batch and
-// a Simbody batch, so slow drifts of the machine hit both alike.
+// One quantity on both engines (and MuJoCo when `mujoco_call` is given): each calibrated, then
+// `batches` rounds of a femdyn batch and a Simbody batch (and a MuJoCo batch), so slow drifts of
+// the machine hit them alike.
 template <class F, class S>
 Row time_both(const std::string& quantity, F&& femdyn_call, S&& simbody_call, int K,
-              const Method& method) {
+              const Method& method, std::function<void(int)> mujoco_call = {}) {
   const long nf = calls_per_batch(femdyn_call, K, method.batch_time_ns);
   const long ns = calls_per_batch(simbody_call, K, method.batch_time_ns);
-  std::vector<double> f, s;
+  const long nm = mujoco_call ? calls_per_batch(mujoco_call, K, method.batch_time_ns) : 0;
+  std::vector<double> f, s, mj;
   for (int b = 0; b < method.batches; ++b) {
     f.push_back(batch_ns(femdyn_call, nf, K));
     s.push_back(batch_ns(simbody_call, ns, K));
+    if (mujoco_call) mj.push_back(batch_ns(mujoco_call, nm, K));
   }
-  return {quantity, summarize(f), summarize(s)};
+  Row row{quantity, summarize(f), summarize(s), std::nullopt};
+  if (mujoco_call) row.mujoco = summarize(mj);
+  return row;
 }
 
 // Why D is not timed, or empty.
@@ -195,8 +234,9 @@ std::string ns_text(double x) { return format_number(x, "%.0f"); }
 
 void print_table(const std::string& path, int n, int K, const Method& method,
                  const std::vector<Row>& rows, const std::string& skipped) {
-  std::cout << escaped(path) << " (" << n
-            << " coordinates) against Simbody: median ns per call over " << method.batches
+  const bool mujoco = std::any_of(rows.begin(), rows.end(), [](const Row& r) { return r.mujoco; });
+  std::cout << escaped(path) << " (" << n << " coordinates) against Simbody"
+            << (mujoco ? " and MuJoCo" : "") << ": median ns per call over " << method.batches
             << " batches of ~" << method.batch_time_ns / 1e6 << " ms, " << K
             << " states, build " FEMDYN_BUILD_TYPE "\n";
   char line[200];
@@ -211,6 +251,19 @@ void print_table(const std::string& path, int n, int K, const Method& method,
                   format_number(r.simbody.median / r.femdyn.median, "%.2f").c_str(), fr.c_str(),
                   sr.c_str());
     std::cout << line;
+  }
+  if (mujoco) {
+    std::snprintf(line, sizeof line, "%-8s %10s %10s %15s   %s\n", "quantity", "femdyn", "MuJoCo",
+                  "MuJoCo/femdyn", "MuJoCo min-max");
+    std::cout << line;
+    for (const Row& r : rows) {
+      if (!r.mujoco) continue;
+      std::snprintf(line, sizeof line, "%-8s %10s %10s %15s   %s\n", r.quantity.c_str(),
+                    ns_text(r.femdyn.median).c_str(), ns_text(r.mujoco->median).c_str(),
+                    format_number(r.mujoco->median / r.femdyn.median, "%.2f").c_str(),
+                    (ns_text(r.mujoco->min) + "-" + ns_text(r.mujoco->max)).c_str());
+      std::cout << line;
+    }
   }
   if (!skipped.empty()) std::cout << "D        skipped (" << skipped << ")\n";
 }
@@ -228,6 +281,7 @@ nlohmann::ordered_json report_json(const std::string& path, const Model& m,
   for (const Row& r : rows) {
     add("femdyn", r.quantity, r.femdyn);
     add("simbody", r.quantity, r.simbody);
+    if (r.mujoco) add("mujoco", r.quantity, *r.mujoco);
   }
   return {{"model", path},
           {"n", m.n()},
@@ -265,6 +319,26 @@ int cmd_bench(int argc, char** argv) {
   Workspace ws(m);
   const States s = random_states(m, K);
   check_agreement(path, m, ws, *twin, s);
+  // MuJoCo's calls for M, qdd and tau (none: not a URDF robot, or built without MuJoCo).
+  std::function<void(int)> mj_mass, mj_forward, mj_inverse;
+#ifdef FEMDYN_WITH_MUJOCO
+  std::unique_ptr<fv::MujocoPeer> peer;
+  std::vector<fv::MujocoPeer::State> mj_states;
+  if (is_urdf_path(path)) {
+    try {
+      peer = std::make_unique<fv::MujocoPeer>(path, m.gravity, a.has("floating-base"),
+                                              m.coordinate_names);
+      check_mujoco_agreement(path, m, ws, *peer, s);
+      for (int k = 0; k < K; ++k)
+        mj_states.push_back(peer->state(s.q[k], s.qd[k], s.tau[k], s.qdd[k]));
+      mj_mass = [&](int k) { peer->time_mass(mj_states[k]); };
+      mj_forward = [&](int k) { peer->time_forward(mj_states[k]); };
+      mj_inverse = [&](int k) { peer->time_inverse(mj_states[k]); };
+    } catch (const std::runtime_error& e) {
+      std::cerr << "femdyn bench: warning: MuJoCo not timed: " << safe_message(e.what()) << "\n";
+    }
+  }
+#endif
 
   std::vector<Row> rows;
   // M^s: femdyn's mass_matrix (M^s alone) / Simbody's calcM at Position.
@@ -274,7 +348,7 @@ int cmd_bench(int argc, char** argv) {
         mass_matrix(m, ws, s.q[k]);
         keep(ws.Ms.data());
       },
-      [&](int k) { twin->time_mass(s.q[k]); }, K, method));
+      [&](int k) { twin->time_mass(s.q[k]); }, K, method, mj_mass));
   // h without gravity: velocity terms alone.
   rows.push_back(time_both(
       "h",
@@ -306,7 +380,7 @@ int cmd_bench(int argc, char** argv) {
         forward_dynamics(m, ws, s.q[k], s.qd[k], s.tau[k]);
         keep(ws.qdd.data());
       },
-      [&](int k) { twin->time_forward(s.q[k], s.qd[k], s.tau[k]); }, K, method));
+      [&](int k) { twin->time_forward(s.q[k], s.qd[k], s.tau[k]); }, K, method, mj_forward));
   // τ: inverse dynamics.
   rows.push_back(time_both(
       "tau",
@@ -314,7 +388,7 @@ int cmd_bench(int argc, char** argv) {
         inverse_dynamics(m, ws, s.q[k], s.qd[k], s.qdd[k]);
         keep(ws.tau.data());
       },
-      [&](int k) { twin->time_inverse(s.q[k], s.qd[k], s.qdd[k]); }, K, method));
+      [&](int k) { twin->time_inverse(s.q[k], s.qd[k], s.qdd[k]); }, K, method, mj_inverse));
   // D: femdyn's tensor / Simbody's symmetric part by polarization of h.
   const std::string skipped = tensor_skipped(n, quick);
   if (skipped.empty())

@@ -326,6 +326,29 @@ TEST_CASE("bench: every quantity timed on both engines, D skipped as documented,
   CHECK(bad.out ==
         "femdyn bench: /nonexistent.json: cannot open file: No such file or directory\n");
 }
+
+#if defined(FEMDYN_WITH_MUJOCO) && defined(NDEBUG)
+TEST_CASE("bench: a URDF robot is timed on MuJoCo too (M, qdd, tau), a mimic joint is left out",
+          "[cli][bench][mujoco]") {
+  const std::string hyq = std::string(FEMDYN_SOURCE_DIR) + "/tests/robots/hyq.urdf";
+  const Run js = run_shell("{ " + std::string(FEMDYN_BINARY) + " bench " + hyq +
+                           " --floating-base --quick --states 2 --json 2>/dev/null; }");
+  REQUIRE(js.code == 0);
+  const auto j = nlohmann::json::parse(js.out);
+  std::set<std::string> mujoco;
+  for (const auto& r : j.at("results"))
+    if (r.at("engine") == "mujoco") {
+      CHECK(r.at("median_ns").get<double>() > 0);
+      mujoco.insert(r.at("quantity").get<std::string>());
+    }
+  CHECK(mujoco == std::set<std::string>{"M", "qdd", "tau"});
+  const Run hand = run("bench " + model_path("urdf/hand16.urdf") + " --quick --states 2");
+  CHECK(hand.code == 0);
+  CHECK_THAT(hand.out, Catch::StartsWith("femdyn bench: warning: MuJoCo not timed: "));
+  CHECK_THAT(hand.out, Catch::Contains("(a <mimic> joint?)\n"));
+  CHECK_THAT(hand.out, Catch::Contains("against Simbody: median"));
+}
+#endif
 #endif
 
 TEST_CASE("import writes JSON that loads back, atomically, or nothing at all", "[cli][urdf]") {

@@ -1,8 +1,9 @@
 // femdyn_bench: femdyn's equations against Simbody's on the same mechanisms (docs/benchmarks.md,
 // docs/performance.md, generated from it by tools/update-performance-docs.sh).
 //
-// For each bundled model, hand16, the KUKA iiwa, HyQ and Atlas, a seeded random 20-DOF chain
-// and random chains and trees of --sizes= bodies (default 8 to 1024), at one seeded state:
+// For each bundled model, hand16, the KUKA iiwa, HyQ and Atlas (welded, and HyQ and Atlas on a
+// floating base: hyq_floating, atlas_floating), a seeded random 20-DOF chain and random chains
+// and trees of --sizes= bodies (default 8 to 1024), at one seeded state:
 //   femdyn/mass/M       mass_matrix(): M^s alone     simbody/mass/M      calcM
 //   femdyn/evaluate/M   evaluate(): M^s, h, Q          simbody/evaluate/M  calcM + residual (h − Q)
 //   femdyn/bias/M       evaluate_bias(): h             simbody/bias/M      residual, no forces (h)
@@ -12,15 +13,20 @@
 //   simbody/inverse/M   residual with θ̈
 //   femdyn/rest/M       evaluate() at q̇ = 0 (h not computed)
 //   femdyn/weightless/M evaluate() on the model without gravity (models with gravity only)
+//   mujoco/mass/M       mj_kinematics, mj_comPos, mj_crb, mj_fullM (URDF robots, when built
+//   mujoco/inverse/M    mj_inverse                  with MuJoCo: validation/mujoco_peer.hpp)
+//   mujoco/forward/M    mj_forward, constraints off (qacc = qacc_smooth)
 //   reference/{mass,bias,forward,inverse}/M: femdyn on the reference routes (Tᵀ M T, node-level
 //   sweeps, Cholesky) where n ≤ 128, for the crossovers.
 // and, for the growth of loading with n, on generated chains and binary trees of --load-sizes=
 // bodies (default 1,000 to 200,000) with one lumped point each (validation/scaling_models.hpp):
 //   load/chain/N, load/tree/N  load_model() of the JSON file: read, parse, compile; counter
 //                              peak_MB, the peak resident memory loading added to the process.
-// Simbody's side is SimbodyTwin::time_* (validation/twin.hpp): its own work only. This file
-// does not include Simbody, so it is compiled like the rest of femdyn (C++20, NDEBUG).
-// Exits 1 if an engine disagrees with Simbody or femdyn allocates in a timed call.
+// Simbody's side is SimbodyTwin::time_* (validation/twin.hpp): its own work only; MuJoCo's is
+// MujocoPeer::time_* on the URDF as MuJoCo imports it, its state set in its own coordinates
+// outside the timing. This file does not include Simbody or MuJoCo, so it is compiled like the
+// rest of femdyn (C++20, NDEBUG).
+// Exits 1 if an engine disagrees with Simbody (or MuJoCo) or femdyn allocates in a timed call.
 //
 // Heap allocations are counted (validation/alloc_counter.hpp) and reported per iteration as the
 // counter `allocs`; femdyn's hot path is documented allocation-free and must show 0.
@@ -48,6 +54,9 @@
 #include "core/sampling.hpp"
 #include "io/model_loader.hpp"
 #include "validation/alloc_counter.hpp"
+#ifdef FEMDYN_WITH_MUJOCO
+#include "validation/mujoco_peer.hpp"
+#endif
 #include "validation/scaling_models.hpp"
 #include "validation/twin.hpp"
 #include "validation/validate.hpp"
@@ -62,6 +71,10 @@ struct Case {
   Model model;
   std::unique_ptr<Workspace> ws;
   std::unique_ptr<fv::SimbodyTwin> twin;
+#ifdef FEMDYN_WITH_MUJOCO
+  std::unique_ptr<fv::MujocoPeer> mujoco;  // URDF robots only
+  fv::MujocoPeer::State mujoco_state;      // the state above in MuJoCo's coordinates
+#endif
   VecX q, qd, tau, qdd, rest;  // rest: q̇ = 0
   // The same mechanism on the reference routes (Tᵀ M T, node-level sweeps, Cholesky), for the
   // crossovers in docs/performance.md; up to 128 coordinates (Tᵀ M T is O(N_u n²)).
@@ -85,10 +98,16 @@ std::vector<std::unique_ptr<Case>>& cases() {
   return all;
 }
 
+// A URDF robot's file, for MuJoCo's own import of it (empty: not a URDF robot).
+struct Urdf {
+  std::string path;
+  bool floating = false;
+};
+
 // The state of femdyn validate's first sample: seed 1, q within the joint limits,
-// q̇ in ±2, τ in ±1, q̈ in ±5. Checks once, outside the timing, that both sides agree.
+// q̇ in ±2, τ in ±1, q̈ in ±5. Checks once, outside the timing, that the engines agree.
 template <class Spec>
-void add_case(std::string name, Spec spec) {
+void add_case(std::string name, Spec spec, const Urdf& urdf = {}) {
   auto c = std::make_unique<Case>();
   c->name = std::move(name);
   c->model = compile(spec());
@@ -127,6 +146,26 @@ void add_case(std::string name, Spec spec) {
                  c->name.c_str(), e);
     failures().insert(c->name + ": femdyn and Simbody differ");
   }
+#ifdef FEMDYN_WITH_MUJOCO
+  if (!urdf.path.empty()) {
+    c->mujoco =
+        std::make_unique<fv::MujocoPeer>(urdf.path, m.gravity, urdf.floating, m.coordinate_names);
+    fv::MujocoPeer& p = *c->mujoco;
+    double e_mj = INFINITY;
+    if (forward_dynamics(m, *c->ws, c->q, c->qd, c->tau).ok)
+      e_mj = relative_error(p.forward(c->q, c->qd, c->tau), c->ws->qdd, 1e-6);
+    inverse_dynamics(m, *c->ws, c->q, c->qd, c->qdd);
+    e_mj = std::max(e_mj, relative_error(p.inverse(c->q, c->qd, c->qdd), c->ws->tau, 1e-6));
+    mass_matrix(m, *c->ws, c->q);
+    e_mj = std::max(e_mj, relative_error(p.mass(c->q), c->ws->Ms, 1e-6));
+    if (!(e_mj < 1e-8)) {
+      std::fprintf(stderr, "femdyn_bench: %s: femdyn and MuJoCo differ (relative %.3g)\n",
+                   c->name.c_str(), e_mj);
+      failures().insert(c->name + ": femdyn and MuJoCo differ");
+    }
+    c->mujoco_state = p.state(c->q, c->qd, c->tau, c->qdd);
+  }
+#endif
   cases().push_back(std::move(c));
 }
 
@@ -158,9 +197,18 @@ void register_case(Case* c) {
       timed(st, *c, full, lib == "femdyn", [&] { fn(*c); });
     })->Unit(benchmark::kMicrosecond);
   };
-  // femdyn and Simbody alternate, so drifts of a noisy machine hit both alike.
+  // femdyn, Simbody and MuJoCo alternate, so drifts of a noisy machine hit them alike.
+  const auto reg_mujoco = [&](const std::string& op) {
+#ifdef FEMDYN_WITH_MUJOCO
+    if (!c->mujoco) return;
+    if (op == "mass") reg("mujoco", op, [](Case& c) { c.mujoco->time_mass(c.mujoco_state); });
+    if (op == "inverse") reg("mujoco", op, [](Case& c) { c.mujoco->time_inverse(c.mujoco_state); });
+    if (op == "forward") reg("mujoco", op, [](Case& c) { c.mujoco->time_forward(c.mujoco_state); });
+#endif
+  };
   reg("femdyn", "mass", [](Case& c) { mass_matrix(c.model, *c.ws, c.q); });
   reg("simbody", "mass", [](Case& c) { c.twin->time_mass(c.q); });
+  reg_mujoco("mass");
   reg("femdyn", "evaluate", [](Case& c) { evaluate(c.model, *c.ws, c.q, c.qd, c.tau); });
   reg("simbody", "evaluate", [](Case& c) { c.twin->time_mass_and_bias(c.q, c.qd); });
   reg("femdyn", "rest", [](Case& c) { evaluate(c.model, *c.ws, c.q, c.rest, c.tau); });
@@ -173,8 +221,10 @@ void register_case(Case* c) {
     benchmark::DoNotOptimize(forward_dynamics(c.model, *c.ws, c.q, c.qd, c.tau).ok);
   });
   reg("simbody", "forward", [](Case& c) { c.twin->time_forward(c.q, c.qd, c.tau); });
+  reg_mujoco("forward");
   reg("femdyn", "inverse", [](Case& c) { inverse_dynamics(c.model, *c.ws, c.q, c.qd, c.qdd); });
   reg("simbody", "inverse", [](Case& c) { c.twin->time_inverse(c.q, c.qd, c.qdd); });
+  reg_mujoco("inverse");
   if (!c->reference) return;
   reg("reference", "mass", [](Case& c) { mass_matrix(*c.reference, *c.ws_ref, c.q); });
   reg("reference", "bias", [](Case& c) { evaluate_bias(*c.reference, *c.ws_ref, c.q, c.qd); });
@@ -266,8 +316,15 @@ int main(int argc, char** argv) {
                              "finger_coupled", "hand"})
       add_case(name, file(root + "models/" + name + ".json"));
     add_case("hand16", file(root + "models/urdf/hand16.urdf"));
-    for (const char* name : {"iiwa", "hyq", "atlas"})
-      add_case(name, file(root + "tests/robots/" + name + ".urdf"));
+    for (const char* name : {"iiwa", "hyq", "atlas"}) {
+      const std::string path = root + "tests/robots/" + name + ".urdf";
+      add_case(name, file(path), {path});
+    }
+    for (const char* name : {"hyq", "atlas"}) {  // on a floating base (--floating-base)
+      const std::string path = root + "tests/robots/" + name + ".urdf";
+      add_case(std::string(name) + "_floating",
+               [path] { return read_spec(path, {.floating_base = true}); }, {path, true});
+    }
     add_case("random_chain20", random(20, 20, 0));
     // Growth with n: serial chains and branching trees (docs/performance.md).
     for (int n : sizes) add_case("chain" + std::to_string(n), random(3, n, 0));
