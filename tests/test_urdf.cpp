@@ -230,12 +230,65 @@ TEST_CASE(
     for (int k = 0; k < 4; ++k) {
       const VecX q = random_uniform(m.n(), 1.5, rng), qd = random_uniform(m.n(), 2.0, rng);
       evaluate(m, ws, q, qd, VecX());
-      const validation::UrdfTwinEquations s = twin.equations(m.coordinate_names, q, qd);
+      const validation::UrdfTwinEquations s =
+          twin.equations(m.coordinate_names, m.configuration_names, q, qd);
       CHECK(rel_error(ws.Ms, s.M) < 1e-10);
       CHECK(rel_error(ws.h, s.h) < 1e-10);
       CHECK(rel_error(ws.Q, s.Q) < 1e-10);
     }
   }
+}
+
+// A robot with a planar joint (tilted normal, so e₁ is not the frame's x) and a floating joint
+// inside the tree, tilted origins, full inertias and a mimic pair after them.
+std::string inner_multi_dof_urdf() {
+  const auto link = [](const std::string& name, double m) {
+    return "<link name='" + name + "'><inertial><origin xyz='0.05 -0.02 0.1' rpy='0.3 0.1 -0.2'/>" +
+           "<mass value='" + std::to_string(m) + "'/><inertia ixx='0.03' iyy='0.04' izz='0.05' " +
+           "ixy='0.002' ixz='-0.001' iyz='0.003'/></inertial></link>";
+  };
+  const auto joint = [](const std::string& name, const std::string& type, const std::string& parent,
+                        const std::string& child, const std::string& extra) {
+    return "<joint name='" + name + "' type='" + type + "'><parent link='" + parent +
+           "'/><child link='" + child + "'/><origin xyz='0.2 0.1 -0.3' rpy='0.2 -0.4 0.7'/>" +
+           extra + "</joint>";
+  };
+  return "<robot name='inner'>" + link("base", 4) + link("l1", 2) + link("slab", 1.5) +
+         link("puck", 1) + link("f1", 0.5) + link("f2", 0.4) +
+         joint("j1", "revolute", "base", "l1", "<axis xyz='0 1 0'/>") +
+         joint("glide", "planar", "l1", "slab", "<axis xyz='1 0.2 0.1'/>") +
+         joint("drift", "floating", "slab", "puck", "") +
+         joint("k1", "revolute", "puck", "f1", "<axis xyz='0 0 1'/>") +
+         joint("k2", "revolute", "f1", "f2",
+               "<axis xyz='0 0 1'/><mimic joint='k1' multiplier='0.7' offset='0.1'/>") +
+         "</robot>";
+}
+
+TEST_CASE("inner planar and floating URDF joints: the import equals the independent twin",
+          "[urdf][validation][joints]") {
+  const std::string path = write_temp("inner_multi_dof.urdf", inner_multi_dof_urdf());
+  for (const bool floating : {false, true}) {
+    INFO("floating base " << floating);
+    const Model m = load_model(path, {.floating_base = floating});
+    REQUIRE(m.n() == (floating ? 6 : 0) + 1 + 3 + 6 + 1);
+    validation::UrdfTwin twin(path, m.gravity, floating);
+    Workspace ws(m);
+    std::mt19937 rng(23);
+    for (int k = 0; k < 4; ++k) {
+      const VecX q = random_posture(m, rng), qd = random_uniform(m.n(), 2.0, rng);
+      evaluate(m, ws, q, qd, VecX());
+      const validation::UrdfTwinEquations s =
+          twin.equations(m.coordinate_names, m.configuration_names, q, qd);
+      CHECK(rel_error(ws.Ms, s.M) < 1e-10);
+      CHECK(rel_error(ws.h, s.h) < 1e-10);
+      CHECK(rel_error(ws.Q, s.Q) < 1e-10);
+    }
+  }
+  // femdyn validate checks the import too, and passes.
+  const Run r = run("validate " + path + " --floating-base --states 3 --t-end 0.05");
+  INFO(r.out);
+  CHECK(r.code == 0);
+  CHECK_THAT(r.out, Catch::Contains("import ") && Catch::EndsWith("PASS\n"));
 }
 
 TEST_CASE(
@@ -249,13 +302,13 @@ TEST_CASE(
     const std::string path = std::string(FEMDYN_SOURCE_DIR) + "/tests/robots/" + robot;
     const Model m = load_model(path, {.floating_base = true});
     validation::UrdfTwin twin(path, m.gravity, true);
-    const std::vector<std::string> names(m.coordinate_names.begin() + 6, m.coordinate_names.end());
     Workspace ws(m);
     std::mt19937 rng(22);
     for (int k = 0; k < 4; ++k) {
       const VecX q = random_posture(m, rng), qd = random_uniform(m.n(), 2.0, rng);
       evaluate(m, ws, q, qd, VecX());
-      const validation::UrdfTwinEquations s = twin.equations(names, q, qd);
+      const validation::UrdfTwinEquations s =
+          twin.equations(m.coordinate_names, m.configuration_names, q, qd);
       CHECK(rel_error(ws.Ms, s.M) < 1e-10);
       CHECK(rel_error(ws.h, s.h) < 1e-10);
       CHECK(rel_error(ws.Q, s.Q) < 1e-10);

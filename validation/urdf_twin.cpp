@@ -4,6 +4,7 @@
 #include <Simbody.h>
 #include <tinyxml2.h>
 
+#include <cmath>
 #include <functional>
 #include <map>
 #include <sstream>
@@ -60,21 +61,63 @@ struct UrdfTwin::Impl {
   MultibodySystem system;
   SimbodyMatterSubsystem matter{system};
   GeneralForceSubsystem forces{system};
-  std::map<std::string, MobilizedBody> joint_body;  // movable joint -> its mobilized body
+  // A movable joint: its URDF type ("revolute", "continuous", "prismatic", "planar" or
+  // "floating"; a floating root is one named after its link) and its mobilized body.
+  struct Joint {
+    std::string name, type;
+    MobilizedBody body;
+  };
+  std::vector<Joint> joints;
   struct Mimic {
     std::string leader;
     double k, offset;
   };
   std::map<std::string, Mimic> mimic;
-  MobilizedBody base;  // the root's Free mobilizer, with a floating root
-  bool floating = false;
   State state;
 };
+
+namespace {
+
+// The in-plane axes of a URDF planar joint about its normal n (docs/model-format.md, "planar"):
+// e₁ the joint frame's x made normal to n (its y when x is nearly along n), e₂ = n × e₁, as the
+// columns of the frame (e₁, e₂, n) in which Simbody's Planar mobilizer turns about z.
+Rotation planar_frame(const Vec3& normal) {
+  const UnitVec3 n(normal);
+  Vec3 x(1, 0, 0);
+  if (std::abs(dot(x, n)) >= 0.9) x = Vec3(0, 1, 0);
+  const UnitVec3 e1(x - dot(x, n) * n);
+  const UnitVec3 e2(cross(n, e1));
+  Mat33 R;
+  R.col(0) = e1.asVec3();
+  R.col(1) = e2.asVec3();
+  R.col(2) = n.asVec3();
+  return Rotation(R, true);
+}
+
+MobilizedBody mobilize(MobilizedBody& parent, const std::string& type, const Transform& X_PJ,
+                       const Vec3& axis, const Body::Rigid& body) {
+  if (type == "fixed") return MobilizedBody::Weld(parent, X_PJ, body, Transform());
+  if (type == "floating") return MobilizedBody::Free(parent, X_PJ, body, Transform());
+  if (type == "planar") {
+    const Rotation R_a = planar_frame(axis);
+    return MobilizedBody::Planar(parent, Transform(X_PJ.R() * R_a, X_PJ.p()), body,
+                                 Transform(R_a, Vec3(0)));
+  }
+  if (type == "prismatic") {
+    const Rotation R_a(UnitVec3(axis), XAxis);  // Slider moves along x
+    return MobilizedBody::Slider(parent, Transform(X_PJ.R() * R_a, X_PJ.p()), body,
+                                 Transform(R_a, Vec3(0)));
+  }
+  const Rotation R_a(UnitVec3(axis), ZAxis);  // revolute, continuous: Pin turns about z
+  return MobilizedBody::Pin(parent, Transform(X_PJ.R() * R_a, X_PJ.p()), body,
+                            Transform(R_a, Vec3(0)));
+}
+
+}  // namespace
 
 UrdfTwin::UrdfTwin(const std::string& path, const Eigen::Vector3d& gravity, bool floating)
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
-  s.floating = floating;
   tinyxml2::XMLDocument doc;
   if (doc.LoadFile(path.c_str()) != tinyxml2::XML_SUCCESS)
     throw femdyn::Error(path + ": cannot read");
@@ -93,10 +136,11 @@ UrdfTwin::UrdfTwin(const std::string& path, const Eigen::Vector3d& gravity, bool
     if (!joint_to_child.count(name)) root = name;
   // Build from the root outwards; a floating root carries its own <inertial>.
   MobilizedBody root_body = s.matter.updGround();
-  if (floating)
-    root_body = s.base =
-        MobilizedBody::Free(s.matter.updGround(), Transform(),
-                            Body::Rigid(mass_properties(links.at(root))), Transform());
+  if (floating) {
+    root_body = MobilizedBody::Free(s.matter.updGround(), Transform(),
+                                    Body::Rigid(mass_properties(links.at(root))), Transform());
+    s.joints.push_back({root, "floating", root_body});
+  }
   std::vector<std::pair<std::string, MobilizedBody>> todo{{root, root_body}};
   while (!todo.empty()) {
     auto [link, parent] = todo.back();
@@ -104,26 +148,12 @@ UrdfTwin::UrdfTwin(const std::string& path, const Eigen::Vector3d& gravity, bool
     for (const tinyxml2::XMLElement* j : children[link]) {
       const std::string name = j->Attribute("name"), type = j->Attribute("type");
       const std::string child = j->FirstChildElement("child")->Attribute("link");
-      const Body::Rigid body(mass_properties(links.at(child)));
-      const Transform X_PJ = origin(j);
-      Vec3 axis = triple(j->FirstChildElement("axis"), "xyz", Vec3(1, 0, 0));
-      MobilizedBody mb;
-      if (type == "floating" || type == "planar")  // (femdyn's own twin checks those joints)
-        throw femdyn::Error(path + ": joint '" + name + "': the independent URDF twin models no " +
-                            type + " joint");
-      if (type == "fixed") {
-        mb = MobilizedBody::Weld(parent, X_PJ, body, Transform());
-      } else if (type == "prismatic") {
-        const Rotation R_a(UnitVec3(axis), XAxis);  // Slider moves along x
-        mb = MobilizedBody::Slider(parent, Transform(X_PJ.R() * R_a, X_PJ.p()), body,
-                                   Transform(R_a, Vec3(0)));
-      } else {                                      // revolute, continuous
-        const Rotation R_a(UnitVec3(axis), ZAxis);  // Pin turns about z
-        mb = MobilizedBody::Pin(parent, Transform(X_PJ.R() * R_a, X_PJ.p()), body,
-                                Transform(R_a, Vec3(0)));
-      }
-      if (type != "fixed") {
-        s.joint_body[name] = mb;
+      const Vec3 axis = triple(j->FirstChildElement("axis"), "xyz",
+                               type == "planar" ? Vec3(0, 0, 1) : Vec3(1, 0, 0));
+      const MobilizedBody mb =
+          mobilize(parent, type, origin(j), axis, Body::Rigid(mass_properties(links.at(child))));
+      if (type != "fixed") s.joints.push_back({name, type, mb});
+      if (type != "fixed" && type != "planar" && type != "floating") {
         const double c = number(j->FirstChildElement("dynamics"), "damping", 0);
         if (c != 0) Force::MobilityLinearDamper(s.forces, mb, MobilizerUIndex(0), c);
         if (const auto* mim = j->FirstChildElement("mimic"))
@@ -141,54 +171,68 @@ UrdfTwin::UrdfTwin(const std::string& path, const Eigen::Vector3d& gravity, bool
 
 UrdfTwin::~UrdfTwin() = default;
 
-UrdfTwinEquations UrdfTwin::equations(const std::vector<std::string>& names,
+UrdfTwinEquations UrdfTwin::equations(const std::vector<std::string>& rate_names,
+                                      const std::vector<std::string>& configuration_names,
                                       const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
   Impl& s = *impl_;
-  // nb rates of the floating root come first; then the named coordinates, at q index nb + 1 + a
-  // (after the quaternion's extra entry) and rate index nb + a.
-  const int nb = s.floating ? 6 : 0, nqb = s.floating ? 7 : 0;
-  const int n = nb + static_cast<int>(names.size()), nu = s.state.getNU();
-  // u = C v and θ(q): a coordinate drives its joint; a mimic joint follows its leader; the
-  // Free mobilizer's u = (ω, v) in the world is (R ω_b, R v_b) of femdyn's rates in body axes.
+  const int n = static_cast<int>(rate_names.size()), nu = s.state.getNU();
+  std::map<std::string, int> rate, entry;  // a name -> its index in v, in q
+  for (int a = 0; a < n; ++a) rate[rate_names[a]] = a;
+  for (int i = 0; i < static_cast<int>(configuration_names.size()); ++i)
+    entry[configuration_names[i]] = i;
+  const auto at = [](const std::map<std::string, int>& index, const std::string& name) {
+    const auto it = index.find(name);
+    if (it == index.end()) throw femdyn::Error("the URDF twin finds no coordinate '" + name + "'");
+    return it->second;
+  };
+  // u = C v + Ċ-free part and Simbody's q from femdyn's: a coordinate drives its joint, a mimic
+  // joint follows its leader, a planar joint's (x, y, θ) is Simbody's (θ, x, y), and a floating
+  // joint's (v, ω) in its child's axes is Simbody's u = (R ω, R v) in the parent's (F) axes, so
+  // u̇ = C v̇ + Ċ v with Ċ v = R (ω × v) on the linear part (R ω has no such term).
   Eigen::MatrixXd C = Eigen::MatrixXd::Zero(nu, n);
-  Eigen::VectorXd Cdot_v = Eigen::VectorXd::Zero(nu);  // Ċ v
-  const Eigen::VectorXd q_named = q.tail(q.size() - nqb);
-  if (s.floating) {
-    const Eigen::Quaterniond quat(q[3], q[4], q[5], q[6]);
-    const Eigen::Matrix3d R = quat.normalized().toRotationMatrix();
-    const int u0 = s.base.getFirstUIndex(s.state), q0 = s.base.getFirstQIndex(s.state);
-    for (int k = 0; k < 4; ++k) s.state.updQ()[q0 + k] = q[3 + k];  // Simbody: (quaternion, p)
-    for (int k = 0; k < 3; ++k) s.state.updQ()[q0 + 4 + k] = q[k];
-    C.block<3, 3>(u0, 3) = R;      // ω
-    C.block<3, 3>(u0 + 3, 0) = R;  // v
-    // d(R v_b)/dt = R v̇_b + R (ω_b × v_b); R ω_b has no such term (ω_b × ω_b = 0).
-    Cdot_v.segment<3>(u0 + 3) = R * qd.segment<3>(3).cross(qd.head<3>());
-  }
-  Eigen::VectorXd theta0 = Eigen::VectorXd::Zero(nu);
-  std::map<std::string, int> coordinate;
-  for (int a = nb; a < n; ++a) coordinate[names[a - nb]] = a;
+  Eigen::VectorXd Cdot_v = Eigen::VectorXd::Zero(nu);
+  Vector& sq = s.state.updQ();
   std::function<void(const std::string&, Eigen::RowVectorXd&, double&)> resolve =
-      [&](const std::string& joint, Eigen::RowVectorXd& row, double& offset) {
-        if (coordinate.count(joint)) {
-          row = Eigen::RowVectorXd::Zero(n);
-          row[coordinate[joint]] = 1;
-          offset = 0;
+      [&](const std::string& joint, Eigen::RowVectorXd& row, double& theta) {
+        if (rate.count(joint)) {
+          row = Eigen::RowVectorXd::Unit(n, rate.at(joint));
+          theta = q[at(entry, joint)];
           return;
         }
-        const Impl::Mimic& m = s.mimic.at(joint);
-        resolve(m.leader, row, offset);
-        row *= m.k;
-        offset = m.k * offset + m.offset;
+        const auto m = s.mimic.find(joint);
+        if (m == s.mimic.end())
+          throw femdyn::Error("the URDF twin finds no coordinate '" + joint + "'");
+        resolve(m->second.leader, row, theta);
+        row *= m->second.k;
+        theta = m->second.k * theta + m->second.offset;
       };
-  for (const auto& [joint, mb] : s.joint_body) {
-    Eigen::RowVectorXd row;
-    double offset = 0;
-    resolve(joint, row, offset);
-    const int u = mb.getFirstUIndex(s.state);
-    C.row(u) = row;
-    theta0[u] = offset;
-    s.state.updQ()[mb.getFirstQIndex(s.state)] =
-        row.tail(n - nb).dot(q_named) + offset;  // Pin, Slider: q = θ
+  for (const Impl::Joint& j : s.joints) {
+    const int u0 = j.body.getFirstUIndex(s.state), q0 = j.body.getFirstQIndex(s.state);
+    if (j.type == "floating") {
+      const auto rates = [&](const char* first) { return at(rate, j.name + "." + first); };
+      const int x = at(entry, j.name + ".x"), w = at(entry, j.name + ".qw");
+      const Eigen::Matrix3d R =
+          Eigen::Quaterniond(q[w], q[w + 1], q[w + 2], q[w + 3]).normalized().toRotationMatrix();
+      for (int k = 0; k < 4; ++k) sq[q0 + k] = q[w + k];  // Simbody: (quaternion, p)
+      for (int k = 0; k < 3; ++k) sq[q0 + 4 + k] = q[x + k];
+      const int v = rates("vx"), om = rates("wx");
+      C.block<3, 3>(u0, om) = R;
+      C.block<3, 3>(u0 + 3, v) = R;
+      Cdot_v.segment<3>(u0 + 3) = R * qd.segment<3>(om).cross(qd.segment<3>(v));
+    } else if (j.type == "planar") {
+      const char* kOrder[] = {"theta", "x", "y"};  // Simbody's Planar: (θ, x, y)
+      for (int k = 0; k < 3; ++k) {
+        const std::string name = j.name + "." + kOrder[k];
+        C(u0 + k, at(rate, name)) = 1;
+        sq[q0 + k] = q[at(entry, name)];
+      }
+    } else {  // Pin, Slider: one q, one u
+      Eigen::RowVectorXd row;
+      double theta = 0;
+      resolve(j.name, row, theta);
+      C.row(u0) = row;
+      sq[q0] = theta;
+    }
   }
   {
     const Eigen::VectorXd u = C * qd;

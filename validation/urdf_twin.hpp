@@ -2,9 +2,9 @@
 // import (io/urdf_loader) — so that comparing it with femdyn's equations of the same file checks
 // the import itself: the rpy convention (Simbody's own space-fixed X-Y-Z sequence), the rotation
 // of the inertia out of the <inertial> frame (Inertia::reexpress) and its shift to the link
-// origin, the tree, fixed joints, axes, mimic couplings and damping. Gravity is given (URDF has
-// none; femdyn's default for URDF is (0, 0, −9.81)).
-// Like twin.hpp, this header uses only Eigen; urdf_twin.cpp is C++17 without NDEBUG.
+// origin, the tree, fixed, planar and floating joints, axes, mimic couplings and damping. Gravity
+// is given (URDF has none; femdyn's default for URDF is (0, 0, −9.81)). Like twin.hpp, this header
+// uses only Eigen; urdf_twin.cpp is C++17 without NDEBUG.
 #pragma once
 #include <Eigen/Dense>
 #include <memory>
@@ -27,14 +27,16 @@ class UrdfTwin {
   UrdfTwin(const UrdfTwin&) = delete;
   UrdfTwin& operator=(const UrdfTwin&) = delete;
 
-  // The equations in the coordinates `names` (movable, non-mimic joints by name, in any order):
-  // Simbody's over all joints, reduced by the mimic relations θ_j = k θ_leader + offset.
-  // With a floating root, q and q̇ start with the root's own 7 and 6 (q: x, y, z, qw, qx, qy, qz
-  // of the root link in the world; v: its origin's velocity and its ω, both in the root's axes,
-  // docs/notation.md), and the equations' first 6 rows and columns are those rates; `names`
-  // names the rest.
-  UrdfTwinEquations equations(const std::vector<std::string>& names, const Eigen::VectorXd& q,
-                              const Eigen::VectorXd& qd);
+  // The equations in femdyn's coordinates, found by their names: `rate_names` name v (a joint's
+  // own name for one rate; "NAME.x", "NAME.y", "NAME.theta" for a planar joint; "NAME.vx" …
+  // "NAME.wz" for a floating one, the floating root named after its link) and
+  // `configuration_names` name q likewise ("NAME.x" … "NAME.qz" for a floating joint: its
+  // child's origin in the joint frame and the quaternion (w, x, y, z); v and ω in the child's
+  // axes, docs/notation.md). Simbody's equations over all joints, reduced by the mimic
+  // relations θ_j = k θ_leader + offset.
+  UrdfTwinEquations equations(const std::vector<std::string>& rate_names,
+                              const std::vector<std::string>& configuration_names,
+                              const Eigen::VectorXd& q, const Eigen::VectorXd& qd);
 
  private:
   struct Impl;

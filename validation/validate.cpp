@@ -797,9 +797,7 @@ QuantityError validate_urdf_import(const Model& m, const std::string& path,
     const VecX q = random_posture(m, rng);
     const VecX qd = random_uniform(m.n(), o.qd_scale, rng);
     evaluate(m, ws, q, qd, VecX());
-    const std::vector<std::string> names(m.coordinate_names.begin() + (floating ? 6 : 0),
-                                         m.coordinate_names.end());
-    const UrdfTwinEquations s = twin->equations(names, q, qd);
+    const UrdfTwinEquations s = twin->equations(m.coordinate_names, m.configuration_names, q, qd);
     accumulate(e, ws.Ms, s.M);
     accumulate(e, ws.h, s.h);
     accumulate(e, ws.Q, s.Q);
