@@ -7,6 +7,7 @@
 #include "core/equations.hpp"
 #include "core/limits.hpp"
 #include "core/memory.hpp"
+#include "core/sampling.hpp"
 #include "io/model_loader.hpp"
 #include "io/output.hpp"
 #include "python/py_model.hpp"
@@ -173,11 +174,23 @@ void bind_model(py::module_& m) {
       });
 
   py::class_<PyModel>(m, "Model", "A compiled mechanism (immutable); femdyn.load makes one")
-      .def_property_readonly("n", [](const PyModel& s) { return s.model->n(); })
+      .def_property_readonly(
+          "n", [](const PyModel& s) { return s.model->n(); },
+          "the rates v (q̇ for joints of one coordinate): M^s is n × n")
+      .def_property_readonly(
+          "n_q", [](const PyModel& s) { return s.model->n_q(); },
+          "the entries of q (n_q = n + one per spherical or free joint)")
       .def_property_readonly("n_u", [](const PyModel& s) { return s.model->n_u(); })
       .def_property_readonly("name", [](const PyModel& s) { return s.model->name; })
-      .def_property_readonly("coordinates",
-                             [](const PyModel& s) { return s.model->coordinate_names; })
+      .def_property_readonly(
+          "coordinates", [](const PyModel& s) { return s.model->coordinate_names; },
+          "the names of v's entries (base.vx, …, joint names)")
+      .def_property_readonly(
+          "configuration", [](const PyModel& s) { return s.model->configuration_names; },
+          "the names of q's entries (base.x, …, base.qw, …, joint names)")
+      .def(
+          "neutral_configuration", [](const PyModel& s) { return neutral_posture(*s.model); },
+          "q with every joint at 0 and every quaternion the identity (n_q entries)")
       .def_property_readonly("gravity", [](const PyModel& s) { return Vec3(s.model->gravity); })
       .def("equations", &equations, py::arg("q"), py::arg("qd") = py::none(),
            py::arg("tau") = py::none(),

@@ -114,3 +114,15 @@ def test_couplings_beside_quaternions_from_python(tmp_path, law):
     for k in range(len(qs)):
         assert np.allclose(batch[k], model.forward_dynamics(qs[k], vs[k], taus[k]),
                            rtol=1e-13, atol=1e-13)
+
+
+def test_model_names_q_and_v(tmp_path):
+    path = tmp_path / "coupled.json"
+    path.write_text(json.dumps(COUPLED_FLOATING))
+    model = femdyn.load(str(path))
+    assert (model.n, model.n_q) == (10, 12)
+    assert model.configuration[:4] == ["base.x", "base.y", "base.z", "base.qw"]
+    assert model.configuration[-1] == "l1"
+    assert model.coordinates[:2] == ["base.vx", "base.vy"] and "l2" not in model.coordinates
+    q = model.neutral_configuration()
+    assert q.shape == (12,) and q[3] == 1 and q[7] == 1 and np.count_nonzero(q) == 2
