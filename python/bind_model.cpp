@@ -27,8 +27,10 @@ void require_finite(const Model& model, const double* x, Eigen::Index size, Eige
                            "' is NaN or Inf (the forces or the state overflow double precision)");
 }
 
-std::unique_ptr<PyModel> load(const std::string& path, const OptArray& gravity) {
+std::unique_ptr<PyModel> load(const std::string& path, const OptArray& gravity,
+                              bool floating_base) {
   LoadOptions options;
+  options.floating_base = floating_base;
   std::vector<std::string> warnings;
   options.warn = [&warnings](const std::string& w) { warnings.push_back(w); };
   if (gravity) {
@@ -228,8 +230,11 @@ void bind_model(py::module_& m) {
       });
 
   m.def("load", &load, py::arg("path"), py::arg("gravity") = py::none(),
+        py::arg("floating_base") = false,
         "A femdyn JSON model or a URDF file (*.urdf) as a Model; gravity (3,) overrides the "
-        "model's. Raises femdyn.ModelError (a ValueError) naming the file, place and problem.");
+        "model's; floating_base puts a free joint between the world and a URDF's root link (the "
+        "CLI's --floating-base). Raises femdyn.ModelError (a ValueError) naming the file, place "
+        "and problem.");
 }
 
 }  // namespace femdyn::python

@@ -126,3 +126,18 @@ def test_model_names_q_and_v(tmp_path):
     assert model.coordinates[:2] == ["base.vx", "base.vy"] and "l2" not in model.coordinates
     q = model.neutral_configuration()
     assert q.shape == (12,) and q[3] == 1 and q[7] == 1 and np.count_nonzero(q) == 2
+
+
+def test_load_urdf_with_a_floating_base():
+    # HyQ's root link on a free joint, as the CLI's --floating-base; welded by default.
+    import os
+    path = os.path.join(os.path.dirname(__file__), "..", "..", "tests", "robots", "hyq.urdf")
+    welded, floating = femdyn.load(path), femdyn.load(path, floating_base=True)
+    assert (welded.n, welded.n_q) == (12, 12)
+    assert (floating.n, floating.n_q) == (18, 19)
+    assert floating.configuration[3].endswith(".qw")
+    q = floating.neutral_configuration()
+    qdd = floating.forward_dynamics(q, np.zeros(18), np.zeros(18))
+    # At rest in free fall every body accelerates with g: the joints keep still.
+    assert np.abs(qdd[6:]).max() < 1e-9
+    assert np.allclose(qdd[:3], floating.gravity, atol=1e-9)
