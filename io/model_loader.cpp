@@ -2,7 +2,9 @@
 
 #include <cctype>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "compile/compile.hpp"
@@ -356,16 +358,12 @@ LoadSpec read_load(const Params& p, const BodiesByName& bodies) {
 // the bodies (and couplings, loads, table); the file's own name, gravity and loads apply on top.
 MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std::string& source);
 
-Json expand_plugin(const Catalog& catalog, const Json& root, const std::string& source) {
-  const Params p(root, source + ": ");
-  p.allow_only({"model", "params", "name", "description", "gravity", "loads", "$schema"});
-  const std::string name = p.string("model");
-  const ModelPlugin* plugin = catalog.plugins.find(name);
-  if (!plugin)
-    p.fail("model", "unknown model plugin " + quoted_text(name) +
-                        " (known: " + catalog.plugins.names() + ")");
-  static const Json empty = Json::object();
-  Json doc = plugin->expand(p.has("params") ? p.child("params") : Params(empty, p.path("params")));
+// {"model": "urdf", "params": {"file": F, "root_joint": "fixed" | "free"}, …}: a URDF by
+// reference (F relative to the JSON file), read from a file only (read_spec, model_document).
+constexpr const char* kUrdfReference = "urdf";
+
+// The file's own name, description, gravity and loads on top of the document it expands to.
+void apply_overrides(const Json& root, const Params& p, Json& doc) {
   for (const char* key : {"name", "description", "gravity"})
     if (root.contains(key)) doc[key] = root[key];
   if (root.contains("loads")) {
@@ -373,6 +371,23 @@ Json expand_plugin(const Catalog& catalog, const Json& root, const std::string& 
     if (!doc.contains("loads")) doc["loads"] = Json::array();
     for (const Json& l : root["loads"]) doc["loads"].push_back(l);
   }
+}
+
+Json expand_plugin(const Catalog& catalog, const Json& root, const std::string& source) {
+  const Params p(root, source + ": ");
+  p.allow_only({"model", "params", "name", "description", "gravity", "loads", "$schema"});
+  const std::string name = p.string("model");
+  if (name == kUrdfReference)
+    p.fail("model", "\"urdf\" names a file relative to this one: load it from a file");
+  const ModelPlugin* plugin = catalog.plugins.find(name);
+  if (!plugin) {
+    const std::string known = catalog.plugins.names();
+    p.fail("model", "unknown model plugin " + quoted_text(name) + " (known: " + known +
+                        (known.empty() ? "" : ", ") + kUrdfReference + ")");
+  }
+  static const Json empty = Json::object();
+  Json doc = plugin->expand(p.has("params") ? p.child("params") : Params(empty, p.path("params")));
+  apply_overrides(root, p, doc);
   return doc;
 }
 
@@ -524,15 +539,56 @@ std::string read_text(const std::string& path) { return read_input_file(path); }
 
 }  // namespace
 
-Json model_document(const std::string& path, const LoadOptions& options) {
-  if (is_urdf_path(path)) {
-    UrdfResult r = read_urdf(path, {.floating_base = options.floating_base});
-    if (options.warn)
-      for (const std::string& w : r.warnings) options.warn(w);
-    return std::move(r.model);
+namespace {
+
+Json urdf_document(const std::string& urdf, bool floating_base, const LoadOptions& options) {
+  UrdfResult r = read_urdf(urdf, {.floating_base = floating_base});
+  if (options.warn)
+    for (const std::string& w : r.warnings) options.warn(w);
+  return std::move(r.model);
+}
+
+// A JSON file {"model": "urdf", …}: the URDF it names as femdyn JSON (with the file's own name,
+// description, gravity and loads), and that URDF's path for messages; nullopt for any other file.
+std::optional<std::pair<Json, std::string>> urdf_reference(const std::string& path,
+                                                           const std::string& text,
+                                                           const LoadOptions& options) {
+  Json root;
+  try {
+    root = Json::parse(text);
+  } catch (const Json::exception&) {
+    return std::nullopt;  // (parse_spec reports malformed JSON)
   }
+  if (!root.is_object() || !root.contains("model") || root["model"] != kUrdfReference)
+    return std::nullopt;
+  const Params p(root, path + ": ");
+  p.allow_only({"model", "params", "name", "description", "gravity", "loads", "$schema"});
+  const Params params = p.child("params");
+  params.allow_only({"file", "root_joint"});
+  const std::string root_joint = params.has("root_joint") ? params.string("root_joint") : "fixed";
+  if (root_joint != "fixed" && root_joint != "free")
+    params.fail("root_joint", "expected \"fixed\" or \"free\", got " + quoted_text(root_joint));
+  const std::string file = params.string("file");
+  std::filesystem::path urdf(file);
+  if (urdf.is_relative()) urdf = std::filesystem::path(path).parent_path() / urdf;
+  if (!is_urdf_path(urdf.string())) params.fail("file", "expected a *.urdf file");
+  Json doc;
+  try {
+    doc = urdf_document(urdf.string(), root_joint == "free", options);
+  } catch (const Error& e) {
+    params.fail("file", e.what());
+  }
+  apply_overrides(root, p, doc);
+  return std::pair{std::move(doc), urdf.string()};
+}
+
+}  // namespace
+
+Json model_document(const std::string& path, const LoadOptions& options) {
+  if (is_urdf_path(path)) return urdf_document(path, options.floating_base, options);
   Json root;
   const std::string text = read_text(path);
+  if (auto ref = urdf_reference(path, text, options)) return std::move(ref->first);
   const Catalog& catalog = options.catalog ? *options.catalog : default_catalog();
   (void)parse_spec(text, path, catalog);  // reports malformed JSON, every model error by path
   root = Json::parse(text);
@@ -544,8 +600,19 @@ MechanismSpec read_spec(const std::string& path, const LoadOptions& options) {
   if (!is_urdf_path(path) && options.floating_base)
     throw ModelError(path,
                      "--floating-base is for URDF models: a JSON model gives its root body a "
-                     "free joint itself (\"joint\": {\"type\": \"free\"})");
-  if (!is_urdf_path(path)) return parse_spec(read_text(path), path, catalog);
+                     "free joint itself (\"joint\": {\"type\": \"free\"}), a URDF "
+                     "reference by \"root_joint\": \"free\"");
+  if (!is_urdf_path(path)) {
+    const std::string text = read_text(path);
+    if (auto ref = urdf_reference(path, text, options)) {
+      try {
+        return parse_model_json(ref->first, ref->second, catalog);
+      } catch (const ModelError& e) {
+        rethrow_for_urdf(e, ref->first, ref->second);
+      }
+    }
+    return parse_spec(text, path, catalog);
+  }
   const Json doc = model_document(path, options);
   try {
     return parse_model_json(doc, path, catalog);

@@ -264,6 +264,50 @@ std::string inner_multi_dof_urdf() {
          "</robot>";
 }
 
+TEST_CASE("a URDF by reference in JSON, welded or on a free root joint", "[urdf][joints]") {
+  // {"model": "urdf", "params": {"file", "root_joint"}} loads the same equations as the URDF
+  // itself (with --floating-base for "free"), the file's own name and gravity on top; errors
+  // name the reference's place.
+  const std::string hyq = std::string(FEMDYN_SOURCE_DIR) + "/tests/robots/hyq.urdf";
+  for (const bool free : {false, true}) {
+    const std::string ref = write_temp(
+        "hyq_ref.json", R"({"model": "urdf", "name": "moon hyq", "gravity": [0, 0, -1.62],
+          "params": {"file": ")" +
+                            hyq + R"(", "root_joint": ")" + (free ? "free" : "fixed") + "\"}}");
+    const Model a = load_model(ref);
+    const Model b = load_model(hyq, {.gravity = Vec3(0, 0, -1.62), .floating_base = free});
+    CHECK(a.name == "moon hyq");
+    REQUIRE(a.n() == b.n());
+    REQUIRE(a.n_q() == (free ? 19 : 12));
+    Workspace wa(a), wb(b);
+    std::mt19937 rng(5);
+    const VecX q = random_posture(b, rng), qd = random_uniform(b.n(), 1.0, rng);
+    evaluate(a, wa, q, qd, VecX());
+    evaluate(b, wb, q, qd, VecX());
+    CHECK(wa.Ms == wb.Ms);
+    CHECK(wa.h == wb.h);
+    CHECK(wa.Q == wb.Q);
+  }
+  const auto error_of = [](const std::string& text) {
+    try {
+      load_model(write_temp("bad_ref.json", text));
+    } catch (const ModelError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(loaded)");
+  };
+  CHECK_THAT(error_of(R"({"model": "urdf", "params": {"file": "none.urdf"}})"),
+             Catch::Contains("bad_ref.json: /params/file: ") &&
+                 Catch::Contains("none.urdf: cannot open file"));
+  CHECK_THAT(error_of(R"({"model": "urdf", "params": {"file": ")" + hyq +
+                      R"(", "root_joint": "floating"}})"),
+             Catch::Contains("/params/root_joint: expected \"fixed\" or \"free\""));
+  CHECK_THAT(error_of(R"({"model": "urdf", "params": {"file": "a.json"}})"),
+             Catch::Contains("/params/file: expected a *.urdf file"));
+  CHECK_THAT(error_of(R"({"model": "urdf", "params": {"file": "a.urdf", "extra": 1}})"),
+             Catch::Contains("/params/extra"));
+}
+
 TEST_CASE("inner planar and floating URDF joints: the import equals the independent twin",
           "[urdf][validation][joints]") {
   const std::string path = write_temp("inner_multi_dof.urdf", inner_multi_dof_urdf());
