@@ -41,7 +41,7 @@ template <class J, class F>
 
 // f(J{}) for the joint type J of `type`: the one switch over the joint types.
 template <class F>
-decltype(auto) visit_joint(JointType type, F&& f) {
+[[gnu::always_inline]] inline decltype(auto) visit_joint(JointType type, F&& f) {
   switch (type) {
     case JointType::Revolute:
       return f(RevoluteJoint{});
@@ -88,16 +88,25 @@ template <class J>
 
 // Column k of S_J as a spatial motion about the world origin: (s_ω, s_v + p_B × s_ω).
 template <class J>
-Vec6 spatial_column(const Joint& j, const Mat3& R_B, const Mat3& R_P, const Vec3& p_B, int k) {
+[[gnu::always_inline]] inline Vec6 spatial_column(const Joint& j, const Mat3& R_B, const Mat3& R_P,
+                                                  const Vec3& p_B, int k) {
   Vec6 S;
   const Vec3 w = world_angular<J>(j, R_B, R_P, k);
   S.head<3>() = w;
-  S.tail<3>() = world_linear<J>(j, R_B, R_P, k) + cross3(p_B, w);
+  if constexpr (J::angular && J::linear)
+    S.tail<3>() = world_linear<J>(j, R_B, R_P, k) + cross3(p_B, w);
+  else if constexpr (J::angular)
+    S.tail<3>() = cross3(p_B, w);
+  else
+    S.tail<3>() = world_linear<J>(j, R_B, R_P, k);
   return S;
 }
-inline Vec6 spatial_column(const Joint& j, const Mat3& R_B, const Mat3& R_P, const Vec3& p_B,
-                           int k) {
-  return visit_joint(j.type, [&]<class J>(J) { return spatial_column<J>(j, R_B, R_P, p_B, k); });
+[[gnu::always_inline]] inline Vec6 spatial_column(const Joint& j, const Mat3& R_B, const Mat3& R_P,
+                                                  const Vec3& p_B, int k) {
+  return visit_joint(
+      j.type, [&]<class J>(J) __attribute__((always_inline)) {
+        return spatial_column<J>(j, R_B, R_P, p_B, k);
+      });
 }
 
 // All nv columns of S_J as spatial motions about the world origin, into S[0 .. nv).
@@ -118,6 +127,14 @@ template <class J>
                                                     const Mat3& R_P, const Vec3& p_B,
                                                     const double* rate, const double* acc, Vec6* S,
                                                     Vec6& V, Vec6& a) {
+  if constexpr (J::nv == 1 && !J::in_parent(0)) {  // one column fixed in B: no zero terms
+    S[0] = spatial_column<J>(j, R_B, R_P, p_B, 0);
+    const Vec6 vj = S[0] * rate[0];
+    V += vj;
+    a += cross_motion(V, vj);
+    if (acc) a += S[0] * acc[0];
+    return;
+  }
   Vec6 vj = Vec6::Zero(), vj_parent = Vec6::Zero();
   for (int k = 0; k < J::nv; ++k) {
     S[k] = spatial_column<J>(j, R_B, R_P, p_B, k);
@@ -130,10 +147,14 @@ template <class J>
   if (acc)
     for (int k = 0; k < J::nv; ++k) a += S[k] * acc[k];
 }
-inline void add_joint_motion(const Joint& j, const Mat3& R_B, const Mat3& R_P, const Vec3& p_B,
-                             const double* rate, const double* acc, Vec6* S, Vec6& V, Vec6& a) {
-  visit_joint(j.type,
-              [&]<class J>(J) { add_joint_motion<J>(j, R_B, R_P, p_B, rate, acc, S, V, a); });
+[[gnu::always_inline]] inline void add_joint_motion(const Joint& j, const Mat3& R_B,
+                                                    const Mat3& R_P, const Vec3& p_B,
+                                                    const double* rate, const double* acc, Vec6* S,
+                                                    Vec6& V, Vec6& a) {
+  visit_joint(
+      j.type, [&]<class J>(J) __attribute__((always_inline)) {
+        add_joint_motion<J>(j, R_B, R_P, p_B, rate, acc, S, V, a);
+      });
 }
 
 // The joint's own generalized force on a 1-DOF joint's coordinate: its spring and damper,
