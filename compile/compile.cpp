@@ -123,6 +123,29 @@ Joint compile_joint(const JointSpec& js, const std::string& body_name) {
   return j;
 }
 
+// Every body's own frame, then the named frames of the spec (names unique among all).
+void compile_frames(const MechanismSpec& spec, Model& m) {
+  std::map<std::string, int> body_of;
+  for (int b = 0; b < static_cast<int>(m.bodies.size()); ++b) {
+    body_of.emplace(m.bodies[b].name, b);
+    m.frames.push_back({m.bodies[b].name, b, Mat3::Identity(), Vec3::Zero()});
+  }
+  std::set<std::string> names;
+  for (const Body& b : m.bodies) names.insert(b.name);
+  for (const FrameSpec& f : spec.frames) {
+    check_name(f.name, f.where + "/name", "frame name");
+    if (!names.insert(f.name).second)
+      throw ModelError(f.where + "/name", "frame name " + quoted_text(f.name) +
+                                              " is taken (by a body or another frame)");
+    const auto it = body_of.find(f.body);
+    if (it == body_of.end())
+      throw ModelError(f.where + "/body", "unknown body " + quoted_text(f.body));
+    check_magnitude(f.xyz, f.where + "/xyz", "xyz");
+    check_magnitude(f.rpy, f.where + "/rpy", "rpy");
+    m.frames.push_back({f.name, it->second, rpy_to_rotation(f.rpy), f.xyz});
+  }
+}
+
 // Couplings join joints of one rate (a coupled multi-rate joint would need a law per rate).
 void check_one_rate(const Model& m, int t, const std::string& where) {
   const Joint& j = m.bodies[m.theta_joint[t]].joint;
@@ -319,6 +342,7 @@ Model compile_tree(MechanismSpec spec, const CompileOptions& options) {
     }
     m.bodies.push_back(std::move(b));
   }
+  compile_frames(spec, m);
   compile_coupling(spec, m);
   lay_out_coordinates(m);
   configuration_coupling(m);

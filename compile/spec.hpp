@@ -75,6 +75,14 @@ struct CorrelationSpec {
   std::string where;
 };
 
+// A named frame fixed on a body: its origin at `xyz` (or at a node of the body) and its axes
+// turned by `rpy` from the body's (docs/model-format.md#frames).
+struct FrameSpec {
+  std::string name, body;
+  Vec3 xyz = Vec3::Zero(), rpy = Vec3::Zero();
+  std::string where;
+};
+
 struct MechanismSpec {
   std::string name;
   Vec3 gravity = Vec3::Zero();
@@ -82,6 +90,7 @@ struct MechanismSpec {
   std::vector<BodySpec> bodies;
   std::vector<CouplingSpec> couplings;
   std::vector<LoadSpec> loads;
+  std::vector<FrameSpec> frames;
   std::optional<CorrelationSpec> correlation;
   std::string where;  // the file
 };

@@ -115,6 +115,11 @@ void propagate_bilinear(const Model& m, Workspace& ws, const VecX& q, const VecX
     ws.u_dot = t.u_dot;
   }
   share_bodies(ws);
+  if (request.bias)  // at q̈ = 0 the tree moves with θ̈ = γ: each body's bias gains J_θ,b γ
+    for (std::size_t b = 0; b < ws.body.size(); ++b) {
+      ws.body[b].alpha.noalias() += t.Jw.middleRows<3>(3 * b) * s.gamma;
+      ws.body[b].a.noalias() += t.Jv.middleRows<3>(3 * b) * s.gamma;
+    }
 }
 
 std::vector<MatX> transform_hessian(const Model& m, Workspace& ws, const VecX& q) {

@@ -65,6 +65,15 @@ struct CoordinateJoint {
   int q = 0, v = 0;
 };
 
+// A frame fixed on a body (core/frames.hpp): every body is one (its own frame, by its name), and
+// a model names more (JSON "frames"). R_BF, p_BF place it in the body frame.
+struct Frame {
+  std::string name;
+  int body = -1;
+  Mat3 R_BF = Mat3::Identity();
+  Vec3 p_BF = Vec3::Zero();
+};
+
 enum class DofKind : unsigned char { Translation, Rotation };
 
 // One transition coordinate u_i: a translation of a node or a rotation rate of a body.
@@ -146,6 +155,7 @@ struct Model {
   std::string where;  // the source, for messages
   Vec3 gravity = Vec3::Zero();
   std::vector<Body> bodies;      // parents before children
+  std::vector<Frame> frames;     // the bodies' own (in body order), then the named ones
   std::vector<int> theta_joint;  // θ index -> body index of its joint
   std::vector<int> rate_parent;  // θ̇ index -> λ, the rate before it on its path to the world
                                  // (a joint's previous column, else the last rate of the nearest

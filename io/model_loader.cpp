@@ -330,6 +330,31 @@ BodiesByName bodies_by_name(const Json& bodies) {
   return by_name;
 }
 
+// {"name", "body", "xyz" | "node", "rpy"}: a frame on a body, at a point or at one of its nodes.
+FrameSpec read_frame(const Params& p, const BodiesByName& bodies) {
+  p.allow_only({"name", "body", "xyz", "node", "rpy"});
+  FrameSpec f;
+  f.where = p.where();
+  f.name = p.string("name");
+  f.body = p.string("body");
+  if (p.has("node") && p.has("xyz")) p.fail("xyz", "give either xyz or node, not both");
+  if (p.has("node")) {
+    std::map<std::string, Vec3> nodes;
+    const auto named = bodies.find(f.body);
+    if (named != bodies.end())
+      for (const Json* b : named->second)
+        if (b->contains("nodes") && (*b)["nodes"].is_object())
+          for (auto it = (*b)["nodes"].begin(); it != (*b)["nodes"].end(); ++it)
+            nodes[it.key()] = json_vec3(it.value(), p.path("node"));
+    const Params np(p.json(), p.where(), f.body, &nodes);
+    f.xyz = np.node("node").position;
+  } else {
+    f.xyz = p.vec3_or("xyz", Vec3::Zero());
+  }
+  f.rpy = p.vec3_or("rpy", Vec3::Zero());
+  return f;
+}
+
 LoadSpec read_load(const Params& p, const BodiesByName& bodies) {
   p.allow_only({"body", "point", "node", "force", "torque"});
   LoadSpec l;
@@ -366,16 +391,17 @@ constexpr const char* kUrdfReference = "urdf";
 void apply_overrides(const Json& root, const Params& p, Json& doc) {
   for (const char* key : {"name", "description", "gravity"})
     if (root.contains(key)) doc[key] = root[key];
-  if (root.contains("loads")) {
-    if (!root["loads"].is_array()) p.fail("loads", "expected an array");
-    if (!doc.contains("loads")) doc["loads"] = Json::array();
-    for (const Json& l : root["loads"]) doc["loads"].push_back(l);
-  }
+  for (const char* list : {"loads", "frames"})
+    if (root.contains(list)) {
+      if (!root[list].is_array()) p.fail(list, "expected an array");
+      if (!doc.contains(list)) doc[list] = Json::array();
+      for (const Json& l : root[list]) doc[list].push_back(l);
+    }
 }
 
 Json expand_plugin(const Catalog& catalog, const Json& root, const std::string& source) {
   const Params p(root, source + ": ");
-  p.allow_only({"model", "params", "name", "description", "gravity", "loads", "$schema"});
+  p.allow_only({"model", "params", "name", "description", "gravity", "loads", "frames", "$schema"});
   const std::string name = p.string("model");
   if (name == kUrdfReference)
     p.fail("model", "\"urdf\" names a file relative to this one: load it from a file");
@@ -396,8 +422,8 @@ MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std
   spec.where = source + ": ";
   const auto path = [&](const std::string& s) { return source + ": /" + s; };
   for (auto it = root.begin(); it != root.end(); ++it) {
-    static const char* known[] = {"name",      "description", "gravity",           "bodies",
-                                  "couplings", "loads",       "correlation_table", "$schema"};
+    static const char* known[] = {"name",  "description",       "gravity", "bodies", "couplings",
+                                  "loads", "correlation_table", "frames",  "$schema"};
     bool ok = false;
     for (const char* k : known) ok = ok || it.key() == k;
     if (!ok) throw ModelError(path(truncated(it.key())), "unknown key " + quoted_text(it.key()));
@@ -428,6 +454,13 @@ MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std
     for (std::size_t i = 0; i < root["loads"].size(); ++i)
       spec.loads.push_back(
           read_load(Params(root["loads"][i], path("loads/" + std::to_string(i))), by_name));
+  }
+  if (root.contains("frames")) {
+    if (!root["frames"].is_array()) throw ModelError(path("frames"), "expected an array");
+    const BodiesByName by_name = bodies_by_name(bodies);
+    for (std::size_t i = 0; i < root["frames"].size(); ++i)
+      spec.frames.push_back(
+          read_frame(Params(root["frames"][i], path("frames/" + std::to_string(i))), by_name));
   }
   if (root.contains("correlation_table")) {
     // [[…], …]  or  {"rows": [[…], …], "join": "same" | "deepest"}
@@ -562,7 +595,7 @@ std::optional<std::pair<Json, std::string>> urdf_reference(const std::string& pa
   if (!root.is_object() || !root.contains("model") || root["model"] != kUrdfReference)
     return std::nullopt;
   const Params p(root, path + ": ");
-  p.allow_only({"model", "params", "name", "description", "gravity", "loads", "$schema"});
+  p.allow_only({"model", "params", "name", "description", "gravity", "loads", "frames", "$schema"});
   const Params params = p.child("params");
   params.allow_only({"file", "root_joint"});
   const std::string root_joint = params.has("root_joint") ? params.string("root_joint") : "fixed";

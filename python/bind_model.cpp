@@ -5,8 +5,10 @@
 #include <cmath>
 
 #include "core/equations.hpp"
+#include "core/frames.hpp"
 #include "core/limits.hpp"
 #include "core/memory.hpp"
+#include "core/names.hpp"
 #include "core/sampling.hpp"
 #include "io/model_loader.hpp"
 #include "io/output.hpp"
@@ -85,6 +87,30 @@ VecX inverse(PyModel& self, const Array& q, const OptArray& qd, const OptArray& 
                    vector_arg(qdd, "qdd", m));
   require_finite(m, self.ws.tau.data(), m.n(), m.n(), "τ");
   return self.ws.tau;
+}
+
+// A frame's kinematics (core/frames.hpp) as a dict of numpy arrays.
+py::dict frame_of(PyModel& self, const std::string& name, const Array& q, const OptArray& qd,
+                  const std::string& axes_text) {
+  const Model& m = *self.model;
+  const int f = find_frame(m, name);
+  if (f < 0) throw py::value_error("no frame " + quoted_text(name) + " (model.frames names them)");
+  FrameAxes axes = FrameAxes::LocalWorldAligned;
+  if (!parse_frame_axes(axes_text, axes))
+    throw py::value_error("axes: expected 'local_world_aligned', 'local' or 'world', got " +
+                          quoted_text(axes_text));
+  FrameKinematics k;
+  frame_kinematics(m, self.ws, configuration_arg(q, "q", m), vector_arg(qd, "qd", m), f, axes, k);
+  if (!k.J.allFinite() || !k.bias.allFinite() || !k.p.allFinite())
+    throw NumericalError("at this state the kinematics of frame " + quoted_text(name) +
+                         " are NaN or Inf (the state overflows double precision)");
+  py::dict out;
+  out["p"] = VecX(k.p);
+  out["R"] = MatX(k.R);
+  out["J"] = k.J;
+  out["velocity"] = VecX(k.velocity);
+  out["bias"] = VecX(k.bias);
+  return out;
 }
 
 // D as an (n, n, n) array, D[a, b, c] = D_abc, h_a = Σ_bc D_abc q̇_b q̇_c.
@@ -197,6 +223,20 @@ void bind_model(py::module_& m) {
       .def("equations", &equations, py::arg("q"), py::arg("qd") = py::none(),
            py::arg("tau") = py::none(),
            "M^s, h, Q and q̈ at (q, q̇, τ) (omitted: zero), as `femdyn equations` computes them")
+      .def_property_readonly(
+          "frames",
+          [](const PyModel& s) {
+            std::vector<std::string> names;
+            for (const Frame& f : s.model->frames) names.push_back(f.name);
+            return names;
+          },
+          "the frames: every body by its name, then the model's named frames")
+      .def("frame_kinematics", &frame_of, py::arg("frame"), py::arg("q"),
+           py::arg("qd") = py::none(), py::arg("axes") = "local_world_aligned",
+           "A frame's kinematics at (q, q̇) as a dict: p (3,), R (3, 3), J (6, n; linear rows "
+           "then angular), velocity J q̇ (6,) and bias J̇ q̇ (6,), in axes 'local_world_aligned' "
+           "(about the frame's origin, world axes), 'local' (the frame's axes) or 'world' "
+           "(the body point at the world origin), as `femdyn kinematics` (docs/notation.md)")
       .def("forward_dynamics", &forward, py::arg("q"), py::arg("qd") = py::none(),
            py::arg("tau") = py::none(), "q̈ = (M^s)⁻¹ (Q − h); NumericalError if M^s is singular")
       .def("inverse_dynamics", &inverse, py::arg("q"), py::arg("qd") = py::none(),

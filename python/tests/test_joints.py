@@ -141,3 +141,31 @@ def test_load_urdf_with_a_floating_base():
     # At rest in free fall every body accelerates with g: the joints keep still.
     assert np.abs(qdd[6:]).max() < 1e-9
     assert np.allclose(qdd[:3], floating.gravity, atol=1e-9)
+
+
+def test_frame_kinematics_from_python_equal_the_cli(tmp_path):
+    # A named frame on the floating coupled chain: J (6, n), velocity = J v, and the CLI's
+    # `femdyn kinematics --json` gives the same numbers in every set of axes.
+    spec = json.loads(json.dumps(COUPLED_FLOATING))
+    spec["frames"] = [{"name": "tool", "body": "l2", "xyz": [0.2, 0, 0.05], "rpy": [0.1, 0.2, 0.3]}]
+    path = tmp_path / "framed.json"
+    path.write_text(json.dumps(spec))
+    model = femdyn.load(str(path))
+    assert model.frames[-1] == "tool" and "base" in model.frames
+    rng = np.random.default_rng(8)
+    q = model.neutral_configuration()
+    q[:3] = rng.uniform(-1, 1, 3)
+    q[11] = 0.4
+    v = rng.uniform(-1, 1, model.n)
+    for axes in ("local_world_aligned", "local", "world"):
+        k = model.frame_kinematics("tool", q, v, axes=axes)
+        assert k["J"].shape == (6, model.n)
+        assert np.allclose(k["velocity"], k["J"] @ v, rtol=0, atol=1e-12)
+        out = cli_json("kinematics", str(path), "--frame=tool", f"--axes={axes}",
+                       f"--q={numbers(q)}", f"--qd={numbers(v)}", "--json")
+        frame = out["frames"][0]
+        assert frame["name"] == "tool" and frame["body"] == "l2"
+        assert np.allclose(np.array(frame["J"]), k["J"], rtol=0, atol=1e-12)
+        assert np.allclose(np.array(frame["bias"]), k["bias"], rtol=0, atol=1e-12)
+    with pytest.raises(ValueError, match="no frame 'nope'"):
+        model.frame_kinematics("nope", q)

@@ -1,0 +1,118 @@
+// femdyn kinematics: the pose, Jacobian, velocity and J̇v of named frames at a state
+// (core/frames.hpp) — what a controller asks of the model.
+#include <iostream>
+#include <sstream>
+
+#include "cli/commands.hpp"
+#include "core/frames.hpp"
+#include "core/names.hpp"
+#include "io/output.hpp"
+
+namespace femdyn::cli {
+namespace {
+
+constexpr const char* kHelp =
+    R"(usage: femdyn kinematics MODEL [--q …] [--qd …] [--frame NAME[,NAME…]]
+                          [--axes local_world_aligned|local|world] [--json] [--gravity gx,gy,gz]
+
+The kinematics of frames at the state (--q: n_q values, default the neutral configuration; --qd:
+n rates, default 0): each frame's position p and orientation R (world), its Jacobian J (6 × n,
+linear rows then angular), its velocity J v and J̇v, the acceleration at q̈ = 0, in the chosen
+axes (docs/notation.md#frames):
+  local_world_aligned (default)  about the frame's origin, world axes
+  local                          about the frame's origin, the frame's own axes
+  world                          the body point at the world origin, world axes (spatial)
+Frames: every body by its name, and the model's named "frames"; without --frame, the named
+frames, or the bodies without children when it has none. --json prints {"model", "n",
+"coordinates", "axes", "q", "qd", "frames": [{"name", "body", "p", "R", "J", "velocity",
+"bias"}]}.
+)";
+
+Json vector_json(const VecX& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+Json matrix_json(const MatX& m) {
+  Json rows = Json::array();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) rows.push_back(vector_json(m.row(r).transpose()));
+  return rows;
+}
+
+// The frames asked for, by name; by default the named frames, else the leaf bodies.
+std::vector<int> chosen_frames(const Args& a, const Model& m) {
+  std::vector<int> out;
+  if (a.has("frame")) {
+    std::istringstream names(a.options.at("frame"));
+    for (std::string name; std::getline(names, name, ',');) {
+      const int f = find_frame(m, name);
+      if (f < 0) {
+        std::string known;
+        for (const Frame& F : m.frames) known += (known.empty() ? "" : ", ") + F.name;
+        throw CliError("--frame: no frame " + quoted_text(name) + " (frames: " + known + ")");
+      }
+      out.push_back(f);
+    }
+    return out;
+  }
+  for (std::size_t f = m.bodies.size(); f < m.frames.size(); ++f)
+    out.push_back(static_cast<int>(f));
+  if (!out.empty()) return out;
+  std::vector<bool> parent(m.bodies.size(), false);
+  for (const Body& b : m.bodies)
+    if (b.parent >= 0) parent[b.parent] = true;
+  for (std::size_t b = 0; b < m.bodies.size(); ++b)
+    if (!parent[b]) out.push_back(static_cast<int>(b));
+  return out;
+}
+
+}  // namespace
+
+int cmd_kinematics(int argc, char** argv) {
+  const Args a =
+      parse_args(argc, argv, 2, {"help", "json"}, {"q", "qd", "frame", "axes", "gravity"});
+  if (a.has("help")) {
+    std::cout << kHelp;
+    return 0;
+  }
+  const Model m = load(a);
+  FrameAxes axes = FrameAxes::LocalWorldAligned;
+  if (a.has("axes") && !parse_frame_axes(a.options.at("axes"), axes))
+    throw CliError("--axes expects local_world_aligned, local or world");
+  const VecX q = configuration_vector(a, "q", m), qd = state_vector(a, "qd", m);
+  const std::vector<int> frames = chosen_frames(a, m);
+  Workspace ws(m);
+  FrameKinematics k;
+  Json list = Json::array();
+  std::ostringstream text;
+  text << "model: " << m.name << "\naxes: " << frame_axes_name(axes) << "\n";
+  for (const int f : frames) {
+    frame_kinematics(m, ws, q, qd, f, axes, k);
+    if (!k.J.allFinite() || !k.bias.allFinite() || !k.p.allFinite())
+      throw CliError("the kinematics of frame " + quoted_text(m.frames[f].name) +
+                     " are not finite at this state");
+    const std::string body = m.bodies[m.frames[f].body].name;
+    list.push_back({{"name", m.frames[f].name},
+                    {"body", body},
+                    {"p", vector_json(k.p)},
+                    {"R", matrix_json(k.R)},
+                    {"J", matrix_json(k.J)},
+                    {"velocity", vector_json(k.velocity)},
+                    {"bias", vector_json(k.bias)}});
+    text << "\nframe " << m.frames[f].name << " (body " << body << ")\n  p = " << k.p.transpose()
+         << "\n  R =\n"
+         << k.R << "\n  J (linear rows, then angular) =\n"
+         << k.J << "\n  velocity (v, w) = " << k.velocity.transpose()
+         << "\n  Jdot v (q'' = 0)  = " << k.bias.transpose() << "\n";
+  }
+  if (a.has("json"))
+    std::cout << json_text(Json{{"model", m.name},
+                                {"n", m.n()},
+                                {"coordinates", m.coordinate_names},
+                                {"axes", frame_axes_name(axes)},
+                                {"q", vector_json(q)},
+                                {"qd", vector_json(qd)},
+                                {"frames", list}})
+              << "\n";
+  else
+    std::cout << text.str();
+  return 0;
+}
+
+}  // namespace femdyn::cli
