@@ -330,6 +330,24 @@ BodiesByName bodies_by_name(const Json& bodies) {
   return by_name;
 }
 
+// A point on `body` (body frame): the node named by p's "node", or p's `point_key` (default 0);
+// the two exclude each other.
+Vec3 point_on_body(const Params& p, const std::string& body, const BodiesByName& bodies,
+                   const char* point_key) {
+  if (p.has("node") && p.has(point_key))
+    p.fail(point_key, std::string("give either ") + point_key + " or node, not both");
+  if (!p.has("node")) return p.vec3_or(point_key, Vec3::Zero());
+  std::map<std::string, Vec3> nodes;
+  const auto named = bodies.find(body);
+  if (named != bodies.end())
+    for (const Json* b : named->second)
+      if (b->contains("nodes") && (*b)["nodes"].is_object())
+        for (auto it = (*b)["nodes"].begin(); it != (*b)["nodes"].end(); ++it)
+          nodes[it.key()] = json_vec3(it.value(), p.path("node"));
+  const Params np(p.json(), p.where(), body, &nodes);
+  return np.node("node").position;
+}
+
 // {"name", "body", "xyz" | "node", "rpy"}: a frame on a body, at a point or at one of its nodes.
 FrameSpec read_frame(const Params& p, const BodiesByName& bodies) {
   p.allow_only({"name", "body", "xyz", "node", "rpy"});
@@ -337,20 +355,7 @@ FrameSpec read_frame(const Params& p, const BodiesByName& bodies) {
   f.where = p.where();
   f.name = p.string("name");
   f.body = p.string("body");
-  if (p.has("node") && p.has("xyz")) p.fail("xyz", "give either xyz or node, not both");
-  if (p.has("node")) {
-    std::map<std::string, Vec3> nodes;
-    const auto named = bodies.find(f.body);
-    if (named != bodies.end())
-      for (const Json* b : named->second)
-        if (b->contains("nodes") && (*b)["nodes"].is_object())
-          for (auto it = (*b)["nodes"].begin(); it != (*b)["nodes"].end(); ++it)
-            nodes[it.key()] = json_vec3(it.value(), p.path("node"));
-    const Params np(p.json(), p.where(), f.body, &nodes);
-    f.xyz = np.node("node").position;
-  } else {
-    f.xyz = p.vec3_or("xyz", Vec3::Zero());
-  }
+  f.xyz = point_on_body(p, f.body, bodies, "xyz");
   f.rpy = p.vec3_or("rpy", Vec3::Zero());
   return f;
 }
@@ -360,20 +365,7 @@ LoadSpec read_load(const Params& p, const BodiesByName& bodies) {
   LoadSpec l;
   l.where = p.where();
   l.body = p.string("body");
-  if (p.has("node") && p.has("point")) p.fail("point", "give either point or node, not both");
-  if (p.has("node")) {
-    std::map<std::string, Vec3> nodes;
-    const auto named = bodies.find(l.body);
-    if (named != bodies.end())
-      for (const Json* b : named->second)
-        if (b->contains("nodes") && (*b)["nodes"].is_object())
-          for (auto it = (*b)["nodes"].begin(); it != (*b)["nodes"].end(); ++it)
-            nodes[it.key()] = json_vec3(it.value(), p.path("node"));
-    const Params np(p.json(), p.where(), l.body, &nodes);
-    l.point = np.node("node").position;
-  } else {
-    l.point = p.vec3_or("point", Vec3::Zero());
-  }
+  l.point = point_on_body(p, l.body, bodies, "point");
   l.force = p.vec3_or("force", Vec3::Zero());
   l.torque = p.vec3_or("torque", Vec3::Zero());
   return l;
