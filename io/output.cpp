@@ -179,6 +179,13 @@ std::string info_text(const Model& model) {
     element_types[e.body].append(" ").append(e.element->type_name());
   for (std::size_t b = 0; b < model.bodies.size(); ++b)
     out << "  " << model.bodies[b].name << ":" << element_types[b] << "\n";
+  out << "frames (every body by its name, and " << model.frames.size() - model.bodies.size()
+      << " named):\n";
+  for (std::size_t f = model.bodies.size(); f < model.frames.size(); ++f) {
+    const Frame& F = model.frames[f];
+    out << "  " << F.name << " on " << model.bodies[F.body].name << " at [" << F.p_BF.transpose()
+        << "]\n";
+  }
   out << "transition coordinates u (N_u = " << model.n_u() << " kept):\n";
   for (int i = 0; i < model.n_u(); ++i)
     out << "  " << std::setw(3) << i + 1 << " " << model.dof_name(i) << "\n";
@@ -212,6 +219,13 @@ Json info_json(const Model& model) {
                         {"body", model.bodies[e.body].name},
                         {"nodes", e.node_labels}});
   j["elements"] = elements;
+  Json frames = Json::array();  // every frame: the bodies' own, then the named ones
+  for (const Frame& F : model.frames)
+    frames.push_back({{"name", F.name},
+                      {"body", model.bodies[F.body].name},
+                      {"xyz", vec_json(F.p_BF)},
+                      {"R", mat_json(F.R_BF)}});
+  j["frames"] = frames;
   return j;
 }
 

@@ -3,6 +3,8 @@
 // the three sets of axes; on trees of every joint type, a floating base, linear couplings and a
 // coupling law (whose bias needs θ̈ = γ at q̈ = 0). And frames from JSON: xyz, node, rpy, errors.
 #include <catch2/catch.hpp>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <random>
 
 #include "core/frames.hpp"
@@ -125,4 +127,22 @@ TEST_CASE("a frame sits where its JSON puts it: xyz, rpy or a node of its body",
   CHECK_THAT(text_error(R"({"model": "dexterous_finger", "frames": [
       {"name": "x", "body": "distal", "node": "b", "xyz": [0, 0, 0]}]})"),
              Catch::Contains("give either xyz or node"));
+}
+
+TEST_CASE("info lists the frames; kinematics takes them by name", "[frames][cli]") {
+  Scratch dir("frames_cli");
+  std::ofstream(dir / "tip.json")
+      << R"({"model": "dexterous_finger", "frames": [{"name": "fingertip", "body": "distal", "node": "b"}]})";
+  const Run info = run("info " + (dir / "tip.json") + " --json");
+  REQUIRE(info.code == 0);
+  const auto j = nlohmann::json::parse(info.out);
+  CHECK(j["frames"].back()["name"] == "fingertip");
+  CHECK(j["frames"].back()["body"] == "distal");
+  CHECK(j["frames"].size() == 5);  // base, proximal, middle, distal, fingertip
+  const Run k = run("kinematics " + (dir / "tip.json") + " --frame fingertip,distal --json");
+  REQUIRE(k.code == 0);
+  CHECK(nlohmann::json::parse(k.out)["frames"].size() == 2);
+  const Run bad = run("kinematics " + (dir / "tip.json") + " --frame nope");
+  CHECK(bad.code == 2);
+  CHECK_THAT(bad.out, Catch::Contains("--frame: no frame 'nope' (frames: base, proximal"));
 }
