@@ -185,6 +185,21 @@ void append_finger(const FingerParams& f, const std::string& prefix, const std::
                      {"force", vec3_json(f.tip_force)}});
 }
 
+Json tip_frames(const Json& bodies) {
+  static const std::string kDistal = "distal";
+  Json frames = Json::array();
+  for (const Json& b : bodies) {
+    const std::string name = b.at("name");
+    if (name.size() < kDistal.size() ||
+        name.compare(name.size() - kDistal.size(), kDistal.size(), kDistal) != 0)
+      continue;
+    if (!b.contains("nodes") || !b["nodes"].contains("b")) continue;
+    const std::string prefix = name.substr(0, name.size() - kDistal.size());
+    frames.push_back({{"name", prefix + "tip"}, {"body", name}, {"node", "b"}});
+  }
+  return frames;
+}
+
 Json dexterous_finger(const Params& params) {
   const FingerParams f = FingerParams::from(params);
   Json bodies = Json::array(), couplings = Json::array(), loads = Json::array();
@@ -195,6 +210,7 @@ Json dexterous_finger(const Params& params) {
       {"bodies", bodies}};
   if (!couplings.empty()) model["couplings"] = couplings;
   if (!loads.empty()) model["loads"] = loads;
+  if (Json tips = tip_frames(bodies); !tips.empty()) model["frames"] = tips;
   if (f.paper_lumping) {
     if (f.coupled) params.fail("coupling", "the paper's discretisation has 4 independent joints");
     Json rows = Json::array();

@@ -36,6 +36,9 @@ struct FingerParams {
 void append_finger(const FingerParams& f, const std::string& prefix, const std::string& parent,
                    const Vec3& xyz, const Vec3& rpy, Json& bodies, Json& couplings, Json& loads);
 
+// A frame "<prefix>tip" at the fingertip (node b of each "<prefix>distal" body in `bodies`).
+Json tip_frames(const Json& bodies);
+
 Json dexterous_finger(const Params& params);
 
 }  // namespace femdyn

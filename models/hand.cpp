@@ -74,6 +74,7 @@ Json dexterous_hand(const Params& p) {
   Json model = {{"name", "dexterous hand"}, {"bodies", bodies}};
   if (!couplings.empty()) model["couplings"] = couplings;
   if (!loads.empty()) model["loads"] = loads;
+  if (Json tips = tip_frames(bodies); !tips.empty()) model["frames"] = tips;
   return model;
 }
 

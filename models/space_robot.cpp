@@ -2,6 +2,7 @@
 
 #include <numbers>
 
+#include "models/dexterous_finger.hpp"
 #include "models/hand.hpp"
 
 namespace femdyn {
@@ -101,6 +102,7 @@ Json space_robot(const Params& p) {
   Json model = {{"name", "space robot"}, {"bodies", bodies}};
   if (!couplings.empty()) model["couplings"] = couplings;
   if (!loads.empty()) model["loads"] = loads;
+  if (Json tips = tip_frames(bodies); !tips.empty()) model["frames"] = tips;
   return model;
 }
 

@@ -117,13 +117,14 @@ TEST_CASE("a frame sits where its JSON puts it: xyz, rpy or a node of its body",
   // A frame at a node: the finger's tip node.
   const Model finger = load_text(R"({"model": "dexterous_finger", "frames": [
       {"name": "fingertip", "body": "distal", "node": "b"}]})");
-  CHECK(find_frame(finger, "fingertip") == static_cast<int>(finger.bodies.size()));
+  CHECK(find_frame(finger, "tip") == static_cast<int>(finger.bodies.size()));  // the plugin's
+  CHECK(find_frame(finger, "fingertip") == static_cast<int>(finger.bodies.size()) + 1);
   CHECK_THAT(text_error(R"({"model": "dexterous_finger", "frames": [
       {"name": "proximal", "body": "distal"}]})"),
-             Catch::Contains("/frames/0/name: frame name 'proximal' is taken"));
+             Catch::Contains("/name: frame name 'proximal' is taken"));
   CHECK_THAT(text_error(R"({"model": "dexterous_finger", "frames": [
       {"name": "x", "body": "nowhere"}]})"),
-             Catch::Contains("/frames/0/body: unknown body 'nowhere'"));
+             Catch::Contains("/body: unknown body 'nowhere'"));
   CHECK_THAT(text_error(R"({"model": "dexterous_finger", "frames": [
       {"name": "x", "body": "distal", "node": "b", "xyz": [0, 0, 0]}]})"),
              Catch::Contains("give either xyz or node"));
@@ -138,7 +139,9 @@ TEST_CASE("info lists the frames; kinematics takes them by name", "[frames][cli]
   const auto j = nlohmann::json::parse(info.out);
   CHECK(j["frames"].back()["name"] == "fingertip");
   CHECK(j["frames"].back()["body"] == "distal");
-  CHECK(j["frames"].size() == 5);  // base, proximal, middle, distal, fingertip
+  REQUIRE(j["frames"].size() == 6);  // base, proximal, middle, distal; the plugin's tip; fingertip
+  CHECK(j["frames"][4]["name"] == "tip");  // the plugin's own, at the same node
+  CHECK(j["frames"][4]["xyz"] == j["frames"][5]["xyz"]);
   const Run k = run("kinematics " + (dir / "tip.json") + " --frame fingertip,distal --json");
   REQUIRE(k.code == 0);
   CHECK(nlohmann::json::parse(k.out)["frames"].size() == 2);
