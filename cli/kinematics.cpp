@@ -1,5 +1,7 @@
 // femdyn kinematics: the pose, Jacobian, velocity and J̇v of named frames at a state
 // (core/frames.hpp) — what a controller asks of the model.
+#include "core/kinematics.hpp"
+
 #include <iostream>
 #include <sstream>
 
@@ -82,8 +84,9 @@ int cmd_kinematics(int argc, char** argv) {
   Json list = Json::array();
   std::ostringstream text;
   text << "model: " << m.name << "\naxes: " << frame_axes_name(axes) << "\n";
+  propagate(m, ws, q, qd, {.jacobian = true, .bias = true, .rows = false});
   for (const int f : frames) {
-    frame_kinematics(m, ws, q, qd, f, axes, k);
+    frame_kinematics(m, ws, f, axes, k);
     if (!k.J.allFinite() || !k.bias.allFinite() || !k.p.allFinite())
       throw CliError("the kinematics of frame " + quoted_text(m.frames[f].name) +
                      " are not finite at this state");

@@ -13,6 +13,11 @@ int find_frame(const Model& model, const std::string& name) {
 void frame_kinematics(const Model& model, Workspace& ws, const VecX& q, const VecX& v, int frame,
                       FrameAxes axes, FrameKinematics& out) {
   propagate(model, ws, q, v, {.jacobian = true, .bias = true, .rows = false});
+  frame_kinematics(model, ws, frame, axes, out);
+}
+
+void frame_kinematics(const Model& model, const Workspace& ws, int frame, FrameAxes axes,
+                      FrameKinematics& out) {
   const Frame& F = model.frames.at(frame);
   const BodyState& B = ws.body[F.body];
   const Vec3 r = B.R * F.p_BF;

@@ -32,7 +32,11 @@ struct FrameKinematics {
 // The index of the frame named `name` in Model::frames, or -1.
 int find_frame(const Model& model, const std::string& name);
 
-// The kinematics of frame `frame` at (q, v) in `axes` (one propagate of the model's route).
+// The kinematics of frame `frame` in `axes` from the body states and Jacobians of the last
+// propagate(model, ws, q, v, {.jacobian = true, .bias = true}) — one propagate serves every frame.
+void frame_kinematics(const Model& model, const Workspace& ws, int frame, FrameAxes axes,
+                      FrameKinematics& out);
+// The same at (q, v), after its own propagate.
 void frame_kinematics(const Model& model, Workspace& ws, const VecX& q, const VecX& v, int frame,
                       FrameAxes axes, FrameKinematics& out);
 

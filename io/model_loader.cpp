@@ -391,9 +391,15 @@ void apply_overrides(const Json& root, const Params& p, Json& doc) {
     }
 }
 
-Json expand_plugin(const Catalog& catalog, const Json& root, const std::string& source) {
-  const Params p(root, source + ": ");
+// {"model", "params", …}: the keys of a plugin's (or a URDF reference's) form, checked.
+Params plugin_form(const Json& root, const std::string& source) {
+  Params p(root, source + ": ");
   p.allow_only({"model", "params", "name", "description", "gravity", "loads", "frames", "$schema"});
+  return p;
+}
+
+Json expand_plugin(const Catalog& catalog, const Json& root, const std::string& source) {
+  const Params p = plugin_form(root, source);
   const std::string name = p.string("model");
   if (name == kUrdfReference)
     p.fail("model", "\"urdf\" names a file relative to this one: load it from a file");
@@ -501,8 +507,11 @@ CouplingSpec parse_coupling(const Json& coupling, const std::string& where) {
   return read_coupling(Params(coupling, where));
 }
 
-MechanismSpec parse_spec(const std::string& text, const std::string& source,
-                         const Catalog& catalog) {
+namespace {
+
+// The text as JSON, its nesting and body count bounded first; malformed JSON named by line and
+// column.
+Json parse_json(const std::string& text, const std::string& source) {
   // The nesting depth and the number of bodies are bounded (core/limits.hpp) by one pass over
   // the text, before a deep or huge document can cost anything.
   const JsonOutline shape = outline(text);
@@ -525,7 +534,14 @@ MechanismSpec parse_spec(const std::string& text, const std::string& source,
     throw ModelError(source, "malformed JSON: " +
                                  (bracket == std::string::npos ? what : what.substr(bracket + 2)));
   }
-  return parse_model_json(root, source, catalog);
+  return root;
+}
+
+}  // namespace
+
+MechanismSpec parse_spec(const std::string& text, const std::string& source,
+                         const Catalog& catalog) {
+  return parse_model_json(parse_json(text, source), source, catalog);
 }
 
 MechanismSpec parse_model_json(const Json& root, const std::string& source,
@@ -576,18 +592,11 @@ Json urdf_document(const std::string& urdf, bool floating_base, const LoadOption
 // A JSON file {"model": "urdf", …}: the URDF it names as femdyn JSON (with the file's own name,
 // description, gravity and loads), and that URDF's path for messages; nullopt for any other file.
 std::optional<std::pair<Json, std::string>> urdf_reference(const std::string& path,
-                                                           const std::string& text,
+                                                           const Json& root,
                                                            const LoadOptions& options) {
-  Json root;
-  try {
-    root = Json::parse(text);
-  } catch (const Json::exception&) {
-    return std::nullopt;  // (parse_spec reports malformed JSON)
-  }
   if (!root.is_object() || !root.contains("model") || root["model"] != kUrdfReference)
     return std::nullopt;
-  const Params p(root, path + ": ");
-  p.allow_only({"model", "params", "name", "description", "gravity", "loads", "frames", "$schema"});
+  const Params p = plugin_form(root, path);
   const Params params = p.child("params");
   params.allow_only({"file", "root_joint"});
   const std::string root_joint = params.has("root_joint") ? params.string("root_joint") : "fixed";
@@ -611,12 +620,10 @@ std::optional<std::pair<Json, std::string>> urdf_reference(const std::string& pa
 
 Json model_document(const std::string& path, const LoadOptions& options) {
   if (is_urdf_path(path)) return urdf_document(path, options.floating_base, options);
-  Json root;
-  const std::string text = read_text(path);
-  if (auto ref = urdf_reference(path, text, options)) return std::move(ref->first);
+  const Json root = parse_json(read_text(path), path);
+  if (auto ref = urdf_reference(path, root, options)) return std::move(ref->first);
   const Catalog& catalog = options.catalog ? *options.catalog : default_catalog();
-  (void)parse_spec(text, path, catalog);  // reports malformed JSON, every model error by path
-  root = Json::parse(text);
+  (void)parse_model_json(root, path, catalog);  // reports every model error by its path
   return root.contains("model") ? expand_plugin(catalog, root, path) : root;
 }
 
@@ -628,15 +635,15 @@ MechanismSpec read_spec(const std::string& path, const LoadOptions& options) {
                      "free joint itself (\"joint\": {\"type\": \"free\"}), a URDF "
                      "reference by \"root_joint\": \"free\"");
   if (!is_urdf_path(path)) {
-    const std::string text = read_text(path);
-    if (auto ref = urdf_reference(path, text, options)) {
+    const Json root = parse_json(read_text(path), path);
+    if (auto ref = urdf_reference(path, root, options)) {
       try {
         return parse_model_json(ref->first, ref->second, catalog);
       } catch (const ModelError& e) {
         rethrow_for_urdf(e, ref->first, ref->second);
       }
     }
-    return parse_spec(text, path, catalog);
+    return parse_model_json(root, path, catalog);
   }
   const Json doc = model_document(path, options);
   try {

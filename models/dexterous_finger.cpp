@@ -185,6 +185,8 @@ void append_finger(const FingerParams& f, const std::string& prefix, const std::
                      {"force", vec3_json(f.tip_force)}});
 }
 
+namespace {
+
 Json tip_frames(const Json& bodies) {
   static const std::string kDistal = "distal";
   Json frames = Json::array();
@@ -200,17 +202,25 @@ Json tip_frames(const Json& bodies) {
   return frames;
 }
 
+}  // namespace
+
+Json fingered_model(const std::string& name, const Json& bodies, const Json& couplings,
+                    const Json& loads) {
+  Json model = {{"name", name}, {"bodies", bodies}};
+  if (!couplings.empty()) model["couplings"] = couplings;
+  if (!loads.empty()) model["loads"] = loads;
+  if (Json tips = tip_frames(bodies); !tips.empty()) model["frames"] = tips;
+  return model;
+}
+
 Json dexterous_finger(const Params& params) {
   const FingerParams f = FingerParams::from(params);
   Json bodies = Json::array(), couplings = Json::array(), loads = Json::array();
   append_finger(f, "", "world", Vec3::Zero(), Vec3(0, 0, std::numbers::pi / 2), bodies, couplings,
                 loads);
-  Json model = {
-      {"name", f.paper_lumping ? "dexterous finger (paper's discretisation)" : "dexterous finger"},
-      {"bodies", bodies}};
-  if (!couplings.empty()) model["couplings"] = couplings;
-  if (!loads.empty()) model["loads"] = loads;
-  if (Json tips = tip_frames(bodies); !tips.empty()) model["frames"] = tips;
+  Json model = fingered_model(
+      f.paper_lumping ? "dexterous finger (paper's discretisation)" : "dexterous finger", bodies,
+      couplings, loads);
   if (f.paper_lumping) {
     if (f.coupled) params.fail("coupling", "the paper's discretisation has 4 independent joints");
     Json rows = Json::array();

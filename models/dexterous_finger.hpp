@@ -36,8 +36,10 @@ struct FingerParams {
 void append_finger(const FingerParams& f, const std::string& prefix, const std::string& parent,
                    const Vec3& xyz, const Vec3& rpy, Json& bodies, Json& couplings, Json& loads);
 
-// A frame "<prefix>tip" at the fingertip (node b of each "<prefix>distal" body in `bodies`).
-Json tip_frames(const Json& bodies);
+// The model document {"name", "bodies", "couplings", "loads", "frames"} of fingered parts: empty
+// lists left out, a frame "<prefix>tip" at each fingertip (node b of each "<prefix>distal").
+Json fingered_model(const std::string& name, const Json& bodies, const Json& couplings,
+                    const Json& loads);
 
 Json dexterous_finger(const Params& params);
 

@@ -71,11 +71,7 @@ void append_hand(const Params& p, const std::string& parent, const Json& mount, 
 Json dexterous_hand(const Params& p) {
   Json bodies = Json::array(), couplings = Json::array(), loads = Json::array();
   append_hand(p, "world", {{"xyz", {0, 0, 0}}}, bodies, couplings, loads);
-  Json model = {{"name", "dexterous hand"}, {"bodies", bodies}};
-  if (!couplings.empty()) model["couplings"] = couplings;
-  if (!loads.empty()) model["loads"] = loads;
-  if (Json tips = tip_frames(bodies); !tips.empty()) model["frames"] = tips;
-  return model;
+  return fingered_model("dexterous hand", bodies, couplings, loads);
 }
 
 }  // namespace femdyn

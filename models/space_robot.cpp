@@ -99,11 +99,7 @@ Json space_robot(const Params& p) {
   append_hand(Params(hand, p.path("hand")), parent, {{"xyz", {0, 0, 0.045}}}, bodies, couplings,
               loads);
 
-  Json model = {{"name", "space robot"}, {"bodies", bodies}};
-  if (!couplings.empty()) model["couplings"] = couplings;
-  if (!loads.empty()) model["loads"] = loads;
-  if (Json tips = tip_frames(bodies); !tips.empty()) model["frames"] = tips;
-  return model;
+  return fingered_model("space robot", bodies, couplings, loads);
 }
 
 }  // namespace femdyn

@@ -76,6 +76,25 @@ std::vector<std::string> urdf_files() {
   return out;
 }
 
+#ifdef FEMDYN_WITH_SIMBODY
+// femdyn's M^s, h and Q of `m` equal the independent URDF twin's at 4 states: q = draw_q(), q̇
+// uniform in ±2.
+template <class DrawQ>
+void check_equal_to_twin(const Model& m, validation::UrdfTwin& twin, std::mt19937& rng,
+                         DrawQ draw_q) {
+  Workspace ws(m);
+  for (int k = 0; k < 4; ++k) {
+    const VecX q = draw_q(), qd = random_uniform(m.n(), 2.0, rng);
+    evaluate(m, ws, q, qd, VecX());
+    const validation::UrdfTwinEquations s =
+        twin.equations(m.coordinate_names, m.configuration_names, q, qd);
+    CHECK(rel_error(ws.Ms, s.M) < 1e-10);
+    CHECK(rel_error(ws.h, s.h) < 1e-10);
+    CHECK(rel_error(ws.Q, s.Q) < 1e-10);
+  }
+}
+#endif
+
 }  // namespace
 
 TEST_CASE("URDF <inertial> rpy rotates the inertia into the link frame", "[urdf]") {
@@ -225,17 +244,8 @@ TEST_CASE(
     INFO(path);
     const Model m = load_model(path);
     validation::UrdfTwin twin(path, Vec3(0, 0, -9.81));
-    Workspace ws(m);
     std::mt19937 rng(21);
-    for (int k = 0; k < 4; ++k) {
-      const VecX q = random_uniform(m.n(), 1.5, rng), qd = random_uniform(m.n(), 2.0, rng);
-      evaluate(m, ws, q, qd, VecX());
-      const validation::UrdfTwinEquations s =
-          twin.equations(m.coordinate_names, m.configuration_names, q, qd);
-      CHECK(rel_error(ws.Ms, s.M) < 1e-10);
-      CHECK(rel_error(ws.h, s.h) < 1e-10);
-      CHECK(rel_error(ws.Q, s.Q) < 1e-10);
-    }
+    check_equal_to_twin(m, twin, rng, [&] { return VecX(random_uniform(m.n(), 1.5, rng)); });
   }
 }
 
@@ -316,17 +326,8 @@ TEST_CASE("inner planar and floating URDF joints: the import equals the independ
     const Model m = load_model(path, {.floating_base = floating});
     REQUIRE(m.n() == (floating ? 6 : 0) + 1 + 3 + 6 + 1);
     validation::UrdfTwin twin(path, m.gravity, floating);
-    Workspace ws(m);
     std::mt19937 rng(23);
-    for (int k = 0; k < 4; ++k) {
-      const VecX q = random_posture(m, rng), qd = random_uniform(m.n(), 2.0, rng);
-      evaluate(m, ws, q, qd, VecX());
-      const validation::UrdfTwinEquations s =
-          twin.equations(m.coordinate_names, m.configuration_names, q, qd);
-      CHECK(rel_error(ws.Ms, s.M) < 1e-10);
-      CHECK(rel_error(ws.h, s.h) < 1e-10);
-      CHECK(rel_error(ws.Q, s.Q) < 1e-10);
-    }
+    check_equal_to_twin(m, twin, rng, [&] { return random_posture(m, rng); });
   }
   // femdyn validate checks the import too, and passes.
   const Run r = run("validate " + path + " --floating-base --states 3 --t-end 0.05");
@@ -346,17 +347,8 @@ TEST_CASE(
     const std::string path = std::string(FEMDYN_SOURCE_DIR) + "/tests/robots/" + robot;
     const Model m = load_model(path, {.floating_base = true});
     validation::UrdfTwin twin(path, m.gravity, true);
-    Workspace ws(m);
     std::mt19937 rng(22);
-    for (int k = 0; k < 4; ++k) {
-      const VecX q = random_posture(m, rng), qd = random_uniform(m.n(), 2.0, rng);
-      evaluate(m, ws, q, qd, VecX());
-      const validation::UrdfTwinEquations s =
-          twin.equations(m.coordinate_names, m.configuration_names, q, qd);
-      CHECK(rel_error(ws.Ms, s.M) < 1e-10);
-      CHECK(rel_error(ws.h, s.h) < 1e-10);
-      CHECK(rel_error(ws.Q, s.Q) < 1e-10);
-    }
+    check_equal_to_twin(m, twin, rng, [&] { return random_posture(m, rng); });
     validation::ValidationOptions o;
     o.states = 4;
     std::string failure;
