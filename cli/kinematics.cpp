@@ -1,12 +1,15 @@
 // femdyn kinematics: the pose, Jacobian, velocity and J̇v of named frames at a state
-// (core/frames.hpp) — what a controller asks of the model.
+// (core/frames.hpp), the centre of mass and the centroidal momentum (core/momentum.hpp), and on
+// a free-floating tree each frame's generalized Jacobian — what a controller asks of the model.
 #include "core/kinematics.hpp"
 
 #include <iostream>
 #include <sstream>
 
 #include "cli/commands.hpp"
+#include "core/errors.hpp"
 #include "core/frames.hpp"
+#include "core/momentum.hpp"
 #include "core/names.hpp"
 #include "io/output.hpp"
 
@@ -25,9 +28,18 @@ axes (docs/notation.md#frames):
   local                          about the frame's origin, the frame's own axes
   world                          the body point at the world origin, world axes (spatial)
 Frames: every body by its name, and the model's named "frames"; without --frame, the named
-frames, or the bodies without children when it has none. --json prints {"model", "n",
-"coordinates", "axes", "q", "qd", "frames": [{"name", "body", "p", "R", "J", "velocity",
-"bias"}]}.
+frames, or the bodies without children when it has none.
+
+The mechanism as a whole (docs/notation.md#momentum): its mass m, centre of mass c, the Jacobian
+J_c (ċ = J_c v) and c̈ at q̈ = 0; its centroidal momentum h_G = (P, L_G) (linear, then angular
+about c, world axes), the centroidal momentum matrix A_G (h_G = A_G v) and Ȧ_G v. On a tree
+on a free joint, each frame's generalized Jacobian J* (Umetani–Yoshida): its velocity is
+J* v_m + drift with the base floating, v_m the rates of every joint but the base's.
+
+--json prints {"model", "n", "coordinates", "axes", "q", "qd", "frames": [{"name", "body", "p",
+"R", "J", "velocity", "bias"[, "generalized_jacobian": {"rates", "J", "drift"}]}],
+"centroidal": {"mass", "com", "Jcom", "com_velocity", "com_bias", "inertia_com", "momentum",
+"A", "bias"}}.
 )";
 
 Json vector_json(const VecX& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
@@ -64,6 +76,16 @@ std::vector<int> chosen_frames(const Args& a, const Model& m) {
   return out;
 }
 
+// Whether the model is one tree on a free joint (core/momentum.hpp): then J* is printed.
+bool floating_tree(const Model& m) {
+  try {
+    floating_base_rate(m);
+    return true;
+  } catch (const ModelError&) {
+    return false;
+  }
+}
+
 }  // namespace
 
 int cmd_kinematics(int argc, char** argv) {
@@ -85,25 +107,52 @@ int cmd_kinematics(int argc, char** argv) {
   std::ostringstream text;
   text << "model: " << m.name << "\naxes: " << frame_axes_name(axes) << "\n";
   propagate(m, ws, q, qd, {.jacobian = true, .bias = true, .rows = false});
+  MomentumKinematics c;
+  momentum_kinematics(m, ws, c);
+  if (!c.A.allFinite() || !c.bias.allFinite())
+    throw CliError("the momentum is not finite at this state");
+  const bool floating = floating_tree(m);
   for (const int f : frames) {
     frame_kinematics(m, ws, f, axes, k);
     if (!k.J.allFinite() || !k.bias.allFinite() || !k.p.allFinite())
       throw CliError("the kinematics of frame " + quoted_text(m.frames[f].name) +
                      " are not finite at this state");
     const std::string body = m.bodies[m.frames[f].body].name;
-    list.push_back({{"name", m.frames[f].name},
-                    {"body", body},
-                    {"p", vector_json(k.p)},
-                    {"R", matrix_json(k.R)},
-                    {"J", matrix_json(k.J)},
-                    {"velocity", vector_json(k.velocity)},
-                    {"bias", vector_json(k.bias)}});
+    Json entry = {{"name", m.frames[f].name},   {"body", body},
+                  {"p", vector_json(k.p)},      {"R", matrix_json(k.R)},
+                  {"J", matrix_json(k.J)},      {"velocity", vector_json(k.velocity)},
+                  {"bias", vector_json(k.bias)}};
     text << "\nframe " << m.frames[f].name << " (body " << body << ")\n  p = " << k.p.transpose()
          << "\n  R =\n"
          << k.R << "\n  J (linear rows, then angular) =\n"
          << k.J << "\n  velocity (v, w) = " << k.velocity.transpose()
          << "\n  Jdot v (q'' = 0)  = " << k.bias.transpose() << "\n";
+    if (floating) {
+      GeneralizedJacobian g;
+      generalized_jacobian(m, ws, f, axes, k, c, g);
+      std::vector<std::string> rates;
+      for (const int r : g.rates) rates.push_back(m.coordinate_names[r]);
+      entry["generalized_jacobian"] = {
+          {"rates", rates}, {"J", matrix_json(g.J)}, {"drift", vector_json(g.drift)}};
+      text << "  generalized Jacobian J* (base floating; columns: every rate after the base's) =\n"
+           << g.J << "\n  drift J_b A_b^-1 h = " << g.drift.transpose() << "\n";
+    }
+    list.push_back(std::move(entry));
   }
+  text << "\nmechanism: mass " << c.mass << " kg\n  com c = " << c.com.transpose() << "\n  J_c =\n"
+       << c.Jcom << "\n  com velocity = " << c.com_velocity.transpose()
+       << "\n  com acceleration at q'' = 0 = " << c.com_bias.transpose()
+       << "\n  centroidal momentum h_G (P, L_G) = " << c.momentum.transpose() << "\n  A_G =\n"
+       << c.A << "\n  A_G-dot v (q'' = 0) = " << c.bias.transpose() << "\n";
+  const Json centroidal = {{"mass", c.mass},
+                           {"com", vector_json(c.com)},
+                           {"Jcom", matrix_json(c.Jcom)},
+                           {"com_velocity", vector_json(c.com_velocity)},
+                           {"com_bias", vector_json(c.com_bias)},
+                           {"inertia_com", matrix_json(c.inertia_com)},
+                           {"momentum", vector_json(c.momentum)},
+                           {"A", matrix_json(c.A)},
+                           {"bias", vector_json(c.bias)}};
   if (a.has("json"))
     std::cout << json_text(Json{{"model", m.name},
                                 {"n", m.n()},
@@ -111,7 +160,8 @@ int cmd_kinematics(int argc, char** argv) {
                                 {"axes", frame_axes_name(axes)},
                                 {"q", vector_json(q)},
                                 {"qd", vector_json(qd)},
-                                {"frames", list}})
+                                {"frames", list},
+                                {"centroidal", centroidal}})
               << "\n";
   else
     std::cout << text.str();

@@ -5,6 +5,7 @@
 // A_G q̈ + Ȧ_G v = (m g, 0) with q̈ from forward dynamics. The generalized Jacobian against a
 // free-floating simulation, whose momentum the dynamics alone conserves.
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 #include <random>
 
 #include "core/equations.hpp"
@@ -200,4 +201,25 @@ TEST_CASE("the generalized Jacobian asks for one tree on a free joint", "[moment
   const Model fixed = load_model(model_path("hand.json"));
   CHECK_THROWS_WITH(floating_base_rate(fixed),
                     Catch::Contains("needs one tree on a free joint at its root"));
+}
+
+TEST_CASE("kinematics prints the centroidal quantities, and J* on a floating tree",
+          "[momentum][cli]") {
+  const Model m = load_model(model_path("space_robot.json"));
+  const Run floating =
+      run("kinematics " + model_path("space_robot.json") + " --frame index_tip --json");
+  REQUIRE(floating.code == 0);
+  const auto j = nlohmann::json::parse(floating.out);
+  CHECK(j["centroidal"]["mass"].get<double>() == Approx(element_mass(m)).epsilon(1e-12));
+  CHECK(j["centroidal"]["A"].size() == 6);
+  CHECK(j["centroidal"]["A"][0].size() == static_cast<std::size_t>(m.n()));
+  const auto& g = j["frames"][0]["generalized_jacobian"];
+  CHECK(g["rates"][0] == "joint1");
+  CHECK(g["J"].size() == 6);
+  CHECK(g["J"][0].size() == static_cast<std::size_t>(m.n() - 6));
+  const Run fixed = run("kinematics " + model_path("hand.json") + " --json");
+  REQUIRE(fixed.code == 0);
+  const auto h = nlohmann::json::parse(fixed.out);
+  CHECK(h["centroidal"]["com"].size() == 3);
+  CHECK(!h["frames"][0].contains("generalized_jacobian"));
 }
