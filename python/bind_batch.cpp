@@ -6,7 +6,11 @@
 #include <limits>
 
 #include "core/equations.hpp"
+#include "core/frames.hpp"
+#include "core/kinematics.hpp"
 #include "core/memory.hpp"
+#include "core/momentum.hpp"
+#include "core/names.hpp"
 #include "core/sampling.hpp"
 #include "python/parallel.hpp"
 #include "python/py_model.hpp"
@@ -154,6 +158,109 @@ py::array_t<double> dynamics_batch(const PyModel& self, const Array& q, const Op
   return out;
 }
 
+// Row-major (k, rows, cols) storage of a fixed-size or dynamic matrix at row i.
+template <class Mat>
+void store(double* base, Eigen::Index i, const Mat& x) {
+  const Eigen::Index size = x.rows() * x.cols();
+  Eigen::Map<RowMatX>(base + i * size, x.rows(), x.cols()) = x;
+}
+
+void require_finite_row(bool finite, Eigen::Index i, const std::string& what) {
+  if (!finite)
+    throw NumericalError("row " + std::to_string(i) + ": " + what +
+                         " is NaN or Inf (the state overflows double precision)");
+}
+
+// A frame's kinematics at k states: p (k, 3), R (k, 3, 3), J (k, 6, n), velocity, bias (k, 6).
+py::dict frame_kinematics_batch(const PyModel& self, const std::string& name, const Array& q,
+                                const OptArray& qd, const std::string& axes_text, int threads) {
+  const Model& m = *self.model;
+  const int f = find_frame(m, name);
+  if (f < 0) throw py::value_error("no frame " + quoted_text(name) + " (model.frames names them)");
+  FrameAxes axes = FrameAxes::LocalWorldAligned;
+  if (!parse_frame_axes(axes_text, axes))
+    throw py::value_error("axes: expected 'local_world_aligned', 'local' or 'world', got " +
+                          quoted_text(axes_text));
+  const Batch b(m, q, qd, std::nullopt, "", Entries::Bounded);
+  const py::ssize_t k = b.k, n = b.n;
+  const int nthreads = batch_threads(k, threads);
+  require_batch_memory("frame_kinematics_batch", m, k, nthreads, dense_bytes(6, n + 5),
+                       evaluation_bytes(m));
+  py::array_t<double> p = new_array({k, 3}), R = new_array({k, 3, 3}), J = new_array({k, 6, n}),
+                      vel = new_array({k, 6}), bias = new_array({k, 6});
+  double *pp = p.mutable_data(), *pR = R.mutable_data(), *pJ = J.mutable_data(),
+         *pv = vel.mutable_data(), *pb = bias.mutable_data();
+  {
+    py::gil_scoped_release release;
+    for_each_row(m, k, nthreads, [&](Workspace& ws, Eigen::Index i) {
+      thread_local RowState s;
+      thread_local FrameKinematics fk;
+      s.load(b, i);
+      frame_kinematics(m, ws, s.q, s.qd, f, axes, fk);
+      require_finite_row(fk.J.allFinite() && fk.bias.allFinite() && fk.p.allFinite(), i,
+                         "the kinematics of frame " + quoted_text(name));
+      store(pp, i, fk.p);
+      store(pR, i, fk.R);
+      store(pJ, i, fk.J);
+      store(pv, i, fk.velocity);
+      store(pb, i, fk.bias);
+    });
+  }
+  py::dict d;
+  d["p"] = p;
+  d["R"] = R;
+  d["J"] = J;
+  d["velocity"] = vel;
+  d["bias"] = bias;
+  return d;
+}
+
+// The centroidal quantities at k states (core/momentum.hpp), each with a leading k axis.
+py::dict centroidal_batch(const PyModel& self, const Array& q, const OptArray& qd, int threads) {
+  const Model& m = *self.model;
+  const Batch b(m, q, qd, std::nullopt, "", Entries::Bounded);
+  const py::ssize_t k = b.k, n = b.n;
+  const int nthreads = batch_threads(k, threads);
+  require_batch_memory("centroidal_batch", m, k, nthreads, dense_bytes(9, n + 6),
+                       evaluation_bytes(m));
+  py::array_t<double> mass = new_array({k}), com = new_array({k, 3}), Jcom = new_array({k, 3, n}),
+                      cv = new_array({k, 3}), cb = new_array({k, 3}), I = new_array({k, 3, 3}),
+                      h = new_array({k, 6}), A = new_array({k, 6, n}), bias = new_array({k, 6});
+  double *pm = mass.mutable_data(), *pc = com.mutable_data(), *pJ = Jcom.mutable_data(),
+         *pcv = cv.mutable_data(), *pcb = cb.mutable_data(), *pI = I.mutable_data(),
+         *ph = h.mutable_data(), *pA = A.mutable_data(), *pb = bias.mutable_data();
+  {
+    py::gil_scoped_release release;
+    for_each_row(m, k, nthreads, [&](Workspace& ws, Eigen::Index i) {
+      thread_local RowState s;
+      thread_local MomentumKinematics c;
+      s.load(b, i);
+      momentum_kinematics(m, ws, s.q, s.qd, c);
+      require_finite_row(c.A.allFinite() && c.bias.allFinite(), i, "the momentum");
+      pm[i] = c.mass;
+      store(pc, i, c.com);
+      store(pJ, i, c.Jcom);
+      store(pcv, i, c.com_velocity);
+      store(pcb, i, c.com_bias);
+      store(pI, i, c.inertia_com);
+      store(ph, i, c.momentum);
+      store(pA, i, c.A);
+      store(pb, i, c.bias);
+    });
+  }
+  py::dict d;
+  d["mass"] = mass;
+  d["com"] = com;
+  d["Jcom"] = Jcom;
+  d["com_velocity"] = cv;
+  d["com_bias"] = cb;
+  d["inertia_com"] = I;
+  d["momentum"] = h;
+  d["A"] = A;
+  d["bias"] = bias;
+  return d;
+}
+
 }  // namespace
 
 void bind_batch(py::module_& m) {
@@ -168,7 +275,16 @@ void bind_batch(py::module_& m) {
            "q̈ at k states, (k, n); NumericalError naming the first failed row")
       .def("inverse_dynamics_batch", &dynamics_batch<false>, py::arg("q"),
            py::arg("qd") = py::none(), py::arg("qdd") = py::none(), py::arg("threads") = 0,
-           "τ at k states, (k, n)");
+           "τ at k states, (k, n)")
+      .def("frame_kinematics_batch", &frame_kinematics_batch, py::arg("frame"), py::arg("q"),
+           py::arg("qd") = py::none(), py::arg("axes") = "local_world_aligned",
+           py::arg("threads") = 0,
+           "frame_kinematics at k states: dict of p (k, 3), R (k, 3, 3), J (k, 6, n), velocity "
+           "and bias (k, 6)")
+      .def("centroidal_batch", &centroidal_batch, py::arg("q"), py::arg("qd") = py::none(),
+           py::arg("threads") = 0,
+           "centroidal at k states: each entry with a leading axis of k (mass (k,), A (k, 6, n), "
+           "…)");
 }
 
 }  // namespace femdyn::python

@@ -6,8 +6,10 @@
 
 #include "core/equations.hpp"
 #include "core/frames.hpp"
+#include "core/kinematics.hpp"
 #include "core/limits.hpp"
 #include "core/memory.hpp"
+#include "core/momentum.hpp"
 #include "core/names.hpp"
 #include "core/sampling.hpp"
 #include "io/model_loader.hpp"
@@ -110,6 +112,63 @@ py::dict frame_of(PyModel& self, const std::string& name, const Array& q, const 
   out["J"] = k.J;
   out["velocity"] = VecX(k.velocity);
   out["bias"] = VecX(k.bias);
+  return out;
+}
+
+// The mechanism's centre of mass and centroidal momentum (core/momentum.hpp) as a dict.
+py::dict centroidal_dict(const MomentumKinematics& c) {
+  py::dict out;
+  out["mass"] = c.mass;
+  out["com"] = VecX(c.com);
+  out["Jcom"] = c.Jcom;
+  out["com_velocity"] = VecX(c.com_velocity);
+  out["com_bias"] = VecX(c.com_bias);
+  out["inertia_com"] = MatX(c.inertia_com);
+  out["momentum"] = VecX(c.momentum);
+  out["A"] = c.A;
+  out["bias"] = VecX(c.bias);
+  return out;
+}
+
+void require_finite_momentum(const MomentumKinematics& c) {
+  if (!c.A.allFinite() || !c.bias.allFinite() || !std::isfinite(c.mass))
+    throw NumericalError(
+        "at this state the momentum is NaN or Inf (the state overflows double "
+        "precision)");
+}
+
+py::dict centroidal_of(PyModel& self, const Array& q, const OptArray& qd) {
+  const Model& m = *self.model;
+  MomentumKinematics c;
+  momentum_kinematics(m, self.ws, configuration_arg(q, "q", m), vector_arg(qd, "qd", m), c);
+  require_finite_momentum(c);
+  return centroidal_dict(c);
+}
+
+py::dict generalized_of(PyModel& self, const std::string& name, const Array& q, const OptArray& qd,
+                        const std::string& axes_text) {
+  const Model& m = *self.model;
+  const int f = find_frame(m, name);
+  if (f < 0) throw py::value_error("no frame " + quoted_text(name) + " (model.frames names them)");
+  FrameAxes axes = FrameAxes::LocalWorldAligned;
+  if (!parse_frame_axes(axes_text, axes))
+    throw py::value_error("axes: expected 'local_world_aligned', 'local' or 'world', got " +
+                          quoted_text(axes_text));
+  floating_base_rate(m);  // ModelError (a ValueError) unless one tree on a free joint
+  propagate(m, self.ws, configuration_arg(q, "q", m), vector_arg(qd, "qd", m),
+            {.jacobian = true, .bias = true, .rows = false});
+  FrameKinematics k;
+  MomentumKinematics c;
+  GeneralizedJacobian g;
+  generalized_jacobian(m, self.ws, f, axes, k, c, g);
+  require_finite_momentum(c);
+  std::vector<std::string> names;
+  for (const int r : g.rates) names.push_back(m.coordinate_names[r]);
+  py::dict out;
+  out["J"] = g.J;
+  out["rates"] = names;
+  out["rate_index"] = g.rates;
+  out["drift"] = VecX(g.drift);
   return out;
 }
 
@@ -237,6 +296,17 @@ void bind_model(py::module_& m) {
            "then angular), velocity J q̇ (6,) and bias J̇ q̇ (6,), in axes 'local_world_aligned' "
            "(about the frame's origin, world axes), 'local' (the frame's axes) or 'world' "
            "(the body point at the world origin), as `femdyn kinematics` (docs/notation.md)")
+      .def("centroidal", &centroidal_of, py::arg("q"), py::arg("qd") = py::none(),
+           "The mechanism as a whole at (q, q̇) as a dict: mass, com (3,), Jcom (3, n), "
+           "com_velocity, com_bias (c̈ at q̈ = 0), inertia_com (3, 3), momentum h_G (6,: linear, "
+           "then angular about the centre of mass, world axes), A (6, n: h_G = A q̇) and bias "
+           "(Ȧ q̇), as `femdyn kinematics` (docs/notation.md#momentum)")
+      .def("generalized_jacobian", &generalized_of, py::arg("frame"), py::arg("q"),
+           py::arg("qd") = py::none(), py::arg("axes") = "local_world_aligned",
+           "Umetani–Yoshida's generalized Jacobian of a frame on a free-floating tree: dict of J "
+           "(6, n − 6), rates (the names of its columns: every rate but the base's), rate_index "
+           "and drift (6,): with no external force the frame moves with J v_m + drift "
+           "(femdyn.ModelError on a model that is not one tree on a free joint)")
       .def("forward_dynamics", &forward, py::arg("q"), py::arg("qd") = py::none(),
            py::arg("tau") = py::none(), "q̈ = (M^s)⁻¹ (Q − h); NumericalError if M^s is singular")
       .def("inverse_dynamics", &inverse, py::arg("q"), py::arg("qd") = py::none(),
