@@ -91,8 +91,8 @@ def main():
         if when <= args.t_end:
             i = min(np.searchsorted(t, when), len(t) - 1)
             print(f"t = {t[i]:6.3f} s   fingertip error {e[i]:.3e} m")
-    late = e[t >= 0.5]
-    print(f"max error after 0.5 s: {late.max():.3e} m; controller calls "
+    late = e[t >= min(0.5, args.t_end)]
+    print(f"max error after {t[len(t) - len(late)]:g} s: {late.max():.3e} m; controller calls "
           f"{r['run']['stats']['controller_calls']}, wall time {r['run']['stats']['wall_time']:.2f} s")
 
     import matplotlib

@@ -8,7 +8,7 @@ rk4 at dt = 1 ms for --t-end s, the same motion under a constant tau run
      period),
   4. by Simulator.run with that controller called at every evaluation of f (four a step);
 
-the median of --repeat runs each, all in one process. Prints a Markdown table: time per period,
+the median CPU time of --repeat runs each, all in one process, the four interleaved. Prints a Markdown table: time per period,
 and the overhead over the baseline per period and per controller call.
 
     PYTHONPATH=build/python /usr/bin/python3 tools/bench_control.py [--t-end 2] [--repeat 7] [--quick]
@@ -28,13 +28,17 @@ Q0 = np.array([0.1, 0.4, 0.3, 0.2])
 DT = 1e-3
 
 
-def median_time(f, repeat):
-    times = []
+def median_times(functions, repeat):
+    """The median CPU time of each function (this process's, so that other work on a shared
+    machine does not count), the runs interleaved (one of each per round), so that a change in
+    the machine's load falls on all of them alike."""
+    times = [[] for _ in functions]
     for _ in range(repeat):
-        start = time.perf_counter()
-        f()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
+        for f, t in zip(functions, times):
+            start = time.process_time()
+            f()
+            t.append(time.process_time() - start)
+    return [statistics.median(t) for t in times]
 
 
 def main():
@@ -69,10 +73,11 @@ def main():
             ("Simulator.step(tau) from a Python loop", stepped, 1),
             ("Simulator.run, controller held (mode='hold')", held, 1),
             ("Simulator.run, controller in f (mode='evaluation')", evaluated, 5)]
-    times = {name: median_time(f, a.repeat) / periods for name, f, _ in runs}
+    medians = median_times([f for _, f, _ in runs], a.repeat)
+    times = {name: m / periods for (name, _, _), m in zip(runs, medians)}
     base = times[runs[0][0]]
     print(f"finger (n = 4), rk4, dt = {DT * 1e3:g} ms, {periods} periods a run, median of "
-          f"{a.repeat} runs; {os.cpu_count()} CPUs\n")
+          f"{a.repeat} runs; {os.cpu_count()} CPUs, load {os.getloadavg()[0]:.1f}\n")
     print("| loop | µs per period | overhead µs per period | Python calls per period | "
           "overhead µs per call |")
     print("|---|---|---|---|---|")

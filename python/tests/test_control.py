@@ -1,6 +1,7 @@
 """femdyn.Simulator, the controller in the loop (docs/control.md), and the two control examples."""
 import os
 import signal
+import subprocess
 import sys
 import threading
 
@@ -8,7 +9,7 @@ import numpy as np
 import pytest
 
 import femdyn
-from conftest import ROOT, model_path
+from conftest import ROOT, model_path, subprocess_env
 
 sys.path.insert(0, str(ROOT / "examples"))
 import control_computed_torque  # noqa: E402
@@ -152,3 +153,18 @@ def test_task_space_controller_moves_the_tip_to_the_point(mode):
     e = r["error"]
     assert e[0] > 1e-2  # 1 cm or more away at the start
     assert e[-1] < 1e-6  # at the point within a micrometre after 1 s
+
+
+@pytest.mark.parametrize("script", ["control_computed_torque.py", "control_task_space.py"])
+def test_examples_run_as_scripts_and_plot(script, tmp_path):
+    plot = tmp_path / "error.png"
+    out = subprocess.run([sys.executable, str(ROOT / "examples" / script), "--t-end", "0.3",
+                          "--plot", str(plot)], cwd=tmp_path, env=subprocess_env(),
+                         capture_output=True, text=True, check=True).stdout
+    assert "t =  0.300 s" in out and plot.stat().st_size > 1000
+
+
+def test_overhead_benchmark_smoke():
+    out = subprocess.run([sys.executable, str(ROOT / "tools" / "bench_control.py"), "--quick"],
+                         env=subprocess_env(), capture_output=True, text=True, check=True).stdout
+    assert out.count("| Simulator.") == 3 and "| femdyn.simulate" in out
