@@ -62,8 +62,7 @@ void tau_of(const py::handle& value, const Model& m, double t, VecX& tau) {
     throw py::value_error(at + "expected tau of shape (" + std::to_string(m.n()) + ",), got " +
                           shape_text(a));
   tau = Eigen::Map<const VecX>(a.data(), m.n());
-  if (const std::string bad = tau_problem(m, tau, "the controller"); !bad.empty())
-    throw py::value_error(at + bad);
+  if (const std::string bad = tau_problem(m, tau); !bad.empty()) throw py::value_error(at + bad);
 }
 
 // Rows of a run: (t, q, q̇, τ applied from t, W, E) at every period.
@@ -237,12 +236,14 @@ void bind_simulator(py::module_& m) {
       .def_property_readonly("integrator", &Simulator::integrator)
       .def("run", &Simulator::run, py::arg("controller"), py::arg("t_end"),
            py::arg("mode") = "hold", py::arg("check") = true,
-           "Runs to t_end from the current state with tau = controller(t, q, qd): called at "
+           "Runs whole periods from the current state until t >= t_end with tau = "
+           "controller(t, q, qd): called at "
            "every period and held (mode='hold'), or at every evaluation of f "
            "(mode='evaluation'). Returns a dict: t (m,), q (m, n_q), qd, tau (m, n), work, total "
            "(m,), stats; tau[k] is applied from t[k] (the last row repeats the last). A wrong or "
            "NaN tau is a ValueError, the controller's own exception propagates, a numerical "
-           "failure raises NumericalError (check=False: the rows so far, stats['ok'] False).");
+           "failure raises NumericalError (check=False: the rows so far, stats['ok'] False). "
+           "One thread at a time: a Simulator is not shared between threads.");
 }
 
 }  // namespace femdyn::python

@@ -13,14 +13,12 @@ std::string ControlLoopOptions::check() const {
   return {};
 }
 
-std::string tau_problem(const Model& model, const VecX& tau, const char* who) {
+std::string tau_problem(const Model& model, const VecX& tau) {
   const int n = model.n();
   if (tau.size() != n)
-    return std::string(who) + "'s tau has " + std::to_string(tau.size()) + " entries, expected " +
-           std::to_string(n);
+    return "tau has " + std::to_string(tau.size()) + " entries, expected " + std::to_string(n);
   for (int i = 0; i < n; ++i)
-    if (!std::isfinite(tau[i]))
-      return std::string(who) + "'s tau is NaN or Inf (" + model.coordinate_names[i] + ")";
+    if (!std::isfinite(tau[i])) return "tau is NaN or Inf (" + model.coordinate_names[i] + ")";
   return {};
 }
 
@@ -64,14 +62,14 @@ Status ControlLoop::step() {
   v_ = integ_->qd();
   if (u_) u_(t, q_, v_, held_);
   ++calls_;
-  if (const std::string bad = tau_problem(model_, held_, "the controller"); !bad.empty())
-    return {false, at_time(t) + bad, -1};
+  if (const std::string bad = tau_problem(model_, held_); !bad.empty())
+    return {false, at_time(t) + "the controller's " + bad, -1};
   return advance_period();
 }
 
 Status ControlLoop::step(const VecX& tau) {
-  if (const std::string bad = tau_problem(model_, tau, "the given"); !bad.empty())
-    return {false, at_time(integ_->t()) + bad, -1};
+  if (const std::string bad = tau_problem(model_, tau); !bad.empty())
+    return {false, at_time(integ_->t()) + "the given " + bad, -1};
   held_ = tau;
   return advance_period();
 }

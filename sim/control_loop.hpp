@@ -61,7 +61,8 @@ class ControlLoop {
   // One period with τ given and held (ZOH whatever the mode; the controller is not called). A τ
   // of the wrong size or not finite is a failed Status naming it.
   Status step(const VecX& tau);
-  // Periods until t reaches t_end (whole periods: stops at the first t_k ≥ t_end).
+  // Periods until t reaches t_end (whole periods: stops at the first t_k ≥ t_end). A fixed-step
+  // run beyond max_steps is refused first (Integrator::plan).
   Status run(double t_end);
 
   // The controller from now on (empty: none).
@@ -90,8 +91,7 @@ class ControlLoop {
   bool was_held_ = true;         // the last period held τ (a switch of mode is a jump in τ)
 };
 
-// "the controller's tau has 3 entries, expected 4" or "the controller's tau is NaN or Inf (mcp)";
-// "" when τ is usable.
-std::string tau_problem(const Model& model, const VecX& tau, const char* who);
+// "tau has 3 entries, expected 4" or "tau is NaN or Inf (mcp)"; "" when τ is usable.
+std::string tau_problem(const Model& model, const VecX& tau);
 
 }  // namespace femdyn

@@ -3,6 +3,8 @@
 //
 //   y = (q, q̇, W),   ẏ = f(t, y) = (q̇,  q̈ = (M^s)⁻¹ (Q(q, q̇, τ(t)) − h(q, q̇)),  P_nc),
 //
+// where τ(t) is a prescribed Actuation or a controller's τ = u(t, q, v) (Control; the modes in
+// which one runs, and what they do to the error control, in sim/control_loop.hpp),
 // for a model whose coordinates form a vector space (every joint flat: q̇ = v). With a spherical
 // or free joint (nq ≠ nv) q lives on a manifold, and y holds chart coordinates instead:
 //
