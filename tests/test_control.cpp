@@ -215,3 +215,26 @@ TEST_CASE("a control period allocates nothing (rk4, both modes)", "[control][hot
     CHECK(mallocs == 0);
   }
 }
+
+TEST_CASE("a discontinuous controller in f costs dopri rejected steps; held, far fewer",
+          "[control]") {
+  // Bang-bang on the abduction joint: τ₀ = −τ_max sign(q₀ − q_d), which switches as q₀ crosses
+  // q_d. In f the switch lies inside steps, which the error test rejects until they are short;
+  // held, τ is constant over every period and the method restarts at each sample (a few steps
+  // are rejected there, the first after a jump taken as long as the last before it).
+  const FingerCase f;
+  const Control bang = [](double, const VecX& q, const VecX&, VecX& tau) {
+    tau.setZero();
+    tau[0] = q[0] > 0.1 ? -2e-3 : 2e-3;
+  };
+  long rejected[2];
+  int i = 0;
+  for (ControlMode mode : {ControlMode::PerEvaluation, ControlMode::ZeroOrderHold}) {
+    ControlLoop c(f.m, adaptive(IntegratorKind::Dopri, 1e-8, 1e-10), loop(mode, 0.01), bang);
+    c.reset(0, f.q0, VecX::Zero(4));
+    for (int k = 0; k < 50; ++k) REQUIRE(c.step().ok);
+    rejected[i++] = c.integrator().stats().rejected;
+  }
+  INFO("rejected steps: in f " << rejected[0] << ", held " << rejected[1]);
+  CHECK(rejected[0] >= 5 * std::max(rejected[1], 1L));
+}
