@@ -238,3 +238,40 @@ TEST_CASE("a discontinuous controller in f costs dopri rejected steps; held, far
   INFO("rejected steps: in f " << rejected[0] << ", held " << rejected[1]);
   CHECK(rejected[0] >= 5 * std::max(rejected[1], 1L));
 }
+
+TEST_CASE("on a spherical joint the controller sees q (n_q = 4) and v (n = 3)", "[control]") {
+  // A spherical pendulum (a 1 kg body 1 m below the ball) under a damping controller τ = −c v; the
+  // quaternion makes y hold chart coordinates, which the adaptive method moves, restarting, as the
+  // ball turns.
+  const Model m = load_text(R"({"name": "ball", "gravity": [0, 0, -9.81], "bodies": [
+    {"name": "bob", "parent": "world", "joint": {"name": "ball", "type": "spherical"},
+     "elements": [{"type": "rigid_body", "mass": 1.0, "com": [0, 0, -1], "inertia": {"ixx": 0.01,
+       "iyy": 0.01, "izz": 0.02, "ixy": 0, "ixz": 0, "iyz": 0}}]}]})");
+  REQUIRE(m.n_q() == 4);
+  REQUIRE(m.n() == 3);
+  VecX q0(4), v0(3);
+  q0 << std::cos(0.6), std::sin(0.6), 0, 0;  // tilted 1.2 rad about x
+  v0 << 0, 1.5, 4.0;                         // and spinning about the vertical
+  for (ControlMode mode : {ControlMode::PerEvaluation, ControlMode::ZeroOrderHold}) {
+    for (const IntegratorOptions& o :
+         {fixed(IntegratorKind::Rk4, 1e-3), adaptive(IntegratorKind::Dopri, 1e-10, 1e-12)}) {
+      INFO((mode == ControlMode::ZeroOrderHold ? "ZOH " : "per evaluation ")
+           << integrator_name(o.kind));
+      bool sizes = true;
+      ControlLoop c(m, o, loop(mode, 0.01), [&](double, const VecX& q, const VecX& v, VecX& tau) {
+        sizes = sizes && q.size() == 4 && v.size() == 3 && std::abs(q.norm() - 1) < 1e-12;
+        tau = -0.2 * v;
+      });
+      c.reset(0, q0, v0);
+      Motion& motion = c.integrator().motion();
+      const double E0 = motion.energy_at(c.integrator().y().data()).total();
+      for (int k = 0; k < 200; ++k) REQUIRE(c.step().ok);
+      const double E = motion.energy_at(c.integrator().y().data()).total(),
+                   W = c.integrator().work();
+      INFO("E − E0 = " << E - E0 << " J, W = " << W << " J");
+      CHECK(sizes);
+      CHECK(W < -0.5);  // the controller dissipated
+      CHECK(std::abs(E - E0 - W) < (o.kind == IntegratorKind::Rk4 ? 1e-9 : 1e-7) * std::abs(E0));
+    }
+  }
+}
