@@ -78,8 +78,9 @@ class Integrator {
   // τ jumps at t() (a controller's new sample, sim/control_loop.hpp): the method restarts from
   // the current state, W and the statistics kept, and never steps past t_stop. A fixed-step
   // method continues on its grid (no step of it straddles t(): it landed there); an adaptive
-  // one is reinitialised at t() (ERKStepReInit / CVodeReInit, on the memory it has), its first
-  // step the last one it took, so that no step, error estimate or BDF history spans the jump.
+  // one is reinitialised at t() (ERKStepReInit / CVodeReInit, on the memory it has: no
+  // allocation), its first step the last one it took, so that no step, error estimate or BDF
+  // history spans the jump.
   void restart(double t_stop);
   // The controller τ = u(t, q, v) in f from now on (Motion::set_control).
   void set_control(Control u) { motion_.set_control(std::move(u)); }

@@ -197,22 +197,29 @@ TEST_CASE("a bad controller is named: wrong size, NaN, and its exception", "[con
   CHECK(given.t() == 0);
 }
 
-TEST_CASE("a control period allocates nothing (rk4, both modes)", "[control][hot-path]") {
+TEST_CASE("a control period allocates nothing (rk4, dopri, bdf; both modes)",
+          "[control][hot-path]") {
   if (!alloc_counter::kAvailable) {
     WARN("skipped under sanitizers: ASan owns malloc, nothing is counted");
     return;
   }
   const FingerCase f;
   for (ControlMode mode : {ControlMode::PerEvaluation, ControlMode::ZeroOrderHold}) {
-    ControlLoop c(f.m, fixed(IntegratorKind::Rk4, 1e-3), loop(mode, 0.005), f.u);
-    c.reset(0, f.q0, f.qd0);
-    REQUIRE(c.step().ok);  // warm-up
-    alloc_counter::start();
-    bool ok = true;
-    for (int k = 0; k < 20; ++k) ok = ok && c.step().ok;
-    const long mallocs = alloc_counter::stop();
-    CHECK(ok);
-    CHECK(mallocs == 0);
+    for (const IntegratorOptions& o :
+         {fixed(IntegratorKind::Rk4, 1e-3), adaptive(IntegratorKind::Dopri, 1e-8, 1e-10),
+          adaptive(IntegratorKind::Bdf, 1e-8, 1e-10)}) {
+      INFO((mode == ControlMode::ZeroOrderHold ? "ZOH " : "per evaluation ")
+           << integrator_name(o.kind));
+      ControlLoop c(f.m, o, loop(mode, 0.005), f.u);
+      c.reset(0, f.q0, f.qd0);
+      REQUIRE(c.step().ok);  // warm-up
+      alloc_counter::start();
+      bool ok = true;
+      for (int k = 0; k < 20; ++k) ok = ok && c.step().ok;
+      const long mallocs = alloc_counter::stop();
+      CHECK(ok);
+      CHECK(mallocs == 0);
+    }
   }
 }
 
