@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "core/memory.hpp"
 #include "python/py_model.hpp"
 #include "sim/control_loop.hpp"
 
@@ -138,6 +139,15 @@ class Simulator {
       throw py::value_error("t_end: expected a time in [t, 1e9] s, t = " + format_short(integ.t()));
     if (Status plan = integ.plan(t_end); !plan.ok) throw py::value_error(plan.message);
     const Model& m = *model_;
+    // Memory, before any is allocated: a row a period, n_q + 3n + 2 numbers, held in growing
+    // vectors and then copied into arrays (twice that at the end).
+    const double T = loop_->options().period;
+    const double row_count = std::ceil((t_end - integ.t()) / T) + 2;
+    const double bytes = 2 * row_count * dense_bytes(m.n_q() + 3.0 * m.n() + 2, 1);
+    require_memory("Simulator.run: " + std::to_string(static_cast<long long>(row_count)) +
+                       " rows of n = " + std::to_string(m.n()) + " coordinates",
+                   bytes, 0,
+                   "a shorter run (several run() calls), or " + set_max_memory_text(bytes));
     VecX tau = VecX::Zero(m.n());
     // The controller at the current state, into tau (the GIL held).
     const auto call = [&](double t, const VecX& q, const VecX& qd, VecX& out) {
@@ -154,7 +164,6 @@ class Simulator {
         ++calls;
         call(t, q, qd, out);
       });
-    const double T = loop_->options().period;
     const auto begin = std::chrono::steady_clock::now();
     const IntegratorStats before = integ.stats();
     const long k_before = loop_->period_index();

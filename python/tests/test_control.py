@@ -168,3 +168,15 @@ def test_overhead_benchmark_smoke():
     out = subprocess.run([sys.executable, str(ROOT / "tools" / "bench_control.py"), "--quick"],
                          env=subprocess_env(), capture_output=True, text=True, check=True).stdout
     assert out.count("| Simulator.") == 3 and "| femdyn.simulate" in out
+
+
+def test_a_run_beyond_the_memory_limit_is_refused_before_it_starts(finger):
+    sim = femdyn.Simulator(finger, dt=1e-3, q0=Q0)
+    calls = []
+    femdyn.set_max_memory(1e-6)  # 1 kB
+    try:
+        with pytest.raises(ValueError, match=r"Simulator.run: 1002 rows of n = 4 coordinates needs"):
+            sim.run(lambda t, q, qd: calls.append(t) or TAU, 1.0)
+    finally:
+        femdyn.set_max_memory(None)
+    assert calls == [] and sim.t == 0
