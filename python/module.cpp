@@ -89,6 +89,7 @@ PYBIND11_MODULE(_femdyn, m) {
   bind_model(m);
   bind_batch(m);
   bind_simulate(m);
+  bind_simulator(m);
   bind_validate(m);
   bind_builder(m);
 }

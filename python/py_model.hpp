@@ -40,6 +40,7 @@ inline std::string set_max_memory_text(double bytes) {
 void bind_model(py::module_& m);
 void bind_batch(py::module_& m);
 void bind_simulate(py::module_& m);
+void bind_simulator(py::module_& m);
 void bind_validate(py::module_& m);
 void bind_builder(py::module_& m);
 

@@ -103,6 +103,11 @@ void Integrator::reset(double t0, const VecX& q0, const VecX& qd0, double t_stop
   start();
 }
 
+void Integrator::restart(double t_stop) {
+  t_stop_ = t_stop;
+  restart_method();
+}
+
 Status Integrator::advance_to(double t_out) {
   const auto begin = std::chrono::steady_clock::now();
   Status st = t_out > t_ ? advance(t_out) : Status{};
@@ -153,8 +158,13 @@ Status Integrator::explain(Status failure) {
 
 Status Integrator::diverged() {
   const int n = motion_.n();
-  VecX tau0(n);
-  motion_.actuation(t0_, tau0);
+  VecX tau0 = VecX::Zero(n);
+  try {  // (τ at the start, for the cause: a controller is asked at (q0, q̇0))
+    motion_.tau_at(t0_, q0_, y0_.segment(n, n), tau0);
+  } catch (...) {
+    tau0.setZero(n);
+  }
+  if (tau0.size() != n) tau0.setZero(n);
   Status st{false,
             at_time(t_) + "the solution diverges (the state holds " + format_short(watch_.gain()) +
                 " J more energy than the " + format_short(watch_.supplied()) +

@@ -75,6 +75,15 @@ class Integrator {
   // land on t_out; adaptive ones stop at t_out by dense output. On failure the state stays at
   // the last good step (t() < t_out) and the Status says why.
   Status advance_to(double t_out);
+  // τ jumps at t() (a controller's new sample, sim/control_loop.hpp): the method restarts from
+  // the current state, W and the statistics kept, and never steps past t_stop. A fixed-step
+  // method continues on its grid (no step of it straddles t(): it landed there); an adaptive
+  // one is reinitialised at t() (ERKStepReInit / CVodeReInit, on the memory it has: no
+  // allocation), its first step the last one it took, so that no step, error estimate or BDF
+  // history spans the jump.
+  void restart(double t_stop);
+  // The controller τ = u(t, q, v) in f from now on (Motion::set_control).
+  void set_control(Control u) { motion_.set_control(std::move(u)); }
   // One step: dt for a fixed-step method, one internal (error-controlled) step for an adaptive
   // one; never past t_stop.
   Status step();
@@ -107,7 +116,8 @@ class Integrator {
 
  protected:
   Integrator(const Model& model, Actuation tau);
-  virtual void start() = 0;  // after reset: (re)initialise the method at (t_, y_, t_stop_)
+  virtual void start() = 0;         // after reset: (re)initialise the method at (t_, y_, t_stop_)
+  virtual void restart_method() {}  // restart(): the method's own (fixed step: nothing)
   virtual Status advance(double t_out) = 0;  // the method's own advance_to
   virtual Status one_step() = 0;             // the method's own step
   // After an accepted step: the divergence test when the rates have grown (sim/divergence.hpp).

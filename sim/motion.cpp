@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "core/joints/kernel.hpp"
 #include "core/sampling.hpp"
@@ -98,10 +99,28 @@ Status Motion::rhs(double t, const double* y, double* ydot) {
   const int n = model_.n();
   configuration(y, q_);
   qd_ = Eigen::Map<const VecX>(y + n, n);
-  actuation(t, u_);
   if (Status st = check_state(t, y); !st.ok) return st;
+  if (control_) {
+    try {
+      control_(t, q_, qd_, u_);
+    } catch (...) {  // (no exception crosses SUNDIALS' C frames: kept, rethrown by the caller)
+      control_error_ = std::current_exception();
+      return {false, at_time(t) + "the controller failed", -1};
+    }
+    if (u_.size() != n)
+      return {false,
+              at_time(t) + "the controller's tau has " + std::to_string(u_.size()) +
+                  " entries, expected " + std::to_string(n),
+              -1};
+  } else {
+    actuation(t, u_);
+  }
   // (an input's fault, not an overflow of the motion: non_finite stays false)
-  if (!u_.allFinite()) return {false, at_time(t) + "the actuation tau(t) is NaN or Inf", -1};
+  if (!u_.allFinite())
+    return {false,
+            at_time(t) + (control_ ? "the controller's tau is NaN or Inf"
+                                   : "the actuation tau(t) is NaN or Inf"),
+            -1};
   Status st = forward_dynamics(model_, ws_, q_, qd_, u_);
   if (!st.ok) {
     st.message = at_time(t) + st.message;
@@ -118,6 +137,19 @@ void Motion::actuation(double t, VecX& tau) const {
     tau_(t, tau);
   else
     tau.setZero(n());
+}
+
+void Motion::tau_at(double t, const VecX& q, const VecX& v, VecX& tau) const {
+  if (control_)
+    control_(t, q, v, tau);
+  else
+    actuation(t, tau);
+}
+
+void Motion::rethrow_control_error() {
+  if (!control_error_) return;
+  std::exception_ptr e = std::exchange(control_error_, nullptr);
+  std::rethrow_exception(e);
 }
 
 Energy Motion::energy_at(const double* y) {

@@ -3,6 +3,8 @@
 //
 //   y = (q, q̇, W),   ẏ = f(t, y) = (q̇,  q̈ = (M^s)⁻¹ (Q(q, q̇, τ(t)) − h(q, q̇)),  P_nc),
 //
+// where τ(t) is a prescribed Actuation or a controller's τ = u(t, q, v) (Control; the modes in
+// which one runs, and what they do to the error control, in sim/control_loop.hpp),
 // for a model whose coordinates form a vector space (every joint flat: q̇ = v). With a spherical
 // or free joint (nq ≠ nv) q lives on a manifold, and y holds chart coordinates instead:
 //
@@ -18,6 +20,7 @@
 // checked: a singular or indefinite M^s, or a NaN/Inf in q̈, is a failed Status naming the time,
 // the quantity and the coordinate, never a NaN handed on.
 #pragma once
+#include <exception>
 #include <functional>
 
 #include "core/equations.hpp"
@@ -26,10 +29,18 @@ namespace femdyn {
 
 // τ(t) on the generalized coordinates. An empty Actuation is the passive motion (τ = 0).
 using Actuation = std::function<void(double t, VecX& tau)>;
+// A controller in the loop, τ = u(t, q, v): q the configuration (n_q entries, Motion::
+// configuration of y), v the rates (n), τ (n, sized by the caller: write it in place). Given to a
+// Motion it replaces the Actuation and is part of f (sim/control_loop.hpp for the modes). It may
+// throw: rhs then fails and keeps the exception for rethrow_control_error().
+using Control = std::function<void(double t, const VecX& q, const VecX& v, VecX& tau)>;
 
 class Motion {
  public:
   Motion(const Model& model, Actuation tau = {});
+  // τ = u(t, q, v) from now on (an empty u: back to the Actuation).
+  void set_control(Control u) { control_ = std::move(u); }
+  bool controlled() const { return static_cast<bool>(control_); }
 
   const Model& model() const { return model_; }
   int n() const { return model_.n(); }
@@ -56,14 +67,20 @@ class Motion {
 
   // Mechanical energy at y (kinetic, potential; the work W is y's last entry).
   Energy energy_at(const double* y);
-  // τ(t) (zero when passive).
-  void actuation(double t, VecX& tau) const;
+  // τ at (t, q, v): the controller's when there is one, else τ(t) (zero when passive).
+  void tau_at(double t, const VecX& q, const VecX& v, VecX& tau) const;
+  // The exception the controller threw in the last failed rhs, rethrown (then cleared); nothing
+  // if it threw none.
+  void rethrow_control_error();
   // The workspace of the last evaluation (rhs or energy_at).
   const Workspace& workspace() const { return ws_; }
 
  private:
+  void actuation(double t, VecX& tau) const;  // τ(t), zero when passive
   const Model& model_;
   Actuation tau_;
+  Control control_;
+  std::exception_ptr control_error_;
   Workspace ws_;
   bool flat_ = true;
   VecX q_c_;         // the chart centre (non-flat)

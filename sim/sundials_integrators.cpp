@@ -150,6 +150,16 @@ Status Adaptive::advance_on_manifold(double t_out) {
   return {};
 }
 
+void Adaptive::restart_method() {
+  if (!run_) return;
+  const double h = current_step();
+  restarted_ = stats_;  // (the counters restart from 0 with the method)
+  reinit();
+  if (h > 0) set_initial_step(h);
+  set_stop_time(t_stop_);
+  rhs_failure_ = {};
+}
+
 Status Adaptive::one_step() {
   double t_reached = t_;
   const int flag = evolve(std::isfinite(t_stop_) ? t_stop_ : t_ + 1, t_reached, true);
@@ -192,6 +202,8 @@ void DormandPrince::start() {
   if (std::isfinite(t_stop_)) ERKStepSetStopTime(r.arkode, t_stop_);
   rhs_failure_ = {};
 }
+
+void DormandPrince::reinit() { ERKStepReInit(run_->arkode, rhs_callback, t_, run_->y); }
 
 int DormandPrince::evolve(double t_out, double& t_reached, bool one_step) {
   if (options_.stop_at_outputs && !one_step) ERKStepSetStopTime(run_->arkode, t_out);
@@ -262,6 +274,8 @@ int Bdf::jacobian(double t, const double* y, const double* fy, double* J) {
   }
   return 0;
 }
+
+void Bdf::reinit() { CVodeReInit(run_->cvode, t_, run_->y); }
 
 int Bdf::evolve(double t_out, double& t_reached, bool one_step) {
   if (options_.stop_at_outputs && !one_step) CVodeSetStopTime(run_->cvode, t_out);

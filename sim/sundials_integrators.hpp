@@ -34,6 +34,8 @@ class Adaptive : public Integrator {
   Status one_step() override;
   std::string setting() const override;
   Status plan(double t_end) override;  // a span SUNDIALS cannot start on, refused
+  void restart_method() override;      // reinit at (t_, y_), the last step as the first
+  virtual void reinit() = 0;           // ERKStepReInit / CVodeReInit at (t_, y_)
   Status finish(int flag, double t_reached, double t_target);
   // What SUNDIALS' return code means for the user, with the step size where it failed.
   Status failure(int flag);
@@ -68,6 +70,7 @@ class DormandPrince final : public Adaptive {
 
  private:
   void start() override;
+  void reinit() override;
   int evolve(double t_out, double& t_reached, bool one_step) override;
   void read_stats() override;
   double current_step() const override;
@@ -84,6 +87,7 @@ class Bdf final : public Adaptive {
 
  private:
   void start() override;
+  void reinit() override;
   int evolve(double t_out, double& t_reached, bool one_step) override;
   void read_stats() override;
   double current_step() const override;

@@ -45,6 +45,7 @@ try:
         Model,
         ModelError,
         NumericalError,
+        Simulator,
         load,
         set_max_memory,
         simulate,

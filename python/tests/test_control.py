@@ -1,0 +1,182 @@
+"""femdyn.Simulator, the controller in the loop (docs/control.md), and the two control examples."""
+import os
+import signal
+import subprocess
+import sys
+import threading
+
+import numpy as np
+import pytest
+
+import femdyn
+from conftest import ROOT, model_path, subprocess_env
+
+sys.path.insert(0, str(ROOT / "examples"))
+import control_computed_torque  # noqa: E402
+import control_task_space  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def finger():
+    return femdyn.load(model_path("models/finger.json"))
+
+
+Q0 = np.array([0.1, 0.4, 0.3, 0.2])
+QD0 = np.array([1.0, -0.5, 0.2, 0.3])
+TAU = np.array([0.002, -0.001, 0.0015, 0.0005])
+
+
+def test_step_holds_tau_as_simulate_does(finger):
+    sim = femdyn.Simulator(finger, integrator="rk4", dt=1e-3, q0=Q0, qd0=QD0)
+    for _ in range(200):
+        sim.step(TAU)
+    ref = femdyn.simulate(finger, 0.2, q0=Q0, qd0=QD0, integrator="rk4", dt=1e-3, tau=TAU)
+    s = sim.state
+    assert s["t"] == pytest.approx(0.2, abs=1e-12) and sim.t == s["t"]
+    np.testing.assert_allclose(s["q"], ref["q"][-1], rtol=0, atol=1e-13)
+    np.testing.assert_allclose(s["qd"], ref["qd"][-1], rtol=0, atol=1e-12)
+    assert s["work"] == pytest.approx(ref["work"][-1], abs=1e-15)
+    sim.reset(Q0, t=1.0)
+    assert sim.state["t"] == 1.0 and np.all(sim.state["qd"] == 0)
+    np.testing.assert_array_equal(sim.state["q"], Q0)
+
+
+@pytest.mark.parametrize("mode", ["hold", "evaluation"])
+def test_run_with_a_constant_controller_is_simulate(finger, mode):
+    sim = femdyn.Simulator(finger, integrator="rk4", dt=1e-3, q0=Q0, qd0=QD0)
+    r = sim.run(lambda t, q, qd: TAU, 0.1, mode=mode)
+    ref = femdyn.simulate(finger, 0.1, q0=Q0, qd0=QD0, integrator="rk4", dt=1e-3, tau=TAU)
+    assert r["t"].shape == (101,) and r["q"].shape == (101, 4) and r["tau"].shape == (101, 4)
+    np.testing.assert_allclose(r["t"], ref["t"], atol=1e-12)
+    np.testing.assert_allclose(r["q"], ref["q"], rtol=0, atol=1e-13)
+    np.testing.assert_allclose(r["work"], ref["work"], rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(r["tau"], np.tile(TAU, (101, 1)))
+    s = r["stats"]
+    assert s["ok"] and s["periods"] == 100 and s["steps"] == 100
+    # hold: one call a period; evaluation: four a step (rk4) and one a row
+    assert s["controller_calls"] == (100 if mode == "hold" else 4 * 100 + 100)
+
+
+def test_zoh_samples_the_state_at_each_period(finger):
+    seen = []
+
+    def pd(t, q, qd):
+        seen.append(t)
+        return -1e-4 * q - 1e-6 * qd
+
+    sim = femdyn.Simulator(finger, integrator="dopri", dt=0.01, rtol=1e-9, atol=1e-11, q0=Q0)
+    r = sim.run(pd, 0.2)
+    np.testing.assert_allclose(seen, np.arange(20) * 0.01, atol=1e-12)
+    np.testing.assert_allclose(r["tau"][:-1], -1e-4 * r["q"][:-1] - 1e-6 * r["qd"][:-1])
+    # E(t) - E(0) = W(t) with the controller's tau
+    assert np.max(np.abs(r["total"] - r["total"][0] - r["work"])) < 1e-7 * np.max(np.abs(r["work"]))
+    assert np.max(np.abs(r["work"])) > 0
+
+
+def test_bad_controllers_are_named(finger):
+    sim = femdyn.Simulator(finger, dt=1e-3, q0=Q0)
+    with pytest.raises(ValueError, match=r"controller at t = 0 s: expected tau of shape \(4,\), "
+                                         r"got \(3,\)"):
+        sim.run(lambda t, q, qd: np.zeros(3), 0.01)
+    with pytest.raises(ValueError, match=r"tau is NaN or Inf \(pip\)"):
+        sim.run(lambda t, q, qd: np.array([0, 0, np.nan, 0]), 0.01)
+    with pytest.raises(ValueError, match="expected tau, an array of shape"):
+        sim.run(lambda t, q, qd: "up", 0.01)
+    with pytest.raises(TypeError, match="callable"):
+        sim.run(3, 0.01)
+    with pytest.raises(ValueError, match="mode"):
+        sim.run(lambda t, q, qd: TAU, 0.01, mode="sometimes")
+
+    class SensorLost(Exception):
+        pass
+
+    def lost(t, q, qd):
+        if t > 0.005:
+            raise SensorLost("sensor lost")
+        return TAU
+
+    for mode in ("hold", "evaluation"):
+        sim.reset(Q0)
+        with pytest.raises(SensorLost, match="sensor lost"):
+            sim.run(lost, 0.02, mode=mode)
+        sim.reset(Q0)
+        with pytest.raises(ValueError, match=r"tau is NaN or Inf"):
+            sim.run(lambda t, q, qd: TAU * (np.nan if t > 0.005 else 1), 0.02, mode=mode)
+    with pytest.raises(ValueError, match=r"tau: expected shape \(4,\)"):
+        sim.step(np.zeros(2))
+    with pytest.raises(ValueError, match="substeps"):
+        femdyn.Simulator(finger, integrator="dopri", substeps=4)
+    with pytest.raises(ValueError, match="dt"):
+        femdyn.Simulator(finger, dt=0)
+
+
+def test_a_diverging_run_raises_numerical_error_with_its_cause(finger):
+    stiff = lambda t, q, qd: -1e4 * q  # noqa: E731  far beyond rk4's stability at 1 ms
+    sim = femdyn.Simulator(finger, dt=1e-3, q0=Q0)
+    with pytest.raises(femdyn.NumericalError, match="the solution diverges"):
+        sim.run(stiff, 1.0)
+    sim.reset(Q0)
+    r = sim.run(stiff, 1.0, check=False)
+    assert not r["stats"]["ok"] and r["stats"]["diverged"]
+    assert r["stats"]["t_reached"] < 1.0 and np.all(np.isfinite(r["q"]))
+
+
+def test_ctrl_c_stops_a_run(finger):
+    sim = femdyn.Simulator(finger, dt=1e-3, substeps=50, q0=Q0)
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            sim.run(lambda t, q, qd: TAU, 100.0)
+    finally:
+        timer.cancel()
+
+
+# ---- the examples converge (short horizons) --------------------------------------------------
+
+def test_computed_torque_tracks_the_fingertip_path():
+    r = control_computed_torque.run(t_end=1.0)
+    t, e = r["t"], r["error"]
+    assert r["run"]["stats"]["ok"]
+    assert e[0] > 1e-3  # it starts off the path
+    assert np.max(e[t >= 0.5]) < 1e-4  # and follows it after the transient
+
+
+def test_computed_torque_with_the_wrong_sign_does_not_track():
+    r = control_computed_torque.run(t_end=0.5, kp=-control_computed_torque.OMEGA**2, check=False)
+    assert r["error"][-1] > 1e-3  # the error grows (until the run diverges)
+
+
+@pytest.mark.parametrize("mode", ["hold", "evaluation"])
+def test_task_space_controller_moves_the_tip_to_the_point(mode):
+    r = control_task_space.run(t_end=1.0, mode=mode)
+    e = r["error"]
+    assert e[0] > 1e-2  # 1 cm or more away at the start
+    assert e[-1] < 1e-6  # at the point within a micrometre after 1 s
+
+
+@pytest.mark.parametrize("script", ["control_computed_torque.py", "control_task_space.py"])
+def test_examples_run_as_scripts_and_plot(script, tmp_path):
+    plot = tmp_path / "error.png"
+    out = subprocess.run([sys.executable, str(ROOT / "examples" / script), "--t-end", "0.3",
+                          "--plot", str(plot)], cwd=tmp_path, env=subprocess_env(),
+                         capture_output=True, text=True, check=True).stdout
+    assert "t =  0.300 s" in out and plot.stat().st_size > 1000
+
+
+def test_overhead_benchmark_smoke():
+    out = subprocess.run([sys.executable, str(ROOT / "tools" / "bench_control.py"), "--quick"],
+                         env=subprocess_env(), capture_output=True, text=True, check=True).stdout
+    assert out.count("| Simulator.") == 3 and "| femdyn.simulate" in out
+
+
+def test_a_run_beyond_the_memory_limit_is_refused_before_it_starts(finger):
+    sim = femdyn.Simulator(finger, dt=1e-3, q0=Q0)
+    calls = []
+    femdyn.set_max_memory(1e-6)  # 1 kB
+    try:
+        with pytest.raises(ValueError, match=r"Simulator.run: 1002 rows of n = 4 coordinates needs"):
+            sim.run(lambda t, q, qd: calls.append(t) or TAU, 1.0)
+    finally:
+        femdyn.set_max_memory(None)
+    assert calls == [] and sim.t == 0

@@ -1,0 +1,102 @@
+#include "sim/control_loop.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace femdyn {
+
+std::string ControlLoopOptions::check() const {
+  if (!(period > 0) || !std::isfinite(period))
+    return "period: the control period must be a positive number, got " +
+           format_number(period, "%g");
+  return {};
+}
+
+std::string tau_problem(const Model& model, const VecX& tau) {
+  const int n = model.n();
+  if (tau.size() != n)
+    return "tau has " + std::to_string(tau.size()) + " entries, expected " + std::to_string(n);
+  for (int i = 0; i < n; ++i)
+    if (!std::isfinite(tau[i])) return "tau is NaN or Inf (" + model.coordinate_names[i] + ")";
+  return {};
+}
+
+ControlLoop::ControlLoop(const Model& model, const IntegratorOptions& integrator,
+                         const ControlLoopOptions& options, Control u)
+    : model_(model),
+      options_(options),
+      u_(std::move(u)),
+      held_(VecX::Zero(model.n())),
+      q_(VecX::Zero(model.n_q())),
+      v_(VecX::Zero(model.n())) {
+  if (const std::string why = options.check(); !why.empty()) throw std::invalid_argument(why);
+  integ_ = make_integrator(model, integrator);
+  // f's τ: the controller inside f (per evaluation), or the held sample (ZOH, and step(tau)).
+  integ_->set_control([this](double t, const VecX& q, const VecX& v, VecX& tau) {
+    if (per_evaluation_)
+      u_(t, q, v, tau);
+    else
+      tau = held_;
+  });
+}
+
+void ControlLoop::reset(double t0, const VecX& q0, const VecX& v0) {
+  t0_ = t0;
+  k_ = calls_ = 0;
+  was_held_ = true;
+  held_.setZero();
+  integ_->reset(t0, q0, v0);
+}
+
+Status ControlLoop::step() {
+  if (options_.mode == ControlMode::PerEvaluation && u_) {
+    per_evaluation_ = true;
+    Status st = advance_period();
+    per_evaluation_ = false;
+    return st;
+  }
+  // τ_k = u(t_k, q_k, v_k), without allocating: q_ and v_ are sized once.
+  const double t = integ_->t();
+  integ_->motion().configuration(integ_->y().data(), q_);
+  v_ = integ_->qd();
+  if (u_) u_(t, q_, v_, held_);
+  ++calls_;
+  if (const std::string bad = tau_problem(model_, held_); !bad.empty())
+    return {false, at_time(t) + "the controller's " + bad, -1};
+  return advance_period();
+}
+
+Status ControlLoop::step(const VecX& tau) {
+  if (const std::string bad = tau_problem(model_, tau); !bad.empty())
+    return {false, at_time(integ_->t()) + "the given " + bad, -1};
+  held_ = tau;
+  return advance_period();
+}
+
+Status ControlLoop::run(double t_end) {
+  if (Status plan = integ_->plan(t_end); !plan.ok) return plan;
+  while (integ_->t() < t_end)
+    if (Status st = step(); !st.ok) return st;
+  return {};
+}
+
+Status ControlLoop::advance_period() {
+  const double t_next = sample_time(k_ + 1);
+  // ZOH: τ jumps at t_k; the method restarts there and stops exactly at t_{k+1}. Per
+  // evaluation: one smooth run (restarted once where it follows held periods).
+  if (!per_evaluation_)
+    integ_->restart(t_next);
+  else if (was_held_ && k_ > 0)
+    integ_->restart(std::numeric_limits<double>::infinity());
+  was_held_ = !per_evaluation_;
+  Status st = integ_->advance_to(t_next);
+  if (!st.ok) {
+    integ_->motion().rethrow_control_error();  // the controller's own exception, if it threw
+    return st;
+  }
+  ++k_;
+  return st;
+}
+
+}  // namespace femdyn
