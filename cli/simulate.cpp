@@ -263,6 +263,11 @@ int cmd_simulate(int argc, char** argv) {
     for (const VelocityExcess& v : run.velocity_excesses)
       std::cerr << "femdyn simulate: warning: joint '" << v.name << "' exceeded its velocity limit "
                 << num(v.limit) << " at t = " << num(v.t) << " s (rate " << num(v.value) << ")\n";
+    if (!run.unapplied_effort_limits.empty()) {
+      std::cerr << "femdyn simulate: warning: the effort limits of the coupled joints";
+      for (const std::string& name : run.unapplied_effort_limits) std::cerr << " '" << name << "'";
+      std::cerr << " are not applied (tau acts on the coordinates they follow)\n";
+    }
     if (run.saturated_evaluations > 0) {
       std::cerr << "femdyn simulate: warning: tau saturated at the effort limits in "
                 << run.saturated_evaluations << " of " << integ->stats().rhs_evals
@@ -318,6 +323,7 @@ int cmd_simulate(int argc, char** argv) {
     j["saturations"] = saturated;
     j["saturated_evaluations"] = run.saturated_evaluations;
     j["saturated_steps"] = run.saturated_steps;
+    j["unapplied_effort_limits"] = run.unapplied_effort_limits;
     if (is_adaptive(o.kind))
       j["options"] = {{"rtol", o.adaptive.rtol}, {"atol", o.adaptive.atol}};
     else

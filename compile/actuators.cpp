@@ -1,7 +1,6 @@
 #include "compile/actuators.hpp"
 
 #include <cmath>
-#include <set>
 #include <vector>
 
 #include "core/errors.hpp"
@@ -95,24 +94,14 @@ void compile_actuators(Model& m) {
   m.armature_mass.setFromTriplets(entries.begin(), entries.end());
   m.armature_mass.makeCompressed();
 
-  // Effort limits, on the rates of q that the joints own.
-  std::set<int> owners;
+  // Effort limits, on the rates of q that the joints own. A coupled joint's is kept but not
+  // applied: no τ acts on it directly (simulate says so, sim/recorded_run.hpp).
   m.effort_limit = VecX::Constant(n, INFINITY);
   for (const CoordinateJoint& c : m.coordinate_joints) {
-    owners.insert(c.body);
     const Joint& J = m.bodies[c.body].joint;
     if (J.nv == 1) m.effort_limit[c.v] = J.effort_limit;
   }
-  m.has_effort_limits = false;
-  for (int b = 0; b < static_cast<int>(m.bodies.size()); ++b) {
-    const Joint& J = m.bodies[b].joint;
-    if (!std::isfinite(J.effort_limit)) continue;
-    if (!owners.count(b))
-      throw ModelError(
-          J.where + "/effort_limit",
-          "joint '" + J.name + "' is coupled: τ acts on the coordinate it follows, limit that one");
-    m.has_effort_limits = true;
-  }
+  m.has_effort_limits = (m.effort_limit.array() < INFINITY).any();
 }
 
 }  // namespace femdyn

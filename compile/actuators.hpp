@@ -13,7 +13,7 @@ namespace femdyn {
 void compile_actuator(const JointSpec& js, Joint& j);
 
 // After the coordinates are laid out: M_a = Cᵀ diag(I_a G²) C and the effort limit of each rate
-// of q. A coupled joint's effort limit is refused (its τ is its leader's).
+// of q (that of the joint owning it; a coupled joint's limit is not applied).
 void compile_actuators(Model& m);
 
 }  // namespace femdyn

@@ -225,6 +225,7 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
   stats["saturations"] = saturated;
   stats["saturated_evaluations"] = run.saturated_evaluations;
   stats["saturated_steps"] = run.saturated_steps;
+  stats["unapplied_effort_limits"] = run.unapplied_effort_limits;
   stats["failure"] = st.message;
   py::dict d;
   d["t"] = vector_array(rows.t);

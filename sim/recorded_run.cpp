@@ -105,6 +105,11 @@ RecordedRun run_recorded(Integrator& integ, double t_end, long every,
     }
   }
   r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  for (const Body& b : model.bodies)
+    if (std::isfinite(b.joint.effort_limit) &&
+        std::none_of(model.coordinate_joints.begin(), model.coordinate_joints.end(),
+                     [&](const CoordinateJoint& c) { return &model.bodies[c.body] == &b; }))
+      r.unapplied_effort_limits.push_back(b.joint.name);
   const Motion& motion = integ.motion();
   r.saturated_evaluations = motion.saturated_evaluations();
   for (int i = 0; i < model.n(); ++i)

@@ -53,6 +53,8 @@ struct RecordedRun {
   // beyond a limit, and the coordinates saturated (those with an evaluation saturated).
   long saturated_evaluations = 0, saturated_steps = 0;
   std::vector<EffortSaturation> saturations;
+  // Coupled joints with an effort limit: no τ acts on them directly, so it is not applied.
+  std::vector<std::string> unapplied_effort_limits;
   long rows = 0;
   double wall_time = 0;  // s, the whole loop (rows included)
 };

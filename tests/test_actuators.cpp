@@ -409,3 +409,23 @@ TEST_CASE("check sees a stiff stop and the friction's slope", "[actuators][check
   CHECK(zero == 0);
   CHECK(friction_step.get<double>() == Approx(2.785 / 200).epsilon(1e-3));
 }
+
+TEST_CASE("a coupled joint's effort limit is kept, not applied, and a run says so",
+          "[actuators][urdf]") {
+  // The hand's distal joints mimic the middle ones: their <limit effort> has no τ to saturate.
+  const Model m = load_model(model_path("urdf/hand16.urdf"));
+  IntegratorOptions o;
+  o.kind = IntegratorKind::Rk4;
+  o.fixed.dt = 1e-4;
+  auto integ = make_integrator(m, o);
+  integ->reset(0, VecX::Zero(m.n()), VecX::Zero(m.n()));
+  const RecordedRun r = run_recorded(
+      *integ, 1e-3, 10, nullptr, [](const Integrator&, const Energy&) {},
+      [](double) { return false; });
+  REQUIRE(r.status.ok);
+  CHECK(r.unapplied_effort_limits ==
+        std::vector<std::string>{"index_dip", "middle_dip", "ring_dip", "little_dip"});
+  // The coordinates' own limits are applied.
+  CHECK(m.has_effort_limits);
+  CHECK(m.effort_limit.allFinite());
+}
