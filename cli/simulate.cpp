@@ -31,7 +31,7 @@ Integrates M^s q̈ + h = Q from (q0, q̇0) (default 0) over [0, T] and prints a 
 integrator, steps, rejected steps, evaluations of forward dynamics, Jacobians, wall time,
 real-time factor (simulated time / integration wall time), and the energy balance: the largest
 |E(t) − E(0) − W(t)| over the output rows, W the work of the non-conservative forces (τ,
-dampers, body torques); for a conservative model that is the energy drift. It is given
+dampers, friction, joint stops, body torques); for a conservative model that is the energy drift. It is given
 relative to the energy the motion started with plus the work done (docs/simulation.md).
 
 integrators (docs/simulation.md):

@@ -446,3 +446,35 @@ TEST_CASE("a coupled joint's effort limit is kept, not applied, and a run says s
   CHECK(m.has_effort_limits);
   CHECK(m.effort_limit.allFinite());
 }
+
+TEST_CASE("simulate warns of saturation, velocity limits and limits left, and --json has them",
+          "[actuators][cli]") {
+  Scratch s("actuators_simulate");
+  std::ofstream(s / "arm.json")
+      << arm(0, {{"effort_limit", 2.0}, {"velocity_limit", 1.01}, {"limits", {-1, 0.5}}}).dump();
+  const std::string args =
+      "simulate " + (s / "arm.json") + " --t-end 1 --integrator rk4 --dt 0.01 --tau 5";
+  const Run text = run(args);
+  CHECK(text.code == 0);
+  CHECK_THAT(
+      text.out,
+      Catch::Contains("warning: joint 'theta' exceeded its velocity limit 1.01 at t = 0.51 "
+                      "s (rate 1.02)") &&
+          Catch::Contains("warning: joint 'theta' left its limits [-1, 0.5] at t = 0.71 s") &&
+          Catch::Contains("limits are not enforced") &&
+          Catch::Contains("warning: tau saturated at the effort limits in") &&
+          Catch::Contains("and 100 steps (theta at ±2: "));
+  const Run js = run(args + " --json 2>/dev/null");
+  const Json j = Json::parse(js.out);
+  CHECK(j["saturated_steps"] == 100);
+  CHECK(j["saturated_evaluations"] == j["rhs_evals"]);
+  CHECK(j["saturations"][0]["coordinate"] == "theta");
+  CHECK(j["velocity_excesses"][0]["t"].get<double>() == Approx(0.51).margin(1e-9));
+  CHECK(j["limit_crossings"][0]["t"].get<double>() == Approx(0.71).margin(1e-9));
+  CHECK(j["unapplied_effort_limits"].empty());
+  // With a stop the crossing is said to be into a compliant stop, not unenforced.
+  std::ofstream(s / "stop.json")
+      << arm(0, {{"limits", {-1, 0.5}}, {"stop", Json::object()}}).dump();
+  CHECK_THAT(run("simulate " + (s / "stop.json") + " --t-end 1 --tau 5").out,
+             Catch::Contains("its stop is compliant"));
+}
