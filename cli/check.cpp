@@ -26,7 +26,8 @@ constexpr const char* kHelp =
                     [--max-memory GB] [--gravity gx,gy,gz]
 
 Diagnoses the model at K seeded states (default 10: q = 0 at rest, then q within the joint
-limits and q̇ in ±1):
+limits and q̇ in ±1), and one more per enforced joint stop (q = 0 with that joint 1e-3 into its
+stop, at rest: a stop's stiffness is felt only there; "stop_states" in --json):
   - cond(M^s) = λ_max/λ_min over the states (q̈ loses about log10 cond digits; a cond that
     overflows double precision is said so), symmetry and positive definiteness;
   - the modes of the linearised dynamics A = ∂(q̇, q̈)/∂(q, q̇) (central differences of
