@@ -26,7 +26,8 @@ constexpr const char* kHelp =
                     [--max-memory GB] [--gravity gx,gy,gz]
 
 Diagnoses the model at K seeded states (default 10: q = 0 at rest, then q within the joint
-limits and q̇ in ±1):
+limits and q̇ in ±1), and one more per enforced joint stop (q = 0 with that joint 1e-3 into its
+stop, at rest: a stop's stiffness is felt only there; "stop_states" in --json):
   - cond(M^s) = λ_max/λ_min over the states (q̈ loses about log10 cond digits; a cond that
     overflows double precision is said so), symmetry and positive definiteness;
   - the modes of the linearised dynamics A = ∂(q̇, q̈)/∂(q, q̇) (central differences of
@@ -150,6 +151,24 @@ void diagnose_state(const Model& m, Workspace& ws, const VecX& q, const VecX& qd
       d.h_max[i] = std::min(d.h_max[i], *hs);
 }
 
+// A joint's stop is felt only beyond its limit: one more state per enforced stop, the neutral
+// posture with that joint 1e-3 (relative) into its upper stop (else its lower), at rest. Its
+// linearisation then holds the stop's mode, of frequency sqrt(k_s / m_eff). Returns how many.
+int diagnose_stops(const Model& m, Workspace& ws, bool dampers, Diagnosis& d) {
+  int pressed = 0;
+  for (const CoordinateJoint& c : m.coordinate_joints) {
+    const Joint& J = m.bodies[c.body].joint;
+    if (!J.stop) continue;
+    const bool upper = std::isfinite(J.upper);
+    const double edge = upper ? J.upper : J.lower;
+    VecX q = neutral_posture(m);
+    q[c.q] = edge + (upper ? 1 : -1) * 1e-3 * std::max(1.0, std::abs(edge));
+    diagnose_state(m, ws, q, VecX::Zero(m.n()), dampers, d);
+    ++pressed;
+  }
+  return pressed;
+}
+
 // The advice, as text and as numbers (dt 0 where no step is recommended).
 struct Advice {
   std::string text, integrator;
@@ -270,6 +289,7 @@ int cmd_check(int argc, char** argv) {
       progress.update(k + 1);
     }
   }
+  const int pressed = diagnose_stops(m, ws, dampers, d);
   const std::vector<SuspiciousBody> bodies = suspicious_bodies(m);
   bool flagged = false;
   for (const auto& b : bodies) flagged = flagged || !b.note;
@@ -281,6 +301,7 @@ int cmd_check(int argc, char** argv) {
         {"n", n},
         {"coordinates", m.coordinate_names},
         {"states", K},
+        {"stop_states", pressed},
         {"condition", {{"min", finite_or_null(d.cond_lo)}, {"max", finite_or_null(d.cond_hi)}}},
         {"condition_overflows", d.singular_states < K && !std::isfinite(d.cond_hi)},
         {"digits_lost", finite_or_null(std::log10(d.cond_hi))},
@@ -311,7 +332,10 @@ int cmd_check(int argc, char** argv) {
     std::cout << json_text(j) << "\n";
   } else {
     std::cout << "model: " << m.name << " (" << n << " coordinates, " << m.bodies.size()
-              << " bodies), " << K << " states\n";
+              << " bodies), " << K << " states"
+              << (pressed ? " and " + std::to_string(pressed) + " pressed into their joint stops"
+                          : std::string())
+              << "\n";
     if (d.singular_states)
       std::cout << "M^s: singular at " << d.singular_states << " of " << K
                 << " states: " << d.singular_message << "\n";

@@ -14,8 +14,8 @@ constexpr const char* kHelp =
 Writes the femdyn JSON document of MODEL: a URDF robot converted (each link with an <inertial>
 becomes a body with one rigid_body element, its inertia rotated out of the <inertial> frame; a
 link with an inertia but zero mass gets a rotary_node; links without <inertial> are massless;
-joints keep their names, origins, axes, limits and damping, fixed joints are kept as fixed
-joints; <mimic> becomes a coupling; the root link is welded to the world; gravity (0, 0, -9.81)
+joints keep their names, origins, axes, limits, damping, friction and effort and velocity
+limits, fixed joints are kept as fixed joints; <mimic> becomes a coupling; the root link is welded to the world; gravity (0, 0, -9.81)
 m/s^2 unless --gravity), or a plugin model expanded. The file loads back to the same
 equations. It is written atomically: a failure leaves no partial file. An existing OUT.json is
 replaced only with --force, and never when it is MODEL itself.

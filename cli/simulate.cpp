@@ -31,7 +31,7 @@ Integrates M^s q̈ + h = Q from (q0, q̇0) (default 0) over [0, T] and prints a 
 integrator, steps, rejected steps, evaluations of forward dynamics, Jacobians, wall time,
 real-time factor (simulated time / integration wall time), and the energy balance: the largest
 |E(t) − E(0) − W(t)| over the output rows, W the work of the non-conservative forces (τ,
-dampers, body torques); for a conservative model that is the energy drift. It is given
+dampers, friction, joint stops, body torques); for a conservative model that is the energy drift. It is given
 relative to the energy the motion started with plus the work done (docs/simulation.md).
 
 integrators (docs/simulation.md):
@@ -57,7 +57,9 @@ memory limit (--max-memory GB, default half the available memory) with the memor
 adaptive run (dopri, bdf) over less than 1e-100 s is refused. A solution that diverges
 (its energy grows far beyond what it started with and was given) stops as a failure that names
 the stiffest mode and the step it allows. A joint that leaves its declared limits gets one
-warning (the joint, the time, the value). Exit 1 on a numerical fault or a divergence (the
+warning (the joint, the time, the value), as does one faster than its velocity limit; tau is
+saturated at the joints' effort limits, and the saturated evaluations and steps are counted and
+warned of (docs/control.md). Exit 1 on a numerical fault or a divergence (the
 message names the time, the quantity and the likely cause), 130 when interrupted.
 )";
 
@@ -252,7 +254,30 @@ int cmd_simulate(int argc, char** argv) {
     for (const LimitCrossing& c : run.limit_crossings)
       std::cerr << "femdyn simulate: warning: joint '" << c.name << "' left its limits ["
                 << num(c.lower) << ", " << num(c.upper) << "] at t = " << num(c.t) << " s (value "
-                << num(c.value) << "); limits are not enforced\n";
+                << num(c.value) << ")"
+                << (m.bodies[m.theta_joint[c.joint]].joint.stop
+                        ? "; its stop is compliant (docs/control.md)"
+                        : "; limits are not enforced")
+                << "\n";
+  if (!a.has("json")) {
+    for (const VelocityExcess& v : run.velocity_excesses)
+      std::cerr << "femdyn simulate: warning: joint '" << v.name << "' exceeded its velocity limit "
+                << num(v.limit) << " at t = " << num(v.t) << " s (rate " << num(v.value) << ")\n";
+    if (!run.unapplied_effort_limits.empty()) {
+      std::cerr << "femdyn simulate: warning: the effort limits of the coupled joints";
+      for (const std::string& name : run.unapplied_effort_limits) std::cerr << " '" << name << "'";
+      std::cerr << " are not applied (tau acts on the coordinates they follow)\n";
+    }
+    if (run.saturated_evaluations > 0) {
+      std::cerr << "femdyn simulate: warning: tau saturated at the effort limits in "
+                << run.saturated_evaluations << " of " << integ->stats().rhs_evals
+                << " evaluations and " << run.saturated_steps << " steps (";
+      for (std::size_t k = 0; k < run.saturations.size(); ++k)
+        std::cerr << (k ? ", " : "") << run.saturations[k].name << " at ±"
+                  << num(run.saturations[k].limit) << ": " << run.saturations[k].evaluations;
+      std::cerr << ")\n";
+    }
+  }
 
   const IntegratorStats& s = integ->stats();
   const double simulated = integ->t();
@@ -288,6 +313,17 @@ int cmd_simulate(int argc, char** argv) {
                            {"lower", c.lower},
                            {"upper", c.upper}});
     j["limit_crossings"] = crossings;
+    Json too_fast = Json::array(), saturated = Json::array();
+    for (const VelocityExcess& v : run.velocity_excesses)
+      too_fast.push_back({{"joint", v.name}, {"t", v.t}, {"value", v.value}, {"limit", v.limit}});
+    for (const EffortSaturation& e : run.saturations)
+      saturated.push_back(
+          {{"coordinate", e.name}, {"limit", e.limit}, {"evaluations", e.evaluations}});
+    j["velocity_excesses"] = too_fast;
+    j["saturations"] = saturated;
+    j["saturated_evaluations"] = run.saturated_evaluations;
+    j["saturated_steps"] = run.saturated_steps;
+    j["unapplied_effort_limits"] = run.unapplied_effort_limits;
     if (is_adaptive(o.kind))
       j["options"] = {{"rtol", o.adaptive.rtol}, {"atol", o.adaptive.atol}};
     else

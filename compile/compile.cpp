@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 
+#include "compile/actuators.hpp"
 #include "compile/compile_level.hpp"
 #include "compile/correlation.hpp"
 #include "core/body_inertia.hpp"
@@ -120,6 +121,7 @@ Joint compile_joint(const JointSpec& js, const std::string& body_name) {
   j.damping = js.damping;
   j.lower = js.lower;
   j.upper = js.upper;
+  compile_actuator(js, j);
   return j;
 }
 
@@ -346,6 +348,7 @@ Model compile_tree(MechanismSpec spec, const CompileOptions& options) {
   compile_coupling(spec, m);
   lay_out_coordinates(m);
   configuration_coupling(m);
+  compile_actuators(m);
   // The passes below run kinematics on the model being built: its routes so far (the reference
   // ones, no law) until choose_routes settles them.
   m.routes = choose_equation_routes(m);

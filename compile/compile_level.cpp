@@ -5,6 +5,7 @@
 #include <map>
 #include <numbers>
 
+#include "compile/actuators.hpp"
 #include "core/errors.hpp"
 #include "core/joints/kernel.hpp"
 #include "core/kinematics.hpp"
@@ -170,6 +171,7 @@ Model compile_with_coupling_level(MechanismSpec spec, const CompileOptions& opti
   m.C.resize(nt, n);
   m.C.setFromTriplets(entries.begin(), entries.end());
   m.C_sparse = m.C;
+  compile_actuators(m);
   m.theta0 = VecX::Zero(nt);  // θ0 = g(q_ref) − G q_ref on the one-coordinate joints
   for (int t = 0; t < nt; ++t)
     if (level->theta_q[t] >= 0) {

@@ -25,7 +25,13 @@ struct JointSpec {
   double pitch = 0;           // helical: m/rad
   double lower = -std::numeric_limits<double>::infinity();
   double upper = std::numeric_limits<double>::infinity();
-  double stiffness = 0, rest = 0, damping = 0;  // linear spring / damper on θ
+  double stiffness = 0, rest = 0, damping = 0;    // linear spring / damper on θ
+  double armature = 0, gear = 1;                  // rotor inertia I_a, gear ratio G
+  double friction = 0, friction_velocity = 0.01;  // Coulomb F_c, regularisation v_s
+  double effort_limit = std::numeric_limits<double>::infinity();
+  double velocity_limit = std::numeric_limits<double>::infinity();
+  bool stop = false;  // enforce [lower, upper] by a stiff stop (core/joints/passive.hpp)
+  double stop_stiffness = 1e4, stop_dissipation = 0.5;
   std::string where;
 };
 

@@ -6,6 +6,7 @@
 #include "core/body_inertia.hpp"
 #include "core/body_loads.hpp"
 #include "core/joints/kernel.hpp"
+#include "core/joints/passive.hpp"
 #include "core/kinematics.hpp"
 
 namespace femdyn {
@@ -15,7 +16,7 @@ namespace {
 double joint_force(const Joint& J, const Workspace& ws, const VecX& tau) {
   const int j = J.idx_v;
   return (tau.size() > j ? tau[j] : 0.0) +
-         spring_damper_force(J, ws.theta[J.idx_q], ws.theta_dot[j]);
+         passive_joint_force(J, ws.theta[J.idx_q], ws.theta_dot[j]);
 }
 
 Status dependent_pivot(const Model& model, int j) {
@@ -45,13 +46,13 @@ Status check_regularity(const Model& model, Workspace& ws) {
   for (int b = 0; b < nb; ++b)
     for (int k = 0; k < model.bodies[b].joint.nv; ++k) {
       const Vec6& S = column(model, ws, b, k);
-      scale = std::max(scale, S.dot(ws.composite[b] * S));
+      scale = std::max(scale, S.dot(ws.composite[b] * S) + model.bodies[b].joint.reflected_inertia);
     }
   for (int b = 0; b < nb; ++b)
     for (int k = 0; k < model.bodies[b].joint.nv; ++k) {
       const int j = model.bodies[b].joint.idx_v + k;
       const Vec6& S = column(model, ws, b, k);
-      const double Mjj = S.dot(ws.composite[b] * S);
+      const double Mjj = S.dot(ws.composite[b] * S) + model.bodies[b].joint.reflected_inertia;
       if (!std::isfinite(Mjj))
         return {false, "the mass matrix M^s has NaN or Inf entries", -1, true};
       if (!(Mjj > 1e-13 * scale))
@@ -61,7 +62,8 @@ Status check_regularity(const Model& model, Workspace& ws) {
   for (int b = nb - 1; b >= 0; --b)
     for (int k = model.bodies[b].joint.nv - 1; k >= 0; --k) {
       const Vec6& S = column(model, ws, b, k);
-      if (!(pivot(model, ws, b, k) >= 1e-13 * S.dot(ws.composite[b] * S)))
+      if (!(pivot(model, ws, b, k) >=
+            1e-13 * (S.dot(ws.composite[b] * S) + model.bodies[b].joint.reflected_inertia)))
         return dependent_pivot(model, model.bodies[b].joint.idx_v + k);
     }
   return {};
@@ -189,7 +191,7 @@ Status articulated_forward_dynamics(const Model& model, Workspace& ws, const Vec
     const int p = body.parent;
     if (body.joint.nv == 1) {
       A.U = A.IA * A.S;
-      A.d = A.S.dot(A.U);
+      A.d = A.S.dot(A.U) + body.joint.reflected_inertia;  // D = Sᵀ I^A S + I_a G²
       A.u = joint_force(body.joint, ws, tau) - A.S.dot(A.pA);
       if (p < 0) continue;
       A.IA.noalias() -= (A.U / A.d) * A.U.transpose();  // I^a = I^A − U Uᵀ / d

@@ -166,13 +166,15 @@ void composite_mass(const Model& m, Workspace& ws) {
 
 namespace {
 
-// Calls f(k, i, S_kᵀ I^c_b S_i) for every rate i (of body b = theta_joint[i]) and every rate
-// k = i, λ(i), λ(λ(i)), … on its path: the entries of M^s's upper triangle (k ≤ i).
+// Calls f(k, i, M_θ(k, i)) for every rate i (of body b = theta_joint[i]) and every rate
+// k = i, λ(i), λ(λ(i)), … on its path: the entries of M_θ's upper triangle (k ≤ i),
+// M_θ(k, i) = S_kᵀ I^c_b S_i, plus the joint's reflected rotor inertia I_a G² on the diagonal.
 template <class F>
 void for_path_entries(const Model& m, const Workspace& ws, F&& f) {
   for (int i = 0; i < m.n_theta(); ++i) {
     const Vec6 F_i = ws.composite[m.theta_joint[i]] * ws.subspace[i];
-    for (int k = i; k >= 0; k = m.rate_parent[k]) f(k, i, ws.subspace[k].dot(F_i));
+    f(i, i, ws.subspace[i].dot(F_i) + m.bodies[m.theta_joint[i]].joint.reflected_inertia);
+    for (int k = m.rate_parent[i]; k >= 0; k = m.rate_parent[k]) f(k, i, ws.subspace[k].dot(F_i));
   }
 }
 

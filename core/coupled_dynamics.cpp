@@ -4,6 +4,7 @@
 #include "core/body_loads.hpp"
 #include "core/coupling.hpp"
 #include "core/joints/kernel.hpp"
+#include "core/joints/passive.hpp"
 #include "core/kinematics.hpp"
 
 namespace femdyn {
@@ -49,8 +50,8 @@ Status coupled_forward_dynamics(const Model& model, Workspace& ws, const VecX& q
   // Q − h = τ + Cᵀ(spring + damper − τ_θ).
   for (int j = 0; j < model.n_theta(); ++j) {
     const Joint& J = model.bodies[model.theta_joint[j]].joint;
-    if (J.nv != 1) continue;  // (springs and dampers are on joints of one coordinate)
-    ws.tau_theta[j] += spring_damper_force(J, ws.theta[J.idx_q], ws.theta_dot[j]);
+    if (J.nv != 1) continue;  // (springs, dampers, friction and stops: joints of one coordinate)
+    ws.tau_theta[j] += passive_joint_force(J, ws.theta[J.idx_q], ws.theta_dot[j]);
   }
   coupling_apply_transpose(model, ws.tau_theta, ws.qdd);
   if (tau.size() == ws.qdd.size()) ws.qdd += tau;

@@ -10,6 +10,7 @@
 #include "core/coupling.hpp"
 #include "core/coupling_chain.hpp"
 #include "core/joints/kernel.hpp"
+#include "core/joints/passive.hpp"
 #include "core/kinematics.hpp"
 #include "core/mass_solver.hpp"
 #include "core/newton_euler.hpp"
@@ -67,8 +68,8 @@ void add_joint_forces(const Model& model, const Workspace& ws, bool with_rates, 
                       VecX& y) {
   for (int j = 0; j < model.n_theta(); ++j) {
     const Joint& J = model.bodies[model.theta_joint[j]].joint;
-    if (J.nv != 1) continue;  // (springs and dampers are on joints of one coordinate)
-    const double f = spring_damper_force(J, ws.theta[J.idx_q], with_rates ? ws.theta_dot[j] : 0.0);
+    if (J.nv != 1) continue;  // (springs, dampers, friction and stops: joints of one coordinate)
+    const double f = passive_joint_force(J, ws.theta[J.idx_q], with_rates ? ws.theta_dot[j] : 0.0);
     if (f != 0) coupling_add_row(model, j, sign * f, y);
   }
 }
@@ -97,8 +98,11 @@ void form_mass_matrix(const Model& model, Workspace& ws) {
       ws.MT.resize(ws.T.rows(), ws.T.cols());  // first use only
     ws.MT.noalias() = model.M * ws.T;
     ws.Ms.noalias() = ws.T.transpose() * ws.MT;
+    mirror_upper(ws.Ms);
+    if (model.has_armature) ws.Ms += model.armature_mass;  // + Cᵀ diag(I_a G²) C
+    return;
   }
-  mirror_upper(ws.Ms);
+  mirror_upper(ws.Ms);  // (the composite route has the rotor inertia on its diagonal)
 }
 
 // M^s alone: the body poses (composite) or T (transform), then form_mass_matrix.
@@ -173,6 +177,7 @@ void inverse_by_bodies(const Model& model, Workspace& ws, const VecX& q, const V
                        const VecX& qdd) {
   newton_euler(model, ws, q, qd, &qdd, true, ws.tau);
   add_joint_forces(model, ws, true, -1.0, ws.tau);
+  if (model.has_armature) ws.tau.noalias() += model.armature_mass * qdd;  // rotors: M_a q̈
 }
 
 // τ = M^s q̈ + h − Q(τ = 0) = Tᵀ (M (T q̈ + T'[q̇,q̇]) + g(u̇,u̇) − F) − Cᵀ(spring + damper),
@@ -190,6 +195,7 @@ void inverse_by_nodes(const Model& model, Workspace& ws, const VecX& q, const Ve
   if (model.has_nodal_forces) ws.nodal -= model.F_constant;
   apply_transpose(model, ws, ws.nodal, ws.tau, model.has_nodal_forces ? -1.0 : 0.0);
   add_joint_forces(model, ws, true, -1.0, ws.tau);
+  if (model.has_armature) ws.tau.noalias() += model.armature_mass * qdd;  // rotors: M_a q̈
 }
 
 std::vector<MatX> transform_hessian_levels(const Model& model, Workspace& ws, const VecX& q) {
@@ -246,6 +252,10 @@ Energy energy_levels(const Model& model, Workspace& ws, const VecX& q, const Vec
       V << B.R.transpose() * B.w, B.R.transpose() * B.v;
       E.kinetic += 0.5 * V.dot(model.body_inertia[b] * V);
     }
+    if (model.has_armature)  // the rotors: ½ Σ I_a G² θ̇² (the other route has them in M^s)
+      for (int j = 0; j < model.n_theta(); ++j)
+        E.kinetic += 0.5 * model.bodies[model.theta_joint[j]].joint.reflected_inertia *
+                     ws.theta_dot[j] * ws.theta_dot[j];
   } else {
     evaluate(model, ws, q, qd, VecX());
     E.kinetic = 0.5 * qd.dot(ws.Ms.lazyProduct(qd));  // (no temporary: looked at mid-run)
@@ -260,8 +270,7 @@ Energy energy_levels(const Model& model, Workspace& ws, const VecX& q, const Vec
   }
   for (int j = 0; j < model.n_theta(); ++j) {
     const Joint& J = model.bodies[model.theta_joint[j]].joint;
-    if (J.stiffness == 0) continue;
-    E.potential += 0.5 * J.stiffness * (ws.theta[J.idx_q] - J.rest) * (ws.theta[J.idx_q] - J.rest);
+    if (J.nv == 1) E.potential += passive_joint_potential(J, ws.theta[J.idx_q]);
   }
   return E;
 }

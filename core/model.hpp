@@ -8,6 +8,7 @@
 #pragma once
 #include <Eigen/Sparse>
 #include <array>
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
@@ -36,6 +37,16 @@ struct Joint {
   int idx_q = -1, idx_v = -1;    // its first coordinate in θ, first rate in θ̇; -1 when fixed
   double lower = 0, upper = 0;
   double stiffness = 0, rest = 0, damping = 0;
+  // Actuator and friction (core/joints/passive.hpp; 1-DOF joints only): rotor inertia I_a and
+  // gear ratio G (reflected inertia I_a G² on θ̇, derived below), Coulomb friction F_c with its
+  // regularisation velocity v_s, effort and velocity limits (+inf: none), and an enforced stop at
+  // [lower, upper] (Simbody's MobilityLinearStop: stiffness k, Hunt–Crossley dissipation d).
+  double armature = 0, gear = 1;
+  double friction = 0, friction_velocity = 0.01;
+  double effort_limit = INFINITY, velocity_limit = INFINITY;
+  bool stop = false;
+  double stop_stiffness = 1e4, stop_dissipation = 0.5;
+  double reflected_inertia = 0;  // derived: I_a G²
   std::string where;
   // Derived by compile() for the pose (core/joints/): R_pj [a]×, R_pj [a]×², R_pj a.
   Mat3 R_pj_K = Mat3::Zero(), R_pj_K2 = Mat3::Zero();
@@ -209,6 +220,14 @@ struct Model {
   // (core/coupling_chain.hpp).
   std::shared_ptr<const CouplingLevel> coupling_level;
   std::shared_ptr<const Model> tree;
+
+  // Actuators (core/joints/passive.hpp), decided once by compile(): the reflected rotor
+  // inertia on q, M_a = Cᵀ diag(I_a G²) C (n × n; empty without armature), and each rate's
+  // effort limit |τ_i| ≤ effort_limit_i of its joint (+inf: none; empty without limits).
+  bool has_armature = false;
+  SpMat armature_mass;
+  VecX effort_limit;
+  bool has_effort_limits = false;
 
   bool has_nodal_forces = false;     // gravity or loads present
   bool has_velocity_forces = false;  // some element has a gyroscopic term

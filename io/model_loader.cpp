@@ -95,8 +95,28 @@ JointType joint_type(const Params& p) {
   p.fail("type", "unknown joint type " + quoted_text(t) + " (expected " + joint_type_list() + ")");
 }
 
+// The joint's actuator, friction and stop (docs/model-format.md); compile checks their ranges.
+void read_actuator(const Params& p, JointSpec& j) {
+  if (p.has("armature")) j.armature = p.non_negative("armature");
+  if (p.has("gear")) j.gear = p.number("gear");
+  if (p.has("friction")) j.friction = p.non_negative("friction");
+  if (p.has("friction_velocity")) j.friction_velocity = p.positive("friction_velocity");
+  if (p.has("effort_limit")) j.effort_limit = p.positive("effort_limit");
+  if (p.has("velocity_limit")) j.velocity_limit = p.positive("velocity_limit");
+  if (p.has("stop")) {
+    const Params s = p.child("stop");
+    s.allow_only({"stiffness", "dissipation"});
+    j.stop = true;
+    if (s.has("stiffness")) j.stop_stiffness = s.positive("stiffness");
+    if (s.has("dissipation")) j.stop_dissipation = s.non_negative("dissipation");
+    if (!p.has("limits")) p.fail("stop", "a stop needs the joint's limits [lower, upper]");
+  }
+}
+
 JointSpec read_joint(const Params& p) {
-  p.allow_only({"name", "type", "origin", "axis", "axis2", "pitch", "limits", "spring", "damping"});
+  p.allow_only({"name", "type", "origin", "axis", "axis2", "pitch", "limits", "spring", "damping",
+                "armature", "gear", "friction", "friction_velocity", "effort_limit",
+                "velocity_limit", "stop"});
   JointSpec j;
   j.where = p.where();
   j.name = p.has("name") ? p.string("name") : "";
@@ -120,6 +140,10 @@ JointSpec read_joint(const Params& p) {
     for (const char* key : {"axis", "limits", "spring", "damping"})
       if (p.has(key))
         p.fail(key, "a fixed joint has no motion: no axis, limits, spring or damping");
+  if (j.type == JointType::Fixed)
+    for (const char* key : {"armature", "gear", "friction", "friction_velocity", "effort_limit",
+                            "velocity_limit", "stop"})
+      if (p.has(key)) p.fail(key, "a fixed joint has no motion: no actuator, friction or stop");
   if (p.has("limits")) {
     const Json& l = p.json().at("limits");
     if (!l.is_array() || l.size() != 2) p.fail("limits", "expected [lower, upper]");
@@ -133,6 +157,7 @@ JointSpec read_joint(const Params& p) {
     j.rest = s.number_or("rest", 0.0);
   }
   if (p.has("damping")) j.damping = p.non_negative("damping");
+  read_actuator(p, j);
   return j;
 }
 

@@ -229,14 +229,26 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source,
         if (lo > hi) c.fail(who, "limit lower > upper");
         if (lo < hi) joint["limits"] = {lo, hi};
       }
+      // <limit effort velocity>: τ saturated at ±effort, |θ̇| beyond velocity reported. URDF
+      // requires both; 0 (common for "not given") leaves that limit out, with a warning.
+      for (const auto& [attr, key] :
+           {std::pair{"effort", "effort_limit"}, std::pair{"velocity", "velocity_limit"}}) {
+        if (!lim || !lim->Attribute(attr)) continue;
+        const double x = number_attr(c, lim, attr, 0, who);
+        if (x < 0) c.fail(who, std::string("negative limit ") + attr);
+        if (x > 0)
+          joint[key] = x;
+        else
+          out.warnings.push_back(source + ": " + who + ": <limit " + attr + "=\"0\"> read as no " +
+                                 attr + " limit");
+      }
       if (const XMLElement* dyn = ji.e->FirstChildElement("dynamics")) {
         const double damping = number_attr(c, dyn, "damping", 0, who);
         const double friction = number_attr(c, dyn, "friction", 0, who);
         if (damping < 0) c.fail(who, "negative damping");
         if (damping > 0) joint["damping"] = damping;
-        if (friction != 0)
-          out.warnings.push_back(source + ": " + who + ": friction " + format_number(friction) +
-                                 " ignored (femdyn models no joint friction)");
+        if (friction < 0) c.fail(who, "negative friction");
+        if (friction > 0) joint["friction"] = friction;  // Coulomb, regularised (docs/control.md)
       }
       if (const XMLElement* mimic = ji.e->FirstChildElement("mimic")) {
         const char* leader = mimic->Attribute("joint");

@@ -3,7 +3,8 @@
 //   links  -> bodies with one rigid_body element (inertia rotated out of the <inertial> frame)
 //   joints -> revolute / continuous / prismatic / fixed / planar joints, floating -> free;
 //             <mimic> -> couplings;
-//             <dynamics damping> -> joint dampers (friction is ignored, with a warning)
+//             <dynamics damping friction> -> joint dampers and Coulomb friction
+//             <limit effort velocity> -> effort limits (τ saturated) and velocity limits (reported)
 //   the root link is welded to the world (its children hang from "world"), or with
 //   `floating_base` a body of its own on a free joint named after it (a floating base).
 // Errors: ModelError "file.urdf: joint 'elbow': axis is zero" (the element and the problem).

@@ -38,7 +38,12 @@ void check_fixed_joint(const JointSpec& j) {
                       : j.lower != defaults.lower || j.upper != defaults.upper       ? "limits"
                       : j.stiffness != defaults.stiffness || j.rest != defaults.rest ? "spring"
                       : j.damping != defaults.damping                                ? "damping"
-                                                                                     : nullptr;
+                      : j.armature != defaults.armature || j.gear != defaults.gear   ? "armature"
+                      : j.friction != defaults.friction                              ? "friction"
+                      : j.effort_limit != defaults.effort_limit     ? "effort_limit"
+                      : j.velocity_limit != defaults.velocity_limit ? "velocity_limit"
+                      : j.stop                                      ? "stop"
+                                                                    : nullptr;
   if (given)
     throw ModelError(j.where + "/" + given,
                      "a fixed joint has no motion: no axis, limits, spring or damping (is the "

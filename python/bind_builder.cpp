@@ -72,6 +72,46 @@ NodeDescription node_arg(const py::object& node, const char* name) {
 using OptArray = std::optional<Array>;
 using OptNumber = std::optional<double>;
 
+// Builder.body's actuator, friction and stop arguments (None: not given). `stop`: None, a bool,
+// or a dict {"stiffness": k, "dissipation": d} (docs/model-format.md).
+struct ActuatorArgs {
+  OptNumber armature, gear, friction, friction_velocity, effort_limit, velocity_limit;
+  py::object stop = py::none();
+  bool given() const {
+    return armature || gear || friction || friction_velocity || effort_limit || velocity_limit ||
+           !stop.is_none();
+  }
+};
+
+void actuator_arg(const ActuatorArgs& a, JointSpec& j) {
+  if (j.type == JointType::Fixed && a.given())
+    throw py::value_error("a fixed joint has no motion: no actuator, friction or stop");
+  j.armature = a.armature.value_or(j.armature);
+  j.gear = a.gear.value_or(j.gear);
+  j.friction = a.friction.value_or(j.friction);
+  j.friction_velocity = a.friction_velocity.value_or(j.friction_velocity);
+  j.effort_limit = a.effort_limit.value_or(j.effort_limit);
+  j.velocity_limit = a.velocity_limit.value_or(j.velocity_limit);
+  if (a.stop.is_none()) return;
+  if (py::isinstance<py::bool_>(a.stop)) {
+    j.stop = a.stop.cast<bool>();
+    return;
+  }
+  if (!py::isinstance<py::dict>(a.stop))
+    throw py::type_error("stop: expected True or a dict {'stiffness': k, 'dissipation': d}");
+  j.stop = true;
+  for (const auto& [key, value] : a.stop.cast<py::dict>()) {
+    const std::string k = py::str(key);
+    if (k == "stiffness")
+      j.stop_stiffness = value.cast<double>();
+    else if (k == "dissipation")
+      j.stop_dissipation = value.cast<double>();
+    else
+      throw py::value_error("stop: unknown key " + quoted_text(k) +
+                            " (expected stiffness, dissipation)");
+  }
+}
+
 // Builder.body's joint: `type` and the arguments that describe the joint, each None when not
 // given. Without a type the body is welded to its parent (a fixed joint at its origin), so a
 // joint argument without one is refused: it would be ignored, or (xyz, rpy) weld a body that
@@ -151,22 +191,37 @@ void bind_builder(py::module_& m) {
              const std::optional<std::string>& type, const std::optional<std::string>& joint,
              const OptArray& axis, const OptArray& xyz, const OptArray& rpy,
              const std::optional<std::pair<double, double>>& limits, OptNumber stiffness,
-             OptNumber rest, OptNumber damping, const OptArray& axis2, OptNumber pitch) {
-            b.body(text_arg(name, "name"), text_arg(parent, "parent"),
-                   joint_arg(text_arg(type, "type"), text_arg(joint, "joint"), axis, xyz, rpy,
-                             limits, stiffness, rest, damping, axis2, pitch));
+             OptNumber rest, OptNumber damping, const OptArray& axis2, OptNumber pitch,
+             OptNumber armature, OptNumber gear, OptNumber friction, OptNumber friction_velocity,
+             OptNumber effort_limit, OptNumber velocity_limit, const py::object& stop) {
+            const ActuatorArgs act{armature,     gear,           friction, friction_velocity,
+                                   effort_limit, velocity_limit, stop};
+            if (!type && act.given())
+              throw py::value_error(
+                  "actuator, friction or stop: given without a joint type; a body without "
+                  "type= is welded to its parent (say type='revolute' or 'prismatic')");
+            JointSpec j = joint_arg(text_arg(type, "type"), text_arg(joint, "joint"), axis, xyz,
+                                    rpy, limits, stiffness, rest, damping, axis2, pitch);
+            actuator_arg(act, j);
+            b.body(text_arg(name, "name"), text_arg(parent, "parent"), std::move(j));
           },
           py::arg("name"), py::arg("parent") = "world", py::arg("type") = py::none(),
           py::arg("joint") = py::none(), py::arg("axis") = py::none(), py::arg("xyz") = py::none(),
           py::arg("rpy") = py::none(), py::arg("limits") = py::none(),
           py::arg("stiffness") = py::none(), py::arg("rest") = py::none(),
           py::arg("damping") = py::none(), py::arg("axis2") = py::none(),
-          py::arg("pitch") = py::none(),
+          py::arg("pitch") = py::none(), py::arg("armature") = py::none(),
+          py::arg("gear") = py::none(), py::arg("friction") = py::none(),
+          py::arg("friction_velocity") = py::none(), py::arg("effort_limit") = py::none(),
+          py::arg("velocity_limit") = py::none(), py::arg("stop") = py::none(),
           "A body on `parent` ('world': the ground) by a joint of `type` (revolute, prismatic, "
           "fixed, helical, universal, planar, spherical, free; docs/notation.md) named `joint` "
           "(default: the body's name), at xyz, rpy (default 0), about axis (default (0, 0, 1)), "
           "with limits (lower, upper), a spring (stiffness, rest) and a damper; a universal "
-          "joint's second axis `axis2`, a helical joint's `pitch` (m/rad). Without type the body "
+          "joint's second axis `axis2`, a helical joint's `pitch` (m/rad); a rotor `armature` "
+          "(kg·m²) behind a `gear` ratio, Coulomb `friction` regularised at `friction_velocity`, "
+          "`effort_limit`, `velocity_limit`, and `stop` (True or {'stiffness': k, "
+          "'dissipation': d}) enforcing the limits (docs/control.md). Without type the body "
           "is welded to its parent's origin and no other joint argument may be given (ValueError "
           "naming it); a fixed joint takes no axis, limits, spring or damper.")
       .def(

@@ -204,6 +204,28 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
     crossings.append(x);
   }
   stats["limit_crossings"] = crossings;
+  py::list too_fast;
+  for (const VelocityExcess& v : run.velocity_excesses) {
+    py::dict x;
+    x["joint"] = v.name;
+    x["t"] = v.t;
+    x["value"] = v.value;
+    x["limit"] = v.limit;
+    too_fast.append(x);
+  }
+  stats["velocity_excesses"] = too_fast;
+  py::list saturated;
+  for (const EffortSaturation& e : run.saturations) {
+    py::dict x;
+    x["coordinate"] = e.name;
+    x["limit"] = e.limit;
+    x["evaluations"] = e.evaluations;
+    saturated.append(x);
+  }
+  stats["saturations"] = saturated;
+  stats["saturated_evaluations"] = run.saturated_evaluations;
+  stats["saturated_steps"] = run.saturated_steps;
+  stats["unapplied_effort_limits"] = run.unapplied_effort_limits;
   stats["failure"] = st.message;
   py::dict d;
   d["t"] = vector_array(rows.t);

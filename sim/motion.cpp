@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "core/joints/kernel.hpp"
+#include "core/joints/passive.hpp"
 #include "core/sampling.hpp"
 
 namespace femdyn {
@@ -20,8 +21,8 @@ double nonconservative_power(const Model& model, const Workspace& ws, const VecX
   if (qd.isZero(0)) return 0;  // at rest nothing does work (and ω, θ̇ were not propagated)
   double P = tau.size() == qd.size() ? qd.dot(tau) : 0.0;
   for (int j = 0; j < model.n_theta(); ++j) {
-    const double c = model.bodies[model.theta_joint[j]].joint.damping;
-    if (c != 0) P -= c * ws.theta_dot[j] * ws.theta_dot[j];
+    const Joint& J = model.bodies[model.theta_joint[j]].joint;
+    if (J.nv == 1 && dissipates(J)) P += passive_joint_power(J, ws.theta[J.idx_q], ws.theta_dot[j]);
   }
   for (const BodyTorque& t : model.torques) P += t.torque.dot(ws.body[t.body].w);
   return P;
@@ -30,6 +31,7 @@ double nonconservative_power(const Model& model, const Workspace& ws, const VecX
 Motion::Motion(const Model& model, Actuation tau)
     : model_(model), tau_(std::move(tau)), ws_(model) {
   q_ = qd_ = u_ = VecX::Zero(model.n());
+  saturations_.assign(model.n(), 0);
   flat_ = flat_model(model);
   if (!flat_) q_c_ = q_ = neutral_posture(model);
 }
@@ -113,7 +115,7 @@ Status Motion::rhs(double t, const double* y, double* ydot) {
                   " entries, expected " + std::to_string(n),
               -1};
   } else {
-    actuation(t, u_);
+    requested_actuation(t, u_);
   }
   // (an input's fault, not an overflow of the motion: non_finite stays false)
   if (!u_.allFinite())
@@ -121,6 +123,7 @@ Status Motion::rhs(double t, const double* y, double* ydot) {
             at_time(t) + (control_ ? "the controller's tau is NaN or Inf"
                                    : "the actuation tau(t) is NaN or Inf"),
             -1};
+  if (model_.has_effort_limits) count_saturation(u_);
   Status st = forward_dynamics(model_, ws_, q_, qd_, u_);
   if (!st.ok) {
     st.message = at_time(t) + st.message;
@@ -132,7 +135,7 @@ Status Motion::rhs(double t, const double* y, double* ydot) {
   return {};
 }
 
-void Motion::actuation(double t, VecX& tau) const {
+void Motion::requested_actuation(double t, VecX& tau) const {
   if (tau_)
     tau_(t, tau);
   else
@@ -140,16 +143,44 @@ void Motion::actuation(double t, VecX& tau) const {
 }
 
 void Motion::tau_at(double t, const VecX& q, const VecX& v, VecX& tau) const {
-  if (control_)
-    control_(t, q, v, tau);
-  else
-    actuation(t, tau);
+  if (!control_) return actuation(t, tau);
+  control_(t, q, v, tau);
+  if (model_.has_effort_limits && tau.size() == n())
+    tau = tau.cwiseMax(-model_.effort_limit).cwiseMin(model_.effort_limit);
 }
 
 void Motion::rethrow_control_error() {
   if (!control_error_) return;
   std::exception_ptr e = std::exchange(control_error_, nullptr);
   std::rethrow_exception(e);
+}
+
+void Motion::actuation(double t, VecX& tau) const {
+  requested_actuation(t, tau);
+  if (model_.has_effort_limits)
+    tau = tau.cwiseMax(-model_.effort_limit).cwiseMin(model_.effort_limit);
+}
+
+bool Motion::saturated_at(double t) const {
+  if (!model_.has_effort_limits) return false;
+  if (control_) return last_saturated_;
+  VecX tau;
+  requested_actuation(t, tau);
+  return (tau.cwiseAbs().array() > model_.effort_limit.array()).any();
+}
+
+// τ_i clamped to ±effort_i, each clamp counted.
+void Motion::count_saturation(VecX& tau) {
+  bool any = false;
+  for (int i = 0; i < n(); ++i) {
+    const double e = model_.effort_limit[i];
+    if (!(std::abs(tau[i]) > e)) continue;
+    tau[i] = std::copysign(e, tau[i]);
+    ++saturations_[i];
+    any = true;
+  }
+  last_saturated_ = any;
+  if (any) ++saturated_evaluations_;
 }
 
 Energy Motion::energy_at(const double* y) {

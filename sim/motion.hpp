@@ -14,7 +14,8 @@
 // fixed step, and whenever a rotation in ξ passes kChartLimit for the adaptive ones. Quaternions
 // are therefore advanced by the exponential map and stay of norm 1 to round-off.
 //
-// with W the work done by the non-conservative forces (actuation τ, joint dampers, body torques)
+// with W the work done by the non-conservative forces (actuation τ saturated at the joints'
+// effort limits, joint dampers, Coulomb friction and stop dissipation, body torques)
 // and P_nc its power, so that E(t) − E(0) = W(t) for the mechanical energy E of
 // core/equations.hpp (docs/simulation.md). Every evaluation goes through forward_dynamics and is
 // checked: a singular or indefinite M^s, or a NaN/Inf in q̈, is a failed Status naming the time,
@@ -22,6 +23,7 @@
 #pragma once
 #include <exception>
 #include <functional>
+#include <vector>
 
 #include "core/equations.hpp"
 
@@ -67,11 +69,21 @@ class Motion {
 
   // Mechanical energy at y (kinetic, potential; the work W is y's last entry).
   Energy energy_at(const double* y);
-  // τ at (t, q, v): the controller's when there is one, else τ(t) (zero when passive).
+  // τ at (t, q, v) as applied: the controller's when there is one, else τ(t) (zero when
+  // passive), saturated at the joints' effort limits.
   void tau_at(double t, const VecX& q, const VecX& v, VecX& tau) const;
   // The exception the controller threw in the last failed rhs, rethrown (then cleared); nothing
   // if it threw none.
   void rethrow_control_error();
+  // τ(t) (zero when passive), saturated at the joints' effort limits |τ_i| ≤ effort_i.
+  void actuation(double t, VecX& tau) const;
+  // τ(t) as asked, before saturation; whether some |τ_i(t)| asked exceeds its effort limit
+  // (under a controller, which is not called again for it: whether the last evaluation's did).
+  void requested_actuation(double t, VecX& tau) const;
+  bool saturated_at(double t) const;
+  // The evaluations (rhs) whose τ was saturated, and per coordinate how many times it was.
+  long saturated_evaluations() const { return saturated_evaluations_; }
+  const std::vector<long>& saturations() const { return saturations_; }
   // The workspace of the last evaluation (rhs or energy_at).
   const Workspace& workspace() const { return ws_; }
 
@@ -86,11 +98,17 @@ class Motion {
   VecX q_c_;         // the chart centre (non-flat)
   VecX q_, qd_, u_;  // buffers: q, q̇ (v), τ at the evaluated state
   long evaluations_ = 0;
+  long saturated_evaluations_ = 0;
+  bool last_saturated_ = false;  // the last evaluation's τ was saturated
+  std::vector<long> saturations_;
+  void count_saturation(VecX& tau);
 };
 
 // Power of the non-conservative forces at the state of the last evaluate(model, ws, q, q̇, τ):
-//   P_nc = q̇ᵀ τ − Σ_j c_j θ̇_j² + Σ_b τ_b · ω_b      (actuation, dampers, body torques).
-// Gravity, constant point loads and springs are conservative: they are in E's potential.
+//   P_nc = q̇ᵀ τ + Σ_j P_j(θ_j, θ̇_j) + Σ_b τ_b · ω_b      (actuation, joints, body torques),
+// P_j the joint's damper, Coulomb friction and stop dissipation (core/joints/passive.hpp).
+// Gravity, constant point loads, springs and the stops' elastic part are conservative: they are
+// in E's potential.
 double nonconservative_power(const Model& model, const Workspace& ws, const VecX& qd,
                              const VecX& tau);
 

@@ -7,7 +7,8 @@
 // with plus the work done, which does not grow with the error. The run is planned first
 // (Integrator::plan: a fixed-step run beyond max_steps is refused before any work), and a
 // solution that diverges fails as such (sim/integrator.hpp). Joints that leave their declared
-// limits are recorded, once per joint, at the first step that finds them outside.
+// limits are recorded, once per joint, at the first step that finds them outside; so are joints
+// that exceed their velocity limit. τ saturated at effort limits is counted (sim/motion.hpp).
 #pragma once
 #include <functional>
 #include <vector>
@@ -24,6 +25,20 @@ struct LimitCrossing {
   double t = 0, value = 0, lower = 0, upper = 0;
 };
 
+// A joint whose rate |θ̇| exceeded its velocity limit (the first step found it so).
+struct VelocityExcess {
+  int joint = -1;  // θ index
+  std::string name;
+  double t = 0, value = 0, limit = 0;
+};
+
+// A coordinate whose τ was saturated at its joint's effort limit, in how many evaluations of f.
+struct EffortSaturation {
+  std::string name;  // the coordinate
+  double limit = 0;
+  long evaluations = 0;
+};
+
 struct RecordedRun {
   Status status;             // the plan's or the integrator's failure (rows end at its last step)
   bool interrupted = false;  // `stop` ended the run
@@ -33,6 +48,13 @@ struct RecordedRun {
   double scale = 0;          // S₀ + max over the rows of |W| (J): the fixed scale of the balance
   double relative_balance() const { return scale > 0 ? max_balance / scale : max_balance; }
   std::vector<LimitCrossing> limit_crossings;
+  std::vector<VelocityExcess> velocity_excesses;
+  // Effort limits: evaluations of f whose τ was saturated, steps that ended with τ(t) asked
+  // beyond a limit, and the coordinates saturated (those with an evaluation saturated).
+  long saturated_evaluations = 0, saturated_steps = 0;
+  std::vector<EffortSaturation> saturations;
+  // Coupled joints with an effort limit: no τ acts on them directly, so it is not applied.
+  std::vector<std::string> unapplied_effort_limits;
   long rows = 0;
   double wall_time = 0;  // s, the whole loop (rows included)
 };
@@ -45,8 +67,8 @@ RecordedRun run_recorded(Integrator& integ, double t_end, long every,
                          const std::function<void(const Integrator&, const Energy&)>& row,
                          const std::function<bool(double t)>& stop);
 
-// True when nothing but conservative forces acts: no τ (`driven` false), no damper, no body
-// torque. The energy balance is then the energy drift.
+// True when nothing but conservative forces acts: no τ (`driven` false), no damper, friction
+// or dissipating stop, no body torque. The energy balance is then the energy drift.
 bool conservative(const Model& model, bool driven);
 
 }  // namespace femdyn

@@ -6,6 +6,7 @@
 #include <limits>
 #include <numbers>
 
+#include "core/joints/passive.hpp"
 #include "core/sampling.hpp"
 
 namespace femdyn {
@@ -196,7 +197,7 @@ std::optional<double> largest_stable_step(const Linearization& lin, IntegratorKi
 
 bool has_dampers(const Model& m) {
   for (const Body& b : m.bodies)
-    if (b.joint.damping != 0) return true;
+    if (dissipates(b.joint)) return true;
   return false;
 }
 

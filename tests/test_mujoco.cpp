@@ -10,6 +10,7 @@
 #include "core/equations.hpp"
 #include "core/sampling.hpp"
 #include "io/model_loader.hpp"
+#include "io/urdf_loader.hpp"
 #include "tests/helpers.hpp"
 #include "validation/mujoco_peer.hpp"
 
@@ -137,5 +138,40 @@ TEST_CASE(
       CHECK(e_inverse < 1e-10);
       CHECK(e_forward < 1e-10);
     }
+  }
+}
+
+TEST_CASE("MuJoCo peer: the iiwa with rotors behind gears (dof_armature) equals femdyn's armature",
+          "[mujoco][validation][actuators]") {
+  // URDF has no armature: femdyn's document of the iiwa is given one per joint, and MuJoCo's
+  // dof_armature the same I_a G², an independent implementation of the reflected inertia.
+  const std::string path = robot_path("iiwa");
+  Json doc = read_urdf(path).model;
+  int k = 0;
+  for (Json& b : doc["bodies"]) {
+    if (b["joint"]["type"] == "fixed") continue;
+    b["joint"]["armature"] = 1e-4 * (1 + k);
+    b["joint"]["gear"] = 100 - 10 * k;
+    ++k;
+  }
+  const Model m = load_text(doc.dump());
+  REQUIRE(m.has_armature);
+  VecX armature(m.n());
+  for (int j = 0; j < m.n(); ++j) armature[j] = m.bodies[m.theta_joint[j]].joint.reflected_inertia;
+  CHECK(armature.minCoeff() > 0.1);  // comparable with the links' own inertias
+  validation::MujocoPeer peer(path, m.gravity, false, m.coordinate_names, armature);
+  validation::MujocoPeer plain(path, m.gravity, false, m.coordinate_names);
+  Workspace ws(m);
+  std::mt19937 rng(3);
+  for (int i = 0; i < 4; ++i) {
+    const VecX q = random_posture(m, rng), qd = random_uniform(m.n(), 2, rng);
+    const VecX qdd = random_uniform(m.n(), 5, rng), tau = random_uniform(m.n(), 1, rng);
+    mass_matrix(m, ws, q);
+    CHECK(rel_error(ws.Ms, peer.mass(q)) < 1e-10);
+    CHECK(rel_error(ws.Ms, plain.mass(q)) > 1e-3);  // (the armature is not negligible)
+    inverse_dynamics(m, ws, q, qd, qdd);
+    CHECK(rel_error(ws.tau, peer.inverse(q, qd, qdd)) < 1e-10);
+    REQUIRE(forward_dynamics(m, ws, q, qd, tau).ok);
+    CHECK(rel_error(ws.qdd, peer.forward(q, qd, tau)) < 1e-10);
   }
 }

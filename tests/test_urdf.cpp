@@ -371,7 +371,40 @@ TEST_CASE(
   int prismatic = 0;
   for (const Body& b : gantry.bodies) prismatic += b.joint.type == JointType::Prismatic;
   CHECK(prismatic == 3);
-  CHECK(read_urdf(model_path("urdf/gantry.urdf")).warnings.size() == 2);  // rail friction
+  // The rails' <dynamics friction> is Coulomb friction now, and <limit effort velocity> read:
+  // nothing is ignored, so nothing is warned of.
+  CHECK(read_urdf(model_path("urdf/gantry.urdf")).warnings.empty());
+  const Joint& rail = gantry.bodies[0].joint;
+  CHECK(rail.friction == 5);
+  CHECK(rail.damping == 40);
+  CHECK(rail.effort_limit == 2000);
+  CHECK(rail.velocity_limit == 1.0);
+  CHECK(gantry.has_effort_limits);
+}
+
+TEST_CASE("URDF <limit effort=\"0\"> is read as no limit, with a warning; negatives refused",
+          "[urdf][actuators]") {
+  const auto robot = [](const std::string& limit, const std::string& dynamics) {
+    return R"(<robot name="r"><link name="base"/><link name="l">)" +
+           inertial(1, "0.1 0 0", "0 0 0", 0.01, 0.01, 0.01) +
+           R"(</link><joint name="j" type="revolute"><parent link="base"/><child link="l"/>
+           <axis xyz="0 0 1"/>)" +
+           limit + dynamics + "</joint></robot>";
+  };
+  const UrdfResult r =
+      urdf_to_model(robot(R"(<limit lower="-1" upper="1" effort="0" velocity="2"/>)",
+                          R"(<dynamics friction="0.4"/>)"),
+                    "r.urdf");
+  REQUIRE(r.warnings.size() == 1);
+  CHECK_THAT(r.warnings[0], Catch::Contains("joint 'j'") && Catch::Contains("effort"));
+  const Json& j = r.model["bodies"][0]["joint"];
+  CHECK(!j.contains("effort_limit"));
+  CHECK(j["velocity_limit"] == 2.0);
+  CHECK(j["friction"] == 0.4);
+  CHECK_THAT(error_of(robot(R"(<limit lower="-1" upper="1" effort="-3" velocity="2"/>)", "")),
+             Equals("bad.urdf: joint 'j': negative limit effort"));
+  CHECK_THAT(error_of(robot("", R"(<dynamics friction="-1"/>)")),
+             Equals("bad.urdf: joint 'j': negative friction"));
 }
 
 TEST_CASE("bad URDF: one line naming the file, the link or joint, and the problem", "[urdf]") {

@@ -244,7 +244,7 @@ struct MujocoPeer::Impl {
 };
 
 MujocoPeer::MujocoPeer(const std::string& urdf_path, const Eigen::Vector3d& gravity, bool floating,
-                       const std::vector<std::string>& coordinates)
+                       const std::vector<std::string>& coordinates, const Eigen::VectorXd& armature)
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   const std::string text = prepared_urdf(urdf_path, floating);
@@ -295,6 +295,7 @@ MujocoPeer::MujocoPeer(const std::string& urdf_path, const Eigen::Vector3d& grav
       refuse("no hinge or slide joint named '" + coordinates[k] + "'");
     s.coord_q.push_back(m.jnt_qposadr[j]);
     s.coord_v.push_back(m.jnt_dofadr[j]);
+    if (armature.size() == s.n) m.dof_armature[m.jnt_dofadr[j]] = armature[k];  // I_a G²
   }
   s.d.reset(mj_makeData(&m));
   if (!s.d) refuse("mj_makeData failed");

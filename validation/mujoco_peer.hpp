@@ -11,7 +11,7 @@
 // a link "world" and a "floating" URDF joint are added above it instead, which MuJoCo turns
 // into a free joint of the root. After compiling: gravity as given, the constraint solver and
 // contacts off (joint limits and frictionloss are constraints in MuJoCo, none in femdyn),
-// armature 0; joint damping stays a passive force in both.
+// armature 0 unless given (then as femdyn's); joint damping stays a passive force in both.
 //
 // Quantities: M = mj_fullM after mj_crb; τ = mj_inverse (qfrc_inverse); q̈ = mj_forward with the
 // constraint solver disabled, so qacc is its smooth part, qacc_smooth.
@@ -36,8 +36,11 @@ class MujocoPeer {
   // `floating` the first six are the root's free joint and the rest name URDF joints. Throws
   // std::runtime_error, one line naming the file: a URDF MuJoCo cannot load (its message), or a
   // joint that does not map one to one (a <mimic> joint, a floating or planar joint inside).
+  // `armature` (n, or empty: 0): each coordinate's reflected rotor inertia I_a G², set as
+  // MuJoCo's dof_armature (URDF has no armature: femdyn's JSON or Builder gives it).
   MujocoPeer(const std::string& urdf_path, const Eigen::Vector3d& gravity, bool floating,
-             const std::vector<std::string>& coordinates);
+             const std::vector<std::string>& coordinates,
+             const Eigen::VectorXd& armature = Eigen::VectorXd());
   ~MujocoPeer();
   MujocoPeer(const MujocoPeer&) = delete;
   MujocoPeer& operator=(const MujocoPeer&) = delete;

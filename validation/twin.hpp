@@ -20,6 +20,8 @@
 //       M_v = Pᵀ M_u P, h_v = Pᵀ (h_u + M_u Ṗ v), Q_v = Pᵀ Q_u, forces in by P (P⁻ᵀ = P);
 //   body mass properties = Σ of the body's equivalent elements' Element::mass_properties();
 //   gravity -> Force::Gravity; springs/dampers -> MobilityLinearSpring / MobilityLinearDamper;
+//   enforced joint stops -> MobilityLinearStop (the same law); Coulomb friction -> a
+//   Force::Custom of femdyn's regularised law; a rotor's armature has no counterpart (refused);
 //   point loads and torques -> Force::ConstantForce / ConstantTorque; τ -> applied mobility
 //   forces; coupling θ = C q + θ0 -> exact reduction (pointwise) and
 //   Constraint::CoordinateCoupler (trajectories).
@@ -70,6 +72,11 @@ struct TwinBody {
   int theta = -1;              // its first coordinate in θ (nq of them)
   int rate = -1;               // its first rate in θ̇ (nv of them; = theta for nq = nv)
   double stiffness = 0, rest = 0, damping = 0;
+  // An enforced stop on [lower, upper] (Force::MobilityLinearStop, femdyn's law exactly).
+  bool stop = false;
+  double lower = 0, upper = 0, stop_stiffness = 0, stop_dissipation = 0;
+  // Coulomb friction −F_c tanh(θ̇ / v_s) (a Force::Custom: Simbody has no such element).
+  double friction = 0, friction_velocity = 1;
   double mass = 0;                     // Σ of the body's equivalent elements:
   Vec3 com = Vec3::Zero();             //   centre of mass (body frame)
   Mat3 inertia_origin = Mat3::Zero();  // inertia about the body origin (body frame)

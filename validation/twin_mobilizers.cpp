@@ -4,6 +4,7 @@
 #include <Simbody.h>
 
 #include "core/names.hpp"
+#include "validation/twin_friction.hpp"
 #include "validation/twin_impl.hpp"
 #include "validation/twin_loops.hpp"
 
@@ -115,6 +116,12 @@ void SimbodyTwin::Impl::add_body(const TwinBody& j) {
         Force::MobilityLinearSpring(forces, mobod.back(), MobilizerQIndex(0), j.stiffness, j.rest);
       if (j.damping != 0)
         Force::MobilityLinearDamper(forces, mobod.back(), MobilizerUIndex(0), j.damping);
+      if (j.friction != 0)
+        Force::Custom(forces,  // (Simbody takes ownership of the implementation)
+                      new CoulombFriction(mobod.back(), j.friction, j.friction_velocity));
+      if (j.stop)
+        Force::MobilityLinearStop(forces, mobod.back(), MobilizerQIndex(0), j.stop_stiffness,
+                                  j.stop_dissipation, j.lower, j.upper);
     }
   }
 }

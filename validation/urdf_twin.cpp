@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "core/errors.hpp"
+#include "validation/twin_friction.hpp"
 
 namespace femdyn::validation {
 
@@ -156,6 +157,11 @@ UrdfTwin::UrdfTwin(const std::string& path, const Eigen::Vector3d& gravity, bool
       if (type != "fixed" && type != "planar" && type != "floating") {
         const double c = number(j->FirstChildElement("dynamics"), "damping", 0);
         if (c != 0) Force::MobilityLinearDamper(s.forces, mb, MobilizerUIndex(0), c);
+        // Coulomb friction, regularised at femdyn's default v_s = 0.01 (URDF gives none).
+        const double f = number(j->FirstChildElement("dynamics"), "friction", 0);
+        if (f != 0)
+          Force::Custom(s.forces,  // (Simbody takes ownership of the implementation)
+                        new CoulombFriction(mb, f, 0.01));
         if (const auto* mim = j->FirstChildElement("mimic"))
           s.mimic[name] = {mim->Attribute("joint"), number(mim, "multiplier", 1),
                            number(mim, "offset", 0)};

@@ -179,6 +179,18 @@ TwinModel twin_model(const Model& m) {
     tb.stiffness = j.stiffness;
     tb.rest = j.rest;
     tb.damping = j.damping;
+    tb.stop = j.stop;
+    tb.lower = j.lower;
+    tb.upper = j.upper;
+    tb.stop_stiffness = j.stop_stiffness;
+    tb.stop_dissipation = j.stop_dissipation;
+    tb.friction = j.friction;
+    tb.friction_velocity = j.friction_velocity;
+    if (j.armature != 0)
+      throw ModelError(j.where + "/armature",
+                       "Simbody has no rotor inertia on a mobility (a rotor body would add the "
+                       "gyroscopic terms femdyn's armature leaves out): the twin cannot check "
+                       "this model; armature is checked against MuJoCo and closed forms");
     const MassProperties p = body_mass_properties(m, static_cast<int>(b));
     tb.mass = p.mass;
     tb.com = p.com;

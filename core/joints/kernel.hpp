@@ -157,15 +157,6 @@ template <class J>
       });
 }
 
-// The joint's own generalized force on a 1-DOF joint's coordinate: its spring and damper,
-// −k (θ − θ_rest) − c θ̇.
-inline double spring_damper_force(const Joint& j, double theta, double theta_dot) {
-  double f = 0;
-  if (j.stiffness != 0) f -= j.stiffness * (theta - j.rest);
-  if (j.damping != 0) f -= j.damping * theta_dot;
-  return f;
-}
-
 // Whether the point r of B (B's frame) stays fixed in the parent under every motion of the
 // joint: S_ω,k × r + S_v,k = 0 for each column (relative to 1 + |r|).
 inline bool fixes_point(const Joint& j, const Vec3& r) {

@@ -1,0 +1,107 @@
+#include "compile/actuators.hpp"
+
+#include <cmath>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "core/joints/kernel.hpp"
+#include "core/limits.hpp"
+#include "core/names.hpp"
+
+namespace femdyn {
+namespace {
+
+void check_finite(double x, const std::string& where, const char* what) {
+  if (std::isnan(x)) throw ModelError(where, std::string(what) + " is NaN");
+  if (std::isfinite(x)) check_magnitude(x, where, what);
+}
+
+bool has_actuator(const JointSpec& js) {
+  return js.armature != 0 || js.friction != 0 || std::isfinite(js.effort_limit) ||
+         std::isfinite(js.velocity_limit) || js.stop;
+}
+
+}  // namespace
+
+void compile_actuator(const JointSpec& js, Joint& j) {
+  const std::string& w = js.where;
+  check_finite(js.armature, w + "/armature", "armature");
+  check_finite(js.gear, w + "/gear", "gear ratio");
+  check_finite(js.friction, w + "/friction", "friction");
+  check_finite(js.friction_velocity, w + "/friction_velocity", "friction_velocity");
+  check_finite(js.effort_limit, w + "/effort_limit", "effort_limit");
+  check_finite(js.velocity_limit, w + "/velocity_limit", "velocity_limit");
+  check_finite(js.stop_stiffness, w + "/stop/stiffness", "stop stiffness");
+  check_finite(js.stop_dissipation, w + "/stop/dissipation", "stop dissipation");
+  if (has_actuator(js) && j.nv != 1)
+    throw ModelError(w, std::string("a ") + std::string(joint_type_name(j.type)) +
+                            " joint takes no armature, friction, effort or velocity limit or "
+                            "stop (only joints of one coordinate do)");
+  if (!(js.armature >= 0) || !std::isfinite(js.armature))
+    throw ModelError(w + "/armature",
+                     "must be finite and not negative, got " + format_number(js.armature));
+  if (!(js.gear != 0) || !std::isfinite(js.gear))
+    throw ModelError(w + "/gear", "must be finite and not zero, got " + format_number(js.gear));
+  if (!(js.friction >= 0) || !std::isfinite(js.friction))
+    throw ModelError(w + "/friction",
+                     "must be finite and not negative, got " + format_number(js.friction));
+  if (!(js.friction_velocity > 0) || !std::isfinite(js.friction_velocity))
+    throw ModelError(w + "/friction_velocity",
+                     "must be finite and positive, got " + format_number(js.friction_velocity));
+  if (!(js.effort_limit > 0))
+    throw ModelError(w + "/effort_limit",
+                     "must be positive, got " + format_number(js.effort_limit));
+  if (!(js.velocity_limit > 0))
+    throw ModelError(w + "/velocity_limit",
+                     "must be positive, got " + format_number(js.velocity_limit));
+  if (js.stop) {
+    if (!std::isfinite(js.lower) && !std::isfinite(js.upper))
+      throw ModelError(w + "/stop", "a stop needs finite limits [lower, upper]");
+    if (!(js.lower <= js.upper))
+      throw ModelError(w + "/limits", "lower > upper: the stop would push both ways");
+    if (!(js.stop_stiffness > 0) || !std::isfinite(js.stop_stiffness))
+      throw ModelError(w + "/stop/stiffness",
+                       "must be finite and positive, got " + format_number(js.stop_stiffness));
+    if (!(js.stop_dissipation >= 0) || !std::isfinite(js.stop_dissipation))
+      throw ModelError(w + "/stop/dissipation", "must be finite and not negative, got " +
+                                                    format_number(js.stop_dissipation));
+  }
+  j.armature = js.armature;
+  j.gear = js.gear;
+  j.reflected_inertia = js.armature * js.gear * js.gear;  // I_a G²
+  j.friction = js.friction;
+  j.friction_velocity = js.friction_velocity;
+  j.effort_limit = js.effort_limit;
+  j.velocity_limit = js.velocity_limit;
+  j.stop = js.stop;
+  j.stop_stiffness = js.stop_stiffness;
+  j.stop_dissipation = js.stop_dissipation;
+}
+
+void compile_actuators(Model& m) {
+  const int n = m.n();
+  // M_a = Cᵀ diag(a) C, a_j = I_a G² of θ̇_j's joint: Σ_j a_j C_jᵀ C_j over the rows of C.
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int j = 0; j < m.n_theta(); ++j) {
+    const double a = m.bodies[m.theta_joint[j]].joint.reflected_inertia;
+    if (a == 0) continue;
+    for (SpRowMat::InnerIterator ck(m.C_sparse, j); ck; ++ck)
+      for (SpRowMat::InnerIterator ci(m.C_sparse, j); ci; ++ci)
+        entries.emplace_back(ck.col(), ci.col(), ck.value() * a * ci.value());
+  }
+  m.has_armature = !entries.empty();
+  m.armature_mass.resize(n, n);
+  m.armature_mass.setFromTriplets(entries.begin(), entries.end());
+  m.armature_mass.makeCompressed();
+
+  // Effort limits, on the rates of q that the joints own. A coupled joint's is kept but not
+  // applied: no τ acts on it directly (simulate says so, sim/recorded_run.hpp).
+  m.effort_limit = VecX::Constant(n, INFINITY);
+  for (const CoordinateJoint& c : m.coordinate_joints) {
+    const Joint& J = m.bodies[c.body].joint;
+    if (J.nv == 1) m.effort_limit[c.v] = J.effort_limit;
+  }
+  m.has_effort_limits = (m.effort_limit.array() < INFINITY).any();
+}
+
+}  // namespace femdyn
