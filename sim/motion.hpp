@@ -88,7 +88,6 @@ class Motion {
   const Workspace& workspace() const { return ws_; }
 
  private:
-  void actuation(double t, VecX& tau) const;  // τ(t), zero when passive
   const Model& model_;
   Actuation tau_;
   Control control_;
