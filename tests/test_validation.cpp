@@ -523,6 +523,12 @@ TEST_CASE("M^s by products (beyond 1000 coordinates) equals M^s V and passes on 
   const ValidationReport r = validation::validate(m, quick(3, 0));
   CHECK(!r.dense_mass);
   CHECK_THAT(r.notes.back(), Catch::StartsWith("M^s compared by its products with 4 seeded"));
+  // Nor are the frames (6 × n Jacobians each) and the momentum beyond kKinematicsLimit.
+  CHECK(std::find(r.notes.begin(), r.notes.end(),
+                  "frames, centre of mass and momentum not compared beyond 1000 coordinates") !=
+        r.notes.end());
+  CHECK(std::none_of(r.quantities.begin(), r.quantities.end(),
+                     [](const auto& q) { return q.name == "momentum"; }));
   REQUIRE(r.failure.empty());
   for (const auto& q : r.quantities) {
     INFO(q.name << " max rel error " << q.max_rel);
@@ -614,4 +620,61 @@ TEST_CASE("the default pointwise tolerance is 1e-10, and eps d^2 on trees deeper
   o.tolerance = 1e-9;
   const ValidationReport r = validation::validate(plugin_chain(50), o);
   for (const auto& q : r.quantities) CHECK(q.tolerance == 1e-9);
+}
+
+namespace {
+
+// The kinematics for control that validate compares (validation/validate.hpp).
+const char* const kKinematicQuantities[] = {
+    "frame pose", "frame velocity", "frame acceleration", "frame J",
+    "com",        "com velocity",   "com acceleration",   "momentum"};
+
+const validation::QuantityError* quantity(const ValidationReport& r, const std::string& name) {
+  const auto at = std::find_if(r.quantities.begin(), r.quantities.end(),
+                               [&](const auto& q) { return q.name == name; });
+  return at == r.quantities.end() ? nullptr : &*at;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "frames, centre of mass and momentum match Simbody: finger, four-bar finger (law and rod), "
+    "free-floating space robot, URDF arm",
+    "[validation][kinematics]") {
+  for (const char* name :
+       {"finger.json", "finger_fourbar.json", "space_robot.json", "urdf/arm7.urdf"}) {
+    INFO(name);
+    const Model m = load_model(model_path(name));
+    REQUIRE(m.frames.size() >= m.bodies.size());  // every body, then the named frames
+    const ValidationReport r = validation::validate(m, quick(8, 0));
+    REQUIRE(r.failure.empty());
+    for (const char* q : kKinematicQuantities) {
+      INFO(q);
+      const validation::QuantityError* e = quantity(r, q);
+      REQUIRE(e);
+      CHECK(e->max_rel < 1e-10);
+      CHECK(e->pass());
+    }
+    CHECK(r.pass());
+  }
+}
+
+TEST_CASE("a frame moved by 1 µm after the twin was built fails the frame quantities alone",
+          "[validation][kinematics]") {
+  // The Validator copies the frames into the twin when it is built; femdyn reads the model's
+  // at each state. Moving the fingertip frame in between is a wrong frame offset on one side.
+  Model m = load_model(model_path("finger.json"));
+  REQUIRE(m.frames.size() > m.bodies.size());  // the fingertip
+  validation::Validator v(m, quick(4, 0));
+  m.frames.back().p_BF += Vec3(1e-6, -1e-6, 0);
+  const ValidationReport r = v.run();
+  for (const char* q : kKinematicQuantities) {
+    INFO(q << ": " << quantity(r, q)->max_rel);
+    const bool moved = std::string(q).rfind("frame", 0) == 0 && std::string(q) != "frame pose";
+    if (moved) CHECK(quantity(r, q)->max_rel > 1e-8);  // velocity, acceleration, J: ω × Δr
+    if (std::string(q) == "frame pose") CHECK(quantity(r, q)->max_rel > 1e-7);
+    if (std::string(q).rfind("frame", 0) != 0) CHECK(quantity(r, q)->max_rel < 1e-10);
+  }
+  CHECK(quantity(r, "M")->max_rel < 1e-10);
+  CHECK_FALSE(r.pass());
 }
