@@ -678,3 +678,40 @@ TEST_CASE("a frame moved by 1 µm after the twin was built fails the frame quant
   CHECK(quantity(r, "M")->max_rel < 1e-10);
   CHECK_FALSE(r.pass());
 }
+
+TEST_CASE(
+    "the twin's kinematics where a coupling cannot be posed as couplers (u̇ from its reduced q̈) "
+    "equal its realized accelerations on the uncoupled tree moving the same way",
+    "[validation][kinematics]") {
+  // θ_a = q_a + q_b: coordinate q_a drives no joint directly, so no CoordinateCoupler can pose
+  // it and the twin takes q̈ from M q̈ = Q − h (no JSON coupling reaches this; a TwinModel can).
+  const Model m = load_text(chain_with(R"([{"type": "rigid_body", "mass": 0.8, "com": [0.2, 0, 0],
+    "inertia": {"ixx": 0.004, "iyy": 0.015, "izz": 0.016, "ixy": 0.0002}}])"));
+  REQUIRE(m.n() == 3);
+  const validation::TwinModel tree = validation::twin_model(m);
+  validation::TwinModel coupled = tree;
+  MatX C = MatX::Identity(3, 3);
+  C(0, 1) = 1;
+  coupled.C = C.sparseView();
+  REQUIRE(validation::independent_theta(coupled, 0) < 0);
+  validation::SimbodyTwin plain(tree), reduced(coupled);
+  REQUIRE_FALSE(reduced.can_simulate());
+  std::vector<validation::TwinFrame> frames;
+  for (const Frame& f : m.frames) frames.push_back({f.body, f.R_BF, f.p_BF});
+  std::mt19937 rng(3);
+  for (int k = 0; k < 4; ++k) {
+    const VecX q = random_posture(m, rng), qd = random_uniform(3, 2, rng),
+               tau = random_uniform(3, 1, rng);
+    const validation::TwinKinematics a = reduced.kinematics(q, qd, tau, frames);
+    // The same motion on the tree: θ = C q, θ̇ = C q̇, θ̈ = C q̈ under τ_θ = its inverse dynamics.
+    const VecX qdd = reduced.equations(q, qd, tau).qdd;
+    const VecX theta = C * q, theta_dot = C * qd, theta_ddot = C * qdd;
+    const validation::TwinKinematics b = plain.kinematics(
+        theta, theta_dot, plain.inverse_dynamics(theta, theta_dot, theta_ddot), frames);
+    CHECK(rel_error(a.velocity, b.velocity) < 1e-14);
+    CHECK(rel_error(a.acceleration, b.acceleration) < 1e-12);
+    CHECK(rel_error(a.com_acceleration, b.com_acceleration) < 1e-12);
+    CHECK(rel_error(a.momentum, b.momentum) < 1e-14);
+    CHECK(a.acceleration.norm() > 1);  // a motion, not rest
+  }
+}
