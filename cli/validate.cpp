@@ -1,6 +1,7 @@
 // femdyn validate MODEL…: the model against its Simbody twin (validation/validate.hpp).
 #include "validation/validate.hpp"
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <deque>
@@ -33,7 +34,11 @@ A model with a nonlinear coupling law or a rod spanning two bodies gets a closed
 every joint a mobilizer, each law a coordinate coupler, each rod a body on a LineOrientation
 joined by a Ball constraint; its M^s, h, Q, q̈ and τ come from Simbody's constrained forward
 dynamics alone, and "loop" is its constraint error at femdyn's θ = g(q), θ̇ = G q̇ (relative
-to the longest rod). Then integrates the passive motion (τ = 0) from the first
+to the longest rod). Up to 1000 coordinates, the kinematics for control too, at the same
+states: every frame's pose, velocity J q̇ and acceleration J q̈ + J̇q̇ (q̈ each engine's own
+forward dynamics under τ), its Jacobian J column by column (up to 300 coordinates), and the
+mechanism's mass, centre of mass and inertia about it, its velocity J_c q̇ and acceleration,
+and the central momentum A_G q̇ (Simbody's calcSystemCentralMomentum). Then integrates the passive motion (τ = 0) from the first
 state for T seconds (default 0.25; 0 skips): femdyn by RK4 (step 1 ms, halved until its own
 error estimate is below 1e-9), Simbody by RungeKuttaMerson at accuracy 1e-10 and 1e-12, and
 compares the joint states (θ, θ̇) over time against 10x the sum of both error estimates.
@@ -51,6 +56,14 @@ trajectory's sample times "t", "state_error" and the energy of both runs.
 )";
 
 std::string sci(double x) { return format_number(x, "%.2e"); }
+
+constexpr int kNameWidth = 18;  // "frame acceleration"
+
+// The kinematics for control (frames, centre of mass, momentum): one markdown column, their
+// largest relative error.
+bool kinematic(const std::string& name) {
+  return name.rfind("frame ", 0) == 0 || name.rfind("com", 0) == 0 || name == "momentum";
+}
 
 Json report_json(const std::string& path, const Model& m, const validation::ValidationReport& r) {
   Json rel = Json::object(), abs = Json::object();
@@ -110,14 +123,15 @@ void print_text(const std::string& path, const validation::ValidationReport& r) 
   }
   std::cout << escaped(path) << " (" << r.n << " coordinates) against Simbody, " << r.states
             << " seeded random states\n"
-            << "quantity   max abs err   max rel err   tolerance   result\n";
+            << std::left << std::setw(kNameWidth) << "quantity"
+            << " max abs err   max rel err   tolerance   result\n";
   for (const auto& q : r.quantities)
-    std::cout << std::left << std::setw(10) << (q.name == "M" ? "M^s" : q.name) << " "
+    std::cout << std::left << std::setw(kNameWidth) << (q.name == "M" ? "M^s" : q.name) << " "
               << std::setw(13) << sci(q.max_abs) << " " << std::setw(13) << sci(q.max_rel) << " "
               << std::setw(11) << sci(q.tolerance) << " " << (q.pass() ? "PASS" : "FAIL") << "\n";
   const auto& t = r.trajectory;
   if (t.run)
-    std::cout << std::setw(10) << "trajectory"
+    std::cout << std::setw(kNameWidth) << "trajectory"
               << " " << std::setw(13) << sci(t.max_state_error) << " " << std::setw(13) << ""
               << " " << std::setw(11) << sci(t.tolerance) << " " << (t.pass() ? "PASS" : "FAIL")
               << "   (" << t.t_end << " s; error estimates: femdyn RK4 (step " << sci(t.rk4_step)
@@ -151,16 +165,21 @@ void print_text(const std::string& path, const validation::ValidationReport& r) 
 void print_markdown_row(const std::string& path, const validation::ValidationReport& r) {
   if (!r.failure.empty()) {
     std::cout << "| `" << path << "` | " << r.n
-              << " | — | — | — | — | — | — | — | FAIL: " << r.failure << " |\n";
+              << " | — | — | — | — | — | — | — | — | FAIL: " << r.failure << " |\n";
     return;
   }
   std::cout << "| `" << path << "` | " << r.n;
-  bool loop = false;  // the closed loop's closure error, a column of its own
+  bool loop = false;       // the closed loop's closure error, a column of its own
+  double kinematics = -1;  // the largest of theirs, if compared
   for (const auto& q : r.quantities)
-    if (q.name != "import" && q.name != "loop") std::cout << " | " << sci(q.max_rel);
+    if (kinematic(q.name))
+      kinematics = std::max(kinematics, q.max_rel);
+    else if (q.name != "import" && q.name != "loop")
+      std::cout << " | " << sci(q.max_rel);
   for (const auto& q : r.quantities)
     if (q.name == "loop") std::cout << " | " << sci(q.max_rel), loop = true;
   if (!loop) std::cout << " | —";
+  std::cout << " | " << (kinematics >= 0 ? sci(kinematics) : "—");
   const auto& t = r.trajectory;
   std::cout << " | "
             << (t.run               ? sci(t.max_state_error) + " (tol " + sci(t.tolerance) + ")"
@@ -228,8 +247,9 @@ int cmd_validate(int argc, char** argv) {
   bool all_pass = true;
   Json reports = Json::array();
   if (a.has("markdown"))
-    std::cout << "| model | n | M^s | h | Q | q̈ | τ | loop | trajectory state error | result |\n"
-              << "|---|---|---|---|---|---|---|---|---|---|\n";
+    std::cout << "| model | n | M^s | h | Q | q̈ | τ | loop | frames, COM, momentum | trajectory "
+                 "state error | result |\n"
+              << "|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (std::size_t i = 0; i < models.size(); ++i) {
     validation::ValidationReport r;
     {

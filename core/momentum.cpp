@@ -9,93 +9,82 @@ namespace femdyn {
 
 namespace {
 
-// A node's place in world: x = p_b + R_b r.
-Vec3 node_position(const Model& model, const Workspace& ws, int node) {
-  const SystemNode& N = model.nodes[node];
-  const BodyState& B = ws.body[N.body];
-  return B.p + B.R * N.r;
+// The elements' local masses m_e, read once per model.
+void element_masses(const Model& model, MomentumKinematics& out) {
+  if (out.masses_of == &model && out.element_mass.size() == model.elements.size()) return;
+  out.element_mass.clear();
+  for (const ElementEntry& e : model.elements) out.element_mass.push_back(e.element->local_mass());
+  out.masses_of = &model;
 }
 
-// G ξ_c for the six unit twists about the world origin (linear x y z, then angular x y z):
-// one row of G per transition coordinate u_i (the map in core/momentum.hpp).
-Vec6 rigid_motion_map(const Model& model, const Workspace& ws, int i) {
-  const SystemDof& d = model.dofs[i];
-  Vec6 row = Vec6::Zero();
-  if (d.kind == DofKind::Translation) {
-    const Vec3 x = node_position(model, ws, d.carrier);
-    row[d.axis] = 1;                              // e_kᵀ v₀
-    row.tail<3>() = x.cross(Vec3::Unit(d.axis));  // e_kᵀ (ω × x) = (x × e_k)ᵀ ω
-  } else {
-    row.tail<3>() = ws.body[d.carrier].R.col(d.axis);  // (R_b e_k)ᵀ ω
-  }
-  return row;
+// Node l of an element as the element's mass sees it: y_l = (x y z, rx ry rz), the node's place
+// on its body b and the rotation rates of the element's body e in e's axes. A rigid twist
+// ξ = (v₀, ω) about the origin moves it by ẏ_l = G_l ξ, G_l = [[1, −[x]×], [0, R_eᵀ]]; the
+// mechanism moves it by
+//   ẏ_l = (v_b + ω_b × r, R_eᵀ ω_e) = Y_l v,   r = R_b r_B, x = p_b + r,
+//   ÿ_l at v̇ = 0: (a_b + α_b × r + ω_b × (ω_b × r), R_eᵀ α_e)   (d/dt R_eᵀ ω_e = R_eᵀ α_e).
+struct NodeMotion {
+  int body = -1;  // b
+  Vec3 r = Vec3::Zero(), x = Vec3::Zero(), xdot = Vec3::Zero();
+  Mat6 G = Mat6::Zero();
+  Vec6 ydot = Vec6::Zero(), ybias = Vec6::Zero();
+};
+
+NodeMotion node_motion(const Workspace& ws, const ElementEntry& e, std::size_t l) {
+  const auto nodes = e.element->nodes();
+  const BodyState& B = ws.body[e.node_body[l]];
+  const BodyState& E = ws.body[e.body];
+  NodeMotion out;
+  out.body = e.node_body[l];
+  out.r = B.R * nodes[l].position;
+  out.x = B.p + out.r;
+  out.xdot = B.v + B.w.cross(out.r);
+  out.G.topLeftCorner<3, 3>().setIdentity();
+  out.G.topRightCorner<3, 3>() = -skew(out.x);
+  out.G.bottomRightCorner<3, 3>() = E.R.transpose();
+  out.ydot << out.xdot, E.R.transpose() * E.w;
+  out.ybias << B.a + B.alpha.cross(out.r) + B.w.cross(B.w.cross(out.r)), E.R.transpose() * E.alpha;
+  return out;
 }
 
-// The moment of Ġᵀ f: Σ_trans ẋ × e_k f_i + Σ_rot (ω_b × R_b e_k) f_i.
-Vec3 rigid_motion_map_rate(const Model& model, const Workspace& ws, const VecX& f) {
-  Vec3 moment = Vec3::Zero();
-  for (int i = 0; i < model.n_u(); ++i) {
-    if (f[i] == 0) continue;
-    const SystemDof& d = model.dofs[i];
-    if (d.kind == DofKind::Translation) {
-      const SystemNode& N = model.nodes[d.carrier];
-      const BodyState& B = ws.body[N.body];
-      const Vec3 xdot = B.v + B.w.cross(B.R * N.r);
-      moment += xdot.cross(Vec3::Unit(d.axis)) * f[i];
-    } else {
-      const BodyState& B = ws.body[d.carrier];
-      moment += B.w.cross(B.R.col(d.axis)) * f[i];
-    }
-  }
-  return moment;
-}
+}  // namespace
 
-// The mechanism locked rigid about the origin, Σ_e Σ_l,l' G_lᵀ m_e[l, l'] G_l' over each element's
-// nodes l, with G_l = [[1, −[x_l]×], [0, R_bᵀ]] on the node's (x y z, rx ry rz).
-Mat6 locked_inertia(const Model& model, const Workspace& ws, MomentumKinematics& out) {
-  if (out.masses_of != &model || out.element_mass.size() != model.elements.size()) {
-    out.element_mass.clear();
-    for (const ElementEntry& e : model.elements)
-      out.element_mass.push_back(e.element->local_mass());
-    out.masses_of = &model;
-  }
-  Mat6 I_O = Mat6::Zero();
-  for (std::size_t k = 0; k < model.elements.size(); ++k) {
-    const ElementEntry& e = model.elements[k];
-    const auto nodes = e.element->nodes();
-    const auto G = [&](std::size_t l) {
-      const BodyState& B = ws.body[e.node_body[l]];
-      Mat6 g = Mat6::Zero();
-      g.topLeftCorner<3, 3>().setIdentity();
-      g.topRightCorner<3, 3>() = -skew(B.p + B.R * nodes[l].position);
-      g.bottomRightCorner<3, 3>() = ws.body[e.body].R.transpose();
-      return g;
-    };
-    for (std::size_t l = 0; l < nodes.size(); ++l)
-      for (std::size_t j = 0; j < nodes.size(); ++j)
-        I_O.noalias() += G(l).transpose() * out.element_mass[k].block<6, 6>(6 * l, 6 * j) * G(j);
-  }
-  return I_O;
-}
-
-// A_O = (MG)ᵀ T without T: each row T_i is its carrier body's Jacobian seen at the DOF,
-//   translation: e_kᵀ (Jv_b − [r_w]× Jω_b),   rotation: (R_b e_k)ᵀ Jω_b,
-// so (MG)_iᵀ is gathered per body on Jv_b and Jω_b, then A_O = Σ_b Wv_b Jv_b + Ww_b Jω_b.
-void momentum_matrix(const Model& model, const Workspace& ws, MomentumKinematics& out) {
+// Everything from the elements' own masses on their own nodes, so that what u leaves out (a
+// node that never moves, a rotation rate that stays 0 while a full inertia tensor couples it to
+// the others) still counts. With K_lj = G_lᵀ m_e[l, j]:
+//   I_O = Σ G_lᵀ m_e[l, j] G_j            h_O = Σ K_lj ẏ_j
+//   A_O = Σ K_lj Y_j, gathered per body on Jv_b, Jω_b (Y_j = [Jv_b − [r]× Jω_b ; R_eᵀ Jω_e])
+//   Ȧ_O v = Σ K_lj ÿ_j + Ġ_lᵀ f_l,  f_l = Σ_j m_e[l, j] ẏ_j,  Ġ_lᵀ f = (0, ẋ_l × f_t + ω_e × R_e
+//   f_r)
+void momentum_kinematics(const Model& model, const Workspace& ws, MomentumKinematics& out) {
+  element_masses(model, out);
   const std::size_t nb = model.bodies.size();
   out.Wv.resize(nb);
   out.Ww.resize(nb);
   for (std::size_t b = 0; b < nb; ++b) out.Wv[b].setZero(), out.Ww[b].setZero();
-  for (int i = 0; i < model.n_u(); ++i) {
-    const SystemDof& d = model.dofs[i];
-    const Vec6 g = out.MG.row(i).transpose();
-    if (d.kind == DofKind::Translation) {
-      const SystemNode& N = model.nodes[d.carrier];
-      const Vec3 rw = ws.body[N.body].R * N.r;
-      out.Wv[N.body].col(d.axis) += g;
-      out.Ww[N.body].noalias() -= g * skew(rw).row(d.axis);
-    } else {
-      out.Ww[d.carrier].noalias() += g * ws.body[d.carrier].R.col(d.axis).transpose();
+  Mat6 I_O = Mat6::Zero();
+  Vec6 h_O = Vec6::Zero(), bias_O = Vec6::Zero();
+  for (std::size_t k = 0; k < model.elements.size(); ++k) {
+    const ElementEntry& e = model.elements[k];
+    const MatX& m_e = out.element_mass[k];
+    const BodyState& E = ws.body[e.body];
+    const std::size_t nl = e.element->nodes().size();
+    for (std::size_t l = 0; l < nl; ++l) {
+      const NodeMotion yl = node_motion(ws, e, l);
+      Vec6 f = Vec6::Zero();  // f_l
+      for (std::size_t j = 0; j < nl; ++j) {
+        const NodeMotion yj = j == l ? yl : node_motion(ws, e, j);
+        const Mat6 m = m_e.block<6, 6>(6 * l, 6 * j);
+        const Mat6 K = yl.G.transpose() * m;
+        I_O.noalias() += K * yj.G;
+        h_O.noalias() += K * yj.ydot;
+        bias_O.noalias() += K * yj.ybias;
+        f.noalias() += m * yj.ydot;
+        out.Wv[yj.body] += K.leftCols<3>();
+        out.Ww[yj.body].noalias() -= K.leftCols<3>() * skew(yj.r);
+        out.Ww[e.body].noalias() += K.rightCols<3>() * E.R.transpose();
+      }
+      bias_O.tail<3>() += yl.xdot.cross(f.head<3>()) + E.w.cross(E.R * f.tail<3>());
     }
   }
   out.A.setZero(6, model.n());
@@ -104,24 +93,8 @@ void momentum_matrix(const Model& model, const Workspace& ws, MomentumKinematics
     out.A.noalias() += out.Wv[b] * ws.Jv.middleRows<3>(bi);
     out.A.noalias() += out.Ww[b] * ws.Jw.middleRows<3>(bi);
   }
-}
 
-}  // namespace
-
-void momentum_kinematics(const Model& model, Workspace& ws, const VecX& q, const VecX& v,
-                         MomentumKinematics& out) {
-  propagate(model, ws, q, v, {.jacobian = true, .bias = true, .rows = false});
-  momentum_kinematics(model, ws, out);
-}
-
-void momentum_kinematics(const Model& model, const Workspace& ws, MomentumKinematics& out) {
-  const int nu = model.n_u();
-  out.G.resize(nu, 6);
-  out.MG.resize(nu, 6);
-  for (int i = 0; i < nu; ++i) out.G.row(i) = rigid_motion_map(model, ws, i).transpose();
-  out.MG.noalias() = model.M * out.G;
   // The locked mechanism: mass, first moment m c, inertia about the origin.
-  const Mat6 I_O = locked_inertia(model, ws, out);
   out.mass = I_O.topLeftCorner<3, 3>().trace() / 3;
   if (!(out.mass > 0)) throw StateError(model.name + ": the mechanism has no mass");
   const Mat3 mc_cross = I_O.bottomLeftCorner<3, 3>();  // [m c]×
@@ -131,13 +104,6 @@ void momentum_kinematics(const Model& model, const Workspace& ws, MomentumKinema
   // I_c = I_O − m [c]×ᵀ[c]× (parallel axes)
   out.inertia_com = I_O.bottomRightCorner<3, 3>() + out.mass * skew(out.com) * skew(out.com);
 
-  momentum_matrix(model, ws, out);  // A_O
-  out.Mu.noalias() = model.M * ws.u_dot;
-  Vec6 h_O, bias_O;
-  h_O.noalias() = out.MG.transpose() * ws.u_dot;
-  bias_O.noalias() = out.MG.transpose() * ws.bias;
-  bias_O.tail<3>() += rigid_motion_map_rate(model, ws, out.Mu);
-
   // Shift the moment from the origin to c.
   const Mat3 c_cross = skew(out.com);
   out.A.bottomRows<3>().noalias() -= c_cross * out.A.topRows<3>();
@@ -146,6 +112,12 @@ void momentum_kinematics(const Model& model, const Workspace& ws, MomentumKinema
   out.Jcom = out.A.topRows<3>() / out.mass;
   out.com_velocity = out.momentum.head<3>() / out.mass;
   out.com_bias = out.bias.head<3>() / out.mass;
+}
+
+void momentum_kinematics(const Model& model, Workspace& ws, const VecX& q, const VecX& v,
+                         MomentumKinematics& out) {
+  propagate(model, ws, q, v, {.jacobian = true, .bias = true, .rows = false});
+  momentum_kinematics(model, ws, out);
 }
 
 int floating_base_rate(const Model& model) {

@@ -2,19 +2,18 @@
 // matrix, and the generalized Jacobian of a free-floating tree (docs/notation.md#momentum).
 //
 // Every element form counts, rods that span two bodies included, because everything is read
-// off the system's lumped mass M (constant in u, core/model.hpp) through the rigid-motion map
-// G (N_u × 6): the u̇ that a rigid twist ξ = (v₀, ω) of the whole mechanism about the world
-// origin would give,
-//   a translation DOF (node at x, axis k):  u̇_i = e_kᵀ (v₀ + ω × x)
-//   a rotation DOF (body b, axis k):        u̇_i = (R_b e_k)ᵀ ω.
-// The kinetic energy is ½ u̇ᵀ M u̇, so the spatial momentum about the origin is the vector h_O
-// with ξᵀ h_O = u̇(ξ)ᵀ M u̇ for every ξ:
-//   h_O = Gᵀ M u̇ = (MG)ᵀ T v = A_O v          (linear rows P, then angular L_O)
-// The mechanism locked rigid has the inertia Σ_e G_eᵀ m_e G_e = [[m 1, −[m c]×], [[m c]×, I_O]],
-// summed over the elements' own DOFs (G_e: the same map on each node's x y z and its body's
-// rx ry rz): u leaves out what never moves, but a node that never moves still has mass.
-// and, M being constant, its rate at v̇ = 0 (the bias) is
-//   Ȧ_O v = (MG)ᵀ T'[v,v] + Ġᵀ M u̇,   Ġᵀ f = (0, Σ_trans ẋ × e_k f_i + Σ_rot (ω_b × R_b e_k) f_i).
+// off each element's own mass m_e on its own nodes y_l = (x y z, rx ry rz) — not off the
+// system's M on u, which leaves out what never moves (a node at rest; a rotation rate that stays
+// 0 about a hinge while a full inertia tensor couples it to the others still carries momentum).
+// A rigid twist ξ = (v₀, ω) of the whole mechanism about the world origin moves node l by
+//   ẏ_l = G_l ξ,   G_l = [[1, −[x_l]×], [0, R_eᵀ]]   (R_e: the element's body's rotation),
+// so the mechanism locked rigid has the inertia I_O = Σ_e Σ_l,j G_lᵀ m_e[l, j] G_j
+// = [[m 1, −[m c]×], [[m c]×, I_O]], and the spatial momentum about the origin is
+//   h_O = Σ_e Σ_l,j G_lᵀ m_e[l, j] ẏ_j = A_O v      (linear rows P, then angular L_O)
+// with ẏ_j = (v_b + ω_b × r_j, R_eᵀ ω_e) = Y_j v from the bodies' Jacobians. Its rate at v̇ = 0
+// (the bias) is
+//   Ȧ_O v = Σ G_lᵀ m_e[l, j] ÿ_j(v̇ = 0) + Ġ_lᵀ f_l,   f_l = Σ_j m_e[l, j] ẏ_j,
+//   Ġ_lᵀ f = (0, ẋ_l × f_t + ω_e × R_e f_r).
 // The centroidal forms shift the moment to c (world axes, Pinocchio's hg/Ag):
 //   h_G = (P, L_O − c × P),   A_G = [A_lin ; A_ang − [c]× A_lin],   bias_G = (Ṗ_b, L̇_b − c × Ṗ_b)
 // and the centre of mass moves with ċ = P / m: J_c = A_lin / m, c̈ at v̇ = 0 is Ṗ_b / m.
@@ -36,11 +35,9 @@ struct MomentumKinematics {
   MatX A;                            // A_G, 6 × n: h_G = A_G v
   Vec6 bias = Vec6::Zero();          // Ȧ_G v: ḣ_G at v̇ = 0
   // Buffers, sized on first use.
-  Eigen::Matrix<double, Eigen::Dynamic, 6> G, MG;  // G and M G, N_u × 6
-  VecX Mu;                                         // M u̇
   std::vector<MatX> element_mass;  // m_e of each element of `masses_of`, on first use
   const Model* masses_of = nullptr;
-  std::vector<Eigen::Matrix<double, 6, 3>> Wv, Ww;  // per body: (MG)ᵀ gathered on Jv_b, Jω_b
+  std::vector<Eigen::Matrix<double, 6, 3>> Wv, Ww;  // per body: A_O's weights on Jv_b, Jω_b
 };
 
 // From the body states, Jacobians and T'[v,v] of the last

@@ -526,6 +526,12 @@ TEST_CASE("M^s by products (beyond 1000 coordinates) equals M^s V and passes on 
   const ValidationReport r = validation::validate(m, quick(3, 0));
   CHECK(!r.dense_mass);
   CHECK_THAT(r.notes.back(), Catch::StartsWith("M^s compared by its products with 4 seeded"));
+  // Nor are the frames (6 × n Jacobians each) and the momentum beyond kKinematicsLimit.
+  CHECK(std::find(r.notes.begin(), r.notes.end(),
+                  "frames, centre of mass and momentum not compared beyond 1000 coordinates") !=
+        r.notes.end());
+  CHECK(std::none_of(r.quantities.begin(), r.quantities.end(),
+                     [](const auto& q) { return q.name == "momentum"; }));
   REQUIRE(r.failure.empty());
   for (const auto& q : r.quantities) {
     INFO(q.name << " max rel error " << q.max_rel);
@@ -666,4 +672,98 @@ TEST_CASE("a model with armature: validate says why the twin cannot check it",
   CHECK_FALSE(r.pass());
   CHECK_THAT(r.failure, Catch::Contains("/bodies/0/joint/armature") &&
                             Catch::Contains("Simbody has no rotor inertia"));
+}
+
+namespace {
+
+// The kinematics for control that validate compares (validation/validate.hpp).
+const char* const kKinematicQuantities[] = {
+    "frame pose", "frame velocity", "frame acceleration", "frame J",
+    "com",        "com velocity",   "com acceleration",   "momentum"};
+
+const validation::QuantityError* quantity(const ValidationReport& r, const std::string& name) {
+  const auto at = std::find_if(r.quantities.begin(), r.quantities.end(),
+                               [&](const auto& q) { return q.name == name; });
+  return at == r.quantities.end() ? nullptr : &*at;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "frames, centre of mass and momentum match Simbody: finger, four-bar finger (law and rod), "
+    "free-floating space robot, URDF arm",
+    "[validation][kinematics]") {
+  for (const char* name :
+       {"finger.json", "finger_fourbar.json", "space_robot.json", "urdf/arm7.urdf"}) {
+    INFO(name);
+    const Model m = load_model(model_path(name));
+    REQUIRE(m.frames.size() >= m.bodies.size());  // every body, then the named frames
+    const ValidationReport r = validation::validate(m, quick(8, 0));
+    REQUIRE(r.failure.empty());
+    for (const char* q : kKinematicQuantities) {
+      INFO(q);
+      const validation::QuantityError* e = quantity(r, q);
+      REQUIRE(e);
+      CHECK(e->max_rel < 1e-10);
+      CHECK(e->pass());
+    }
+    CHECK(r.pass());
+  }
+}
+
+TEST_CASE("a frame moved by 1 µm after the twin was built fails the frame quantities alone",
+          "[validation][kinematics]") {
+  // The Validator copies the frames into the twin when it is built; femdyn reads the model's
+  // at each state. Moving the fingertip frame in between is a wrong frame offset on one side.
+  Model m = load_model(model_path("finger.json"));
+  REQUIRE(m.frames.size() > m.bodies.size());  // the fingertip
+  validation::Validator v(m, quick(4, 0));
+  m.frames.back().p_BF += Vec3(1e-6, -1e-6, 0);
+  const ValidationReport r = v.run();
+  for (const char* q : kKinematicQuantities) {
+    INFO(q << ": " << quantity(r, q)->max_rel);
+    const bool moved = std::string(q).rfind("frame", 0) == 0 && std::string(q) != "frame pose";
+    if (moved) CHECK(quantity(r, q)->max_rel > 1e-8);  // velocity, acceleration, J: ω × Δr
+    if (std::string(q) == "frame pose") CHECK(quantity(r, q)->max_rel > 1e-7);
+    if (std::string(q).rfind("frame", 0) != 0) CHECK(quantity(r, q)->max_rel < 1e-10);
+  }
+  CHECK(quantity(r, "M")->max_rel < 1e-10);
+  CHECK_FALSE(r.pass());
+}
+
+TEST_CASE(
+    "the twin's kinematics where a coupling cannot be posed as couplers (u̇ from its reduced q̈) "
+    "equal its realized accelerations on the uncoupled tree moving the same way",
+    "[validation][kinematics]") {
+  // θ_a = q_a + q_b: coordinate q_a drives no joint directly, so no CoordinateCoupler can pose
+  // it and the twin takes q̈ from M q̈ = Q − h (no JSON coupling reaches this; a TwinModel can).
+  const Model m = load_text(chain_with(R"([{"type": "rigid_body", "mass": 0.8, "com": [0.2, 0, 0],
+    "inertia": {"ixx": 0.004, "iyy": 0.015, "izz": 0.016, "ixy": 0.0002}}])"));
+  REQUIRE(m.n() == 3);
+  const validation::TwinModel tree = validation::twin_model(m);
+  validation::TwinModel coupled = tree;
+  MatX C = MatX::Identity(3, 3);
+  C(0, 1) = 1;
+  coupled.C = C.sparseView();
+  REQUIRE(validation::independent_theta(coupled, 0) < 0);
+  validation::SimbodyTwin plain(tree), reduced(coupled);
+  REQUIRE_FALSE(reduced.can_simulate());
+  std::vector<validation::TwinFrame> frames;
+  for (const Frame& f : m.frames) frames.push_back({f.body, f.R_BF, f.p_BF});
+  std::mt19937 rng(3);
+  for (int k = 0; k < 4; ++k) {
+    const VecX q = random_posture(m, rng), qd = random_uniform(3, 2, rng),
+               tau = random_uniform(3, 1, rng);
+    const validation::TwinKinematics a = reduced.kinematics(q, qd, tau, frames);
+    // The same motion on the tree: θ = C q, θ̇ = C q̇, θ̈ = C q̈ under τ_θ = its inverse dynamics.
+    const VecX qdd = reduced.equations(q, qd, tau).qdd;
+    const VecX theta = C * q, theta_dot = C * qd, theta_ddot = C * qdd;
+    const validation::TwinKinematics b = plain.kinematics(
+        theta, theta_dot, plain.inverse_dynamics(theta, theta_dot, theta_ddot), frames);
+    CHECK(rel_error(a.velocity, b.velocity) < 1e-14);
+    CHECK(rel_error(a.acceleration, b.acceleration) < 1e-12);
+    CHECK(rel_error(a.com_acceleration, b.com_acceleration) < 1e-12);
+    CHECK(rel_error(a.momentum, b.momentum) < 1e-14);
+    CHECK(a.acceleration.norm() > 1);  // a motion, not rest
+  }
 }

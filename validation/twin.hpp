@@ -144,6 +144,31 @@ struct TwinEquations {
   double loop_position_error = 0, loop_velocity_error = 0;
 };
 
+// A frame fixed on a body (femdyn's Model::frames): its axes R_BF and origin p_BF in the body
+// frame, which is the twin's MobilizedBody frame too (X_BM carries the mobilizer's axes).
+struct TwinFrame {
+  int body = -1;
+  Mat3 R_BF = Mat3::Identity();
+  Vec3 p_BF = Vec3::Zero();
+};
+
+// Simbody's kinematics at (q, q̇) (SimbodyTwin::kinematics), in femdyn's order and axes:
+// linear before angular, world axes, moments about the mechanism's centre of mass.
+struct TwinKinematics {
+  std::vector<Mat3> R;  // per frame: R_GF = R_GB R_BF   (findFrameTransformInGround)
+  std::vector<Vec3> p;  //            p_GF = p_GB + R_GB p_BF
+  MatX velocity;        // 6 × frames: (v, ω) of each frame's origin (findFrameVelocityInGround)
+  MatX acceleration;    // 6 × frames: (a, α) under Simbody's own forward dynamics at τ
+  MatX J;               // 6·frames × n when asked: frame f's rows 6f…6f+5, ∂(v, ω)/∂q̇
+  double mass = 0;      // calcSystemMass
+  Vec3 com = Vec3::Zero();                  // calcSystemMassCenterLocationInGround
+  Mat3 inertia_com = Mat3::Zero();          // calcSystemCentralInertiaInGround
+  Vec3 com_velocity = Vec3::Zero();         // ...MassCenterVelocityInGround
+  Vec3 com_acceleration = Vec3::Zero();     // ...MassCenterAccelerationInGround
+  Eigen::Matrix<double, 6, 1> momentum =    // calcSystemCentralMomentum, reordered:
+      Eigen::Matrix<double, 6, 1>::Zero();  //   (P, L_G)
+};
+
 struct TwinSample {
   double t = 0;
   VecX theta, theta_dot;  // all joint coordinates θ (n_theta_q) and rates (n_theta), femdyn's
@@ -223,6 +248,16 @@ class SimbodyTwin {
   // Without V: M, and MV empty.
   TwinEquations equations(const VecX& q, const VecX& qd, const VecX& tau, const MatX* V = nullptr);
   VecX inverse_dynamics(const VecX& q, const VecX& qd, const VecX& qdd);
+
+  // The frames' poses, velocities and accelerations and the mechanism's mass, centre of mass
+  // and central momentum at (q, q̇), the accelerations those of Simbody's forward dynamics
+  // under its forces and τ on the coordinates: the state realized to Acceleration with τ as
+  // discrete mobility forces (constrained: the closed loop's and the couplers'), or, where the
+  // coupling cannot be posed as couplers, u̇ from the reduced equations' q̈ and
+  // calcBodyAccelerationFromUDot. With `jacobian`, J's columns: the frames' velocities at
+  // q̇ = e_k (multiplyByFrameJacobian). Throws femdyn::Error (one line) where Simbody fails.
+  TwinKinematics kinematics(const VecX& q, const VecX& qd, const VecX& tau,
+                            const std::vector<TwinFrame>& frames, bool jacobian = false);
 
   // Passive motion (τ = 0) from (q0, q̇0) by RungeKuttaMersonIntegrator at `accuracy`, sampled
   // at `times`. Empty with `why_not` set if the coupling cannot be posed as coordinate

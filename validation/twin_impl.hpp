@@ -6,6 +6,7 @@
 //   twin_loops.cpp       the closed loops (laws and rods)
 //   twin_state.cpp       femdyn q, q̇ <-> Simbody's state; Cᵀ and C on Simbody's u layout
 //   twin.cpp             the equations, inverse dynamics and the timing entry points
+//   twin_kinematics.cpp  frames, centre of mass and momentum (SimbodyTwin::kinematics)
 //   twin_simulate.cpp    Simbody's integrators and trajectories
 #pragma once
 #include <Simbody.h>
@@ -29,6 +30,8 @@ struct SimbodyTwin::Impl {
   SimTK::MultibodySystem system;
   SimTK::SimbodyMatterSubsystem matter{system};
   SimTK::GeneralForceSubsystem forces{system};
+  // τ as mobility forces while kinematics() realizes Acceleration; zero at every other time.
+  SimTK::Force::DiscreteForces tau_forces{forces, matter};
   std::vector<SimTK::MobilizedBody> mobod;  // per femdyn body
   std::vector<SimTK::MobilizedBody> rods;   // closed loop: per TwinModel::rods
   VecX loop_theta, loop_theta_dot;          // closed loop: θ = g(q), θ̇ = G q̇
@@ -111,6 +114,15 @@ struct SimbodyTwin::Impl {
   MatX constrained_mass(const VecX& a0);
 
   SimTK::Vector expand(const VecX& x) const;  // P C x on Simbody's u layout
+
+  // τ on the coordinates as mobility forces on the joints each drives directly: P f_θ with
+  // (f_θ)_independent[k] = τ_k, so that Cᵀ f_θ = τ (every independent[k] >= 0).
+  SimTK::Vector independent_forces(const VecX& tau) const;
+
+  // SimbodyTwin::kinematics; `qdd` is Simbody's q̈ from the reduced equations where the coupling
+  // cannot be posed as couplers (!couplers), else unused.
+  TwinKinematics kinematics(const VecX& q, const VecX& qd, const VecX& tau, const VecX& qdd,
+                            const std::vector<TwinFrame>& frames, bool jacobian);
 };
 
 }  // namespace femdyn::validation

@@ -14,11 +14,13 @@
 #include "core/body_inertia.hpp"
 #include "core/equations.hpp"
 #include "core/errors.hpp"
+#include "core/frames.hpp"
 #include "core/inertia.hpp"
 #include "core/joints/kernel.hpp"
 #include "core/kinematics.hpp"
 #include "core/math.hpp"
 #include "core/model.hpp"
+#include "core/momentum.hpp"
 #include "core/sampling.hpp"
 #include "sim/fixed_step.hpp"
 #include "validation/twin.hpp"
@@ -255,9 +257,12 @@ const double kTightRatio = std::pow(100.0, 0.25);
 //   memory per body of the twin (Simbody's system and state) and of femdyn's workspaces.
 constexpr double kBytesPerBody = 20e3;
 
-void accumulate(QuantityError& e, const MatX& femdyn, const MatX& simbody) {
+// ‖x_femdyn − x_simbody‖∞ / max(‖x_simbody‖∞, floor) (the absolute error when both are 0). The
+// floor is the size of what the quantity is made of, where it may vanish by cancellation (a
+// centre of mass at the origin): the error is then measured against its parts.
+void accumulate(QuantityError& e, const MatX& femdyn, const MatX& simbody, double floor = 0) {
   const double d = max_abs(femdyn - simbody);
-  const double scale = max_abs(simbody);
+  const double scale = std::max(max_abs(simbody), floor);
   e.max_abs = std::max(e.max_abs, d);
   e.max_rel = std::max(e.max_rel, scale > 0 ? d / scale : d);
 }
@@ -322,6 +327,11 @@ struct Validator::Impl {
   std::unique_ptr<SimbodyTwin> twin;
   Workspace ws;
   MatX V;  // products: the seeded random vectors M^s is multiplied by
+  // The frames and the mechanism (up to kKinematicsLimit coordinates), and femdyn's buffers.
+  bool kinematics = false, frame_jacobian = false;
+  std::vector<TwinFrame> frames;
+  FrameKinematics fk;
+  MomentumKinematics mk;
   WorkEstimate estimate;
   // Probes (s): femdyn's forward dynamics and its energy at a state.
   double t_fd = 0, t_energy = 0;
@@ -380,12 +390,85 @@ struct Validator::Impl {
       r.failure = std::string("Simbody refused the twin: ") + e.what();
       return false;
     }
+    // (A mechanism without mass has no centre of mass: momentum_kinematics refuses it.)
+    double mass = 0;
+    for (const TwinBody& b : tm.bodies) mass += b.mass;
+    for (const TwinRod& rod : tm.rods) mass += rod.mass;
+    kinematics = m.n() <= kKinematicsLimit && mass > 0;
+    frame_jacobian = m.n() <= kFrameJacobianLimit;
+    for (const Frame& f : m.frames) frames.push_back({f.body, f.R_BF, f.p_BF});
     if (!r.dense_mass) {
       std::mt19937 rng(o.seed + 7919);  // apart from the states' sequence
       V.resize(m.n(), kMassProducts);
       for (int c = 0; c < kMassProducts; ++c) V.col(c) = random_uniform(m.n(), 1, rng);
     }
     return true;
+  }
+
+  // femdyn's frames and mechanism at (q, v), stacked as the twin's (TwinKinematics): each
+  // frame's pose, velocity J v and acceleration J v̇ + J̇v (with v̇ = `v_dot`, the forward
+  // dynamics'), J when compared, and the mechanism in `mk`.
+  struct StackedFrames {
+    MatX R, p, velocity, acceleration, J;
+  } femdyn_frames;
+  void femdyn_kinematics(const VecX& q, const VecX& v, const VecX& v_dot) {
+    propagate(m, ws, q, v, {.jacobian = true, .bias = true, .rows = false});
+    const int nf = static_cast<int>(m.frames.size()), n = m.n();
+    StackedFrames& K = femdyn_frames;
+    K.R.resize(3, 3 * nf), K.p.resize(3, nf), K.velocity.resize(6, nf);
+    K.acceleration.resize(6, nf), K.J.resize(frame_jacobian ? 6 * nf : 0, n);
+    for (int f = 0; f < nf; ++f) {
+      frame_kinematics(m, ws, f, FrameAxes::LocalWorldAligned, fk);
+      K.R.middleCols<3>(3 * f) = fk.R;
+      K.p.col(f) = fk.p;
+      K.velocity.col(f) = fk.velocity;
+      K.acceleration.col(f).noalias() = fk.J * v_dot;
+      K.acceleration.col(f) += fk.bias;
+      if (frame_jacobian) K.J.middleRows<6>(6 * f) = fk.J;
+    }
+    momentum_kinematics(m, ws, mk);
+  }
+
+  // The compared kinematics (run() adds them after M, h, Q, q̈, τ and the loop).
+  struct KinematicErrors {
+    QuantityError *pose, *velocity, *acceleration, *jacobian, *com, *com_velocity,
+        *com_acceleration, *momentum;
+  };
+
+  // femdyn (femdyn_frames, mk at v and v̇) against Simbody's `s`. Positions, velocities and
+  // accelerations of the centre of mass and the momentum are measured against the size of what
+  // they are made of as well (accumulate's floor; they may vanish by cancellation): the
+  // mechanism's extent L = max(‖p_F‖∞, ‖c‖∞) over the frames F, its frames' largest speed V and
+  // acceleration A, so P against m V and L_G against m L V. `accelerations` is false where
+  // femdyn's forward dynamics failed.
+  void compare_kinematics(const TwinKinematics& s, const VecX& v, const VecX& v_dot,
+                          bool accelerations, KinematicErrors& e) {
+    const StackedFrames& K = femdyn_frames;
+    const int nf = static_cast<int>(s.R.size());
+    MatX R(3, 3 * nf), p(3, nf);
+    for (int f = 0; f < nf; ++f) R.middleCols<3>(3 * f) = s.R[f], p.col(f) = s.p[f];
+    const double L = std::max(max_abs(p), max_abs(s.com));
+    const double V = max_abs(s.velocity.topRows<3>()), A = max_abs(s.acceleration.topRows<3>());
+    accumulate(*e.pose, K.R, R);
+    accumulate(*e.pose, K.p, p, L);
+    accumulate(*e.velocity, K.velocity, s.velocity);
+    if (e.jacobian) accumulate(*e.jacobian, K.J, s.J);
+    // The mechanism: m, c (against L), I about c (against m L²).
+    accumulate(*e.com, VecX::Constant(1, mk.mass), VecX::Constant(1, s.mass));
+    accumulate(*e.com, mk.com, s.com, L);
+    accumulate(*e.com, mk.inertia_com, s.inertia_com, s.mass * L * L);
+    accumulate(*e.com_velocity, mk.Jcom * v, s.com_velocity, V);  // ċ = J_c v
+    const Vec6 h = mk.A * v;                                      // h_G = A_G v
+    accumulate(*e.momentum, h.head<3>(), s.momentum.head<3>(), s.mass * V);
+    accumulate(*e.momentum, h.tail<3>(), s.momentum.tail<3>(), s.mass * L * V);
+    if (!accelerations) {
+      e.acceleration->max_abs = e.acceleration->max_rel = INFINITY;
+      e.com_acceleration->max_abs = e.com_acceleration->max_rel = INFINITY;
+      return;
+    }
+    accumulate(*e.acceleration, K.acceleration, s.acceleration);
+    const Vec3 c_ddot = mk.Jcom * v_dot + mk.com_bias;  // c̈ = J_c v̇ + J̇_c v
+    accumulate(*e.com_acceleration, c_ddot, s.com_acceleration, A);
   }
 
   // The costs, from one state of each kind of work (a state apart from the compared ones).
@@ -422,7 +505,16 @@ struct Validator::Impl {
     } catch (const std::exception&) {
       // A state Simbody cannot take is reported by the comparison itself; the estimate goes on.
     }
-    estimate.per_state = t_fd + t_eval + t_id + t_sim;
+    double t_kinematics = 0;  // both engines' frames and momentum
+    if (kinematics) {
+      t_kinematics = timed([&] { femdyn_kinematics(q, qd, qdd); });
+      try {
+        t_kinematics += timed([&] { (void)twin->kinematics(q, qd, tau, frames, frame_jacobian); });
+      } catch (const std::exception&) {
+        // As above: the comparison reports it.
+      }
+    }
+    estimate.per_state = t_fd + t_eval + t_id + t_sim + t_kinematics;
     if (!r.dense_mass) estimate.per_state += kSecondsPerProductEntry * double(n) * n;  // M^s V
     estimate.pointwise = o.states * estimate.per_state;
 
@@ -469,6 +561,9 @@ struct Validator::Impl {
     else
       bytes += 4 * dense_bytes(n, kMassProducts);
     if (o.t_end > 0) bytes += 8 * dense_bytes(std::max(1, o.samples) + 1, 2 * (nt + n));
+    if (kinematics && m.mass_route != MassRoute::Transform)
+      bytes += 2 * dense_bytes(3 * nb, n);  // Jω, Jv
+    if (frame_jacobian) bytes += 2 * dense_bytes(6 * static_cast<double>(frames.size()), n);
     estimate.bytes = bytes;
   }
 
@@ -656,6 +751,25 @@ struct Validator::Impl {
     for (const char* name : {"M", "h", "Q", "qdd", "tau"})
       r.quantities.push_back({name, 0, 0, tol});
     if (tm.closed_loop()) r.quantities.push_back({"loop", 0, 0, tol});
+    const std::size_t first_kinematic = r.quantities.size();
+    if (kinematics)
+      for (const char* name : {"frame pose", "frame velocity", "frame acceleration", "frame J",
+                               "com", "com velocity", "com acceleration", "momentum"})
+        if (frame_jacobian || std::string(name) != "frame J")
+          r.quantities.push_back({name, 0, 0, tol});
+    KinematicErrors ek{};
+    if (kinematics) {
+      QuantityError* at = &r.quantities[first_kinematic];
+      ek.pose = at++, ek.velocity = at++, ek.acceleration = at++;
+      ek.jacobian = frame_jacobian ? at++ : nullptr;
+      ek.com = at++, ek.com_velocity = at++, ek.com_acceleration = at++, ek.momentum = at++;
+    } else if (m.n() > kKinematicsLimit) {
+      r.notes.push_back("frames, centre of mass and momentum not compared beyond " +
+                        std::to_string(kKinematicsLimit) + " coordinates");
+    } else {
+      r.notes.push_back(
+          "frames, centre of mass and momentum not compared: the mechanism has no mass");
+    }
     QuantityError &eM = r.quantities[0], &eh = r.quantities[1], &eQ = r.quantities[2],
                   &eqdd = r.quantities[3], &etau = r.quantities[4];
     // The loop's closure at femdyn's θ = g(q), θ̇ = G q̇: Simbody's constraint errors relative
@@ -696,6 +810,11 @@ struct Validator::Impl {
       } else {
         eqdd.max_abs = eqdd.max_rel = INFINITY;
         r.notes.push_back("femdyn: " + st.message);
+      }
+      if (kinematics) {
+        const VecX v_dot = st.ok ? ws.qdd : VecX::Zero(m.n());
+        femdyn_kinematics(q, qd, v_dot);
+        compare_kinematics(tw.kinematics(q, qd, tau, frames, frame_jacobian), qd, v_dot, st.ok, ek);
       }
       inverse_dynamics(m, ws, q, qd, qdd);
       accumulate(etau, ws.tau, tw.inverse_dynamics(q, qd, qdd));

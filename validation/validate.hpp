@@ -30,6 +30,12 @@ inline constexpr double kMaxTrajectoryTime = 100;
 inline constexpr double kDefaultBudget = 120;  // s
 inline constexpr int kDenseMassLimit = 1000;
 inline constexpr int kMassProducts = 4;
+// The kinematics for control (docs/validation.md, "Frames, centre of mass, momentum") are compared
+// up to kKinematicsLimit coordinates (femdyn's frame Jacobians are 6 × n each, its body
+// Jacobians 3·bodies × n), the frame Jacobians J column by column up to kFrameJacobianLimit
+// (Simbody's velocity at q̇ = e_k, n operator calls a state).
+inline constexpr int kKinematicsLimit = kDenseMassLimit;
+inline constexpr int kFrameJacobianLimit = 300;
 
 // The default pointwise tolerance, relative: max(1e-10, ε·d²) for a tree whose longest path
 // from the world holds d bodies. The two engines compute the same physics, so they differ by
@@ -83,9 +89,10 @@ class OverBudget : public Error {
 };
 
 // One compared quantity: max over the states of ‖x_femdyn − x_simbody‖∞ and of that divided by
-// ‖x_simbody‖∞ (the absolute error when the Simbody quantity is zero).
+// ‖x_simbody‖∞ (the absolute error when the Simbody quantity is zero); for the centre of mass
+// and the momentum, by the larger of that and the size of their parts (docs/validation.md).
 struct QuantityError {
-  std::string name;  // "M", "h", "Q", "qdd", "tau"
+  std::string name;  // "M", "h", "Q", "qdd", "tau", "loop", "frame pose", …, "momentum"
   double max_abs = 0, max_rel = 0, tolerance = 0;
   bool pass() const { return max_rel <= tolerance; }
 };
