@@ -1,5 +1,6 @@
 // femdyn track: computed-torque feed-forward along a smooth point-to-point motion, replayed
-// open loop in forward simulation — the control use of the equations.
+// open loop in forward simulation, or with PD feedback closed through the control loop
+// (sim/control_loop.hpp) — the control use of the equations.
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -8,6 +9,7 @@
 #include "cli/commands.hpp"
 #include "io/csv.hpp"
 #include "io/output.hpp"
+#include "sim/control_loop.hpp"
 #include "sim/fixed_step.hpp"
 #include "sim/quintic.hpp"
 
@@ -16,7 +18,7 @@ namespace {
 
 constexpr const char* kHelp =
     R"(usage: femdyn track MODEL --to a,b,… [--from …] [--duration T] [--steps N] [--csv FILE [--force]] [--json]
-                     [--gravity gx,gy,gz]
+                     [--kp KP --kd KD [--start q] [--control evaluation|hold]] [--gravity gx,gy,gz]
 
 Plans the quintic (minimum-jerk) motion q_ref(t) from --from (default 0, the identity rotation
 for a ball or free joint) to --to in T seconds (default 1), along each joint's geodesic
@@ -25,14 +27,38 @@ then simulates the model under τ(t) alone (RK4, N steps, default 1000) and repo
 the simulated motion follows q_ref (max |q_sim ⊖ q_ref|: rad or m; a rotation by the rotation
 vector between the two quaternions). --csv writes t, q_ref, τ and q_sim per step (atomically; an
 existing FILE is replaced only with --force, and never when it is MODEL). --json prints
-{"model", "n", "coordinates", "duration", "steps", "max_tracking_error", "max_abs_tau"}.
+{"model", "n", "coordinates", "duration", "steps", "max_tracking_error", "max_abs_tau",
+"final_tracking_error", "feedback"}.
+
+With --kp and --kd (1/s², 1/s; e.g. ω² and 2ω) the loop is closed: computed torque with PD,
+  τ = M^s(q) (q̈_ref + K_d (v_ref − v) + K_p (q_ref ⊖ q)) + h(q, v) − Q(q, v, τ = 0),
+so that the error obeys ë + K_d ė + K_p e = 0; sampled at every step and held (--control hold,
+the default: a digital controller at 1/dt) or called at every evaluation (--control evaluation)
+(docs/control.md). --start q0 starts the model off the reference (default: --from), to see the
+error converge.
 )";
+
+// Computed torque with PD about the reference at t (held or per evaluation: ControlLoop).
+struct ComputedTorque {
+  const Model& m;
+  const VecX &q_from, &delta;
+  double T, kp, kd;
+  Workspace ws{m}, wref{m};
+  VecX qr, vr, ar;
+  void operator()(double t, const VecX& q, const VecX& v, VecX& tau) {
+    quintic(m, q_from, delta, T, std::min(t, T), qr, vr, ar);
+    evaluate(m, ws, q, v, VecX::Zero(m.n()));  // M^s, h, Q(τ = 0)
+    const VecX a = ar + kd * (vr - v) + kp * configuration_difference(m, q, qr);
+    tau = ws.Ms * a + ws.h - ws.Q;
+  }
+};
 
 }  // namespace
 
 int cmd_track(int argc, char** argv) {
-  const Args a = parse_args(argc, argv, 2, {"help", "json", "force"},
-                            {"to", "from", "duration", "steps", "csv", "gravity"});
+  const Args a = parse_args(
+      argc, argv, 2, {"help", "json", "force"},
+      {"to", "from", "duration", "steps", "csv", "gravity", "kp", "kd", "start", "control"});
   if (a.has("help")) {
     std::cout << kHelp;
     return 0;
@@ -64,9 +90,34 @@ int cmd_track(int argc, char** argv) {
   };
   VecX u(n);
   const double dt = T / N;
+  const bool feedback = a.has("kp") || a.has("kd");
+  if (feedback && !(a.has("kp") && a.has("kd"))) throw CliError("--kp and --kd go together");
+  const double kp = feedback ? number_option(a, "kp", 0) : 0,
+               kd = feedback ? number_option(a, "kd", 0) : 0;
+  if (!(kp >= 0) || !(kd >= 0)) throw CliError("--kp and --kd expect numbers ≥ 0");
+  ControlMode mode = ControlMode::ZeroOrderHold;
+  if (a.has("control")) {
+    const std::string& c = a.options.at("control");
+    if (c == "evaluation")
+      mode = ControlMode::PerEvaluation;
+    else if (c != "hold")
+      throw CliError("--control expects evaluation or hold");
+    if (!feedback) throw CliError("--control needs --kp and --kd");
+  }
+  if (a.has("start") && !feedback) throw CliError("--start needs --kp and --kd");
+  const VecX q_start = a.has("start") ? configuration_vector(a, "start", m) : q0;
+  // Open loop: τ(t) alone, by RK4. Closed: the same RK4 step under computed torque with PD.
   Rk4 rk4(m, {.dt = dt}, tau);
-  rk4.reset(0, q0, VecX::Zero(n), T);
-  double max_err = 0, max_tau = 0;
+  ComputedTorque law{m, q0, delta, T, kp, kd};
+  ControlLoop loop(
+      m, {.kind = IntegratorKind::Rk4, .fixed = {.dt = dt}}, {.mode = mode, .period = dt},
+      [&law](double t, const VecX& q, const VecX& v, VecX& out) { law(t, q, v, out); });
+  Integrator& integ = feedback ? loop.integrator() : rk4;
+  if (feedback)
+    loop.reset(0, q_start, VecX::Zero(n));
+  else
+    rk4.reset(0, q0, VecX::Zero(n), T);
+  double max_err = 0, max_tau = 0, final_err = 0;
   std::ostringstream csv;
   csv.precision(12);
   csv << "t";
@@ -77,17 +128,19 @@ int cmd_track(int argc, char** argv) {
   csv << "\n";
   for (int k = 0; k <= N; ++k) {
     const double t = k * dt;
-    tau(t, u);
+    tau(t, u);                                       // (and q_ref at t into qr)
+    if (feedback) law(t, integ.q(), integ.qd(), u);  // the torque applied from t
     // |q_sim ⊖ q_ref|: rad or m (a ball's rotation: the angle of the rotation vector's entries)
-    max_err = std::max(max_err, configuration_difference(m, qr, rk4.q()).cwiseAbs().maxCoeff());
+    final_err = configuration_difference(m, qr, integ.q()).cwiseAbs().maxCoeff();
+    max_err = std::max(max_err, final_err);
     max_tau = std::max(max_tau, u.cwiseAbs().maxCoeff());
     csv << t;
     for (int i = 0; i < m.n_q(); ++i) csv << "," << qr[i];
     for (int i = 0; i < n; ++i) csv << "," << u[i];
-    for (int i = 0; i < m.n_q(); ++i) csv << "," << rk4.q()[i];
+    for (int i = 0; i < m.n_q(); ++i) csv << "," << integ.q()[i];
     csv << "\n";
     if (k == N) break;
-    const Status st = rk4.advance_to((k + 1) * dt);
+    const Status st = feedback ? loop.step() : rk4.advance_to((k + 1) * dt);
     if (!st.ok) throw CliError(st.message);
   }
   if (a.has("csv")) {
@@ -98,18 +151,30 @@ int cmd_track(int argc, char** argv) {
     }
   }
   if (a.has("json")) {
-    std::cout << json_text(Json{{"model", m.name},
-                                {"n", m.n()},
-                                {"coordinates", m.coordinate_names},
-                                {"duration", T},
-                                {"steps", N},
-                                {"max_tracking_error", max_err},
-                                {"max_abs_tau", max_tau}})
+    std::cout << json_text(Json{
+                     {"model", m.name},
+                     {"n", m.n()},
+                     {"coordinates", m.coordinate_names},
+                     {"duration", T},
+                     {"steps", N},
+                     {"max_tracking_error", max_err},
+                     {"final_tracking_error", final_err},
+                     {"max_abs_tau", max_tau},
+                     {"feedback",
+                      feedback ? Json{{"kp", kp},
+                                      {"kd", kd},
+                                      {"control",
+                                       mode == ControlMode::PerEvaluation ? "evaluation" : "hold"}}
+                               : Json(nullptr)}})
               << "\n";
   } else {
     std::cout << "model: " << m.name << "\nquintic motion over " << T << " s, " << N
-              << " RK4 steps, feed-forward torques by inverse dynamics\n"
-              << "max |tau|: " << max_tau << "\nmax |q_sim - q_ref|: " << max_err << "\n";
+              << " RK4 steps, "
+              << (feedback ? "computed torque with PD feedback (kp " + format_number(kp) + ", kd " +
+                                 format_number(kd) + ")\n"
+                           : std::string("feed-forward torques by inverse dynamics\n"))
+              << "max |tau|: " << max_tau << "\nmax |q_sim - q_ref|: " << max_err
+              << "\nfinal |q_sim - q_ref|: " << final_err << "\n";
   }
   return 0;
 }

@@ -135,6 +135,38 @@ TEST_CASE("track on a floating base: the feed-forward along the geodesic is exac
   CHECK(previous < 1e-6);
 }
 
+TEST_CASE("track --kp --kd closes the loop: the error from an offset start decays",
+          "[cli][control]") {
+  // Computed torque with PD (ω = 20 rad/s, critically damped) from a start 0.1 rad off every
+  // joint: per evaluation the error obeys ë + 2ω ė + ω² e = 0 exactly, e(t) = e0 (1 + ω t)
+  // exp(−ω t), 4.3e-9 rad at t = 1 s. Held at 1/dt the sampled τ lags by O(dt): the error at
+  // 1 s is that lag's, and halves when dt halves.
+  const std::string finger = model_path("finger.json");
+  const std::string motion = " --to 0.3,0.5,0.4,0.2 --duration 1 --json";
+  const std::string start = " --start 0.1,0.1,0.1,0.1 --kp 400 --kd 40";
+  const double e0 = 0.1, omega = 20, decayed = e0 * (1 + omega) * std::exp(-omega);
+  const auto final_error = [&](const std::string& control, int steps) {
+    const Run r = run("track " + finger + motion + start + " --control " + control + " --steps " +
+                      std::to_string(steps));
+    INFO(r.out);
+    REQUIRE(r.code == 0);
+    const auto j = nlohmann::json::parse(r.out);
+    CHECK(j["max_tracking_error"].get<double>() == Approx(e0).epsilon(1e-12));  // at t = 0
+    CHECK(j["feedback"]["control"] == control);
+    return j["final_tracking_error"].get<double>();
+  };
+  CHECK(final_error("evaluation", 1000) == Approx(decayed).epsilon(1e-3));
+  const double held = final_error("hold", 1000), finer = final_error("hold", 2000);
+  CHECK(held < 1e-4);
+  CHECK(held / finer == Approx(2).epsilon(0.1));
+  const Run gains_alone = run("track " + finger + motion + " --kp 400");
+  CHECK(gains_alone.code == 2);
+  CHECK_THAT(gains_alone.out, Catch::Contains("--kp and --kd go together"));
+  const Run open = run("track " + finger + motion + " --start 0.1,0.1,0.1,0.1");
+  CHECK(open.code == 2);
+  CHECK_THAT(open.out, Catch::Contains("--start needs --kp and --kd"));
+}
+
 TEST_CASE("track: feed-forward torques from inverse dynamics reproduce the motion", "[cli]") {
   for (const char* name : {"finger_coupled.json", "branched_tree.json"}) {
     INFO(name);
