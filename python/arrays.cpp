@@ -118,4 +118,18 @@ py::array_t<double> new_array(std::initializer_list<py::ssize_t> shape) {
   return py::array_t<double>(std::vector<py::ssize_t>(shape));
 }
 
+int frame_arg(const Model& model, const std::string& name) {
+  const int f = find_frame(model, name);
+  if (f < 0) throw py::value_error("no frame " + quoted_text(name) + " (model.frames names them)");
+  return f;
+}
+
+FrameAxes axes_arg(const std::string& text) {
+  FrameAxes axes = FrameAxes::LocalWorldAligned;
+  if (!parse_frame_axes(text, axes))
+    throw py::value_error("axes: expected 'local_world_aligned', 'local' or 'world', got " +
+                          quoted_text(text));
+  return axes;
+}
+
 }  // namespace femdyn::python

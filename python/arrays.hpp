@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "core/frames.hpp"
 #include "core/model.hpp"
 
 namespace femdyn::python {
@@ -57,6 +58,9 @@ RowMatX configuration_batch_arg(const Array& a, const char* name, const Model& m
 // as Python's open() refuses it: the system, and C++ code that takes C strings, would see only
 // the part before it ("a\0b.json" would open "a").
 const std::string& text_arg(const std::string& s, const char* name);
+// A frame by name (ValueError naming it), and a set of axes by name (core/frames.hpp).
+int frame_arg(const Model& model, const std::string& name);
+FrameAxes axes_arg(const std::string& text);
 const std::optional<std::string>& text_arg(const std::optional<std::string>& s, const char* name);
 
 // A fresh C-ordered float64 array of the given shape.

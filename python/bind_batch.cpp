@@ -175,12 +175,8 @@ void require_finite_row(bool finite, Eigen::Index i, const std::string& what) {
 py::dict frame_kinematics_batch(const PyModel& self, const std::string& name, const Array& q,
                                 const OptArray& qd, const std::string& axes_text, int threads) {
   const Model& m = *self.model;
-  const int f = find_frame(m, name);
-  if (f < 0) throw py::value_error("no frame " + quoted_text(name) + " (model.frames names them)");
-  FrameAxes axes = FrameAxes::LocalWorldAligned;
-  if (!parse_frame_axes(axes_text, axes))
-    throw py::value_error("axes: expected 'local_world_aligned', 'local' or 'world', got " +
-                          quoted_text(axes_text));
+  const int f = frame_arg(m, name);
+  const FrameAxes axes = axes_arg(axes_text);
   const Batch b(m, q, qd, std::nullopt, "", Entries::Bounded);
   const py::ssize_t k = b.k, n = b.n;
   const int nthreads = batch_threads(k, threads);

@@ -95,12 +95,8 @@ VecX inverse(PyModel& self, const Array& q, const OptArray& qd, const OptArray& 
 py::dict frame_of(PyModel& self, const std::string& name, const Array& q, const OptArray& qd,
                   const std::string& axes_text) {
   const Model& m = *self.model;
-  const int f = find_frame(m, name);
-  if (f < 0) throw py::value_error("no frame " + quoted_text(name) + " (model.frames names them)");
-  FrameAxes axes = FrameAxes::LocalWorldAligned;
-  if (!parse_frame_axes(axes_text, axes))
-    throw py::value_error("axes: expected 'local_world_aligned', 'local' or 'world', got " +
-                          quoted_text(axes_text));
+  const int f = frame_arg(m, name);
+  const FrameAxes axes = axes_arg(axes_text);
   FrameKinematics k;
   frame_kinematics(m, self.ws, configuration_arg(q, "q", m), vector_arg(qd, "qd", m), f, axes, k);
   if (!k.J.allFinite() || !k.bias.allFinite() || !k.p.allFinite())
@@ -148,12 +144,8 @@ py::dict centroidal_of(PyModel& self, const Array& q, const OptArray& qd) {
 py::dict generalized_of(PyModel& self, const std::string& name, const Array& q, const OptArray& qd,
                         const std::string& axes_text) {
   const Model& m = *self.model;
-  const int f = find_frame(m, name);
-  if (f < 0) throw py::value_error("no frame " + quoted_text(name) + " (model.frames names them)");
-  FrameAxes axes = FrameAxes::LocalWorldAligned;
-  if (!parse_frame_axes(axes_text, axes))
-    throw py::value_error("axes: expected 'local_world_aligned', 'local' or 'world', got " +
-                          quoted_text(axes_text));
+  const int f = frame_arg(m, name);
+  const FrameAxes axes = axes_arg(axes_text);
   floating_base_rate(m);  // ModelError (a ValueError) unless one tree on a free joint
   propagate(m, self.ws, configuration_arg(q, "q", m), vector_arg(qd, "qd", m),
             {.jacobian = true, .bias = true, .rows = false});
