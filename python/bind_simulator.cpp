@@ -66,11 +66,14 @@ void tau_of(const py::handle& value, const Model& m, double t, VecX& tau) {
   if (const std::string bad = tau_problem(m, tau); !bad.empty()) throw py::value_error(at + bad);
 }
 
-// Rows of a run: (t, q, q̇, τ applied from t, W, E) at every period.
+// Rows of a run: (t, q, q̇, τ applied from t, W, E) at every period; τ as the dynamics sees it,
+// saturated at the joints' effort limits.
 struct Rows {
   std::vector<double> t, q, qd, tau, work, total;
-  void add(const ControlLoop& loop, Motion& motion, const VecX& tau_k) {
+  void add(const ControlLoop& loop, Motion& motion, VecX tau_k) {
     const Integrator& i = loop.integrator();
+    if (const Model& m = motion.model(); m.has_effort_limits)
+      tau_k = tau_k.cwiseMax(-m.effort_limit).cwiseMin(m.effort_limit);
     t.push_back(i.t());
     const VecX q_now = i.q(), qd_now = i.qd();
     q.insert(q.end(), q_now.data(), q_now.data() + q_now.size());
@@ -81,9 +84,11 @@ struct Rows {
   }
 };
 
+// x as a (rows, cols) array; a column (cols = 0) as (rows,).
 py::array_t<double> table(const std::vector<double>& x, py::ssize_t cols) {
-  const py::ssize_t rows = cols ? static_cast<py::ssize_t>(x.size()) / cols : 0;
-  py::array_t<double> a = cols == 1 ? new_array({rows}) : new_array({rows, cols});
+  const py::ssize_t rows =
+      cols ? static_cast<py::ssize_t>(x.size()) / cols : static_cast<py::ssize_t>(x.size());
+  py::array_t<double> a = cols == 0 ? new_array({rows}) : new_array({rows, cols});
   std::copy(x.begin(), x.end(), a.mutable_data());
   return a;
 }
@@ -166,6 +171,7 @@ class Simulator {
       });
     const auto begin = std::chrono::steady_clock::now();
     const IntegratorStats before = integ.stats();
+    const long saturated_before = integ.motion().saturated_evaluations();
     const long k_before = loop_->period_index();
     Rows rows;
     Status st;
@@ -192,6 +198,7 @@ class Simulator {
     stats["steps"] = s.steps - before.steps;
     stats["rejected"] = s.rejected - before.rejected;
     stats["rhs_evals"] = s.rhs_evals - before.rhs_evals;
+    stats["saturated_evaluations"] = integ.motion().saturated_evaluations() - saturated_before;
     stats["integration_time"] = s.wall_time - before.wall_time;
     stats["wall_time"] =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
@@ -200,12 +207,12 @@ class Simulator {
     stats["diverged"] = st.diverged;
     stats["failure"] = st.message;
     py::dict d;
-    d["t"] = table(rows.t, 1);
+    d["t"] = table(rows.t, 0);
     d["q"] = table(rows.q, m.n_q());
     d["qd"] = table(rows.qd, m.n());
     d["tau"] = table(rows.tau, m.n());
-    d["work"] = table(rows.work, 1);
-    d["total"] = table(rows.total, 1);
+    d["work"] = table(rows.work, 0);
+    d["total"] = table(rows.total, 0);
     d["stats"] = stats;
     return d;
   }
@@ -249,7 +256,10 @@ void bind_simulator(py::module_& m) {
            "controller(t, q, qd): called at "
            "every period and held (mode='hold'), or at every evaluation of f "
            "(mode='evaluation'). Returns a dict: t (m,), q (m, n_q), qd, tau (m, n), work, total "
-           "(m,), stats; tau[k] is applied from t[k] (the last row repeats the last). A wrong or "
+           "(m,), stats; tau[k] is applied from t[k] (the last row repeats the last), saturated at "
+           "the "
+           "joints' effort limits (stats['saturated_evaluations'] counts the evaluations that "
+           "were). A wrong or "
            "NaN tau is a ValueError, the controller's own exception propagates, a numerical "
            "failure raises NumericalError (check=False: the rows so far, stats['ok'] False). "
            "One thread at a time: a Simulator is not shared between threads.");

@@ -84,3 +84,14 @@ def test_actuator_arguments_need_a_moving_joint():
         b.body("link", "world", friction=0.1)
     with pytest.raises(ValueError, match="stop: unknown key 'damping'"):
         b.body("link", "world", type="revolute", limits=(-1, 1), stop={"damping": 1.0})
+
+
+def test_a_controllers_torque_is_saturated_and_recorded_as_applied():
+    # A controller asking 5 N·m of a joint limited to 2: the run records the 2 it got, and the
+    # motion is θ = t² (rk4 exact), as with a prescribed τ.
+    m = arm(effort_limit=2.0)
+    sim = femdyn.Simulator(m, integrator="rk4", dt=0.01, q0=[0.0], qd0=[0.0])
+    r = sim.run(lambda t, q, qd: np.array([5.0]), 1.0)
+    assert np.all(r["tau"] == 2.0)
+    assert r["stats"]["saturated_evaluations"] == r["stats"]["rhs_evals"] >= 400
+    assert r["q"][-1, 0] == pytest.approx(1.0, rel=1e-12)  # (m, n_q) even for n_q = 1
