@@ -132,6 +132,51 @@ std::string correlation_table_text(const Model& model) {
   return out.str();
 }
 
+// A joint's own forces and limits (core/joints/passive.hpp), only those it has: for info.
+Json joint_properties(const Joint& j) {
+  Json p = Json::object();
+  const auto bound = [](double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); };
+  if (std::isfinite(j.lower) || std::isfinite(j.upper))
+    p["limits"] = {bound(j.lower), bound(j.upper)};
+  if (j.stop) p["stop"] = {{"stiffness", j.stop_stiffness}, {"dissipation", j.stop_dissipation}};
+  if (j.stiffness != 0) p["spring"] = {{"stiffness", j.stiffness}, {"rest", j.rest}};
+  if (j.damping != 0) p["damping"] = j.damping;
+  if (j.friction != 0) p["friction"] = {{"force", j.friction}, {"velocity", j.friction_velocity}};
+  if (j.armature != 0)
+    p["armature"] = {{"inertia", j.armature}, {"gear", j.gear}, {"reflected", j.reflected_inertia}};
+  if (std::isfinite(j.effort_limit)) p["effort_limit"] = j.effort_limit;
+  if (std::isfinite(j.velocity_limit)) p["velocity_limit"] = j.velocity_limit;
+  return p;
+}
+
+// The same on one line: "limits [-1, 0.5] with a stop (k 1e4, d 0.5); damping 2; …".
+std::string joint_properties_text(const Joint& j) {
+  std::vector<std::string> parts;
+  const auto bound = [](double x) {
+    return std::isfinite(x) ? format_number(x) : std::string(x < 0 ? "-inf" : "inf");
+  };
+  if (std::isfinite(j.lower) || std::isfinite(j.upper))
+    parts.push_back("limits [" + bound(j.lower) + ", " + bound(j.upper) + "]" +
+                    (j.stop ? " with a stop (k " + format_number(j.stop_stiffness) + ", d " +
+                                  format_number(j.stop_dissipation) + ")"
+                            : " reported"));
+  if (j.stiffness != 0)
+    parts.push_back("spring " + format_number(j.stiffness) + " at " + format_number(j.rest));
+  if (j.damping != 0) parts.push_back("damping " + format_number(j.damping));
+  if (j.friction != 0)
+    parts.push_back("Coulomb friction " + format_number(j.friction) + " (v_s " +
+                    format_number(j.friction_velocity) + ")");
+  if (j.armature != 0)
+    parts.push_back("rotor " + format_number(j.armature) + " x gear " + format_number(j.gear) +
+                    "^2 = " + format_number(j.reflected_inertia));
+  if (std::isfinite(j.effort_limit)) parts.push_back("effort " + format_number(j.effort_limit));
+  if (std::isfinite(j.velocity_limit))
+    parts.push_back("velocity " + format_number(j.velocity_limit));
+  std::string out;
+  for (const std::string& part : parts) out += (out.empty() ? "" : "; ") + part;
+  return out;
+}
+
 std::string info_text(const Model& model) {
   std::ostringstream out;
   out << "model: " << model.name << "\n";
@@ -172,6 +217,7 @@ std::string info_text(const Model& model) {
       if (model.theta0[j.idx_v] != 0) out << " + " << model.theta0[j.idx_v];
     }
     out << "\n";
+    if (const std::string p = joint_properties_text(j); !p.empty()) out << "      " << p << "\n";
   }
   out << "bodies and elements (" << model.elements.size() << " elements):\n";
   std::vector<std::string> element_types(model.bodies.size());
@@ -226,6 +272,16 @@ Json info_json(const Model& model) {
                       {"xyz", vec_json(F.p_BF)},
                       {"R", mat_json(F.R_BF)}});
   j["frames"] = frames;
+  Json joints = Json::array();  // every joint, with its own forces and limits
+  for (const Body& b : model.bodies) {
+    Json joint = {{"name", b.joint.name},
+                  {"type", std::string(joint_type_name(b.joint.type))},
+                  {"parent", b.parent < 0 ? std::string("world") : model.bodies[b.parent].name},
+                  {"body", b.name}};
+    joint.update(joint_properties(b.joint));
+    joints.push_back(joint);
+  }
+  j["joints"] = joints;
   return j;
 }
 

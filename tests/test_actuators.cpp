@@ -427,6 +427,30 @@ TEST_CASE("check sees a stiff stop and the friction's slope", "[actuators][check
   CHECK(friction_step.get<double>() == Approx(2.785 / 200).epsilon(1e-3));
 }
 
+TEST_CASE("info lists each joint's rotor, friction, limits and stop", "[actuators][cli]") {
+  Scratch s("actuators_info");
+  std::ofstream(s / "m.json") << block({{"limits", {-1, 0.1}},
+                                        {"stop", {{"stiffness", 1e4}, {"dissipation", 0.2}}},
+                                        {"friction", 2.0},
+                                        {"armature", 0.01},
+                                        {"gear", 10},
+                                        {"effort_limit", 30},
+                                        {"velocity_limit", 3}})
+                                     .dump();
+  const Run text = run("info " + (s / "m.json"));
+  REQUIRE(text.code == 0);
+  CHECK_THAT(text.out, Catch::Contains("limits [-1, 0.1] with a stop (k 10000, d 0.2); Coulomb "
+                                       "friction 2 (v_s 0.01); rotor 0.01 x gear 10^2 = 1; "
+                                       "effort 30; velocity 3"));
+  const Run json = run("info " + (s / "m.json") + " --json");
+  REQUIRE(json.code == 0);
+  const Json j = Json::parse(json.out)["joints"][0];
+  CHECK(j["armature"]["reflected"].get<double>() == Approx(1.0).epsilon(1e-15));
+  CHECK(j["stop"]["dissipation"] == 0.2);
+  CHECK(j["limits"][1] == 0.1);
+  CHECK(j["effort_limit"] == 30);
+}
+
 TEST_CASE("a coupled joint's effort limit is kept, not applied, and a run says so",
           "[actuators][urdf]") {
   // The hand's distal joints mimic the middle ones: their <limit effort> has no τ to saturate.
