@@ -168,14 +168,20 @@ namespace {
 
 // Calls f(k, i, M_θ(k, i)) for every rate i (of body b = theta_joint[i]) and every rate
 // k = i, λ(i), λ(λ(i)), … on its path: the entries of M_θ's upper triangle (k ≤ i),
-// M_θ(k, i) = S_kᵀ I^c_b S_i, plus the joint's reflected rotor inertia I_a G² on the diagonal.
+// M_θ(k, i) = S_kᵀ I^c_b S_i.
 template <class F>
 void for_path_entries(const Model& m, const Workspace& ws, F&& f) {
   for (int i = 0; i < m.n_theta(); ++i) {
     const Vec6 F_i = ws.composite[m.theta_joint[i]] * ws.subspace[i];
-    f(i, i, ws.subspace[i].dot(F_i) + m.bodies[m.theta_joint[i]].joint.reflected_inertia);
-    for (int k = m.rate_parent[i]; k >= 0; k = m.rate_parent[k]) f(k, i, ws.subspace[k].dot(F_i));
+    for (int k = i; k >= 0; k = m.rate_parent[k]) f(k, i, ws.subspace[k].dot(F_i));
   }
+}
+
+// Calls f(i, i, I_a G²) for every rate i whose joint has a rotor: M_θ's diagonal rotor terms.
+template <class F>
+void for_rotor_entries(const Model& m, F&& f) {
+  for (int i = 0; i < m.n_theta(); ++i)
+    if (const double r = m.bodies[m.theta_joint[i]].joint.reflected_inertia; r != 0) f(i, i, r);
 }
 
 }  // namespace
@@ -186,6 +192,7 @@ void mass_from_composites(const Model& m, Workspace& ws) {
     // triangle, column i written contiguously). The entries off every path are structural
     // zeros, written as zeros when the Workspace is made and never touched: no n² clearing.
     for_path_entries(m, ws, [&](int k, int i, double v) { ws.Ms(k, i) = v; });
+    if (m.has_armature) for_rotor_entries(m, [&](int k, int i, double v) { ws.Ms(k, i) += v; });
     return;
   }
   // With couplings, M^s = Cᵀ M_θ C = Σ_{k,i} C_kᵀ M_θ(k, i) C_i over the rows C_k of C: each
@@ -193,14 +200,16 @@ void mass_from_composites(const Model& m, Workspace& ws) {
   // non-zeros of rows k and i, once for (k, i) and once for (i, k). O(Σ depth · nnz²) and
   // symmetric as built; no M_θ is formed.
   ws.Ms.setZero();
-  for_path_entries(m, ws, [&](int k, int i, double v) {
+  const auto scatter = [&](int k, int i, double v) {
     for (SpRowMat::InnerIterator ck(m.C_sparse, k); ck; ++ck)
       for (SpRowMat::InnerIterator ci(m.C_sparse, i); ci; ++ci) {
         const double w = ck.value() * v * ci.value();
         ws.Ms(ck.col(), ci.col()) += w;
         if (k != i) ws.Ms(ci.col(), ck.col()) += w;
       }
-  });
+  };
+  for_path_entries(m, ws, scatter);
+  if (m.has_armature) for_rotor_entries(m, scatter);
 }
 
 }  // namespace femdyn
