@@ -129,7 +129,7 @@ int cmd_kinematics(int argc, char** argv) {
          << "\n  Jdot v (q'' = 0)  = " << k.bias.transpose() << "\n";
     if (floating) {
       GeneralizedJacobian g;
-      generalized_jacobian(m, ws, f, axes, k, c, g);
+      generalized_jacobian(m, k, c, g);
       std::vector<std::string> rates;
       for (const int r : g.rates) rates.push_back(m.coordinate_names[r]);
       entry["generalized_jacobian"] = {

@@ -139,12 +139,9 @@ int floating_base_rate(const Model& model) {
   throw ModelError(model.where, "the free base owns no coordinates");
 }
 
-void generalized_jacobian(const Model& model, const Workspace& ws, int frame, FrameAxes axes,
-                          FrameKinematics& frame_out, MomentumKinematics& momentum,
-                          GeneralizedJacobian& out) {
+void generalized_jacobian(const Model& model, const FrameKinematics& frame_out,
+                          const MomentumKinematics& momentum, GeneralizedJacobian& out) {
   const int base = floating_base_rate(model), n = model.n(), nm = n - 6;
-  frame_kinematics(model, ws, frame, axes, frame_out);
-  momentum_kinematics(model, ws, momentum);
   const Mat6 A_b = momentum.A.middleCols<6>(base);
   Eigen::FullPivLU<Mat6> lu(A_b);
   if (!lu.isInvertible())

@@ -63,10 +63,10 @@ struct GeneralizedJacobian {
 // one tree on it. Throws ModelError otherwise (a fixed base, several trees, several free joints).
 int floating_base_rate(const Model& model);
 
-// J* of `frame` at the last propagate (as momentum_kinematics); `frame_out` and `momentum` are
-// filled on the way. Throws StateError if A_b is singular (a massless mechanism).
-void generalized_jacobian(const Model& model, const Workspace& ws, int frame, FrameAxes axes,
-                          FrameKinematics& frame_out, MomentumKinematics& momentum,
-                          GeneralizedJacobian& out);
+// J* of a frame from its kinematics and the momentum at the same state (frame_kinematics and
+// momentum_kinematics after one propagate). Throws ModelError unless the model is one tree on a
+// free joint, StateError if A_b is singular (a massless mechanism).
+void generalized_jacobian(const Model& model, const FrameKinematics& frame,
+                          const MomentumKinematics& momentum, GeneralizedJacobian& out);
 
 }  // namespace femdyn

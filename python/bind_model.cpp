@@ -152,8 +152,10 @@ py::dict generalized_of(PyModel& self, const std::string& name, const Array& q, 
   FrameKinematics k;
   MomentumKinematics c;
   GeneralizedJacobian g;
-  generalized_jacobian(m, self.ws, f, axes, k, c, g);
+  frame_kinematics(m, self.ws, f, axes, k);
+  momentum_kinematics(m, self.ws, c);
   require_finite_momentum(c);
+  generalized_jacobian(m, k, c, g);
   std::vector<std::string> names;
   for (const int r : g.rates) names.push_back(m.coordinate_names[r]);
   py::dict out;

@@ -188,7 +188,9 @@ TEST_CASE("the generalized Jacobian gives the tip's velocity in free float", "[m
     FrameKinematics f;
     MomentumKinematics k;
     GeneralizedJacobian g;
-    generalized_jacobian(m, ws, tip, FrameAxes::LocalWorldAligned, f, k, g);
+    frame_kinematics(m, ws, tip, FrameAxes::LocalWorldAligned, f);
+    momentum_kinematics(m, ws, k);
+    generalized_jacobian(m, f, k, g);
     REQUIRE(g.rates.size() == static_cast<std::size_t>(m.n() - 6));
     VecX v_m(m.n() - 6);
     for (int j = 0; j < m.n() - 6; ++j) v_m[j] = v[g.rates[j]];
