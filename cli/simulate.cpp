@@ -9,6 +9,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
+#include "core/loops/assembly.hpp"
 #include "core/memory.hpp"
 #include "core/names.hpp"
 #include "io/actuation_table.hpp"
@@ -25,7 +26,7 @@ constexpr const char* kHelp =
     R"(usage: femdyn simulate MODEL --t-end T [--integrator rk4|euler|dopri|bdf]
                         [--dt h | --rtol r --atol a] [--q0 …] [--qd0 …] [--tau … | --tau-csv FILE]
                         [--out traj.csv] [--every k | --sample-dt s] [--max-steps N] [--force]
-                        [--max-memory GB] [--json] [--gravity gx,gy,gz]
+                        [--max-memory GB] [--json] [--gravity gx,gy,gz] [--baumgarte W]
 
 Integrates M^s q̈ + h = Q from (q0, q̇0) (default 0) over [0, T] and prints a summary:
 integrator, steps, rejected steps, evaluations of forward dynamics, Jacobians, wall time,
@@ -33,6 +34,13 @@ real-time factor (simulated time / integration wall time), and the energy balanc
 |E(t) − E(0) − W(t)| over the output rows, W the work of the non-conservative forces (τ,
 dampers, friction, joint stops, body torques); for a conservative model that is the energy drift. It is given
 relative to the energy the motion started with plus the work done (docs/simulation.md).
+
+A model with closed loops (constraints, docs/loops.md) starts from q0 assembled onto the
+constraints by Newton's least-norm steps and q̇0 projected onto them (an impulse through the
+loops); it moves by the constrained equations with Baumgarte's stabilisation at --baumgarte W
+(1/s, default 20; 0: off), and is projected back onto the constraints after every fixed step, and
+after every adaptive step that leaves them by more than atol. The summary gives the equations,
+their rank (redundant ones counted) and the largest residuals |Phi| and |Phi_q v| over the rows.
 
 integrators (docs/simulation.md):
   rk4    classical Runge–Kutta 4, fixed step --dt (default 1e-3 s)
@@ -150,7 +158,7 @@ int cmd_simulate(int argc, char** argv) {
   const Args a =
       parse_args(argc, argv, 2, {"help", "json", "force"},
                  {"gravity", "t-end", "integrator", "dt", "rtol", "atol", "q0", "qd0", "tau",
-                  "tau-csv", "out", "every", "sample-dt", "max-steps", "max-memory"});
+                  "tau-csv", "out", "every", "sample-dt", "max-steps", "max-memory", "baumgarte"});
   if (a.has("help")) {
     std::cout << kHelp;
     return 0;
@@ -160,7 +168,21 @@ int cmd_simulate(int argc, char** argv) {
   const double t_end = number_option(a, "t-end", 0);
   if (!(t_end > 0) || t_end > 1e9) throw CliError("--t-end expects a time in (0, 1e9] s");
   const IntegratorOptions o = integrator_options(a);
-  const VecX q0 = configuration_vector(a, "q0", m), qd0 = state_vector(a, "qd0", m);
+  VecX q0 = configuration_vector(a, "q0", m), qd0 = state_vector(a, "qd0", m);
+  // Closed loops: the start assembled onto the constraints (docs/loops.md).
+  StateAssembly loops;
+  double baumgarte = Motion::kDefaultBaumgarte;
+  if (a.has("baumgarte")) {
+    if (m.constraints.empty()) throw CliError("--baumgarte: the model has no constraints");
+    baumgarte = number_option(a, "baumgarte", 0);
+    if (!(baumgarte >= 0) || !std::isfinite(baumgarte))
+      throw CliError("--baumgarte expects a rate >= 0 (1/s; 0: off)");
+  }
+  if (!m.constraints.empty()) {
+    loops = assemble_state(m, q0, qd0);
+    if (!loops.assembly.status.ok)
+      throw CliError(a.positional[0] + ": the initial state: " + loops.assembly.status.message);
+  }
   const long every = static_cast<long>(integer_option(a, "every", 1, 1));
   if (a.has("every") && a.has("sample-dt"))
     throw CliError("--every and --sample-dt exclude each other");
@@ -220,6 +242,7 @@ int cmd_simulate(int argc, char** argv) {
   }
 
   std::unique_ptr<Integrator> integ = make_integrator(m, o, tau);
+  integ->motion().set_baumgarte(baumgarte);
   integ->reset(0, q0, qd0, t_end);
   if (out) {
     const Status fits = output_fits(*out, m, o, t_end, every, sample_times);
@@ -328,6 +351,16 @@ int cmd_simulate(int argc, char** argv) {
       j["options"] = {{"rtol", o.adaptive.rtol}, {"atol", o.adaptive.atol}};
     else
       j["options"] = {{"dt", o.fixed.dt}};
+    if (!m.constraints.empty())
+      j["loops"] = {{"equations", m.constraint_rows},
+                    {"rank", loops.assembly.rank},
+                    {"redundant", loops.assembly.redundant},
+                    {"assembly_iterations", loops.assembly.iterations},
+                    {"assembly_residual", loops.assembly.residual},
+                    {"initial_velocity_change", loops.velocity_change},
+                    {"baumgarte", baumgarte},
+                    {"max_position_residual", run.max_position_residual},
+                    {"max_velocity_residual", run.max_velocity_residual}};
     if (out) j["out"] = out->path();
     if (!st.ok) j["failure"] = st.message;
     std::cout << json_text(j) << "\n";
@@ -346,6 +379,16 @@ int cmd_simulate(int argc, char** argv) {
               << balance_name << ": max |E(t) - E(0) - W(t)| = " << num(max_balance) << " J ("
               << num(run.relative_balance()) << " of the " << num(scale)
               << " J the motion started with and was given) over " << rows << " rows\n";
+    if (!m.constraints.empty())
+      std::cout << "loops: " << m.constraint_rows << " constraint equations, rank "
+                << loops.assembly.rank << " (" << loops.assembly.redundant << " redundant); start "
+                << "assembled in " << loops.assembly.iterations
+                << " Newton iterations (|Phi| = " << num(loops.assembly.residual)
+                << "), velocity projected (|dv| = " << num(loops.velocity_change)
+                << "); Baumgarte rate " << num(baumgarte) << " 1/s\n"
+                << "constraint residual over the rows: max |Phi| = "
+                << num(run.max_position_residual)
+                << ", max |Phi_q v| = " << num(run.max_velocity_residual) << "\n";
     if (out) std::cout << "wrote " << escaped(out->path()) << " (" << rows << " rows)\n";
   }
   if (!st.ok) {

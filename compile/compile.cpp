@@ -9,6 +9,7 @@
 #include "compile/actuators.hpp"
 #include "compile/compile_level.hpp"
 #include "compile/correlation.hpp"
+#include "compile/loops.hpp"
 #include "core/body_inertia.hpp"
 #include "core/errors.hpp"
 #include "core/joints/kernel.hpp"
@@ -118,6 +119,8 @@ Joint compile_joint(const JointSpec& js, const std::string& body_name) {
     throw ModelError(js.where + "/limits", "joint limits are NaN or lower > upper");
   j.stiffness = js.stiffness;
   j.rest = js.rest;
+  check_magnitude(js.initial, js.where + "/initial", "initial");
+  j.initial = js.initial;
   j.damping = js.damping;
   j.lower = js.lower;
   j.upper = js.upper;
@@ -295,7 +298,18 @@ void configuration_coupling(Model& m) {
 }
 
 Model compile(MechanismSpec spec, const CompileOptions& options) {
-  if (has_coupling_law(spec)) return compile_with_coupling_level(std::move(spec), options);
+  if (has_coupling_law(spec)) {
+    // (the law chain reduces the tree's equations through θ = g(q); loops and springs act on
+    // the tree's own coordinates)
+    if (!spec.constraints.empty())
+      throw ModelError(spec.where + "/constraints",
+                       "a model with a coupling law cannot also have constraints (close the loop "
+                       "either by the law or by constraints)");
+    if (!spec.springs.empty())
+      throw ModelError(spec.where + "/springs",
+                       "a model with a coupling law cannot also have two-point springs");
+    return compile_with_coupling_level(std::move(spec), options);
+  }
   Model m = compile_tree(std::move(spec), options);
   check_rigid_spans(m);
   return m;
@@ -349,6 +363,7 @@ Model compile_tree(MechanismSpec spec, const CompileOptions& options) {
   lay_out_coordinates(m);
   configuration_coupling(m);
   compile_actuators(m);
+  compile_loops(spec, m);
   // The passes below run kinematics on the model being built: its routes so far (the reference
   // ones, no law) until choose_routes settles them.
   m.routes = choose_equation_routes(m);

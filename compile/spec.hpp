@@ -26,6 +26,7 @@ struct JointSpec {
   double lower = -std::numeric_limits<double>::infinity();
   double upper = std::numeric_limits<double>::infinity();
   double stiffness = 0, rest = 0, damping = 0;    // linear spring / damper on θ
+  double initial = 0;                             // θ in the initial configuration
   double armature = 0, gear = 1;                  // rotor inertia I_a, gear ratio G
   double friction = 0, friction_velocity = 0.01;  // Coulomb F_c, regularisation v_s
   double effort_limit = std::numeric_limits<double>::infinity();
@@ -89,6 +90,37 @@ struct FrameSpec {
   std::string where;
 };
 
+// One end of a loop constraint or a two-point spring: a named frame, a body's own frame, or
+// "world" (`frame`), or else a point `xyz` on `body` with axes turned by `rpy`.
+struct AttachmentSpec {
+  std::string frame;
+  std::string body;
+  Vec3 xyz = Vec3::Zero(), rpy = Vec3::Zero();
+  std::string where;
+};
+
+// A loop-closure constraint (core/loops/constraint.hpp; docs/model-format.md#constraints).
+struct ConstraintSpec {
+  std::string name;
+  std::string type;          // ball, weld, distance, point_on_line, point_on_plane, gear
+  AttachmentSpec a, b;       // all but gear
+  std::optional<Vec3> axis;  // ball's plane normal, point_on_plane's normal, the line direction
+  double length = 0;         // distance
+  // gear: θ_joint = Σ ratio θ_follows + offset
+  std::string joint;
+  std::vector<std::pair<std::string, double>> terms;
+  double offset = 0;
+  std::string where;
+};
+
+// A linear spring-damper between two places (core/springs.hpp).
+struct SpringSpec {
+  std::string name;
+  AttachmentSpec a, b;
+  double stiffness = 0, rest_length = 0, damping = 0;
+  std::string where;
+};
+
 struct MechanismSpec {
   std::string name;
   Vec3 gravity = Vec3::Zero();
@@ -97,6 +129,8 @@ struct MechanismSpec {
   std::vector<CouplingSpec> couplings;
   std::vector<LoadSpec> loads;
   std::vector<FrameSpec> frames;
+  std::vector<ConstraintSpec> constraints;
+  std::vector<SpringSpec> springs;
   std::optional<CorrelationSpec> correlation;
   std::string where;  // the file
 };

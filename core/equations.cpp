@@ -14,6 +14,7 @@
 #include "core/kinematics.hpp"
 #include "core/mass_solver.hpp"
 #include "core/newton_euler.hpp"
+#include "core/springs.hpp"
 
 namespace femdyn {
 namespace {
@@ -163,7 +164,7 @@ void bias_by_nodes(const Model& model, Workspace& ws, const VecX& q, const VecX&
 // q̈ by evaluate(), then the Cholesky factorisation of M^s (DynamicsRoute::Cholesky).
 Status forward_by_cholesky(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                            const VecX& tau) {
-  evaluate(model, ws, q, qd, tau);
+  model.routes.evaluate(model, ws, q, qd, tau);  // (τ holds the springs' Q_s already)
   Status st = ws.solver.factorize(ws.Ms);
   if (st.ok) {
     ws.qdd = ws.Q - ws.h;
@@ -317,8 +318,13 @@ void mass_matrix(const Model& model, Workspace& ws, const VecX& q) {
   model.routes.mass_matrix(model, ws, q);
 }
 
+// Two-point springs (core/springs.hpp) act on every route as a generalized force Q_s added to τ.
+
 void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau) {
   model.routes.evaluate(model, ws, q, qd, tau);
+  if (model.springs.empty()) return;
+  spring_forces(model, ws, q, qd);
+  ws.Q += ws.Q_springs;
 }
 
 void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
@@ -327,7 +333,13 @@ void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX&
 
 Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                         const VecX& tau) {
-  const Status st = model.routes.forward_dynamics(model, ws, q, qd, tau);
+  const VecX* applied = &tau;
+  if (!model.springs.empty()) {
+    spring_forces(model, ws, q, qd);
+    ws.tau_applied = tau + ws.Q_springs;
+    applied = &ws.tau_applied;
+  }
+  const Status st = model.routes.forward_dynamics(model, ws, q, qd, *applied);
   if (!st.ok) return st;
   // A result that overflowed is a failure naming the coordinate, never a NaN handed on.
   for (Eigen::Index a = 0; a < ws.qdd.size(); ++a)
@@ -342,6 +354,9 @@ Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const 
 void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                       const VecX& qdd) {
   model.routes.inverse_dynamics(model, ws, q, qd, qdd);
+  if (model.springs.empty()) return;
+  spring_forces(model, ws, q, qd);
+  ws.tau -= ws.Q_springs;
 }
 
 std::vector<MatX> transform_hessian(const Model& model, Workspace& ws, const VecX& q) {
@@ -357,7 +372,9 @@ void joint_state(const Model& model, Workspace& ws, const VecX& q, const VecX& q
 }
 
 Energy energy(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
-  return model.routes.energy(model, ws, q, qd);
+  Energy E = model.routes.energy(model, ws, q, qd);
+  if (!model.springs.empty()) E.potential += spring_potential(model, ws, q);
+  return E;
 }
 
 }  // namespace femdyn

@@ -52,6 +52,34 @@ void frame_kinematics(const Model& model, const Workspace& ws, int frame, FrameA
   }
 }
 
+void attachment_motion(const Model& model, const Workspace& ws, const Attachment& A,
+                       AttachmentMotion& out, bool jacobian) {
+  const int n = model.n();
+  if (jacobian) {
+    out.Jv.resize(3, n);
+    out.Jw.resize(3, n);
+  }
+  if (A.body < 0) {  // the world
+    out.R = A.R;
+    out.p = A.p;
+    out.v.setZero(), out.w.setZero(), out.a.setZero(), out.alpha.setZero();
+    if (jacobian) out.Jv.setZero(), out.Jw.setZero();
+    return;
+  }
+  const BodyState& B = ws.body[A.body];
+  const Vec3 r = B.R * A.p;
+  out.R = B.R * A.R;
+  out.p = B.p + r;
+  out.w = B.w;
+  out.v = B.v + B.w.cross(r);
+  out.alpha = B.alpha;
+  out.a = B.a + B.alpha.cross(r) + B.w.cross(B.w.cross(r));
+  if (!jacobian) return;
+  out.Jw = ws.Jw.middleRows<3>(3 * A.body);
+  out.Jv = ws.Jv.middleRows<3>(3 * A.body);
+  out.Jv.noalias() -= skew(r) * out.Jw;
+}
+
 const char* frame_axes_name(FrameAxes axes) {
   switch (axes) {
     case FrameAxes::Local:

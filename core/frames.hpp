@@ -14,6 +14,7 @@
 #pragma once
 #include <string>
 
+#include "core/attachment.hpp"
 #include "core/spatial.hpp"
 #include "core/workspace.hpp"
 
@@ -39,6 +40,15 @@ void frame_kinematics(const Model& model, const Workspace& ws, int frame, FrameA
 // The same at (q, v), after its own propagate.
 void frame_kinematics(const Model& model, Workspace& ws, const VecX& q, const VecX& v, int frame,
                       FrameAxes axes, FrameKinematics& out);
+
+// The motion of an attachment A (a body point with axes, core/attachment.hpp), world axes, from
+// the last propagate(model, ws, q, v, {.jacobian = true, .bias = true, .rows = false}); with
+// r = R_b p:
+//   p_A = p_b + r,   R_A = R_b R,   v_A = v_b + ω_b × r,   ω_A = ω_b,
+//   J_A = [Jv_b − [r]× Jω_b ; Jω_b],   bias (q̈ = 0): a_A = a_b + α_b × r + ω_b × (ω_b × r), α_A =
+//   α_b.
+void attachment_motion(const Model& model, const Workspace& ws, const Attachment& A,
+                       AttachmentMotion& out, bool jacobian = true);
 
 // "local_world_aligned", "local", "world" (and back; false if the text names none).
 const char* frame_axes_name(FrameAxes axes);

@@ -17,8 +17,10 @@
 #include "core/coupling_level.hpp"
 #include "core/element.hpp"
 #include "core/joints/joint_type.hpp"
+#include "core/loops/constraint.hpp"
 #include "core/routes.hpp"
 #include "core/spatial.hpp"
+#include "core/springs.hpp"
 
 namespace femdyn {
 
@@ -37,6 +39,7 @@ struct Joint {
   int idx_q = -1, idx_v = -1;    // its first coordinate in θ, first rate in θ̇; -1 when fixed
   double lower = 0, upper = 0;
   double stiffness = 0, rest = 0, damping = 0;
+  double initial = 0;  // θ in the model's initial configuration (1-DOF joints; JSON "initial")
   // Actuator and friction (core/joints/passive.hpp; 1-DOF joints only): rotor inertia I_a and
   // gear ratio G (reflected inertia I_a G² on θ̇, derived below), Coulomb friction F_c with its
   // regularisation velocity v_s, effort and velocity limits (+inf: none), and an enforced stop at
@@ -228,6 +231,12 @@ struct Model {
   SpMat armature_mass;
   VecX effort_limit;
   bool has_effort_limits = false;
+
+  // Loops closed by constraints Φ(q) = 0 on the spanning tree (core/loops/), and two-point
+  // springs (core/springs.hpp). Empty for a tree without them.
+  std::vector<LoopConstraint> constraints;
+  int constraint_rows = 0;  // m = Σ rows: Φ_q is m × n
+  std::vector<TwoPointSpring> springs;
 
   bool has_nodal_forces = false;     // gravity or loads present
   bool has_velocity_forces = false;  // some element has a gyroscopic term

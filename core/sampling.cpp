@@ -64,9 +64,8 @@ VecX random_posture(const Model& m, std::mt19937& rng) {
 }
 
 VecX neutral_posture(const Model& m) {
-  if (flat_model(m)) return VecX::Zero(m.n());
   return per_joint(
-      m, [](const Joint&) { return 0.0; },
+      m, [](const Joint& J) { return J.initial; },
       [](const Joint& J, double* q) { neutral_configuration(J, q); });
 }
 

@@ -11,7 +11,8 @@ VecX random_posture(const Model& model, std::mt19937& rng);
 // Each coordinate at 0, or at its joint's nearest limit when 0 is outside them.
 VecX reference_posture(const Model& model);
 VecX random_uniform(int n, double scale, std::mt19937& rng);
-// Every joint at its neutral configuration (0, the identity rotation): q of size n_q.
+// Every joint at its neutral configuration: its "initial" value (0 unless the model gives one),
+// the identity rotation. q of size n_q.
 VecX neutral_posture(const Model& model);
 // q ⊕ ξ over the coordinate joints (ξ of size n, in each joint's chart around its q).
 VecX integrate_posture(const Model& model, const VecX& q, const VecX& xi);

@@ -4,6 +4,7 @@
 #include <array>
 #include <vector>
 
+#include "core/attachment.hpp"
 #include "core/mass_solver.hpp"
 #include "core/model.hpp"
 
@@ -77,6 +78,12 @@ struct Workspace {
   MatX Ms;  // sized on first use (evaluate, mass_matrix)
   VecX h, Q, qdd, tau;
   MassSolver solver;  // factorisation of M^s (dense or CHOLMOD, chosen for the model)
+
+  // Two-point springs (core/springs.hpp): their generalized force Q_s, τ + Q_s for the routes,
+  // the power their dampers dissipate at the last evaluation, and the ends' motions.
+  VecX Q_springs, tau_applied;
+  double spring_power = 0;
+  AttachmentMotion end_a, end_b;
 
   // With a nonlinear coupling level (Model::tree): the tree's workspace, g's derivatives, and
   // the factorisation of the reduced M^s = Gᵀ M_θ G.

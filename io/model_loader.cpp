@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "compile/compile.hpp"
+#include "core/joints/kernel.hpp"
 #include "core/limits.hpp"
 #include "core/names.hpp"
 #include "io/catalog.hpp"
@@ -116,7 +117,7 @@ void read_actuator(const Params& p, JointSpec& j) {
 JointSpec read_joint(const Params& p) {
   p.allow_only({"name", "type", "origin", "axis", "axis2", "pitch", "limits", "spring", "damping",
                 "armature", "gear", "friction", "friction_velocity", "effort_limit",
-                "velocity_limit", "stop"});
+                "velocity_limit", "stop", "initial"});
   JointSpec j;
   j.where = p.where();
   j.name = p.has("name") ? p.string("name") : "";
@@ -140,6 +141,12 @@ JointSpec read_joint(const Params& p) {
     for (const char* key : {"axis", "limits", "spring", "damping"})
       if (p.has(key))
         p.fail(key, "a fixed joint has no motion: no axis, limits, spring or damping");
+  if (p.has("initial")) {
+    if (joint_type_nq(j.type) != 1)
+      p.fail("initial", "is a joint's one coordinate: this joint has " +
+                            std::to_string(joint_type_nq(j.type)));
+    j.initial = p.number("initial");
+  }
   if (j.type == JointType::Fixed)
     for (const char* key : {"armature", "gear", "friction", "friction_velocity", "effort_limit",
                             "velocity_limit", "stop"})
@@ -299,6 +306,26 @@ std::shared_ptr<const CouplingFunction> read_law(const Params& p, int arity) {
   return std::make_shared<FourBarCoupling>(g);
 }
 
+// "follows": f with "ratio": k, or "follows": [{"joint": f1, "ratio": k1}, …] (a linear
+// coupling's, or a gear constraint's, terms).
+std::vector<std::pair<std::string, double>> read_linear_terms(const Params& p) {
+  std::vector<std::pair<std::string, double>> terms;
+  const Json& f = p.json().contains("follows") ? p.json().at("follows") : Json();
+  if (f.is_string()) {
+    terms.emplace_back(f.get<std::string>(), p.number_or("ratio", 1.0));
+  } else if (f.is_array()) {
+    if (p.has("ratio")) p.fail("ratio", "give ratios inside \"follows\" when it is a list");
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      const Params t(f[i], p.path("follows") + "/" + std::to_string(i));
+      t.allow_only({"joint", "ratio"});
+      terms.emplace_back(t.string("joint"), t.number("ratio"));
+    }
+  } else {
+    p.fail("follows", "expected a joint name or a list of {joint, ratio}");
+  }
+  return terms;
+}
+
 CouplingSpec read_coupling(const Params& p) {
   // {"joint": j, "follows": f, "ratio": k, "offset": o}
   // or {"joint": j, "follows": [{"joint": f1, "ratio": k1}, …], "offset": o}
@@ -329,18 +356,7 @@ CouplingSpec read_coupling(const Params& p) {
     return c;
   }
   c.offset = p.number_or("offset", 0.0);
-  if (f.is_string()) {
-    c.terms.emplace_back(f.get<std::string>(), p.number_or("ratio", 1.0));
-  } else if (f.is_array()) {
-    if (p.has("ratio")) p.fail("ratio", "give ratios inside \"follows\" when it is a list");
-    for (std::size_t i = 0; i < f.size(); ++i) {
-      const Params t(f[i], p.path("follows") + "/" + std::to_string(i));
-      t.allow_only({"joint", "ratio"});
-      c.terms.emplace_back(t.string("joint"), t.number("ratio"));
-    }
-  } else {
-    p.fail("follows", "expected a joint name or a list of {joint, ratio}");
-  }
+  c.terms = read_linear_terms(p);
   return c;
 }
 
@@ -371,6 +387,68 @@ Vec3 point_on_body(const Params& p, const std::string& body, const BodiesByName&
           nodes[it.key()] = json_vec3(it.value(), p.path("node"));
   const Params np(p.json(), p.where(), body, &nodes);
   return np.node("node").position;
+}
+
+// One end of a constraint or spring: "frame, body or world", or {"body", "xyz" | "node", "rpy"}.
+AttachmentSpec read_attachment(const Params& p, const char* key, const BodiesByName& bodies) {
+  AttachmentSpec a;
+  a.where = p.path(key);
+  if (!p.has(key)) p.fail(key, "missing (a frame, a body, \"world\", or {\"body\", \"xyz\"})");
+  const Json& j = p.json().at(key);
+  if (j.is_string()) {
+    a.frame = j.get<std::string>();
+    return a;
+  }
+  if (!j.is_object())
+    p.fail(key, "expected a frame name or {\"body\", \"xyz\" | \"node\", \"rpy\"}");
+  const Params e(j, a.where);
+  e.allow_only({"body", "xyz", "node", "rpy"});
+  a.body = e.string("body");
+  a.xyz = point_on_body(e, a.body, bodies, "xyz");
+  a.rpy = e.vec3_or("rpy", Vec3::Zero());
+  return a;
+}
+
+// {"name", "type", "a", "b", "normal" | "direction" | "length"} or a gear {"name", "type":
+// "gear", "joint", "follows", "ratio", "offset"} (docs/model-format.md#constraints).
+ConstraintSpec read_constraint(const Params& p, const BodiesByName& bodies, std::size_t index) {
+  ConstraintSpec c;
+  c.where = p.where();
+  c.name = p.has("name") ? p.string("name") : "constraint_" + std::to_string(index);
+  c.type = p.string("type");
+  if (c.type == "gear") {
+    p.allow_only({"name", "type", "joint", "follows", "ratio", "offset"});
+    c.joint = p.string("joint");
+    c.terms = read_linear_terms(p);
+    c.offset = p.number_or("offset", 0.0);
+    return c;
+  }
+  const char* axis_key = c.type == "point_on_line" ? "direction" : "normal";
+  if (c.type == "distance")
+    p.allow_only({"name", "type", "a", "b", "length"});
+  else if (c.type == "weld")
+    p.allow_only({"name", "type", "a", "b"});
+  else
+    p.allow_only({"name", "type", "a", "b", axis_key});
+  c.a = read_attachment(p, "a", bodies);
+  c.b = read_attachment(p, "b", bodies);
+  if (p.has(axis_key)) c.axis = p.vec3(axis_key);
+  if (c.type == "distance") c.length = p.positive("length");
+  return c;
+}
+
+// {"name", "a", "b", "stiffness", "rest_length", "damping"}: a two-point spring-damper.
+SpringSpec read_spring(const Params& p, const BodiesByName& bodies, std::size_t index) {
+  p.allow_only({"name", "a", "b", "stiffness", "rest_length", "damping"});
+  SpringSpec s;
+  s.where = p.where();
+  s.name = p.has("name") ? p.string("name") : "spring_" + std::to_string(index);
+  s.a = read_attachment(p, "a", bodies);
+  s.b = read_attachment(p, "b", bodies);
+  s.stiffness = p.non_negative("stiffness");
+  s.rest_length = p.has("rest_length") ? p.non_negative("rest_length") : 0.0;
+  s.damping = p.has("damping") ? p.non_negative("damping") : 0.0;
+  return s;
 }
 
 // {"name", "body", "xyz" | "node", "rpy"}: a frame on a body, at a point or at one of its nodes.
@@ -408,7 +486,7 @@ constexpr const char* kUrdfReference = "urdf";
 void apply_overrides(const Json& root, const Params& p, Json& doc) {
   for (const char* key : {"name", "description", "gravity"})
     if (root.contains(key)) doc[key] = root[key];
-  for (const char* list : {"loads", "frames"})
+  for (const char* list : {"loads", "frames", "constraints", "springs"})
     if (root.contains(list)) {
       if (!root[list].is_array()) p.fail(list, "expected an array");
       if (!doc.contains(list)) doc[list] = Json::array();
@@ -419,7 +497,8 @@ void apply_overrides(const Json& root, const Params& p, Json& doc) {
 // {"model", "params", …}: the keys of a plugin's (or a URDF reference's) form, checked.
 Params plugin_form(const Json& root, const std::string& source) {
   Params p(root, source + ": ");
-  p.allow_only({"model", "params", "name", "description", "gravity", "loads", "frames", "$schema"});
+  p.allow_only({"model", "params", "name", "description", "gravity", "loads", "frames",
+                "constraints", "springs", "$schema"});
   return p;
 }
 
@@ -445,8 +524,9 @@ MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std
   spec.where = source + ": ";
   const auto path = [&](const std::string& s) { return source + ": /" + s; };
   for (auto it = root.begin(); it != root.end(); ++it) {
-    static const char* known[] = {"name",  "description",       "gravity", "bodies", "couplings",
-                                  "loads", "correlation_table", "frames",  "$schema"};
+    static const char* known[] = {
+        "name",        "description", "gravity",           "bodies", "couplings", "loads", "frames",
+        "constraints", "springs",     "correlation_table", "$schema"};
     bool ok = false;
     for (const char* k : known) ok = ok || it.key() == k;
     if (!ok) throw ModelError(path(truncated(it.key())), "unknown key " + quoted_text(it.key()));
@@ -484,6 +564,18 @@ MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std
     for (std::size_t i = 0; i < root["frames"].size(); ++i)
       spec.frames.push_back(
           read_frame(Params(root["frames"][i], path("frames/" + std::to_string(i))), by_name));
+  }
+  for (const char* list : {"constraints", "springs"}) {
+    if (!root.contains(list)) continue;
+    if (!root[list].is_array()) throw ModelError(path(list), "expected an array");
+    const BodiesByName by_name = bodies_by_name(bodies);
+    for (std::size_t i = 0; i < root[list].size(); ++i) {
+      const Params item(root[list][i], path(std::string(list) + "/" + std::to_string(i)));
+      if (std::string(list) == "constraints")
+        spec.constraints.push_back(read_constraint(item, by_name, i));
+      else
+        spec.springs.push_back(read_spring(item, by_name, i));
+    }
   }
   if (root.contains("correlation_table")) {
     // [[…], …]  or  {"rows": [[…], …], "join": "same" | "deepest"}

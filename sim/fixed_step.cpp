@@ -39,6 +39,8 @@ Status FixedStep::advance(double t_out) {
     if (!motion_.check_state(t_next, y_next_.data()).ok) return diverged();
     y_.swap(y_next_);
     motion_.recenter(y_.data());  // (a manifold's chart follows every step)
+    if (motion_.constrained())    // (and closed loops their constraints: no drift kept)
+      if (Status p = motion_.project(t_next, y_.data()); !p.ok) return explain(std::move(p));
     t_ = t_next;
     if (on_grid) ++k_;
     ++stats_.steps;

@@ -6,6 +6,7 @@
 
 #include "core/joints/kernel.hpp"
 #include "core/joints/passive.hpp"
+#include "core/loops/assembly.hpp"
 #include "core/sampling.hpp"
 
 namespace femdyn {
@@ -25,6 +26,7 @@ double nonconservative_power(const Model& model, const Workspace& ws, const VecX
     if (J.nv == 1 && dissipates(J)) P += passive_joint_power(J, ws.theta[J.idx_q], ws.theta_dot[j]);
   }
   for (const BodyTorque& t : model.torques) P += t.torque.dot(ws.body[t.body].w);
+  if (!model.springs.empty()) P += ws.spring_power;  // (of this state: forward dynamics set it)
   return P;
 }
 
@@ -34,6 +36,7 @@ Motion::Motion(const Model& model, Actuation tau)
   saturations_.assign(model.n(), 0);
   flat_ = flat_model(model);
   if (!flat_) q_c_ = q_ = neutral_posture(model);
+  if (!model.constraints.empty()) loops_ = std::make_unique<LoopWorkspace>(model);
 }
 
 // (Joint by joint over Model::coordinate_joints, whose addresses are their places in q and v.)
@@ -124,7 +127,8 @@ Status Motion::rhs(double t, const double* y, double* ydot) {
                                    : "the actuation tau(t) is NaN or Inf"),
             -1};
   if (model_.has_effort_limits) count_saturation(u_);
-  Status st = forward_dynamics(model_, ws_, q_, qd_, u_);
+  Status st = loops_ ? constrained_forward_dynamics(model_, ws_, *loops_, q_, qd_, u_, baumgarte_)
+                     : forward_dynamics(model_, ws_, q_, qd_, u_);
   if (!st.ok) {
     st.message = at_time(t) + st.message;
     return st;
@@ -181,6 +185,31 @@ void Motion::count_saturation(VecX& tau) {
   }
   last_saturated_ = any;
   if (any) ++saturated_evaluations_;
+}
+
+Status Motion::project(double t, double* y) {
+  if (!loops_) return {};
+  const int n = model_.n();
+  configuration(y, q_);
+  AssemblyOptions options;
+  options.max_iterations = 10;
+  const AssemblyReport r = assemble(model_, ws_, loops_->k, q_, options);
+  if (!r.status.ok) return {false, at_time(t) + r.status.message, -1};
+  qd_ = Eigen::Map<const VecX>(y + n, n);
+  if (Status st = project_velocity(model_, ws_, *loops_, q_, qd_); !st.ok)
+    return {false, at_time(t) + st.message, -1};
+  start_chart(q_, y);
+  Eigen::Map<VecX>(y + n, n) = qd_;
+  return {};
+}
+
+Motion::ConstraintResidual Motion::constraint_residual(const double* y) {
+  if (!loops_) return {};
+  const int n = model_.n();
+  configuration(y, q_);
+  qd_ = Eigen::Map<const VecX>(y + n, n);
+  constraint_kinematics(model_, ws_, q_, qd_, loops_->k);
+  return {loops_->k.phi.cwiseAbs().maxCoeff(), (loops_->k.J * qd_).cwiseAbs().maxCoeff()};
 }
 
 Energy Motion::energy_at(const double* y) {

@@ -23,9 +23,11 @@
 #pragma once
 #include <exception>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "core/equations.hpp"
+#include "core/loops/constrained_dynamics.hpp"
 
 namespace femdyn {
 
@@ -60,6 +62,23 @@ class Motion {
   void chart_rates(const double* xi, const double* v, double* xi_dot) const;
   static constexpr double kChartLimit = 1.0;  // rad
 
+  // Loops closed by constraints (core/loops/): q̈ from the constrained equations with Baumgarte's
+  // rate ω (1/s), and the projection of a state back onto Φ = 0, Φ_q v = 0.
+  bool constrained() const { return static_cast<bool>(loops_); }
+  void set_baumgarte(double omega) { baumgarte_ = omega; }
+  double baumgarte() const { return baumgarte_; }
+  static constexpr double kDefaultBaumgarte = 20;  // 1/s: a residual decays in about 1/ω = 50 ms
+  // The state at y moved onto the constraints: q by Newton's least-norm steps, v by the
+  // kinetic-energy projection (core/loops/assembly.hpp). Fails when the loops cannot close.
+  Status project(double t, double* y);
+  // |Φ(q)|∞ and |Φ_q v|∞ at y (0 without constraints).
+  struct ConstraintResidual {
+    double position = 0, velocity = 0;
+  };
+  ConstraintResidual constraint_residual(const double* y);
+  // λ of the last evaluation (constrained only).
+  const VecX& multipliers() const { return loops_->lambda; }
+
   // ẏ = f(t, y) into ydot (both of size(); may be SUNDIALS' arrays). Counts the evaluation.
   Status rhs(double t, const double* y, double* ydot);
   long evaluations() const { return evaluations_; }
@@ -93,6 +112,8 @@ class Motion {
   Control control_;
   std::exception_ptr control_error_;
   Workspace ws_;
+  std::unique_ptr<LoopWorkspace> loops_;  // with constraints only
+  double baumgarte_ = kDefaultBaumgarte;
   bool flat_ = true;
   VecX q_c_;         // the chart centre (non-flat)
   VecX q_, qd_, u_;  // buffers: q, q̇ (v), τ at the evaluated state

@@ -80,6 +80,11 @@ RecordedRun run_recorded(Integrator& integ, double t_end, long every,
     const Energy E = integ.motion().energy_at(integ.y().data());
     r.max_balance = std::max(r.max_balance, std::abs(E.total() - r.initial.total() - integ.work()));
     r.scale = std::max(r.scale, S0 + std::abs(integ.work()));
+    if (integ.motion().constrained()) {
+      const Motion::ConstraintResidual c = integ.motion().constraint_residual(integ.y().data());
+      r.max_position_residual = std::max(r.max_position_residual, c.position);
+      r.max_velocity_residual = std::max(r.max_velocity_residual, c.velocity);
+    }
     row(integ, E);
     ++r.rows;
   };

@@ -55,6 +55,8 @@ struct RecordedRun {
   std::vector<EffortSaturation> saturations;
   // Coupled joints with an effort limit: no τ acts on them directly, so it is not applied.
   std::vector<std::string> unapplied_effort_limits;
+  // Closed loops (Model::constraints): the largest |Φ(q)|∞ and |Φ_q v|∞ over the rows.
+  double max_position_residual = 0, max_velocity_residual = 0;
   long rows = 0;
   double wall_time = 0;  // s, the whole loop (rows included)
 };

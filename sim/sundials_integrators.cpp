@@ -123,31 +123,42 @@ Status Adaptive::plan(double t_end) {
 }
 
 Status Adaptive::advance(double t_out) {
-  if (!motion_.flat()) return advance_on_manifold(t_out);
+  if (!motion_.flat() || motion_.constrained()) return advance_stepwise(t_out);
   double t_reached = t_;
   const int flag = evolve(t_out, t_reached, false);
   return finish(flag, t_reached, t_out);
 }
 
-Status Adaptive::advance_on_manifold(double t_out) {
+Status Adaptive::advance_stepwise(double t_out) {
   set_stop_time(std::min(t_out, t_stop_));
   while (t_ < t_out) {
     double t_reached = t_;
     const int flag = evolve(t_out, t_reached, true);
     if (Status st = finish(flag, t_reached, t_reached); !st.ok) return st;
-    if (motion_.chart_extent(y_.data()) > Motion::kChartLimit) {
-      restarted_ = stats_;
-      const double h = current_step();
-      motion_.recenter(y_.data());
-      restarting_ = true;
-      start();
-      restarting_ = false;
-      set_initial_step(h);
-      set_stop_time(std::min(t_out, t_stop_));
-    }
+    const bool chart_far = motion_.chart_extent(y_.data()) > Motion::kChartLimit;
+    const bool drifted = drifted_off_constraints();
+    if (!chart_far && !drifted) continue;
+    restarted_ = stats_;
+    const double h = current_step();
+    motion_.recenter(y_.data());
+    if (drifted)
+      if (Status p = motion_.project(t_, y_.data()); !p.ok) return p;
+    restarting_ = true;
+    start();
+    restarting_ = false;
+    set_initial_step(h);
+    set_stop_time(std::min(t_out, t_stop_));
   }
   if (std::isfinite(t_stop_)) set_stop_time(t_stop_);
   return {};
+}
+
+// A closed loop's state that has left its constraints by more than the absolute tolerance (the
+// error the method is asked to keep): it is projected back and the method restarted.
+bool Adaptive::drifted_off_constraints() {
+  if (!motion_.constrained()) return false;
+  const Motion::ConstraintResidual r = motion_.constraint_residual(y_.data());
+  return r.position > options_.atol || r.velocity > options_.atol;
 }
 
 void Adaptive::restart_method() {

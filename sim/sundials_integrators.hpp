@@ -46,9 +46,11 @@ class Adaptive : public Integrator {
   // Never step past t (ARKODE's / CVODE's stop time), and the first step of a restarted run.
   virtual void set_stop_time(double t) = 0;
   virtual void set_initial_step(double h) = 0;
-  // On a manifold (Motion::flat() false): steps to t_out, the chart moved and the method
-  // restarted there whenever a rotation in it passes Motion::kChartLimit.
-  Status advance_on_manifold(double t_out);
+  // On a manifold (Motion::flat() false) or with closed loops: steps to t_out one at a time, and
+  // restarts the method where the chart moved (a rotation in it past Motion::kChartLimit) or
+  // where the state was projected back onto the constraints (drifted_off_constraints).
+  Status advance_stepwise(double t_out);
+  bool drifted_off_constraints();
 
  public:                                             // reached from the C callbacks
   int rhs(double t, const double* y, double* ydot);  // 0, or < 0 after recording rhs_failure_

@@ -1,0 +1,262 @@
+// Closed loops (core/loops/) and two-point springs (core/springs.hpp): the constraint Jacobian
+// and its bias against finite differences of Φ, the constrained q̈ and λ against the equations
+// they must satisfy (Φ_q q̈ = −Φ̇_q v, and inverse dynamics giving back τ + Φ_qᵀλ), assembly and
+// projection, redundancy and dead points, springs against their potential, and Andrews'
+// squeezing mechanism against the Test Set for IVP Solvers (its consistent initial values at
+// t = 0 and its reference solution at t = 0.03, computed there with PSIDE at tolerances 1e-14).
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "core/equations.hpp"
+#include "core/kinematics.hpp"
+#include "core/loops/assembly.hpp"
+#include "core/sampling.hpp"
+#include "sim/integrator.hpp"
+#include "tests/helpers.hpp"
+
+using namespace femdyn;
+using namespace femdyn::test;
+using Json = nlohmann::json;
+
+namespace {
+
+Json point(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-0.2, 0.2);
+  return Json::array({u(rng), u(rng), u(rng)});
+}
+
+Json place(const std::string& body, std::mt19937& rng) {
+  return {{"body", body}, {"xyz", point(rng)}};
+}
+
+// A random tree of 9 bodies with one constraint of each kind except the weld (whose angle rows
+// are a rotation vector, exact in its rate only where it holds), and a spring.
+std::string every_constraint_tree(unsigned seed) {
+  Json j = Json::parse(random_tree_json(seed, 9, 0.5, true));
+  std::mt19937 rng(seed);
+  j["constraints"] = Json::array(
+      {{{"type", "ball"}, {"a", place("b8", rng)}, {"b", place("b3", rng)}},
+       {{"type", "ball"}, {"a", place("b5", rng)}, {"b", "world"}, {"normal", {0.3, 0.2, 1}}},
+       {{"type", "point_on_line"},
+        {"a", place("b7", rng)},
+        {"b", place("b1", rng)},
+        {"direction", {1, 0.5, 0.2}}},
+       {{"type", "point_on_plane"},
+        {"a", place("b6", rng)},
+        {"b", place("b2", rng)},
+        {"normal", {0.1, 1, 0.4}}},
+       {{"type", "distance"}, {"a", place("b4", rng)}, {"b", place("b0", rng)}, {"length", 0.3}},
+       {{"type", "gear"}, {"joint", "j6"}, {"follows", "j2"}, {"ratio", 0.7}, {"offset", 0.1}}});
+  j["springs"] = Json::array({{{"a", place("b8", rng)},
+                               {"b", {{"body", "world"}, {"xyz", point(rng)}}},
+                               {"stiffness", 40},
+                               {"rest_length", 0.2},
+                               {"damping", 0.5}}});
+  return j.dump();
+}
+
+// A closable random tree: a 10-body tree whose last body is tied back to the world by a ball at
+// its place in the neutral posture, a distance between two bodies at their neutral distance, a
+// gear, and a spring. Loops that close at the neutral posture and keep some freedom.
+std::string closable_tree(unsigned seed, bool weld) {
+  Json j = Json::parse(random_tree_json(seed, 10, 0.3, false));
+  Model tree = load_text(j.dump());
+  Workspace ws(tree);
+  const VecX q = neutral_posture(tree), v = VecX::Zero(tree.n());
+  propagate(tree, ws, q, v, {.jacobian = false, .bias = false, .rows = false});
+  std::mt19937 rng(seed);
+  const int last = static_cast<int>(tree.bodies.size()) - 1;
+  const Vec3 r = {0.05, 0.02, -0.03};
+  const Vec3 p = ws.body[last].p + ws.body[last].R * r;
+  const Vec3 pa = ws.body[2].p, pb = ws.body[6].p;
+  const std::string name_last = tree.bodies[last].name;
+  j["constraints"] =
+      Json::array({{{"name", "tip"},
+                    {"type", weld ? "weld" : "ball"},
+                    {"a", {{"body", name_last}, {"xyz", {r.x(), r.y(), r.z()}}}},
+                    {"b", {{"body", "world"}, {"xyz", {p.x(), p.y(), p.z()}}, {"rpy", {0, 0, 0}}}}},
+                   {{"name", "rod"},
+                    {"type", "distance"},
+                    {"a", tree.bodies[2].name},
+                    {"b", tree.bodies[6].name},
+                    {"length", (pa - pb).norm()}},
+                   {{"name", "gear"},
+                    {"type", "gear"},
+                    {"joint", tree.bodies[4].joint.name},
+                    {"follows", tree.bodies[1].joint.name},
+                    {"ratio", -0.5}}});
+  if (weld) {  // the weld's frame B: the last body's axes at the neutral posture
+    const Mat3 R = ws.body[last].R;
+    const Vec3 rpy = R.eulerAngles(2, 1, 0).reverse();
+    j["constraints"][0]["b"]["rpy"] = {rpy.x(), rpy.y(), rpy.z()};
+  }
+  j["springs"] = Json::array({{{"a", place(tree.bodies[3].name, rng)},
+                               {"b", {{"body", "world"}, {"xyz", point(rng)}}},
+                               {"stiffness", 30},
+                               {"rest_length", 0.1},
+                               {"damping", 0.2}}});
+  return j.dump();
+}
+
+VecX phi_at(const Model& m, Workspace& ws, ConstraintKinematics& k, const VecX& q) {
+  constraint_kinematics(m, ws, q, VecX::Zero(m.n()), k);
+  return k.phi;
+}
+
+// The Test Set's Andrews mechanism (models/andrews.json), by coordinate name.
+std::map<std::string, double> by_name(const Model& m, const VecX& x) {
+  std::map<std::string, double> out;
+  for (int i = 0; i < m.n(); ++i) out[m.coordinate_names[i]] = x[i];
+  return out;
+}
+
+// Test Set parameters (andrews.f).
+constexpr double rr = 7e-3, d = 28e-3, ss = 35e-3, sc = 18e-3, sd = 2e-2;
+constexpr double xb = -0.03635, yb = .03273, xc = .014, yc = .072, c0 = 4530, l0 = 7785e-5;
+
+}  // namespace
+
+TEST_CASE("constraint Jacobians and biases agree with finite differences of Phi", "[loops]") {
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const Model m = load_text(every_constraint_tree(seed));
+    REQUIRE(m.constraint_rows == 3 + 2 + 2 + 1 + 1 + 1);
+    Workspace ws(m);
+    ConstraintKinematics k(m);
+    std::mt19937 rng(seed);
+    const VecX q = random_posture(m, rng), v = random_uniform(m.n(), 1.0, rng);
+    constraint_kinematics(m, ws, q, v, k);
+    const VecX rate = k.J * v, bias = k.bias;
+    const double h = 1e-6, h2 = 1e-4;
+    const VecX fd_rate = (phi_at(m, ws, k, q + h * v) - phi_at(m, ws, k, q - h * v)) / (2 * h);
+    const VecX fd_bias =
+        (phi_at(m, ws, k, q + h2 * v) - 2 * phi_at(m, ws, k, q) + phi_at(m, ws, k, q - h2 * v)) /
+        (h2 * h2);
+    CAPTURE(seed, rate.transpose(), fd_rate.transpose(), bias.transpose(), fd_bias.transpose());
+    CHECK(rel_error(rate, fd_rate, 1e-3) < 1e-7);
+    CHECK(rel_error(bias, fd_bias, 1e-1) < 1e-5);
+  }
+}
+
+TEST_CASE("constrained dynamics satisfies the equations it solves", "[loops]") {
+  for (bool weld : {false, true}) {
+    for (unsigned seed : {4u, 5u}) {
+      const Model m = load_text(closable_tree(seed, weld));
+      CAPTURE(weld, seed);
+      std::mt19937 rng(seed);
+      // Assemble from a disturbed posture, then a random velocity projected onto the loops.
+      VecX q = neutral_posture(m) + random_uniform(m.n(), 0.05, rng);
+      VecX v = random_uniform(m.n(), 1.0, rng);
+      const StateAssembly s = assemble_state(m, q, v);
+      REQUIRE(s.assembly.status.ok);
+      CHECK(s.assembly.residual < 1e-12);
+      // (a weld on a body with fewer than 6 joints to the world repeats some of its rows)
+      if (!weld) CHECK(s.assembly.redundant == 0);
+      Workspace ws(m);
+      LoopWorkspace lws(m);
+      constraint_kinematics(m, ws, q, v, lws.k);
+      CHECK((lws.k.J * v).cwiseAbs().maxCoeff() < 1e-12);
+      const VecX tau = random_uniform(m.n(), 0.5, rng);
+      REQUIRE(constrained_forward_dynamics(m, ws, lws, q, v, tau, 0).ok);
+      const VecX qdd = ws.qdd, lambda = lws.lambda;
+      constraint_kinematics(m, ws, q, v, lws.k);
+      // Φ_q q̈ + Φ̇_q v = 0
+      const VecX accel = lws.k.J * qdd + lws.k.bias;
+      CHECK(accel.cwiseAbs().maxCoeff() < 1e-9 * (1 + (lws.k.J * qdd).cwiseAbs().maxCoeff()));
+      // M q̈ + h = Q(τ) + Φ_qᵀ λ: inverse dynamics of q̈ gives back τ + Φ_qᵀ λ.
+      inverse_dynamics(m, ws, q, v, qdd);
+      const VecX expected = tau + lws.k.J.transpose() * lambda;
+      CHECK(rel_error(ws.tau, expected, 1e-6) < 1e-10);
+    }
+  }
+}
+
+TEST_CASE("two-point springs: force from the potential, damper power", "[loops]") {
+  const Model m = load_text(every_constraint_tree(7));
+  Workspace ws(m);
+  std::mt19937 rng(7);
+  const VecX q = random_posture(m, rng), v = VecX::Zero(m.n());
+  spring_forces(m, ws, q, v);
+  const VecX Q = ws.Q_springs;
+  VecX fd(m.n());
+  const double h = 1e-6;
+  for (int i = 0; i < m.n(); ++i) {
+    const VecX e = VecX::Unit(m.n(), i);
+    fd[i] = -(spring_potential(m, ws, q + h * e) - spring_potential(m, ws, q - h * e)) / (2 * h);
+  }
+  CHECK(rel_error(Q, fd, 1e-6) < 1e-7);
+  // The damper alone: Q_s(v) − Q_s(0) = −c l̇ ê pushed through J, its power −c l̇².
+  const VecX w = random_uniform(m.n(), 1.0, rng);
+  spring_forces(m, ws, q, w);
+  const double power = (ws.Q_springs - Q).dot(w);
+  CHECK(power < 0);
+  CHECK(std::abs(power - ws.spring_power) < 1e-10 * std::abs(power));
+}
+
+TEST_CASE("Andrews' mechanism at t = 0 matches the Test Set's consistent values", "[loops]") {
+  const Model m = load_model(model_path("andrews.json"));
+  REQUIRE(m.n() == 7);
+  REQUIRE(m.constraint_rows == 6);
+  const VecX q = neutral_posture(m), v = VecX::Zero(7);
+  const auto Q = by_name(m, q);
+  CHECK(Q.at("beta") == -0.0617138900142764496358948458001);
+  Workspace ws(m);
+  LoopWorkspace lws(m);
+  constraint_kinematics(m, ws, q, v, lws.k);
+  CHECK(lws.k.phi.cwiseAbs().maxCoeff() < 1e-16);
+  // The spring's force on γ, the Test Set's f3 (its closed form).
+  spring_forces(m, ws, q, v);
+  const double ga = Q.at("gamma");
+  const double xd = sd * std::cos(ga) + sc * std::sin(ga) + xb;
+  const double yd = sd * std::sin(ga) - sc * std::cos(ga) + yb;
+  const double lang = std::hypot(xd - xc, yd - yc), force = -c0 * (lang - l0) / lang;
+  const double f3 = force * (xd - xc) * (sc * std::cos(ga) - sd * std::sin(ga)) +
+                    force * (yd - yc) * (sd * std::cos(ga) + sc * std::sin(ga));
+  CHECK(std::abs(by_name(m, ws.Q_springs).at("gamma") - f3) < 1e-13 * std::abs(f3));
+  // q̈ and the constraint forces: the Test Set's M q̈ = f − Gᵀλ is ours with Φ = g, λ = −λ_TS.
+  REQUIRE(constrained_forward_dynamics(m, ws, lws, q, v, VecX::Zero(7), 0).ok);
+  const auto qdd = by_name(m, ws.qdd);
+  CHECK(std::abs(qdd.at("beta") - 14222.4439199541138705911625887) < 1e-9 * 14222.44);
+  CHECK(std::abs(qdd.at("theta") - -10666.8329399655854029433719415) < 1e-9 * 14222.44);
+  for (const char* zero : {"gamma", "phi", "delta", "omega", "epsilon"})
+    CHECK(std::abs(qdd.at(zero)) < 1e-9 * 14222.44);
+  const double l1 = 98.5668703962410896057654982170, l2 = -6.12268834425566265503114393122;
+  const double be = Q.at("beta"), bt = be + Q.at("theta");
+  const double G11 = -rr * std::sin(be) + d * std::sin(bt), G12 = d * std::sin(bt);
+  const double G13 = -ss * std::cos(ga), G21 = rr * std::cos(be) - d * std::cos(bt);
+  const double G22 = -d * std::cos(bt), G23 = -ss * std::sin(ga);
+  const auto forces = by_name(m, lws.k.J.transpose() * lws.lambda);
+  CHECK(std::abs(forces.at("beta") + (G11 * l1 + G21 * l2)) < 1e-9);
+  CHECK(std::abs(forces.at("theta") + (G12 * l1 + G22 * l2)) < 1e-9);
+  CHECK(std::abs(forces.at("gamma") + (G13 * l1 + G23 * l2)) < 1e-9);
+  for (const char* zero : {"phi", "delta", "omega", "epsilon"})
+    CHECK(std::abs(forces.at(zero)) < 1e-9);
+}
+
+TEST_CASE("Andrews' mechanism at t = 0.03 reproduces the Test Set's reference solution",
+          "[loops]") {
+  const Model m = load_model(model_path("andrews.json"));
+  AdaptiveOptions o;
+  o.rtol = 1e-12;
+  o.atol = 1e-12;
+  auto integ = make_integrator(m, {.kind = IntegratorKind::Dopri, .adaptive = o}, {});
+  integ->reset(0, neutral_posture(m), VecX::Zero(7), 0.03);
+  REQUIRE(integ->advance_to(0.03).ok);
+  const auto q = by_name(m, integ->q()), v = by_name(m, integ->qd());
+  // Test Set andsoln (PSIDE, rtol = atol = 1e-14).
+  const std::map<std::string, std::pair<double, double>> reference = {
+      {"beta", {0.1581077119629904e+2, 0.1139920302151208e+4}},
+      {"theta", {-0.1575637105984298e+2, -0.1424379294994111e+4}},
+      {"gamma", {0.4082224013073101e-1, 0.1103291221937134e+2}},
+      {"phi", {-0.5347301163226948e+0, 0.1929337464421385e+2}},
+      {"delta", {0.5244099658805304e+0, 0.5735699284790808e+0}},
+      {"omega", {0.5347301163226948e+0, -0.1929337464421385e+2}},
+      {"epsilon", {0.1048080741042263e+1, 0.3231791658026955e+0}}};
+  for (const auto& [name, ref] : reference) {
+    CAPTURE(name, q.at(name), ref.first, v.at(name), ref.second);
+    CHECK(std::abs(q.at(name) - ref.first) < 1e-9 * (1 + std::abs(ref.first)));
+    CHECK(std::abs(v.at(name) - ref.second) < 1e-6 * (1 + std::abs(ref.second)));
+  }
+}
