@@ -13,6 +13,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
+#include "core/loops/assembly.hpp"
 #include "core/memory.hpp"
 #include "core/sampling.hpp"
 #include "io/output.hpp"
@@ -49,9 +50,17 @@ Work is bounded: the time of the whole check is estimated first (4n evaluations 
 eigenproblem of 2n per state); beyond --budget seconds (default 120) it is refused with the
 estimate, and beyond the memory limit (--max-memory GB, default half the available memory)
 with the memory it needs. A progress line shows on a terminal.
+A model with closed loops (docs/loops.md) has each state assembled onto its constraints first
+(states where they cannot close are counted and left out), its modes are those of the
+constrained equations with the default Baumgarte rate (whose pair -20 1/s is among them), and
+the constraint Jacobian's rank (redundant equations) and its nearness to a dead point
+(sigma_min/sigma_max of Phi_q, below 1e-6: near) are reported ("loops" in --json).
 Exit 0: no fault (notes may be printed); 1: M^s is singular at a sampled state, a body is
 flagged, or the check would exceed its budget; 2: a bad command line.
 )";
+
+// Φ_q's σ_min/σ_max below which a state is reported near a dead point.
+constexpr double kDeadPointRatio = 1e-6;
 
 const IntegratorKind kExplicit[] = {IntegratorKind::Rk4, IntegratorKind::Euler,
                                     IntegratorKind::Dopri};
@@ -114,7 +123,37 @@ struct Diagnosis {
   Mode stiffest;  // largest |λ| over the states
   Mode fastest;   // the fastest mode but the stiff dissipative ones (the motion to resolve)
   double h_max[3] = {INFINITY, INFINITY, INFINITY};
+  // Closed loops: each state assembled onto the constraints first (the states where Newton
+  // could not close them are counted and left out), the rank of Φ_q, and the smallest ratio
+  // σ_min/σ_max of its non-redundant singular values: how near a state came to a dead point.
+  int unassembled = 0, rank = -1, redundant = 0, dead_state = -1;
+  double dead_ratio = INFINITY;
+  std::string unassembled_message;
 };
+
+// Moves (q, q̇) onto the loops and records Φ_q's rank and nearness to a dead point. False when
+// the loops cannot close from q.
+bool diagnose_loops(const Model& m, int state, VecX& q, VecX& qd, Diagnosis& d) {
+  const StateAssembly s = assemble_state(m, q, qd);
+  if (!s.assembly.status.ok) {
+    ++d.unassembled;
+    if (d.unassembled_message.empty()) d.unassembled_message = s.assembly.status.message;
+    return false;
+  }
+  Workspace ws(m);
+  ConstraintKinematics k(m);
+  constraint_kinematics(m, ws, q, qd, k);
+  const Eigen::JacobiSVD<MatX> svd(k.J);
+  const VecX& sigma = svd.singularValues();
+  const int rank = s.assembly.rank;
+  d.rank = std::max(d.rank, rank);
+  d.redundant = m.constraint_rows - d.rank;
+  if (rank > 0 && sigma[0] > 0) {
+    const double ratio = sigma[rank - 1] / sigma[0];
+    if (ratio < d.dead_ratio) d.dead_ratio = ratio, d.dead_state = state;
+  }
+  return true;
+}
 
 void diagnose_state(const Model& m, Workspace& ws, const VecX& q, const VecX& qd, bool dampers,
                     Diagnosis& d) {
@@ -283,9 +322,10 @@ int cmd_check(int argc, char** argv) {
   {
     Progress progress(K, "states");
     for (int k = 0; k < K; ++k) {
-      const VecX q = k == 0 ? neutral_posture(m) : random_posture(m, rng);
-      const VecX qd = k == 0 ? VecX::Zero(n) : random_uniform(n, 1.0, rng);
-      diagnose_state(m, ws, q, qd, dampers, d);
+      VecX q = k == 0 ? neutral_posture(m) : random_posture(m, rng);
+      VecX qd = k == 0 ? VecX::Zero(n) : random_uniform(n, 1.0, rng);
+      if (m.constraints.empty() || diagnose_loops(m, k, q, qd, d))
+        diagnose_state(m, ws, q, qd, dampers, d);
       progress.update(k + 1);
     }
   }
@@ -329,6 +369,13 @@ int cmd_check(int argc, char** argv) {
     j["suspicious_bodies"] = flags;
     j["notes"] = notes;
     if (!d.singular_message.empty()) j["singular"] = d.singular_message;
+    if (!m.constraints.empty())
+      j["loops"] = {{"equations", m.constraint_rows},
+                    {"rank", d.rank},
+                    {"redundant", d.redundant},
+                    {"unassembled_states", d.unassembled},
+                    {"dead_point_ratio", finite_or_null(d.dead_ratio)},
+                    {"near_dead_point", d.dead_ratio < kDeadPointRatio}};
     std::cout << json_text(j) << "\n";
   } else {
     std::cout << "model: " << m.name << " (" << n << " coordinates, " << m.bodies.size()
@@ -343,6 +390,21 @@ int cmd_check(int argc, char** argv) {
       std::cout << "M^s: " << condition_text(d.cond_lo, d.cond_hi) << ", symmetric to "
                 << format_short(d.asym)
                 << (d.singular_states ? "" : ", positive definite at every state") << "\n";
+    if (!m.constraints.empty()) {
+      std::cout << "loops: " << m.constraint_rows << " constraint equations, rank " << d.rank
+                << " (" << d.redundant << " redundant) at the states assembled onto them";
+      if (d.unassembled)
+        std::cout << "; " << d.unassembled << " of " << K
+                  << " states could not be assembled (left out): " << d.unassembled_message;
+      if (std::isfinite(d.dead_ratio))
+        std::cout << "\nnearest dead point: sigma_min/sigma_max of Phi_q = "
+                  << format_short(d.dead_ratio) << " at state " << d.dead_state
+                  << (d.dead_ratio < kDeadPointRatio
+                          ? " (near a dead point: the constraint forces there are large, and at "
+                            "the point itself the motion fails)"
+                          : "");
+      std::cout << "\n";
+    }
     std::cout << "stiffest mode: |λ| = " << format_short(d.stiffest.omega) << " 1/s, "
               << d.stiffest.text() << ", in " << where(m, d.stiffest.coordinate) << "\n"
               << "fastest motion: " << d.fastest.text() << ", in " << where(m, d.fastest.coordinate)

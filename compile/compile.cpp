@@ -120,6 +120,10 @@ Joint compile_joint(const JointSpec& js, const std::string& body_name) {
   j.stiffness = js.stiffness;
   j.rest = js.rest;
   check_magnitude(js.initial, js.where + "/initial", "initial");
+  if (js.initial != 0 && j.nq != 1)
+    throw ModelError(js.where + "/initial", "is the coordinate of a joint of one: this " +
+                                                std::string(joint_type_name(j.type)) +
+                                                " joint has " + std::to_string(j.nq));
   j.initial = js.initial;
   j.damping = js.damping;
   j.lower = js.lower;

@@ -8,7 +8,6 @@
 #include <sstream>
 
 #include "compile/compile.hpp"
-#include "core/joints/kernel.hpp"
 #include "core/limits.hpp"
 #include "core/names.hpp"
 #include "io/catalog.hpp"
@@ -141,12 +140,7 @@ JointSpec read_joint(const Params& p) {
     for (const char* key : {"axis", "limits", "spring", "damping"})
       if (p.has(key))
         p.fail(key, "a fixed joint has no motion: no axis, limits, spring or damping");
-  if (p.has("initial")) {
-    if (joint_type_nq(j.type) != 1)
-      p.fail("initial", "is a joint's one coordinate: this joint has " +
-                            std::to_string(joint_type_nq(j.type)));
-    j.initial = p.number("initial");
-  }
+  if (p.has("initial")) j.initial = p.number("initial");  // (compile: joints of one coordinate)
   if (j.type == JointType::Fixed)
     for (const char* key : {"armature", "gear", "friction", "friction_velocity", "effort_limit",
                             "velocity_limit", "stop"})
@@ -622,6 +616,15 @@ MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std
 
 CouplingSpec parse_coupling(const Json& coupling, const std::string& where) {
   return read_coupling(Params(coupling, where));
+}
+
+ConstraintSpec parse_constraint(const Json& constraint, const std::string& where,
+                                std::size_t index) {
+  return read_constraint(Params(constraint, where), {}, index);
+}
+
+SpringSpec parse_spring(const Json& spring, const std::string& where, std::size_t index) {
+  return read_spring(Params(spring, where), {}, index);
 }
 
 namespace {

@@ -33,6 +33,11 @@ Model load_model(const std::string& path, const LoadOptions& options = {});
 // "polynomial" | "spline" | "four_bar", …}), read and checked as in a file; `where` names it in
 // messages. For builders that take a coupling in that form (the Python module).
 CouplingSpec parse_coupling(const Json& coupling, const std::string& where);
+// One entry of "constraints" or "springs" in the same way (its ends by frame, body or
+// {"body", "xyz", "rpy"}; a "node" is not known outside a file); `index` names it by default.
+ConstraintSpec parse_constraint(const Json& constraint, const std::string& where,
+                                std::size_t index);
+SpringSpec parse_spring(const Json& spring, const std::string& where, std::size_t index);
 
 // The model document a file describes (a URDF converted, a plugin expanded), as JSON that
 // loads back to the same equations: what `femdyn import` writes.

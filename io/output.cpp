@@ -177,6 +177,19 @@ std::string joint_properties_text(const Joint& j) {
   return out;
 }
 
+namespace {
+// A constraint's or spring's end as the model file named it: "E_rod (on rod_FE)", a body or
+// "world", or "triangle at [0.02 -0.018 0]" (a point on a body).
+std::string place_name(const Model& model, const Attachment& A) {
+  const std::string body = A.body < 0 ? std::string("world") : model.bodies[A.body].name;
+  if (A.name != body) return A.name + " (on " + body + ")";
+  if (A.p.isZero(0)) return body;
+  std::ostringstream s;
+  s << body << " at [" << A.p.transpose() << "]";
+  return s.str();
+}
+}  // namespace
+
 std::string info_text(const Model& model) {
   std::ostringstream out;
   out << "model: " << model.name << "\n";
@@ -232,6 +245,23 @@ std::string info_text(const Model& model) {
     out << "  " << F.name << " on " << model.bodies[F.body].name << " at [" << F.p_BF.transpose()
         << "]\n";
   }
+  if (!model.constraints.empty()) {
+    out << "constraints (" << model.constraint_rows << " equations; docs/loops.md):\n";
+    for (const LoopConstraint& c : model.constraints) {
+      out << "  " << c.name << ": " << constraint_type_name(c.type) << ", " << c.rows()
+          << (c.rows() == 1 ? " equation" : " equations");
+      if (c.type != ConstraintType::Gear)
+        out << ", " << place_name(model, c.a) << " to " << place_name(model, c.b);
+      out << "\n";
+    }
+  }
+  if (!model.springs.empty()) {
+    out << "springs:\n";
+    for (const TwoPointSpring& s : model.springs)
+      out << "  " << s.name << ": " << place_name(model, s.a) << " to " << place_name(model, s.b)
+          << ", k " << s.stiffness << " N/m, rest " << s.rest_length << " m, c " << s.damping
+          << " N s/m\n";
+  }
   out << "transition coordinates u (N_u = " << model.n_u() << " kept):\n";
   for (int i = 0; i < model.n_u(); ++i)
     out << "  " << std::setw(3) << i + 1 << " " << model.dof_name(i) << "\n";
@@ -282,6 +312,22 @@ Json info_json(const Model& model) {
     joints.push_back(joint);
   }
   j["joints"] = joints;
+  Json constraints = Json::array(), springs = Json::array();
+  for (const LoopConstraint& c : model.constraints) {
+    Json x = {{"name", c.name}, {"type", constraint_type_name(c.type)}, {"rows", c.rows()}};
+    if (c.type != ConstraintType::Gear)
+      x["a"] = place_name(model, c.a), x["b"] = place_name(model, c.b);
+    constraints.push_back(x);
+  }
+  for (const TwoPointSpring& s : model.springs)
+    springs.push_back({{"name", s.name},
+                       {"a", place_name(model, s.a)},
+                       {"b", place_name(model, s.b)},
+                       {"stiffness", s.stiffness},
+                       {"rest_length", s.rest_length},
+                       {"damping", s.damping}});
+  j["constraints"] = constraints;
+  j["springs"] = springs;
   return j;
 }
 

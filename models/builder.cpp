@@ -210,6 +210,35 @@ void MechanismBuilder::coupling(CouplingSpec c) {
   spec_.couplings.push_back(std::move(c));
 }
 
+void MechanismBuilder::constraint(ConstraintSpec c) {
+  if (c.where.empty()) c.where = next_constraint();
+  spec_.constraints.push_back(std::move(c));
+}
+
+void MechanismBuilder::spring(SpringSpec s) {
+  if (s.where.empty()) s.where = next_spring();
+  spec_.springs.push_back(std::move(s));
+}
+
+std::string MechanismBuilder::next_constraint() const {
+  return spec_.where + "/constraints/" + std::to_string(spec_.constraints.size());
+}
+
+std::string MechanismBuilder::next_spring() const {
+  return spec_.where + "/springs/" + std::to_string(spec_.springs.size());
+}
+
+void MechanismBuilder::frame(const std::string& name, const std::string& body, const Vec3& xyz,
+                             const Vec3& rpy) {
+  FrameSpec f;
+  f.where = spec_.where + "/frames/" + std::to_string(spec_.frames.size());
+  f.name = name;
+  f.body = body;
+  f.xyz = xyz;
+  f.rpy = rpy;
+  spec_.frames.push_back(std::move(f));
+}
+
 void MechanismBuilder::load(const std::string& body, const Vec3& point, const Vec3& force,
                             const Vec3& torque) {
   LoadSpec l;

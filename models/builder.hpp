@@ -59,6 +59,17 @@ class MechanismBuilder {
   void coupling(CouplingSpec coupling);
   // Where the next coupling is, for a caller that names it before adding it.
   std::string next_coupling() const;
+  // A loop constraint or a two-point spring (compile/spec.hpp: their ends by frame, body or
+  // "world", or a point on a body); `where` is set here when empty. The next one's place.
+  void constraint(ConstraintSpec constraint);
+  void spring(SpringSpec spring);
+  std::string next_constraint() const;
+  std::string next_spring() const;
+  std::size_t constraint_count() const { return spec_.constraints.size(); }
+  std::size_t spring_count() const { return spec_.springs.size(); }
+  // A named frame on a body (docs/model-format.md#frames).
+  void frame(const std::string& name, const std::string& body, const Vec3& xyz,
+             const Vec3& rpy = Vec3::Zero());
   // A constant force (world frame) at `point` (body frame) and a torque (world frame).
   void load(const std::string& body, const Vec3& point, const Vec3& force, const Vec3& torque);
 

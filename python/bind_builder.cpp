@@ -193,7 +193,8 @@ void bind_builder(py::module_& m) {
              const std::optional<std::pair<double, double>>& limits, OptNumber stiffness,
              OptNumber rest, OptNumber damping, const OptArray& axis2, OptNumber pitch,
              OptNumber armature, OptNumber gear, OptNumber friction, OptNumber friction_velocity,
-             OptNumber effort_limit, OptNumber velocity_limit, const py::object& stop) {
+             OptNumber effort_limit, OptNumber velocity_limit, const py::object& stop,
+             OptNumber initial) {
             const ActuatorArgs act{armature,     gear,           friction, friction_velocity,
                                    effort_limit, velocity_limit, stop};
             if (!type && act.given())
@@ -203,6 +204,7 @@ void bind_builder(py::module_& m) {
             JointSpec j = joint_arg(text_arg(type, "type"), text_arg(joint, "joint"), axis, xyz,
                                     rpy, limits, stiffness, rest, damping, axis2, pitch);
             actuator_arg(act, j);
+            if (initial) j.initial = *initial;
             b.body(text_arg(name, "name"), text_arg(parent, "parent"), std::move(j));
           },
           py::arg("name"), py::arg("parent") = "world", py::arg("type") = py::none(),
@@ -214,6 +216,7 @@ void bind_builder(py::module_& m) {
           py::arg("gear") = py::none(), py::arg("friction") = py::none(),
           py::arg("friction_velocity") = py::none(), py::arg("effort_limit") = py::none(),
           py::arg("velocity_limit") = py::none(), py::arg("stop") = py::none(),
+          py::arg("initial") = py::none(),
           "A body on `parent` ('world': the ground) by a joint of `type` (revolute, prismatic, "
           "fixed, helical, universal, planar, spherical, free; docs/notation.md) named `joint` "
           "(default: the body's name), at xyz, rpy (default 0), about axis (default (0, 0, 1)), "
@@ -221,7 +224,8 @@ void bind_builder(py::module_& m) {
           "joint's second axis `axis2`, a helical joint's `pitch` (m/rad); a rotor `armature` "
           "(kg·m²) behind a `gear` ratio, Coulomb `friction` regularised at `friction_velocity`, "
           "`effort_limit`, `velocity_limit`, and `stop` (True or {'stiffness': k, "
-          "'dissipation': d}) enforcing the limits (docs/control.md). Without type the body "
+          "'dissipation': d}) enforcing the limits (docs/control.md), and the joint's `initial` "
+          "coordinate (the start of a run). Without type the body "
           "is welded to its parent's origin and no other joint argument may be given (ValueError "
           "naming it); a fixed joint takes no axis, limits, spring or damper.")
       .def(
@@ -283,6 +287,33 @@ void bind_builder(py::module_& m) {
           py::arg("joint"), py::arg("follows"),
           "θ_joint from the joint(s) it follows, in the JSON format's words: ratio=, offset=, "
           "or polynomial=, spline=, four_bar= (docs/model-format.md#couplings)")
+      .def(
+          "frame",
+          [](MechanismBuilder& b, const std::string& name, const std::string& body,
+             const Array& xyz, const Array& rpy) {
+            b.frame(text_arg(name, "name"), text_arg(body, "body"), vec3_arg(xyz, "xyz"),
+                    vec3_arg(rpy, "rpy"));
+          },
+          py::arg("name"), py::arg("body"), py::arg("xyz") = Vec3(0, 0, 0),
+          py::arg("rpy") = Vec3(0, 0, 0), "a named frame on a body (its origin and axes)")
+      .def(
+          "constraint",
+          [](MechanismBuilder& b, const std::string& type, const py::kwargs& fields) {
+            Json c = to_json(fields, "constraint");
+            c["type"] = text_arg(type, "type");
+            b.constraint(parse_constraint(c, b.next_constraint(), b.constraint_count()));
+          },
+          py::arg("type"),
+          "a loop constraint in the JSON format's words: type 'ball', 'weld', 'distance', "
+          "'point_on_line', 'point_on_plane' with a=, b= (a frame, a body, 'world' or "
+          "{'body': …, 'xyz': …}) and normal=, direction=, length=; or 'gear' with joint=, "
+          "follows=, ratio=, offset=; name= (docs/loops.md)")
+      .def(
+          "spring",
+          [](MechanismBuilder& b, const py::kwargs& fields) {
+            b.spring(parse_spring(to_json(fields, "spring"), b.next_spring(), b.spring_count()));
+          },
+          "a two-point spring-damper: a=, b=, stiffness=, rest_length=, damping=, name=")
       .def(
           "load",
           [](MechanismBuilder& b, const std::string& body, const Array& point, const Array& force,

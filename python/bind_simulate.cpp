@@ -227,6 +227,10 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
   stats["saturated_steps"] = run.saturated_steps;
   stats["unapplied_effort_limits"] = run.unapplied_effort_limits;
   stats["failure"] = st.message;
+  if (!m.constraints.empty()) {  // closed loops: the largest residuals over the rows
+    stats["max_position_residual"] = run.max_position_residual;
+    stats["max_velocity_residual"] = run.max_velocity_residual;
+  }
   py::dict d;
   d["t"] = vector_array(rows.t);
   d["q"] = q;

@@ -87,6 +87,7 @@ PYBIND11_MODULE(_femdyn, m) {
       "The memory limit (GB) of every call that estimates its memory first (equations, the "
       "batches, simulate, validate without max_memory=); None: half the available memory.");
   bind_model(m);
+  bind_loops(m);
   bind_batch(m);
   bind_simulate(m);
   bind_simulator(m);

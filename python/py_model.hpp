@@ -43,5 +43,6 @@ void bind_simulate(py::module_& m);
 void bind_simulator(py::module_& m);
 void bind_validate(py::module_& m);
 void bind_builder(py::module_& m);
+void bind_loops(py::module_& m);
 
 }  // namespace femdyn::python

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/errors.hpp"
 #include "core/memory.hpp"
 #include "sim/fixed_step.hpp"
 #include "sim/stability.hpp"
@@ -92,6 +93,8 @@ void Integrator::reset(double t0, const VecX& q0, const VecX& qd0, double t_stop
   motion_.start_chart(q0, y_.data());
   y_.segment(n, n) = qd0;
   y_[2 * n] = 0.0;
+  // Closed loops start on their constraints (assembled, the velocity projected).
+  if (Status p = motion_.project(t0, y_.data()); !p.ok) throw StateError(p.message);
   y0_ = y_;
   q0_ = q0;
   t_ = t0_ = t0;

@@ -66,7 +66,9 @@ class Integrator {
   virtual IntegratorKind kind() const = 0;
   const char* name() const { return integrator_name(kind()); }
 
-  // Starts a run at (t0, q0, q̇0) with W = 0; clears the statistics. An adaptive method never
+  // Starts a run at (t0, q0, q̇0) with W = 0; clears the statistics. A model with closed loops
+  // starts from (q0, q̇0) moved onto its constraints (Motion::project; StateError when the loops
+  // cannot close there). An adaptive method never
   // steps past t_stop (τ(t) may not be defined there); by default it may overshoot t_out and
   // interpolate back.
   void reset(double t0, const VecX& q0, const VecX& qd0,

@@ -4,10 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <numbers>
 
 #include "core/joints/passive.hpp"
 #include "core/sampling.hpp"
+#include "sim/motion.hpp"
 
 namespace femdyn {
 namespace {
@@ -130,6 +132,10 @@ Linearization linearize(const Model& m, Workspace& ws, const VecX& q, const VecX
   lin.A = MatX::Zero(2 * n, 2 * n);
   lin.A.topRightCorner(n, n).setIdentity();
   VecX qp = q, qdp = qd, plus(n);
+  // Closed loops: q̈ of the constrained equations with the default Baumgarte rate, as a run
+  // integrates them (its pair of eigenvalues −ω is then among the modes).
+  std::unique_ptr<LoopWorkspace> loops;
+  if (!m.constraints.empty()) loops = std::make_unique<LoopWorkspace>(m);
   // Column j of [K D] by central differences: (q̈(y + δ e_j) − q̈(y − δ e_j)) / 2δ. With a
   // spherical or free joint y = (ξ, v) in the chart around q (core/motion.hpp): q moves by
   // q ⊕ δ e_j, and the top rows are ∂ξ̇/∂(ξ, v) = [∂ξ̇/∂ξ, 1] at ξ = 0.
@@ -143,7 +149,9 @@ Linearization linearize(const Model& m, Workspace& ws, const VecX& q, const VecX
         x[i] = x0 + side * delta;
       else
         qp = integrate_posture(m, q, VecX::Unit(n, i) * (side * delta));
-      lin.status = forward_dynamics(m, ws, qp, qdp, tau);
+      lin.status = loops ? constrained_forward_dynamics(m, ws, *loops, qp, qdp, tau,
+                                                        Motion::kDefaultBaumgarte)
+                         : forward_dynamics(m, ws, qp, qdp, tau);
       if (!lin.status.ok) return lin;
       if (side == 1)
         plus = ws.qdd;

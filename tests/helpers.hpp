@@ -15,6 +15,7 @@ namespace femdyn::test {
 
 std::string model_path(const std::string& name);  // FEMDYN_SOURCE_DIR/models/name
 std::vector<std::string> bundled_models();        // file names of models/*.json, sorted
+std::string read_file(const std::string& path);   // the whole file as text
 Model load_text(const std::string& json_text, const CompileOptions& options = {});
 // The ModelError's message of load_text(json_text), or "(loaded)".
 std::string text_error(const std::string& json_text);

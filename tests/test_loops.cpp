@@ -6,6 +6,7 @@
 // t = 0 and its reference solution at t = 0.03, computed there with PSIDE at tolerances 1e-14).
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -259,4 +260,130 @@ TEST_CASE("Andrews' mechanism at t = 0.03 reproduces the Test Set's reference so
     CHECK(std::abs(q.at(name) - ref.first) < 1e-9 * (1 + std::abs(ref.first)));
     CHECK(std::abs(v.at(name) - ref.second) < 1e-6 * (1 + std::abs(ref.second)));
   }
+}
+
+TEST_CASE("a planar loop closed by 3-D balls is redundant, and moves the same", "[loops]") {
+  const Model planar = load_model(model_path("andrews.json"));
+  Json j = Json::parse(read_file(model_path("andrews.json")));
+  for (Json& c : j["constraints"]) c.erase("normal");  // 3 equations each, the z rows repeat
+  const Model spatial = load_text(j.dump());
+  REQUIRE(spatial.constraint_rows == 9);
+  VecX q = neutral_posture(spatial), v = VecX::Zero(7);
+  const StateAssembly s = assemble_state(spatial, q, v);
+  REQUIRE(s.assembly.status.ok);
+  CHECK(s.assembly.rank == 6);
+  CHECK(s.assembly.redundant == 3);
+  std::mt19937 rng(3);
+  v = random_uniform(7, 50.0, rng);
+  REQUIRE(assemble_state(planar, q, v).assembly.status.ok);  // (v onto the loops)
+  Workspace wa(planar), wb(spatial);
+  LoopWorkspace la(planar), lb(spatial);
+  REQUIRE(constrained_forward_dynamics(planar, wa, la, q, v, VecX::Zero(7), 0).ok);
+  REQUIRE(constrained_forward_dynamics(spatial, wb, lb, q, v, VecX::Zero(7), 0).ok);
+  CHECK(lb.rank == 6);
+  CHECK(rel_error(wb.qdd, wa.qdd) < 1e-9);
+  // The same constraint forces on the coordinates, whichever λ carries them.
+  CHECK(rel_error(lb.k.J.transpose() * lb.lambda, la.k.J.transpose() * la.lambda) < 1e-9);
+}
+
+// Two 1 m links from the origin, the tip held at (2, 0, 0): a loop that can only close fully
+// stretched, where its Jacobian loses rank.
+const char* kStretched = R"({"name": "stretched", "gravity": [0, -9.81, 0], "bodies": [
+  {"name": "l1", "parent": "world", "joint": {"name": "a", "type": "revolute", "axis": [0, 0, 1]},
+   "elements": [{"type": "rigid_body", "mass": 1, "com": [0.5, 0, 0],
+                 "inertia": {"ixx": 0.01, "iyy": 0.1, "izz": 0.1}}]},
+  {"name": "l2", "parent": "l1", "joint": {"name": "b", "type": "revolute", "axis": [0, 0, 1],
+                                           "origin": {"xyz": [1, 0, 0]}},
+   "elements": [{"type": "rigid_body", "mass": 1, "com": [0.5, 0, 0],
+                 "inertia": {"ixx": 0.01, "iyy": 0.1, "izz": 0.1}}]}],
+  "constraints": [{"name": "tip", "type": "ball", "a": {"body": "l2", "xyz": [1, 0, 0]},
+                   "b": {"body": "world", "xyz": [LENGTH, 0, 0]}, "normal": [0, 0, 1]}]})";
+
+std::string stretched(const std::string& length) {
+  std::string s = kStretched;
+  return s.replace(s.find("LENGTH"), 6, length);
+}
+
+TEST_CASE("a dead point is a failure naming the constraint, not a NaN", "[loops]") {
+  const Model m = load_text(stretched("2"));
+  Workspace ws(m);
+  LoopWorkspace lws(m);
+  // Moving through the stretched configuration: v in the null space of Φ_q (the tip still).
+  const VecX q = VecX::Zero(2);
+  const VecX v = (VecX(2) << 2, -1).finished();
+  const Status st = constrained_forward_dynamics(m, ws, lws, q, v, VecX::Zero(2), 0);
+  CHECK_FALSE(st.ok);
+  CHECK(st.message.find("singular") != std::string::npos);
+  CHECK(st.message.find("'tip") != std::string::npos);
+}
+
+TEST_CASE("a loop that cannot close is refused with its residual", "[loops]") {
+  const Model m = load_text(stretched("2.5"));
+  VecX q = VecX::Zero(2), v = VecX::Zero(2);
+  const StateAssembly s = assemble_state(m, q, v);
+  CHECK_FALSE(s.assembly.status.ok);
+  CHECK(s.assembly.status.message.find("cannot close") != std::string::npos);
+  CHECK(s.assembly.status.message.find("'tip") != std::string::npos);
+  CHECK(s.assembly.residual > 0.4);
+  // Through the CLI: one line naming the file, non-zero exit.
+  Scratch dir("stretched");
+  const std::string path = (dir.dir / "stretched.json").string();
+  std::ofstream(path) << stretched("2.5");
+  const Run r = run("simulate " + path + " --t-end 0.1");
+  CHECK(r.code != 0);
+  CHECK(r.out.find("stretched.json: the initial state: the loops cannot close") !=
+        std::string::npos);
+}
+
+TEST_CASE("assembly holds the given coordinates and lands on the loops", "[loops]") {
+  const Model m = load_model(model_path("andrews.json"));
+  const VecX q0 = neutral_posture(m);
+  std::mt19937 rng(11);
+  VecX q = q0 + random_uniform(7, 0.02, rng);
+  Workspace ws(m);
+  ConstraintKinematics k(m);
+  AssemblyOptions o;
+  o.held = {0};  // β, the crank: the driving coordinate stays where it is put
+  const double beta = q[0];
+  const AssemblyReport r = assemble(m, ws, k, q, o);
+  REQUIRE(r.status.ok);
+  CHECK(r.residual < 1e-12);
+  CHECK(q[0] == beta);
+  CHECK(r.iterations <= 8);  // Newton: quadratic from a few hundredths of a radian
+}
+
+TEST_CASE("constraint and spring input errors name the place and the problem", "[loops]") {
+  const std::string base = R"({"name": "x", "bodies": [
+    {"name": "a", "parent": "world", "joint": {"name": "ja", "type": "revolute", "axis": [0,0,1]},
+     "elements": [{"type": "rigid_body", "mass": 1, "inertia": {"ixx": 1, "iyy": 1, "izz": 1}}]},
+    {"name": "b", "parent": "a", "joint": {"name": "jb", "type": "revolute", "axis": [0,0,1]},
+     "elements": [{"type": "rigid_body", "mass": 1, "inertia": {"ixx": 1, "iyy": 1, "izz": 1}}]}],
+    EXTRA})";
+  const auto with = [&](const std::string& extra) {
+    std::string s = base;
+    return text_error(s.replace(s.find("EXTRA"), 5, extra));
+  };
+  CHECK_THAT(with(R"("constraints": [{"type": "ball", "a": "nowhere", "b": "world"}])"),
+             Catch::Contains("/constraints/0/a: unknown frame or body 'nowhere'"));
+  CHECK_THAT(with(R"("constraints": [{"type": "hinge", "a": "a", "b": "world"}])"),
+             Catch::Contains("/constraints/0/type: unknown constraint type 'hinge'"));
+  CHECK_THAT(with(R"("constraints": [{"type": "ball", "a": "a", "b": {"body": "a"}}])"),
+             Catch::Contains("/constraints/0: both ends are on body 'a'"));
+  CHECK_THAT(with(R"("constraints": [{"type": "distance", "a": "a", "b": "b", "length": -1}])"),
+             Catch::Contains("/constraints/0/length"));
+  CHECK_THAT(with(R"("constraints": [{"type": "point_on_plane", "a": "a", "b": "b"}])"),
+             Catch::Contains("/constraints/0: needs \"normal\""));
+  CHECK_THAT(with(R"("constraints": [{"type": "ball", "a": "a", "b": "b", "normal": [0,0,0]}])"),
+             Catch::Contains("/constraints/0/normal: must not be zero"));
+  CHECK_THAT(with(R"("constraints": [{"type": "gear", "joint": "ja", "follows": "ja"}])"),
+             Catch::Contains("a joint cannot follow itself"));
+  CHECK_THAT(with(R"("constraints": [{"type": "gear", "joint": "jz", "follows": "ja"}])"),
+             Catch::Contains("/constraints/0/joint: unknown joint 'jz'"));
+  CHECK_THAT(with(R"("constraints": [{"type": "ball", "a": "a", "b": "b", "lenght": 1}])"),
+             Catch::Contains("lenght"));
+  CHECK_THAT(with(R"("springs": [{"a": "a", "b": "world", "stiffness": -3}])"),
+             Catch::Contains("/springs/0/stiffness"));
+  CHECK_THAT(
+      with(R"("springs": [{"a": "a", "b": {"body": "a", "xyz": [1, 0, 0]}, "stiffness": 3}])"),
+      Catch::Contains("/springs/0: both ends are on the same body"));
 }

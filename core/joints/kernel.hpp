@@ -260,11 +260,6 @@ inline std::string rate_name(const Joint& j, int k) {
   return visit_joint(j.type, [&]<class J>(J) { return std::string(J::rate_name(k)); });
 }
 
-// A type's number of coordinates nq.
-inline int joint_type_nq(JointType type) {
-  return visit_joint(type, []<class J>(J) { return J::nq; });
-}
-
 // Compile: the type's sizes and the constants its pose uses.
 inline void prepare_joint(Joint& j) {
   visit_joint(j.type, [&]<class J>(J) {
