@@ -39,7 +39,7 @@ A model with closed loops (constraints, docs/loops.md) starts from q0 assembled 
 constraints by Newton's least-norm steps and q̇0 projected onto them (an impulse through the
 loops); it moves by the constrained equations with Baumgarte's stabilisation at --baumgarte W
 (1/s, default 20; 0: off), and is projected back onto the constraints after every fixed step, and
-after every adaptive step that leaves them by more than atol. The summary gives the equations,
+after every adaptive step that leaves them by more than 10 (atol + rtol |y|). The summary gives the equations,
 their rank (redundant ones counted) and the largest residuals |Phi| and |Phi_q v| over the rows.
 
 integrators (docs/simulation.md):

@@ -193,6 +193,7 @@ Status Motion::project(double t, double* y) {
   configuration(y, q_);
   AssemblyOptions options;
   options.max_iterations = 10;
+  options.rank = false;
   const AssemblyReport r = assemble(model_, ws_, loops_->k, q_, options);
   if (!r.status.ok) return {false, at_time(t) + r.status.message, -1};
   qd_ = Eigen::Map<const VecX>(y + n, n);

@@ -51,6 +51,9 @@ class Adaptive : public Integrator {
   // where the state was projected back onto the constraints (drifted_off_constraints).
   Status advance_stepwise(double t_out);
   bool drifted_off_constraints();
+  // After an accepted step: the chart moved or the state projected, and the method restarted
+  // (never past t_stop), where either is due.
+  Status settle(double t_stop);
 
  public:                                             // reached from the C callbacks
   int rhs(double t, const double* y, double* ydot);  // 0, or < 0 after recording rhs_failure_

@@ -1,6 +1,7 @@
 #include "core/loops/assembly.hpp"
 
 #include <cstdio>
+#include <limits>
 
 #include "core/equations.hpp"
 #include "core/sampling.hpp"
@@ -52,9 +53,12 @@ AssemblyReport assemble(const Model& model, Workspace& ws, ConstraintKinematics&
   }
   constraint_kinematics(model, ws, q, rest, k);
   report.residual = largest_residual(model, k.phi, report.worst);
-  cod.compute(k.J);
-  report.rank = static_cast<int>(cod.rank());
-  report.redundant = model.constraint_rows - report.rank;
+  report.rank = -1;
+  if (options.rank) {
+    cod.compute(k.J);
+    report.rank = static_cast<int>(cod.rank());
+    report.redundant = model.constraint_rows - report.rank;
+  }
   // Converged, or stalled at the round-off of the mechanism's size.
   double size = 1;
   for (const LoopConstraint& c : model.constraints)
@@ -75,8 +79,11 @@ Status project_velocity(const Model& model, Workspace& ws, LoopWorkspace& lws, c
   if (Status st = ws.solver.factorize(ws.Ms); !st.ok) return st;
   constraint_kinematics(model, ws, q, v, lws.k);
   factorize_constraint_space(model, ws, lws);
-  lws.r.noalias() = -lws.k.J * v;  // S λ = −Φ_q v,  v += Y λ
-  if (Status st = solve_constraint_space(model, lws); !st.ok) return st;
+  lws.r.noalias() = -lws.k.J * v;  // S λ = −Φ_q v,  v += Y λ (least squares where redundant
+                                   // rows of Φ_q v contradict each other: never a failure)
+  if (Status st = solve_constraint_space(model, lws, std::numeric_limits<double>::infinity());
+      !st.ok)
+    return st;
   v.noalias() += lws.Y * lws.lambda;
   return {};
 }

@@ -20,6 +20,7 @@ struct AssemblyOptions {
   double tolerance = 1e-12;  // on |Φ|∞ (m, rad)
   int max_iterations = 50;
   std::vector<int> held;  // rates (v indices) the step leaves alone
+  bool rank = true;       // find Φ_q's rank at the end (a projection after a step does not)
 };
 
 struct AssemblyReport {
@@ -27,7 +28,7 @@ struct AssemblyReport {
   int iterations = 0;
   double residual = 0;  // |Φ|∞ at the end
   std::string worst;    // the constraint row where it is largest
-  int rank = 0;         // of Φ_q at the end
+  int rank = 0;         // of Φ_q at the end (−1 when not asked)
   int redundant = 0;    // m − rank: equations that repeat others
 };
 

@@ -28,7 +28,7 @@ struct LoopWorkspace {
   MatX Y;  // M⁻¹ Φ_qᵀ (n × m)
   MatX S;  // Φ_q M⁻¹ Φ_qᵀ (m × m)
   Eigen::LDLT<MatX> ldlt;
-  VecX r, lambda, Slambda;
+  VecX r, lambda, Slambda, stabilization;
   int rank = 0;  // of S at the last solve
 };
 
@@ -43,7 +43,10 @@ Status constrained_forward_dynamics(const Model& model, Workspace& ws, LoopWorks
 // (Shared by the dynamics and the velocity projection.)
 void factorize_constraint_space(const Model& model, Workspace& ws, LoopWorkspace& lws);
 // λ with S λ = lws.r, dropping the pivots below ε_rank (sets lws.rank); fails when the
-// equations have no solution (lws.r outside the range of S).
-Status solve_constraint_space(const Model& model, LoopWorkspace& lws);
+// equations have no solution: lws.r outside the range of S by more than kConsistencyTolerance
+// of its scale plus `allowance` (the part of r that may be inconsistent: Baumgarte's
+// correction, whose components along redundant equations no λ can meet — it is then met in
+// the least-squares sense).
+Status solve_constraint_space(const Model& model, LoopWorkspace& lws, double allowance);
 
 }  // namespace femdyn
