@@ -103,6 +103,30 @@ struct TwinRod {
   std::string name;  // the element's place in the file, for messages
 };
 
+// A loop constraint of the model (core/loops/constraint.hpp) as Simbody's (twin_constraints.hpp):
+// places A and B fixed on bodies (body frames; −1 the ground) with axes R and origin p.
+struct TwinConstraint {
+  enum class Type { Ball, PointOnLine, PointInPlane, Weld, Rod, Gear } type = Type::Ball;
+  std::string name;  // for messages
+  int body_a = -1, body_b = -1;
+  Mat3 R_a = Mat3::Identity(), R_b = Mat3::Identity();
+  Vec3 p_a = Vec3::Zero(), p_b = Vec3::Zero();
+  Vec3 direction = Vec3::UnitZ();  // PointOnLine: the line's (B's body frame); PointInPlane: n
+  double length = 0;               // Rod
+  // Gear: θ of bodies[0]'s joint = Σ ratios[i] θ of bodies[1 + i]'s + offset (1-DOF joints).
+  std::vector<int> bodies;
+  std::vector<double> ratios;
+  double offset = 0;
+};
+
+// A two-point linear spring-damper (core/springs.hpp): Force::TwoPointLinearSpring and
+// Force::TwoPointLinearDamper between p_a on body_a and p_b on body_b (body frames; −1 the ground).
+struct TwinSpring {
+  int body_a = -1, body_b = -1;
+  Vec3 p_a = Vec3::Zero(), p_b = Vec3::Zero();
+  double stiffness = 0, rest_length = 0, damping = 0;
+};
+
 struct TwinModel {
   std::vector<TwinBody> bodies;  // parents first
   std::vector<int> theta_body;   // θ̇ index (a rate) -> body
@@ -120,6 +144,10 @@ struct TwinModel {
   std::vector<int> coordinate_theta;
   std::vector<TwinLaw> laws;
   std::vector<TwinRod> rods;
+  // Loops closed by constraints (disabled but where SimbodyTwin::loop_dynamics and a simulate
+  // with close_loops(true) enable them: every other entry point sees the tree) and springs.
+  std::vector<TwinConstraint> constraints;
+  std::vector<TwinSpring> springs;
   bool closed_loop() const { return !laws.empty() || !rods.empty(); }
   int n() const { return static_cast<int>(closed_loop() ? coordinate_theta.size() : C.cols()); }
   int n_theta() const { return static_cast<int>(theta_body.size()); }
@@ -150,6 +178,14 @@ struct TwinFrame {
   int body = -1;
   Mat3 R_BF = Mat3::Identity();
   Vec3 p_BF = Vec3::Zero();
+};
+
+// Simbody's constrained forward dynamics with the loop constraints enabled (loop_dynamics).
+struct TwinLoopDynamics {
+  VecX qdd;               // q̈ of the coordinates
+  VecX constraint_force;  // the generalized constraint forces on q: −Cᵀ Pᵀ Gᵀ λ (Simbody's
+                          // M u̇ + Gᵀ λ = f), femdyn's Φ_qᵀ λ
+  double position_error = 0, velocity_error = 0;  // max |qerr|, |uerr| at the state
 };
 
 // Simbody's kinematics at (q, q̇) (SimbodyTwin::kinematics), in femdyn's order and axes:
@@ -258,6 +294,14 @@ class SimbodyTwin {
   // q̇ = e_k (multiplyByFrameJacobian). Throws femdyn::Error (one line) where Simbody fails.
   TwinKinematics kinematics(const VecX& q, const VecX& qd, const VecX& tau,
                             const std::vector<TwinFrame>& frames, bool jacobian = false);
+
+  // The model's loop constraints (TwinModel::constraints): q̈ and the constraint forces at
+  // (q, q̇) under τ with them enabled (twin_constraints.cpp). The state should satisfy them
+  // (femdyn's assemble_state). Throws femdyn::Error (one line) where Simbody fails or the twin
+  // cannot pose them (a closed-loop twin; a coupling not posed as coordinate couplers).
+  TwinLoopDynamics loop_dynamics(const VecX& q, const VecX& qd, const VecX& tau);
+  // Whether simulate() runs with the loop constraints enabled (false: the tree).
+  void close_loops(bool closed);
 
   // Passive motion (τ = 0) from (q0, q̇0) by RungeKuttaMersonIntegrator at `accuracy`, sampled
   // at `times`. Empty with `why_not` set if the coupling cannot be posed as coordinate

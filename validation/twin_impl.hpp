@@ -4,6 +4,7 @@
 //   twin_mobilizers.cpp  femdyn bodies and joints as mobilized bodies, forces, the system
 //   twin_couplings.cpp   couplings θ = C q + θ0 as coordinate couplers
 //   twin_loops.cpp       the closed loops (laws and rods)
+//   twin_constraints.cpp the model's loop constraints and two-point springs
 //   twin_state.cpp       femdyn q, q̇ <-> Simbody's state; Cᵀ and C on Simbody's u layout
 //   twin.cpp             the equations, inverse dynamics and the timing entry points
 //   twin_kinematics.cpp  frames, centre of mass and momentum (SimbodyTwin::kinematics)
@@ -34,9 +35,15 @@ struct SimbodyTwin::Impl {
   SimTK::Force::DiscreteForces tau_forces{forces, matter};
   std::vector<SimTK::MobilizedBody> mobod;  // per femdyn body
   std::vector<SimTK::MobilizedBody> rods;   // closed loop: per TwinModel::rods
-  VecX loop_theta, loop_theta_dot;          // closed loop: θ = g(q), θ̇ = G q̇
-  std::vector<int> theta_q;                 // θ index (n_theta_q) -> Simbody q index
-  std::vector<int> theta_u;                 // θ̇ index (n_theta) -> Simbody u index
+  // Per TwinModel::constraints, disabled by default; enabled while `loops_enabled`.
+  std::vector<SimTK::Constraint> loop_constraints;
+  bool loops_enabled = false;
+  bool simulate_closed = false;  // SimbodyTwin::close_loops
+  // Enables (disables) the loop constraints in `state` (its stage falls to Model on a change).
+  void enable_loops(bool on);
+  VecX loop_theta, loop_theta_dot;  // closed loop: θ = g(q), θ̇ = G q̇
+  std::vector<int> theta_q;         // θ index (n_theta_q) -> Simbody q index
+  std::vector<int> theta_u;         // θ̇ index (n_theta) -> Simbody u index
   // A ball's or free joint's triple of rates: Simbody's u there is R_FM times femdyn's (B's
   // axes to F's), R_FM from the quaternion at Simbody q index `quat`.
   struct Rotated {

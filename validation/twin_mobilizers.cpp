@@ -4,6 +4,7 @@
 #include <Simbody.h>
 
 #include "core/names.hpp"
+#include "validation/twin_constraints.hpp"
 #include "validation/twin_friction.hpp"
 #include "validation/twin_impl.hpp"
 #include "validation/twin_loops.hpp"
@@ -136,6 +137,12 @@ void SimbodyTwin::Impl::finish_system() {
       Force::ConstantForce(forces, mobod[l.body], to_simtk(l.point), to_simtk(l.force));
     if (!l.torque.isZero(0)) Force::ConstantTorque(forces, mobod[l.body], to_simtk(l.torque));
   }
+  try {
+    constraints::add_springs(forces, matter, m, mobod);
+  } catch (const std::exception& e) {
+    throw femdyn::Error("Simbody refuses a spring: " + one_line(e.what()));
+  }
+  loop_constraints = constraints::add_constraints(matter, m, mobod);
 
   if (m.closed_loop()) {  // the laws and rods as constraints, pointwise and for trajectories
     independent = m.coordinate_theta;

@@ -181,6 +181,7 @@ TwinRun SimbodyTwin::simulate(const VecX& q0, const VecX& qd0, const std::vector
   }
   std::unique_ptr<SimTK::Integrator> integ;
   try {
+    s.enable_loops(s.simulate_closed);  // the integrator starts from (a copy of) this state
     s.set_state(q0, qd0, SimTK::Stage::Velocity);
     s.state.setTime(0);
     integ = make_integrator(which, s.system);
@@ -248,6 +249,7 @@ TwinRun SimbodyTwin::simulate(const VecX& q0, const VecX& qd0, const std::vector
     stats.failure = std::string(simbody_integrator_name(which)) + " failed: " + one_line(e.what());
   }
   if (integ) count(*integ, stats);
+  s.enable_loops(false);
   return run;
 }
 

@@ -25,6 +25,7 @@
 #include "sim/fixed_step.hpp"
 #include "validation/twin.hpp"
 #include "validation/urdf_twin.hpp"
+#include "validation/validate_loops.hpp"
 
 namespace femdyn::validation {
 
@@ -211,6 +212,7 @@ TwinModel twin_model(const Model& m) {
   const bool spans = std::any_of(m.elements.begin(), m.elements.end(),
                                  [](const ElementEntry& e) { return e.spans; });
   if (m.coupling_level || spans) add_loops(m, t);
+  add_constraints_and_springs(m, t);
   return t;
 }
 
@@ -284,6 +286,7 @@ void align_quaternions(const Model& m, const VecX& ref, VecX& x) {
 // trajectory (NaN or Inf) is an error, never a skipped comparison.
 struct Run {
   std::vector<VecX> x, q, qd;
+  std::string failure;  // why the integration failed, if it did
   double wall_time = 0;
 };
 bool integrate(const Model& m, Workspace& ws, const VecX& q0, const VecX& qd0,
@@ -296,7 +299,10 @@ bool integrate(const Model& m, Workspace& ws, const VecX& q0, const VecX& qd0,
   for (double target : times) {
     const Status st = rk4.advance_to(target);
     if (st.non_finite) throw femdyn::Error("along the trajectory: " + st.message);
-    if (!st.ok) return false;
+    if (!st.ok) {
+      run.failure = st.message;
+      return false;
+    }
     joint_state(m, ws, rk4.q(), rk4.qd());
     VecX x(ws.theta.size() + ws.theta_dot.size());
     x << ws.theta, ws.theta_dot;
@@ -390,6 +396,15 @@ struct Validator::Impl {
       r.failure = std::string("Simbody refused the twin: ") + e.what();
       return false;
     }
+    // The trajectory of a mechanism with loop constraints is the constrained one, in both, from
+    // a consistent start (consistent_state).
+    twin->close_loops(!m.constraints.empty());
+    if (!m.constraints.empty())
+      r.notes.push_back(
+          "loop constraints: " + std::to_string(m.constraints.size()) + " (" +
+          std::to_string(m.constraint_rows) +
+          " equations); M, h, Q, qdd, tau and the kinematics compare the spanning tree, the "
+          "constrained rows and the trajectory the closed mechanism");
     // (A mechanism without mass has no centre of mass: momentum_kinematics refuses it.)
     double mass = 0;
     for (const TwinBody& b : tm.bodies) mass += b.mass;
@@ -530,7 +545,9 @@ struct Validator::Impl {
       estimate.trajectory = steps * 4 * t_fd + samples * t_energy;
       if (twin->can_simulate()) {
         std::mt19937 first(o.seed);  // the first state of run(): the trajectory's start
-        const VecX q0 = random_posture(m, first), qd0 = random_uniform(n, o.qd_scale, first);
+        VecX q0 = random_posture(m, first), qd0 = random_uniform(n, o.qd_scale, first);
+        std::string why;
+        if (!m.constraints.empty()) (void)consistent_state(m, q0, qd0, why);
         const double stretch = o.t_end / kSimbodyProbeParts;
         const double scale = (1 + kTightRatio) * kSimbodyProbeParts;
         TwinRunLimits limits;  // a probe that runs out of time is over the budget already
@@ -572,11 +589,28 @@ struct Validator::Impl {
                               const std::function<void(double)>& progress) {
     TrajectoryReport tr;
     tr.t_end = o.t_end;
+    tr.constrained = !m.constraints.empty();
     if (o.t_end <= 0) {
       tr.skipped = "--t-end 0";
       return tr;
     }
     if (!twin->can_simulate(&tr.skipped)) return tr;
+    if (tr.constrained) {  // a consistent start: Φ = 0, Φ_q q̇ = 0
+      VecX q = q0, qd = qd0;
+      std::string why;
+      if (!consistent_state(m, q, qd, why)) {
+        tr.skipped =
+            "femdyn cannot assemble a start (the first state or the neutral posture): " + why;
+        return tr;
+      }
+      return trajectory_from(q, qd, deadline, progress, tr);
+    }
+    return trajectory_from(q0, qd0, deadline, progress, tr);
+  }
+
+  TrajectoryReport trajectory_from(const VecX& q0, const VecX& qd0, Clock::time_point deadline,
+                                   const std::function<void(double)>& progress,
+                                   TrajectoryReport tr) {
     const auto left = [&] {
       return std::chrono::duration<double>(deadline - Clock::now()).count();
     };
@@ -585,7 +619,7 @@ struct Validator::Impl {
     std::vector<double> times;
     double dt = o.t_end / std::max(1.0, std::round(o.t_end / o.rk4_step));
     for (int i = 0; i <= samples; ++i) times.push_back(dt * std::round(o.t_end * i / samples / dt));
-    const char* singular = "femdyn's mass matrix turned singular along the trajectory";
+    const std::string singular = "femdyn's integration failed along the trajectory";
     Run coarse, fine;
     double done = 0;  // estimated seconds of trajectory work done, for the progress line
     const auto femdyn_run = [&](double step, Run& run) {
@@ -597,7 +631,7 @@ struct Validator::Impl {
       return ok;
     };
     if (!femdyn_run(dt, coarse) || !femdyn_run(dt / 2, fine)) {
-      tr.skipped = singular;
+      tr.skipped = singular + (": " + (coarse.failure.empty() ? fine.failure : coarse.failure));
       return tr;
     }
     double estimate_rk4 = 0, scale = 1;
@@ -689,7 +723,7 @@ struct Validator::Impl {
         dt /= 2;
         std::swap(coarse, fine);
         if (!femdyn_run(dt / 2, fine)) {
-          tr.skipped = singular;
+          tr.skipped = singular + (": " + fine.failure);
           return tr;
         }
         tr.rk4_step = dt / 2;
@@ -726,7 +760,12 @@ struct Validator::Impl {
     // The two runs may differ by what each integrator gets wrong (with a margin of 10), plus
     // round-off. A comparison whose integrators are not that accurate proves nothing: the motion
     // is unresolved (chaotic over this time, or too fast) and fails with that reason.
-    tr.tolerance = 10 * (tr.rk4_error_estimate + tr.simbody_error_estimate) + 1e-12 * scale;
+    // A closed mechanism's runs are projected onto the constraints, Simbody's to its accuracy
+    // (setConstraintTolerance) and femdyn's after every step to 1e-12 (assemble's tolerance):
+    // errors of that size, not of the step, that neither estimate sees: the floor is Simbody's
+    // accuracy instead of round-off.
+    const double floor = tr.constrained ? std::max(1e-12, o.simbody_accuracy) : 1e-12;
+    tr.tolerance = 10 * (tr.rk4_error_estimate + tr.simbody_error_estimate) + floor * scale;
     tr.resolved = tr.tolerance <= o.resolved_tolerance * scale;
     return tr;
   }
@@ -819,6 +858,13 @@ struct Validator::Impl {
       inverse_dynamics(m, ws, q, qd, qdd);
       accumulate(etau, ws.tau, tw.inverse_dynamics(q, qd, qdd));
       progress((k + 1) * estimate.per_state);
+    }
+    if (!m.constraints.empty()) {  // the closed mechanism at its own consistent states
+      LoopRows loops = compare_loops(m, tw, o, tol);
+      for (QuantityError* e : {&loops.qdd, &loops.force, &loops.closure})
+        r.quantities.push_back(*e);
+      for (std::string& note : loops.notes) r.notes.push_back(std::move(note));
+      if (!loops.failure.empty()) r.failure = loops.failure;
     }
     if (!r.dense_mass)
       r.notes.push_back("M^s compared by its products with " + std::to_string(kMassProducts) +

@@ -99,7 +99,8 @@ struct QuantityError {
 
 struct TrajectoryReport {
   bool run = false;
-  std::string skipped;  // why not run, if not
+  bool constrained = false;  // the closed mechanism's (a model with loop constraints)
+  std::string skipped;       // why not run, if not
   double t_end = 0;
   double max_state_error = 0;  // max over samples of ‖(θ, θ̇)_femdyn − (θ, θ̇)_simbody‖∞
   double rk4_step = 0;         // step of the femdyn run compared
