@@ -16,6 +16,8 @@
 //   mujoco/mass/M       mj_kinematics, mj_comPos, mj_crb, mj_fullM (URDF robots, when built
 //   mujoco/inverse/M    mj_inverse                  with MuJoCo: validation/mujoco_peer.hpp)
 //   mujoco/forward/M    mj_forward, constraints off (qacc = qacc_smooth)
+//   femdyn/forward/finger_fourbar, femdyn/constrained/finger_fourbar_loop: the finger's
+//   four-bar closed by its coupling law and by a loop constraint (register_fourbar_routes).
 //   reference/{mass,bias,forward,inverse}/M: femdyn on the reference routes (Tᵀ M T, node-level
 //   sweeps, Cholesky) where n ≤ 128, for the crossovers.
 // and, for the growth of loading with n, on generated chains and binary trees of --load-sizes=
@@ -45,11 +47,13 @@
 #include <random>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "compile/compile.hpp"
 #include "core/equations.hpp"
+#include "core/loops/assembly.hpp"
 #include "core/math.hpp"
 #include "core/sampling.hpp"
 #include "io/model_loader.hpp"
@@ -274,6 +278,66 @@ void register_load(bool tree, int bodies) {
   })->Unit(benchmark::kMillisecond);
 }
 
+// The finger's four-bar closed two ways (issue 25, item 6), one forward dynamics each at the same
+// state of the same mechanism (tests/test_parallel_robots.cpp shows that they move alike):
+//   femdyn/forward/finger_fourbar          the four_bar coupling law: forward_dynamics(), n = 3
+//   femdyn/constrained/finger_fourbar_loop the loop closed by a constraint (its coupler a body):
+//                                          constrained_forward_dynamics(), n = 5, 2 equations,
+//                                          ω = 0
+struct FourBarRoutes {
+  Model law, loop;
+  std::unique_ptr<Workspace> ws_law, ws_loop;
+  std::unique_ptr<LoopWorkspace> lws;
+  VecX q_law, v_law, tau_law, q_loop, v_loop, tau_loop;
+};
+
+void register_fourbar_routes(const std::string& root) {
+  static FourBarRoutes r;  // outlives the benchmarks
+  r.law = load_model(root + "models/finger_fourbar.json");
+  r.loop = load_model(root + "models/finger_fourbar_loop.json");
+  r.ws_law = std::make_unique<Workspace>(r.law);
+  r.ws_loop = std::make_unique<Workspace>(r.loop);
+  r.lws = std::make_unique<LoopWorkspace>(r.loop);
+  r.q_law = (VecX(3) << 0.1, 0.3, 0.5).finished();
+  r.v_law = (VecX(3) << 0.5, -1.0, 1.0).finished();
+  r.tau_law = (VecX(3) << 2e-4, -1e-4, 5e-5).finished();
+  // The loop's state: the same three coordinates, dip and the coupler assembled, their rates
+  // from Φ_q v = 0.
+  r.q_loop = (VecX(5) << r.q_law, 0.5 * 2 / 3, 0).finished();
+  if (!assemble(r.loop, *r.ws_loop, r.lws->k, r.q_loop, {.held = {0, 1, 2}}).status.ok)
+    throw std::runtime_error("finger_fourbar_loop.json: the start did not assemble");
+  r.v_loop = (VecX(5) << r.v_law, 0, 0).finished();
+  constraint_kinematics(r.loop, *r.ws_loop, r.q_loop, r.v_loop, r.lws->k);
+  const Eigen::Matrix2d Jd = r.lws->k.J.rightCols(2);
+  r.v_loop.tail(2) = Jd.partialPivLu().solve(-r.lws->k.J.leftCols(3) * r.v_law);
+  r.tau_loop = (VecX(5) << r.tau_law, 0, 0).finished();
+  const auto reg = [](const std::string& name, int n, auto body) {
+    benchmark::RegisterBenchmark(name.c_str(), [name, n, body](benchmark::State& state) {
+      body();
+      long allocs = 0;
+      for (auto _ : state) {
+        alloc_counter::start();
+        body();
+        allocs += alloc_counter::stop();
+        benchmark::ClobberMemory();
+      }
+      state.counters["n"] = n;
+      state.counters["allocs"] =
+          state.iterations() ? static_cast<double>(allocs) / static_cast<double>(state.iterations())
+                             : 0;
+      if (allocs > 0) failures().insert(name + ": femdyn allocated");
+    })->Unit(benchmark::kMicrosecond);
+  };
+  reg("femdyn/forward/finger_fourbar", 3, [] {
+    benchmark::DoNotOptimize(forward_dynamics(r.law, *r.ws_law, r.q_law, r.v_law, r.tau_law).ok);
+  });
+  reg("femdyn/constrained/finger_fourbar_loop", 5, [] {
+    benchmark::DoNotOptimize(
+        constrained_forward_dynamics(r.loop, *r.ws_loop, *r.lws, r.q_loop, r.v_loop, r.tau_loop, 0)
+            .ok);
+  });
+}
+
 MechanismSpec random_spec(int seed, int bodies, double branching) {
   const std::string text = R"({"model": "random_tree", "params": {"seed": )" +
                            std::to_string(seed) + R"(, "bodies": )" + std::to_string(bodies) +
@@ -329,6 +393,7 @@ int main(int argc, char** argv) {
     // Growth with n: serial chains and branching trees (docs/performance.md).
     for (int n : sizes) add_case("chain" + std::to_string(n), random(3, n, 0));
     for (int n : sizes) add_case("tree" + std::to_string(n), random(3, n, 0.5));
+    register_fourbar_routes(root);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "femdyn_bench: %s\n", e.what());
     return 1;

@@ -16,7 +16,10 @@ void rows_along_axes(const LoopConstraint& c, ConstraintKinematics& k, int row) 
   for (const Vec3& e : c.axes) {
     const Vec3 g = B.R * e, wg = B.w.cross(g);
     k.phi[row] = g.dot(d);
-    k.J.row(row) = g.transpose() * (A.Jv - B.Jv) + g.cross(d).transpose() * B.Jw;
+    // (term by term: a product with A.Jv − B.Jv would allocate that difference)
+    k.J.row(row).noalias() = g.transpose() * A.Jv;
+    k.J.row(row).noalias() -= g.transpose() * B.Jv;
+    k.J.row(row).noalias() += g.cross(d).transpose() * B.Jw;
     k.bias[row] = g.dot(d0) + 2 * wg.dot(dd) + (B.alpha.cross(g) + B.w.cross(wg)).dot(d);
     ++row;
   }
@@ -50,7 +53,8 @@ void distance_row(const LoopConstraint& c, ConstraintKinematics& k, int row) {
   }
   const Vec3 e = d / l;
   const double ld = e.dot(dd);
-  k.J.row(row) = e.transpose() * (A.Jv - B.Jv);
+  k.J.row(row).noalias() = e.transpose() * A.Jv;
+  k.J.row(row).noalias() -= e.transpose() * B.Jv;
   k.bias[row] = e.dot(A.a - B.a) + (dd.squaredNorm() - ld * ld) / l;
 }
 
