@@ -103,16 +103,29 @@ void add_constraints_and_springs(const Model& m, TwinModel& t) {
 }
 
 bool consistent_state(const Model& m, VecX& q0, VecX& qd0, std::string& why) {
+  // Of the two assembled candidates, the one whose Φ_q is farther from losing rank
+  // (σ_min/σ_max of its non-redundant part): a random posture can assemble into a mode near a
+  // dead point, where no integrator gets far.
+  double best = -1;
+  VecX q_best, qd_best;
+  Workspace ws(m);
+  ConstraintKinematics k(m);
   for (int attempt = 0; attempt < 2; ++attempt) {
     VecX q = attempt == 0 ? q0 : neutral_posture(m), qd = qd0;
     const StateAssembly s = assemble_state(m, q, qd);
-    why = s.assembly.status.message;
-    if (s.assembly.status.ok) {
-      q0 = q, qd0 = qd;
-      return true;
+    if (!s.assembly.status.ok) {
+      why = s.assembly.status.message;
+      continue;
     }
+    constraint_kinematics(m, ws, q, qd, k);
+    const VecX sigma = Eigen::JacobiSVD<MatX>(k.J).singularValues();
+    const int rank = std::max(s.assembly.rank, 1);
+    const double ratio = sigma[0] > 0 ? sigma[rank - 1] / sigma[0] : 0;
+    if (ratio > best) best = ratio, q_best = q, qd_best = qd;
   }
-  return false;
+  if (best < 0) return false;
+  q0 = q_best, qd0 = qd_best;
+  return true;
 }
 
 LoopRows compare_loops(const Model& m, SimbodyTwin& twin, const ValidationOptions& o,

@@ -29,9 +29,9 @@ struct LoopRows {
 LoopRows compare_loops(const Model& m, SimbodyTwin& twin, const ValidationOptions& o,
                        double tolerance);
 
-// A consistent start for the constrained trajectory: (q0, q̇0) assembled, or if that fails the
-// model's neutral posture (its joints' "initial" values) with q̇0; false, with `why`, where
-// neither assembles.
+// A consistent start for the constrained trajectory: (q0, q̇0) assembled, or the model's neutral
+// posture (its joints' "initial" values) with q̇0 assembled, whichever keeps Φ_q farther from a
+// dead point; false, with `why`, where neither assembles.
 bool consistent_state(const Model& m, VecX& q0, VecX& qd0, std::string& why);
 
 }  // namespace femdyn::validation
