@@ -122,12 +122,15 @@ def main():
         for rtol in (1e-6, 1e-8, 1e-10):
             s, results, *extra = fn(a.femdyn, rtol)
             run = f"rtol {rtol:g}: {s['steps']} steps"
+            error = "{:.2e}"
             if not s["ok"]:
-                run += f"; STOPPED at t = {s['t_reached']:.6g} s: {s.get('failure', '')}"
+                run += f"; STOPPED {s.get('failure', '')}"
+                # compared up to the stop; none if it stopped before the first sample time
+                error = "- (stopped before 0.05 s)" if s["t_reached"] < 0.05 else \
+                    "{:.2e} (up to the stop)"
             for what, err in results:
                 lines.append(
-                    f"| {label} | {what} | {sources[key]} | {run} | {err:.2e}"
-                    f"{'' if s['ok'] else ' (up to the stop)'} | "
+                    f"| {label} | {what} | {sources[key]} | {run} | {error.format(err)} | "
                     f"{s['energy_balance_relative']:.1e} | {loops(s)} | {s['wall_time']:.2f} |")
             if extra:
                 b, result = extra
