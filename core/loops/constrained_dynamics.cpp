@@ -14,11 +14,13 @@ LoopWorkspace::LoopWorkspace(const Model& model)
       column(model.n()),
       Y(model.n(), model.constraint_rows),
       S(model.constraint_rows, model.constraint_rows),
-      ldlt(model.constraint_rows),
       r(model.constraint_rows),
       lambda(model.constraint_rows),
       Slambda(model.constraint_rows),
-      stabilization(model.constraint_rows) {}
+      stabilization(model.constraint_rows),
+      F(model.constraint_rows, model.constraint_rows),
+      y(model.constraint_rows),
+      perm(model.constraint_rows) {}
 
 void factorize_constraint_space(const Model& model, Workspace& ws, LoopWorkspace& lws) {
   for (int i = 0; i < model.constraint_rows; ++i) {
@@ -27,27 +29,52 @@ void factorize_constraint_space(const Model& model, Workspace& ws, LoopWorkspace
     lws.Y.col(i) = lws.column;
   }
   lws.S.noalias() = lws.k.J * lws.Y;
-  lws.ldlt.compute(lws.S);
+  pivoted_cholesky(lws);
+}
+
+// P S Pᵀ = L Lᵀ by Cholesky with diagonal pivoting on the Schur complement (Higham, "Accuracy
+// and Stability of Numerical Algorithms" §10.3): at step k the largest remaining diagonal of
+// the complement is the pivot, and the factorisation stops where it falls below ε_rank of S's
+// largest diagonal: L is m × rank, and rank is S's numerical rank. (Eigen's LDLT picks its
+// pivots from S's own diagonal, not the complement's, and is not rank revealing: on Bricard's
+// mechanism it put a near-zero pivot inside the factor and λ grew to 1e9.)
+void pivoted_cholesky(LoopWorkspace& lws) {
+  MatX& F = lws.F;
+  F = lws.S;
+  const int m = static_cast<int>(F.rows());
+  for (int i = 0; i < m; ++i) lws.perm[i] = i;
+  const double largest = m ? F.diagonal().maxCoeff() : 0.0;
+  lws.rank = 0;
+  for (int k = 0; k < m; ++k) {
+    Eigen::Index j = 0;
+    const double pivot = F.diagonal().tail(m - k).maxCoeff(&j);
+    if (!(pivot > kRankTolerance * largest)) break;
+    j += k;
+    F.row(k).swap(F.row(j));
+    F.col(k).swap(F.col(j));
+    std::swap(lws.perm[k], lws.perm[j]);
+    const double d = std::sqrt(F(k, k));
+    F(k, k) = d;
+    const int rest = m - k - 1;
+    F.col(k).tail(rest) /= d;
+    F.bottomRightCorner(rest, rest).noalias() -=
+        F.col(k).tail(rest) * F.col(k).tail(rest).transpose();
+    ++lws.rank;
+  }
 }
 
 Status solve_constraint_space(const Model& model, LoopWorkspace& lws, double allowance) {
-  // P S Pᵀ = L D Lᵀ: λ = Pᵀ L⁻ᵀ D⁺ L⁻¹ P r, D⁺ dropping pivots below ε_rank of the largest.
+  // The basic solution: with P S Pᵀ = [L₁; L₂] [L₁; L₂]ᵀ (L₁ rank × rank), the permuted λ is
+  // (L₁⁻ᵀ L₁⁻¹ (P r)₁, 0): the redundant equations' multipliers zero.
   auto& x = lws.lambda;
-  x = lws.ldlt.transpositionsP() * lws.r;
-  lws.ldlt.matrixL().solveInPlace(x);
-  const auto D = lws.ldlt.vectorD();
-  const double largest = D.size() ? D.cwiseAbs().maxCoeff() : 0;
-  lws.rank = 0;
-  for (Eigen::Index i = 0; i < D.size(); ++i) {
-    if (std::abs(D[i]) > kRankTolerance * largest) {
-      x[i] /= D[i];
-      ++lws.rank;
-    } else {
-      x[i] = 0;
-    }
-  }
-  lws.ldlt.matrixU().solveInPlace(x);
-  x = lws.ldlt.transpositionsP().transpose() * x;
+  const int m = static_cast<int>(x.size()), rank = lws.rank;
+  for (int i = 0; i < m; ++i) lws.y[i] = lws.r[lws.perm[i]];
+  auto head = lws.y.head(rank);
+  const auto L1 = lws.F.topLeftCorner(rank, rank);
+  L1.triangularView<Eigen::Lower>().solveInPlace(head);
+  L1.triangularView<Eigen::Lower>().transpose().solveInPlace(head);
+  lws.y.tail(m - rank).setZero();
+  for (int i = 0; i < m; ++i) x[lws.perm[i]] = lws.y[i];
   // No solution: r has a part outside the range of S (Φ_q lost rank where the loops do not
   // allow it: a dead point, or constraints that contradict each other).
   lws.Slambda.noalias() = lws.S * x;
