@@ -341,14 +341,17 @@ Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const 
   }
   const Status st = model.routes.forward_dynamics(model, ws, q, qd, *applied);
   if (!st.ok) return st;
-  // A result that overflowed is a failure naming the coordinate, never a NaN handed on.
-  for (Eigen::Index a = 0; a < ws.qdd.size(); ++a)
-    if (!std::isfinite(ws.qdd[a]))
+  return finite_accelerations(model, ws.qdd);
+}
+
+Status finite_accelerations(const Model& model, const VecX& qdd) {
+  for (Eigen::Index a = 0; a < qdd.size(); ++a)
+    if (!std::isfinite(qdd[a]))
       return {false,
               "q̈ of '" + model.coordinate_names[a] +
                   "' is NaN or Inf (the forces or the state overflow double precision)",
               static_cast<int>(a), true};
-  return st;
+  return {};
 }
 
 void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,

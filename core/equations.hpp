@@ -31,6 +31,9 @@ void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX&
 Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                         const VecX& tau);
 
+// A q̈ that overflowed as a failure naming the coordinate (never a NaN handed on), else ok.
+Status finite_accelerations(const Model& model, const VecX& qdd);
+
 // τ such that M^s q̈ + h = Q(τ), into ws.tau.
 void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                       const VecX& qdd);

@@ -23,6 +23,7 @@
 #include "core/momentum.hpp"
 #include "core/sampling.hpp"
 #include "sim/fixed_step.hpp"
+#include "sim/stability.hpp"
 #include "validation/twin.hpp"
 #include "validation/urdf_twin.hpp"
 #include "validation/validate_loops.hpp"
@@ -617,7 +618,13 @@ struct Validator::Impl {
     const int samples = std::max(1, o.samples);
     // femdyn's RK4 at dt and dt/2; sample times lie on the grid.
     std::vector<double> times;
-    double dt = o.t_end / std::max(1.0, std::round(o.t_end / o.rk4_step));
+    // The first step, within half of RK4's linear stability limit at the start (a stiff spring
+    // or damper would blow up a run at rk4_step: a diagnosis femdyn check makes the same way).
+    double first = o.rk4_step;
+    if (const Linearization lin = linearize(m, ws, q0, qd0, VecX::Zero(m.n())); lin.status.ok)
+      if (const auto stable = largest_stable_step(lin, IntegratorKind::Rk4))
+        first = std::min(first, 0.5 * *stable);
+    double dt = o.t_end / std::max(1.0, std::round(o.t_end / first));
     for (int i = 0; i <= samples; ++i) times.push_back(dt * std::round(o.t_end * i / samples / dt));
     const std::string singular = "femdyn's integration failed along the trajectory";
     Run coarse, fine;

@@ -79,12 +79,15 @@ double loop_size(const Model& m) {
   return L > 0 ? L : 1;
 }
 
-// Assembled (q, q̇) from a guess: the model's neutral posture moved by a random step, then, if
-// that does not assemble, a random posture.
+// Assembled (q, q̇) from a guess: the model's neutral posture moved by a random step of about
+// 0.3 rad in all (0.3/√n a coordinate: a long chain of loops stays in the assembly mode it was
+// described in, rather than folding some loops over, near their dead points), then, if that
+// does not assemble, a random posture.
 bool assembled_state(const Model& m, std::mt19937& rng, double qd_scale, VecX& q, VecX& qd,
                      std::string& why) {
+  const double step = 0.3 / std::sqrt(static_cast<double>(std::max(m.n(), 1)));
   for (int attempt = 0; attempt < 2; ++attempt) {
-    q = attempt == 0 ? integrate_posture(m, neutral_posture(m), random_uniform(m.n(), 0.3, rng))
+    q = attempt == 0 ? integrate_posture(m, neutral_posture(m), random_uniform(m.n(), step, rng))
                      : random_posture(m, rng);
     qd = random_uniform(m.n(), qd_scale, rng);
     const StateAssembly s = assemble_state(m, q, qd);

@@ -115,13 +115,7 @@ Status constrained_forward_dynamics(const Model& model, Workspace& ws, LoopWorks
   if (Status st = solve_constraint_space(model, lws, allowance); !st.ok) return st;
   ws.qdd = lws.qdd0;
   ws.qdd.noalias() += lws.Y * lws.lambda;
-  for (Eigen::Index a = 0; a < ws.qdd.size(); ++a)
-    if (!std::isfinite(ws.qdd[a]))
-      return {false,
-              "q̈ of '" + model.coordinate_names[a] +
-                  "' is NaN or Inf (the forces or the state overflow double precision)",
-              static_cast<int>(a), true};
-  return {};
+  return finite_accelerations(model, ws.qdd);
 }
 
 }  // namespace femdyn

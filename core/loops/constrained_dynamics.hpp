@@ -13,8 +13,9 @@
 // S is factorised by Cholesky with diagonal pivoting on the Schur complement (rank revealing on
 // a semidefinite S): it stops at pivots below ε_rank of the largest diagonal, so that redundant
 // constraints (a planar loop closed by 3-D balls, Bricard's mechanism) leave λ's redundant part
-// at zero and q̈ exact, and are counted in `rank`. A system with no solution — the constraint Jacobian singular at a dead
-// point or a lock-up — is a failed Status naming the constraint, never a NaN.
+// at zero and q̈ exact, and are counted in `rank`. A system with no solution — the constraint
+// Jacobian singular at a dead point or a lock-up — is a failed Status naming the constraint, never
+// a NaN.
 #pragma once
 #include <vector>
 
@@ -33,7 +34,7 @@ struct LoopWorkspace {
   MatX F;                 // S's pivoted Cholesky factor (pivoted_cholesky)
   VecX y;                 // the permuted right-hand side
   std::vector<int> perm;  // P: position i of the factor holds row perm[i] of S
-  int rank = 0;  // of S at the last solve
+  int rank = 0;           // of S at the last solve
 };
 
 inline constexpr double kRankTolerance = 1e-10;        // ε_rank, relative to S's largest pivot
