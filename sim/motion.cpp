@@ -210,7 +210,8 @@ Motion::ConstraintResidual Motion::constraint_residual(const double* y) {
   configuration(y, q_);
   qd_ = Eigen::Map<const VecX>(y + n, n);
   constraint_kinematics(model_, ws_, q_, qd_, loops_->k);
-  return {loops_->k.phi.cwiseAbs().maxCoeff(), (loops_->k.J * qd_).cwiseAbs().maxCoeff()};
+  loops_->r.noalias() = loops_->k.J * qd_;  // Φ_q v (r: the workspace's scratch of m)
+  return {loops_->k.phi.cwiseAbs().maxCoeff(), loops_->r.cwiseAbs().maxCoeff()};
 }
 
 Energy Motion::energy_at(const double* y) {
