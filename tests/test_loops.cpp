@@ -17,6 +17,7 @@
 #include "core/sampling.hpp"
 #include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
+#include "tests/loop_checks.hpp"
 
 using namespace femdyn;
 using namespace femdyn::test;
@@ -155,21 +156,7 @@ TEST_CASE("constrained dynamics satisfies the equations it solves", "[loops]") {
       CHECK(s.assembly.residual < 1e-12);
       // (a weld on a body with fewer than 6 joints to the world repeats some of its rows)
       if (!weld) CHECK(s.assembly.redundant == 0);
-      Workspace ws(m);
-      LoopWorkspace lws(m);
-      constraint_kinematics(m, ws, q, v, lws.k);
-      CHECK((lws.k.J * v).cwiseAbs().maxCoeff() < 1e-12);
-      const VecX tau = random_uniform(m.n(), 0.5, rng);
-      REQUIRE(constrained_forward_dynamics(m, ws, lws, q, v, tau, 0).ok);
-      const VecX qdd = ws.qdd, lambda = lws.lambda;
-      constraint_kinematics(m, ws, q, v, lws.k);
-      // Φ_q q̈ + Φ̇_q v = 0
-      const VecX accel = lws.k.J * qdd + lws.k.bias;
-      CHECK(accel.cwiseAbs().maxCoeff() < 1e-9 * (1 + (lws.k.J * qdd).cwiseAbs().maxCoeff()));
-      // M q̈ + h = Q(τ) + Φ_qᵀ λ: inverse dynamics of q̈ gives back τ + Φ_qᵀ λ.
-      inverse_dynamics(m, ws, q, v, qdd);
-      const VecX expected = tau + lws.k.J.transpose() * lambda;
-      CHECK(rel_error(ws.tau, expected, 1e-6) < 1e-10);
+      check_constrained_equations(m, q, v, random_uniform(m.n(), 0.5, rng));
     }
   }
 }

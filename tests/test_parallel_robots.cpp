@@ -18,6 +18,7 @@
 #include "core/sampling.hpp"
 #include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
+#include "tests/loop_checks.hpp"
 
 using namespace femdyn;
 using namespace femdyn::test;
@@ -88,20 +89,7 @@ void check_constrained_dynamics(const Model& m, VecX q, unsigned seed) {
   VecX v = random_uniform(m.n(), 1.0, rng);
   const StateAssembly s = assemble_state(m, q, v);
   REQUIRE(s.assembly.status.ok);
-  Workspace ws(m);
-  LoopWorkspace lws(m);
-  constraint_kinematics(m, ws, q, v, lws.k);
-  CHECK((lws.k.J * v).cwiseAbs().maxCoeff() < 1e-12);
-  const VecX tau = random_uniform(m.n(), 0.5, rng);
-  REQUIRE(constrained_forward_dynamics(m, ws, lws, q, v, tau, 0).ok);
-  CHECK(lws.rank == m.constraint_rows);
-  const VecX qdd = ws.qdd, lambda = lws.lambda;
-  constraint_kinematics(m, ws, q, v, lws.k);
-  const VecX accel = lws.k.J * qdd + lws.k.bias;
-  CHECK(accel.cwiseAbs().maxCoeff() < 1e-9 * (1 + (lws.k.J * qdd).cwiseAbs().maxCoeff()));
-  inverse_dynamics(m, ws, q, v, qdd);
-  const VecX expected = tau + lws.k.J.transpose() * lambda;
-  CHECK(rel_error(ws.tau, expected, 1e-6) < 1e-10);
+  CHECK(check_constrained_equations(m, q, v, random_uniform(m.n(), 0.5, rng)) == m.constraint_rows);
 }
 
 // `femdyn simulate` of a bundled model for 0.2 s at tight tolerances: its loops line and report.

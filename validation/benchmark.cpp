@@ -176,8 +176,7 @@ void add_case(std::string name, Spec spec, const Urdf& urdf = {}) {
 // Runs `body` in the timing loop with allocation counting on; `allocs` = heap allocations per
 // iteration (a warm-up call first, so buffers sized on first use are not counted).
 template <class Body>
-void timed(benchmark::State& state, const Case& c, const std::string& name, bool femdyn,
-           Body&& body) {
+void timed(benchmark::State& state, int n, const std::string& name, bool femdyn, Body&& body) {
   body();
   long allocs = 0;
   for (auto _ : state) {
@@ -186,7 +185,7 @@ void timed(benchmark::State& state, const Case& c, const std::string& name, bool
     allocs += alloc_counter::stop();
     benchmark::ClobberMemory();
   }
-  state.counters["n"] = c.model.n();
+  state.counters["n"] = n;
   state.counters["allocs"] =
       state.iterations() ? static_cast<double>(allocs) / static_cast<double>(state.iterations())
                          : 0;
@@ -198,7 +197,7 @@ void register_case(Case* c) {
   auto reg = [&](const std::string& lib, const std::string& op, auto fn) {
     const std::string full = lib + "/" + op + "/" + name;
     benchmark::RegisterBenchmark(full.c_str(), [c, fn, full, lib](benchmark::State& st) {
-      timed(st, *c, full, lib == "femdyn", [&] { fn(*c); });
+      timed(st, c->model.n(), full, lib == "femdyn", [&] { fn(*c); });
     })->Unit(benchmark::kMicrosecond);
   };
   // femdyn, Simbody and MuJoCo alternate, so drifts of a noisy machine hit them alike.
@@ -313,19 +312,7 @@ void register_fourbar_routes(const std::string& root) {
   r.tau_loop = (VecX(5) << r.tau_law, 0, 0).finished();
   const auto reg = [](const std::string& name, int n, auto body) {
     benchmark::RegisterBenchmark(name.c_str(), [name, n, body](benchmark::State& state) {
-      body();
-      long allocs = 0;
-      for (auto _ : state) {
-        alloc_counter::start();
-        body();
-        allocs += alloc_counter::stop();
-        benchmark::ClobberMemory();
-      }
-      state.counters["n"] = n;
-      state.counters["allocs"] =
-          state.iterations() ? static_cast<double>(allocs) / static_cast<double>(state.iterations())
-                             : 0;
-      if (allocs > 0) failures().insert(name + ": femdyn allocated");
+      timed(state, n, name, true, body);
     })->Unit(benchmark::kMicrosecond);
   };
   reg("femdyn/forward/finger_fourbar", 3, [] {
