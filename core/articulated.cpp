@@ -80,8 +80,8 @@ Status check_regularity(const Model& model, Workspace& ws) {
 
 // Step 2 for a joint of N > 1 rates: U = I^A S, D = Sᵀ U, u = τ − Sᵀ p^A; D = W Δ Wᵀ (W unit
 // upper triangular, eliminating the last rate first as the tree LTDL does, so that the pivots Δ
-// are the Cholesky route's); K = D⁻¹ Uᵀ and D⁻¹ u kept for step 3, and with a parent,
-// I^A −= U K, p^A += I^a c + U D⁻¹ u. Fixed sizes: no allocation.
+// are the Cholesky route's); K = D⁻¹ Uᵀ, D⁻¹ u and D⁻¹ itself (for articulated_solve) kept for
+// step 3, and with a parent, I^A −= U K, p^A += I^a c + U D⁻¹ u. Fixed sizes: no allocation.
 template <int N>
 void block_step(const Joint& J, ArticulatedBody& A, const Vec6* columns, ArticulatedRate* rates,
                 const VecX& tau, bool has_parent) {
@@ -91,8 +91,9 @@ void block_step(const Joint& J, ArticulatedBody& A, const Vec6* columns, Articul
   U.noalias() = A.IA * S;
   MatN D;
   D.noalias() = S.transpose() * U;
-  Eigen::Matrix<double, N, 7> X;  // [Uᵀ u], solved in place for [K, D⁻¹ u]
+  Eigen::Matrix<double, N, 7 + N> X;  // [Uᵀ u I], solved in place for [K, D⁻¹ u, D⁻¹]
   X.template leftCols<6>() = U.transpose();
+  X.template rightCols<N>().setIdentity();
   for (int k = 0; k < N; ++k) {
     const int j = J.idx_v + k;
     X(k, 6) = (tau.size() > j ? tau[j] : 0.0) - columns[k].dot(A.pA);
@@ -114,6 +115,7 @@ void block_step(const Joint& J, ArticulatedBody& A, const Vec6* columns, Articul
   for (int k = 0; k < N; ++k) {
     rates[k].K = X.template block<1, 6>(k, 0).transpose();
     rates[k].Du = X(k, 6);
+    rates[k].Dinv.template head<N>() = X.template block<1, N>(k, 7).transpose();
   }
   if (!has_parent) return;
   A.IA.noalias() -= U * X.template leftCols<6>();  // I^a = I^A − U D⁻¹ Uᵀ
@@ -234,6 +236,46 @@ Status articulated_forward_dynamics(const Model& model, Workspace& ws, const Vec
     }
   }
   return {};
+}
+
+void articulated_solve(const Model& model, Workspace& ws, VecX& x) {
+  const int nb = static_cast<int>(model.bodies.size());
+  // Leaves to root: u = f − Sᵀ p, p_parent += p + U D⁻¹ u (the articulated forces of f alone).
+  for (int b = 0; b < nb; ++b) ws.solve_force[b].setZero();
+  for (int b = nb - 1; b >= 0; --b) {
+    const Body& body = model.bodies[b];
+    const Joint& J = body.joint;
+    const ArticulatedBody& A = ws.articulated[b];
+    Vec6& p = ws.solve_force[b];
+    if (J.nv == 1) {
+      x[J.idx_v] -= A.S.dot(p);  // u_b
+      p += A.U * (x[J.idx_v] / A.d);
+    } else {
+      for (int k = 0; k < J.nv; ++k) x[J.idx_v + k] -= ws.subspace[J.idx_v + k].dot(p);
+      for (int k = 0; k < J.nv; ++k) p += ws.articulated_rate[J.idx_v + k].K * x[J.idx_v + k];
+    }
+    if (body.parent >= 0) ws.solve_force[body.parent] += p;
+  }
+  // Root to leaves: ẍ = D⁻¹ u − D⁻¹ Uᵀ a, a += S ẍ (a_0 = 0: no gravity, no velocity).
+  for (int b = 0; b < nb; ++b) {
+    const Body& body = model.bodies[b];
+    const Joint& J = body.joint;
+    const ArticulatedBody& A = ws.articulated[b];
+    Vec6& a = ws.solve_acceleration[b];
+    a = body.parent >= 0 ? ws.solve_acceleration[body.parent] : Vec6::Zero();
+    if (J.nv == 1) {
+      x[J.idx_v] = (x[J.idx_v] - A.U.dot(a)) / A.d;
+      a += A.S * x[J.idx_v];
+    } else if (J.nv > 1) {
+      Vec6 u = Vec6::Zero();
+      u.head(J.nv) = x.segment(J.idx_v, J.nv);
+      for (int k = 0; k < J.nv; ++k) {
+        const ArticulatedRate& r = ws.articulated_rate[J.idx_v + k];
+        x[J.idx_v + k] = r.Dinv.dot(u) - r.K.dot(a);
+      }
+      for (int k = 0; k < J.nv; ++k) a += ws.subspace[J.idx_v + k] * x[J.idx_v + k];
+    }
+  }
 }
 
 }  // namespace femdyn

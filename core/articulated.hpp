@@ -47,4 +47,11 @@ namespace femdyn {
 Status articulated_forward_dynamics(const Model& model, Workspace& ws, const VecX& q,
                                     const VecX& qd, const VecX& tau);
 
+// x ← (M^s)⁻¹ x in O(bodies), M^s never formed: steps 2 and 3 of the recursion at zero velocity
+// and no gravity, with x as the joint forces, on the factorisation (U, d; K, D⁻¹ for a block)
+// that the last articulated_forward_dynamics left in ws at its q (Featherstone, "Rigid Body
+// Dynamics Algorithms" §7.3: the articulated-body algorithm as a factorisation of M⁻¹). Leaves
+// ws.qdd and the body states alone; no allocation.
+void articulated_solve(const Model& model, Workspace& ws, VecX& x);
+
 }  // namespace femdyn

@@ -23,6 +23,10 @@ Workspace::Workspace(const Model& model) : solver(model) {
   subspace.assign(model.n_theta(), Vec6::Zero());
   if (model.dynamics_route == DynamicsRoute::Articulated || model.force_route == ForceRoute::Bodies)
     articulated.assign(nb, ArticulatedBody{});
+  if (model.dynamics_route == DynamicsRoute::Articulated) {
+    solve_force.assign(nb, Vec6::Zero());
+    solve_acceleration.assign(nb, Vec6::Zero());
+  }
   if (model.dynamics_route == DynamicsRoute::Articulated &&
       std::any_of(model.bodies.begin(), model.bodies.end(),
                   [](const Body& b) { return b.joint.nv > 1; }))

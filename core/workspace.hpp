@@ -45,9 +45,10 @@ struct ArticulatedBody {
 // Per rate of a joint of several rates (nv > 1), the articulated route's block quantities
 // (core/articulated.hpp); the rate's column of S is in Workspace::subspace.
 struct ArticulatedRate {
-  Vec6 K = Vec6::Zero();  // its row of D⁻¹ Uᵀ (D = Sᵀ I^A S, U = I^A S)
-  double Du = 0;          // its entry of D⁻¹ u (u = τ − Sᵀ p^A)
-  double pivot = 0;       // its pivot of D = W Δ Wᵀ (the joint's last rate eliminated first)
+  Vec6 K = Vec6::Zero();     // its row of D⁻¹ Uᵀ (D = Sᵀ I^A S, U = I^A S)
+  Vec6 Dinv = Vec6::Zero();  // its row of D⁻¹ (the joint's nv entries), for articulated_solve
+  double Du = 0;             // its entry of D⁻¹ u (u = τ − Sᵀ p^A)
+  double pivot = 0;          // its pivot of D = W Δ Wᵀ (the joint's last rate eliminated first)
 };
 
 struct Workspace {
@@ -67,9 +68,10 @@ struct Workspace {
   std::vector<RigidInertia> composite;  // per body: composite inertia I^c_b (world, origin)
   std::vector<Vec6> subspace;  // per rate of θ̇: its column of S (world, origin), at the joint's
                                // idx_v (core/joints/kernel.hpp)
-  std::vector<ArticulatedBody> articulated;       // per body, for the body-level routes only
-  std::vector<ArticulatedRate> articulated_rate;  // per rate, on the articulated route with a
-                                                  // joint of several rates only
+  std::vector<ArticulatedBody> articulated;           // per body, for the body-level routes only
+  std::vector<ArticulatedRate> articulated_rate;      // per rate, on the articulated route with a
+                                                      // joint of several rates only
+  std::vector<Vec6> solve_force, solve_acceleration;  // per body, articulated_solve's p and a
   std::vector<Vec3> force, moment;  // per body: wrench of Tᵀ f (world; moment about the origin)
   VecX tau_theta;                   // Tᵀ f on the joint coordinates θ
   std::vector<VecX> local_x, local_y, local_g;  // per element local DOF buffers (6k)

@@ -37,14 +37,17 @@ const int kPaperTable[4][12] = {{0, 0, 0, 0, 0, 1, 2, 3, 0, 4, 0, 0},
                                 {5, 6, 7, 8, 0, 0, 9, 10, 11, 12, 0, 0},
                                 {9, 10, 11, 12, 0, 0, 13, 14, 15, 16, 0, 0}};
 
-// The four-bar's coupler as a rod from the input lever's tip (on the proximal phalanx, at the
-// PIP axis) to the output lever's tip (on the distal phalanx, at the DIP axis). The linkage's
-// plane is the flexion plane: a planar angle α from the middle phalanx's direction (+z) towards
-// −y is the point (0, −r sin α, r cos α); the proximal phalanx turns by −θ3 seen from the middle
-// one and the distal by +θ4, so the law needs input_sign −1 and output_sign +1, and its ground
-// is the middle phalanx. compile() then checks that the rod keeps its length.
-void append_coupler(const FingerParams& f, const std::string& prefix, const Vec3& pip,
-                    Json& bodies) {
+// The four-bar's two lever tips: the input lever's on the proximal phalanx, at the PIP axis
+// (`pip`, in the proximal frame), and the output lever's on the distal phalanx, at the DIP axis
+// (in the distal frame). The linkage's plane is the flexion plane: a planar angle α from the
+// middle phalanx's direction (+z) towards −y is the point (0, −r sin α, r cos α); the proximal
+// phalanx turns by −θ3 seen from the middle one and the distal by +θ4, so the law needs
+// input_sign −1 and output_sign +1, and its ground is the middle phalanx.
+struct Levers {
+  Vec3 proximal, distal;
+};
+
+Levers four_bar_levers(const FingerParams& f, const Vec3& pip) {
   const Json& g = f.law.at("four_bar");
   const auto number = [&](const char* key, double fallback) {
     return g.contains(key) && g[key].is_number() ? g[key].get<double>() : fallback;
@@ -52,8 +55,7 @@ void append_coupler(const FingerParams& f, const std::string& prefix, const Vec3
   const double a = number("input", 0), c = number("output", 0);
   const double phi0 = number("input_offset", 0), branch = number("branch", 1);
   double psi0 = number("output_offset", NAN);
-  if (std::isnan(
-          psi0))  // the default: θ4 = 0 at θ3 = 0 (0 where it cannot assemble: refused at load)
+  if (std::isnan(psi0))  // the default: θ4 = 0 at θ3 = 0 (0 where it cannot assemble: refused)
     psi0 = FourBarCoupling::output_angle_at_zero({.ground = number("ground", 0),
                                                   .input = a,
                                                   .coupler = number("coupler", 0),
@@ -64,15 +66,56 @@ void append_coupler(const FingerParams& f, const std::string& prefix, const Vec3
   const auto planar = [](double r, double alpha) {
     return Vec3(0, -r * std::sin(alpha), r * std::cos(alpha));
   };
-  for (Json& b : bodies) {
-    if (b["name"] == prefix + "proximal") b["nodes"]["lever"] = vec3_json(pip + planar(a, phi0));
-    if (b["name"] == prefix + "distal") b["nodes"]["lever"] = vec3_json(planar(c, psi0));
-  }
+  return {pip + planar(a, phi0), planar(c, psi0)};
+}
+
+Json* find_body(Json& bodies, const std::string& name) {
   for (Json& b : bodies)
-    if (b["name"] == prefix + "proximal")
-      b["elements"].push_back({{"type", "rod"},
-                               {"nodes", {"lever", prefix + "distal/lever"}},
-                               {"mass", f.coupler_mass}});
+    if (b["name"] == name) return &b;
+  return nullptr;
+}
+
+// Closed by the law: the coupler as a rod spanning the two lever tips (compile() checks that it
+// keeps its length).
+void append_coupler_rod(const FingerParams& f, const std::string& prefix, const Levers& levers,
+                        Json& bodies) {
+  Json& proximal = *find_body(bodies, prefix + "proximal");
+  find_body(bodies, prefix + "distal")->at("nodes")["lever"] = vec3_json(levers.distal);
+  proximal["nodes"]["lever"] = vec3_json(levers.proximal);
+  proximal["elements"].push_back(
+      {{"type", "rod"}, {"nodes", {"lever", prefix + "distal/lever"}}, {"mass", f.coupler_mass}});
+}
+
+// Closed by a constraint (docs/loops.md): the coupler a body of its own on a revolute joint
+// "<prefix>coupler" at the input lever's tip, its rod from there to its far end, which a ball in
+// the flexion plane (normal x, 2 equations) holds on the output lever's tip. The DIP joint stays a
+// coordinate. At q = 0 the loop is closed where the law's zero is (θ4 = 0 at θ3 = 0): the far end
+// is the output lever's tip there, on the distal phalanx whose joint is at `dip` (in the proximal
+// frame at q = 0).
+void append_coupler_loop(const FingerParams& f, const std::string& prefix, const Levers& levers,
+                         const Vec3& dip, FingeredParts& parts) {
+  find_body(parts.bodies, prefix + "distal")->at("nodes")["lever"] = vec3_json(levers.distal);
+  const Vec3 span = dip + levers.distal - levers.proximal;
+  parts.bodies.push_back(
+      {{"name", prefix + "coupler"},
+       {"parent", prefix + "proximal"},
+       {"joint",
+        {{"name", prefix + "coupler"},
+         {"type", "revolute"},
+         {"axis", vec3_json(Vec3::UnitX())},
+         {"origin", {{"xyz", vec3_json(levers.proximal)}}}}},
+       {"nodes", {{"a", vec3_json(Vec3::Zero())}, {"b", vec3_json(span)}}},
+       {"elements",
+        Json::array({{{"type", "rod"}, {"nodes", {"a", "b"}}, {"mass", f.coupler_mass}}})}});
+  parts.frames.push_back(
+      {{"name", prefix + "coupler_end"}, {"body", prefix + "coupler"}, {"node", "b"}});
+  parts.frames.push_back(
+      {{"name", prefix + "distal_lever"}, {"body", prefix + "distal"}, {"node", "lever"}});
+  parts.constraints.push_back({{"name", prefix + "coupler_end"},
+                               {"type", "ball"},
+                               {"a", prefix + "coupler_end"},
+                               {"b", prefix + "distal_lever"},
+                               {"normal", vec3_json(Vec3::UnitX())}});
 }
 
 }  // namespace
@@ -99,7 +142,8 @@ FingerParams FingerParams::from(const Params& p) {
   }
   if (p.has("coupling") && !p.json().at("coupling").is_null()) {
     const Params c = p.child("coupling");
-    c.allow_only({"ratio", "offset", "four_bar", "polynomial", "spline", "coupler_mass"});
+    c.allow_only(
+        {"ratio", "offset", "four_bar", "polynomial", "spline", "coupler_mass", "closure"});
     f.coupled = true;
     f.ratio = c.number_or("ratio", 1.0);
     f.offset = c.number_or("offset", 0.0);
@@ -114,6 +158,16 @@ FingerParams FingerParams::from(const Params& p) {
       if (!f.law.contains("four_bar")) c.fail("coupler_mass", "belongs to a four_bar coupling");
       f.coupler_mass = c.positive("coupler_mass");
     }
+    if (c.has("closure")) {
+      const std::string closure = c.string("closure");
+      if (closure != "law" && closure != "constraint")
+        c.fail("closure", "expected \"law\" or \"constraint\"");
+      if (closure == "constraint" && !(f.law.contains("four_bar") && f.coupler_mass > 0))
+        c.fail("closure",
+               "a loop closed by a constraint needs a four_bar and its coupler_mass (the coupler "
+               "is a body of its own, which must have mass)");
+      f.closed_by_constraint = closure == "constraint";
+    }
   }
   f.tip_force = p.vec3_or("tip_force", Vec3::Zero());
   if (p.has("lumping")) {
@@ -125,7 +179,8 @@ FingerParams FingerParams::from(const Params& p) {
 }
 
 void append_finger(const FingerParams& f, const std::string& prefix, const std::string& parent,
-                   const Vec3& xyz, const Vec3& rpy, Json& bodies, Json& couplings, Json& loads) {
+                   const Vec3& xyz, const Vec3& rpy, FingeredParts& parts) {
+  Json& bodies = parts.bodies;
   static const char* body[] = {"base", "proximal", "middle", "distal"};
   static const char* joint[] = {"abduction", "mcp", "pip", "dip"};
   // Unit k runs from its joint to the next: the base radially along −y, knuckles along +z.
@@ -167,22 +222,24 @@ void append_finger(const FingerParams& f, const std::string& prefix, const std::
               {"elements", Json::array({bar})}};
     bodies.push_back(b);
   }
-  if (f.coupled && !f.law.is_null()) {
+  if (f.closed_by_constraint) {
+    append_coupler_loop(f, prefix, four_bar_levers(f, along[1]), along[1] + along[2], parts);
+  } else if (f.coupled && !f.law.is_null()) {
     Json c = f.law;  // the law's key and value, checked when the model is loaded
     c["joint"] = prefix + "dip";
     c["follows"] = prefix + "pip";
-    couplings.push_back(c);
-    if (f.coupler_mass > 0) append_coupler(f, prefix, along[1], bodies);
+    parts.couplings.push_back(c);
+    if (f.coupler_mass > 0) append_coupler_rod(f, prefix, four_bar_levers(f, along[1]), bodies);
   } else if (f.coupled) {
-    couplings.push_back({{"joint", prefix + "dip"},
-                         {"follows", prefix + "pip"},
-                         {"ratio", f.ratio},
-                         {"offset", f.offset}});
+    parts.couplings.push_back({{"joint", prefix + "dip"},
+                               {"follows", prefix + "pip"},
+                               {"ratio", f.ratio},
+                               {"offset", f.offset}});
   }
   if (!f.tip_force.isZero(0))
-    loads.push_back({{"body", prefix + "distal"},
-                     {"point", vec3_json(along[3])},
-                     {"force", vec3_json(f.tip_force)}});
+    parts.loads.push_back({{"body", prefix + "distal"},
+                           {"point", vec3_json(along[3])},
+                           {"force", vec3_json(f.tip_force)}});
 }
 
 namespace {
@@ -204,23 +261,23 @@ Json tip_frames(const Json& bodies) {
 
 }  // namespace
 
-Json fingered_model(const std::string& name, const Json& bodies, const Json& couplings,
-                    const Json& loads) {
-  Json model = {{"name", name}, {"bodies", bodies}};
-  if (!couplings.empty()) model["couplings"] = couplings;
-  if (!loads.empty()) model["loads"] = loads;
-  if (Json tips = tip_frames(bodies); !tips.empty()) model["frames"] = tips;
+Json fingered_model(const std::string& name, const FingeredParts& parts) {
+  Json model = {{"name", name}, {"bodies", parts.bodies}};
+  if (!parts.couplings.empty()) model["couplings"] = parts.couplings;
+  if (!parts.loads.empty()) model["loads"] = parts.loads;
+  Json frames = tip_frames(parts.bodies);
+  for (const Json& frame : parts.frames) frames.push_back(frame);
+  if (!frames.empty()) model["frames"] = frames;
+  if (!parts.constraints.empty()) model["constraints"] = parts.constraints;
   return model;
 }
 
 Json dexterous_finger(const Params& params) {
   const FingerParams f = FingerParams::from(params);
-  Json bodies = Json::array(), couplings = Json::array(), loads = Json::array();
-  append_finger(f, "", "world", Vec3::Zero(), Vec3(0, 0, std::numbers::pi / 2), bodies, couplings,
-                loads);
+  FingeredParts parts;
+  append_finger(f, "", "world", Vec3::Zero(), Vec3(0, 0, std::numbers::pi / 2), parts);
   Json model = fingered_model(
-      f.paper_lumping ? "dexterous finger (paper's discretisation)" : "dexterous finger", bodies,
-      couplings, loads);
+      f.paper_lumping ? "dexterous finger (paper's discretisation)" : "dexterous finger", parts);
   if (f.paper_lumping) {
     if (f.coupled) params.fail("coupling", "the paper's discretisation has 4 independent joints");
     Json rows = Json::array();

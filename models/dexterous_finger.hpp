@@ -24,22 +24,30 @@ struct FingerParams {
   bool coupled = false;                       // θ4 = ratio·θ3 + offset, or
   double ratio = 1.0, offset = 0.0;
   Json law;  // {"four_bar" | "polynomial" | "spline": …}: θ4 = law(θ3) (docs/model-format.md)
-  double coupler_mass = 0;        // with a four_bar: its coupler as a rod between the two levers
-  Vec3 tip_force = Vec3::Zero();  // constant external force at the fingertip (world, N)
-  bool paper_lumping = false;     // the paper's own discretisation (table N_m, lumping)
+  double coupler_mass = 0;  // with a four_bar: its coupler as a rod between the two levers
+  bool closed_by_constraint = false;  // with a four_bar: "closure": "constraint" (docs/loops.md)
+  Vec3 tip_force = Vec3::Zero();      // constant external force at the fingertip (world, N)
+  bool paper_lumping = false;         // the paper's own discretisation (table N_m, lumping)
 
   static FingerParams from(const Params& p);
 };
 
-// Appends the finger's bodies (names prefixed) to `bodies`, its base joint at `xyz`/`rpy` in
-// `parent`; appends its coupling and tip load to `couplings` / `loads`.
-void append_finger(const FingerParams& f, const std::string& prefix, const std::string& parent,
-                   const Vec3& xyz, const Vec3& rpy, Json& bodies, Json& couplings, Json& loads);
+// The parts of a model document that fingers add to: JSON arrays of the model format.
+struct FingeredParts {
+  Json bodies = Json::array(), couplings = Json::array(), loads = Json::array(),
+       frames = Json::array(), constraints = Json::array();
+};
 
-// The model document {"name", "bodies", "couplings", "loads", "frames"} of fingered parts: empty
-// lists left out, a frame "<prefix>tip" at each fingertip (node b of each "<prefix>distal").
-Json fingered_model(const std::string& name, const Json& bodies, const Json& couplings,
-                    const Json& loads);
+// Appends the finger's bodies (names prefixed), its base joint at `xyz`/`rpy` in `parent`, its
+// coupling (a law, or a coupler body with its loop constraint and the frames it joins) and tip
+// load.
+void append_finger(const FingerParams& f, const std::string& prefix, const std::string& parent,
+                   const Vec3& xyz, const Vec3& rpy, FingeredParts& parts);
+
+// The model document {"name", "bodies", "couplings", "loads", "frames", "constraints"} of
+// fingered parts: empty lists left out, a frame "<prefix>tip" at each fingertip (node b of each
+// "<prefix>distal") before the parts' own frames.
+Json fingered_model(const std::string& name, const FingeredParts& parts);
 
 Json dexterous_finger(const Params& params);
 

@@ -2,12 +2,11 @@
 
 #include <numbers>
 
-#include "models/dexterous_finger.hpp"
-
 namespace femdyn {
 
-void append_hand(const Params& p, const std::string& parent, const Json& mount, Json& bodies,
-                 Json& couplings, Json& loads) {
+void append_hand(const Params& p, const std::string& parent, const Json& mount,
+                 FingeredParts& parts) {
+  Json& bodies = parts.bodies;
   p.allow_only({"thumb", "wrist", "finger", "palm_mass"});
   const bool thumb = p.boolean_or("thumb", true);
   const bool wrist = p.boolean_or("wrist", true);
@@ -60,18 +59,16 @@ void append_hand(const Params& p, const std::string& parent, const Json& mount, 
   for (int i = 0; i < 4; ++i)
     // Finger frame: abduction axis along the palm's z (the fingers' pointing direction at
     // rest is +z). The plugin's base yaw of π/2 makes the flexion axis the palm's x.
-    append_finger(f, names[i], "palm", Vec3(x[i], 0, 0.10), Vec3(0, 0, half_pi + splay[i]), bodies,
-                  couplings, loads);
+    append_finger(f, names[i], "palm", Vec3(x[i], 0, 0.10), Vec3(0, 0, half_pi + splay[i]), parts);
   if (thumb)
     // Thumb on the side of the palm, its abduction axis tilted towards the palm normal.
-    append_finger(f, "thumb_", "palm", Vec3(0.045, 0.01, 0.03), Vec3(0, 0.9, half_pi - 0.6), bodies,
-                  couplings, loads);
+    append_finger(f, "thumb_", "palm", Vec3(0.045, 0.01, 0.03), Vec3(0, 0.9, half_pi - 0.6), parts);
 }
 
 Json dexterous_hand(const Params& p) {
-  Json bodies = Json::array(), couplings = Json::array(), loads = Json::array();
-  append_hand(p, "world", {{"xyz", {0, 0, 0}}}, bodies, couplings, loads);
-  return fingered_model("dexterous hand", bodies, couplings, loads);
+  FingeredParts parts;
+  append_hand(p, "world", {{"xyz", {0, 0, 0}}}, parts);
+  return fingered_model("dexterous hand", parts);
 }
 
 }  // namespace femdyn

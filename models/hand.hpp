@@ -2,15 +2,15 @@
 // (flexion, deviation) carrying four fingers and, optionally, an opposed thumb. Every finger is
 // the same `dexterous_finger` (params under "finger"), mounted at its own place on the palm.
 #pragma once
-#include "io/params.hpp"
+#include "models/dexterous_finger.hpp"
 
 namespace femdyn {
 
 Json dexterous_hand(const Params& params);
 
-// Appends the hand's bodies, couplings and loads, its first joint (the wrist's deviation, or the
-// palm's fixed mount) under `parent` at `mount` ({"xyz", "rpy"}, the joint's origin).
-void append_hand(const Params& params, const std::string& parent, const Json& mount, Json& bodies,
-                 Json& couplings, Json& loads);
+// Appends the hand's parts, its first joint (the wrist's deviation, or the palm's fixed mount)
+// under `parent` at `mount` ({"xyz", "rpy"}, the joint's origin).
+void append_hand(const Params& params, const std::string& parent, const Json& mount,
+                 FingeredParts& parts);
 
 }  // namespace femdyn

@@ -62,7 +62,8 @@ Json space_robot(const Params& p) {
   const Vec3 size = p.vec3_or("satellite_size", Vec3(1.2, 1.0, 1.0));
   if ((size.array() <= 0).any()) p.fail("satellite_size", "every side must be > 0");
 
-  Json bodies = Json::array(), couplings = Json::array(), loads = Json::array();
+  FingeredParts parts;
+  Json& bodies = parts.bodies;
   // The satellite: a uniform box on a free joint, its centre at the body origin.
   bodies.push_back({{"name", "satellite"},
                     {"parent", "world"},
@@ -96,10 +97,9 @@ Json space_robot(const Params& p) {
   Json hand = p.has("hand") ? p.json().at("hand") : Json::object();
   if (!hand.is_object()) p.fail("hand", "expected an object of dexterous_hand params");
   if (!hand.contains("wrist")) hand["wrist"] = false;
-  append_hand(Params(hand, p.path("hand")), parent, {{"xyz", {0, 0, 0.045}}}, bodies, couplings,
-              loads);
+  append_hand(Params(hand, p.path("hand")), parent, {{"xyz", {0, 0, 0.045}}}, parts);
 
-  return fingered_model("space robot", bodies, couplings, loads);
+  return fingered_model("space robot", parts);
 }
 
 }  // namespace femdyn

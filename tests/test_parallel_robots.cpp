@@ -287,3 +287,78 @@ TEST_CASE("four-bar finger: the loop closed by a constraint moves as the four_ba
   CHECK(worst_rate < 1e-8);
   CHECK(worst_tip < 1e-10);
 }
+
+TEST_CASE("four-bar hand: the plugin's closure by constraints moves as its four_bar laws",
+          "[loops][parallel][couplings]") {
+  // models/hand_fourbar_loop.json is models/hand_fourbar.json with "closure": "constraint": the
+  // same 17 coordinates, plus each finger's dip and coupler joints, closed by 5 planar balls.
+  const Model law = load_model(model_path("hand_fourbar.json"));
+  const Model loop = load_model(model_path("hand_fourbar_loop.json"));
+  REQUIRE(law.n() == 17);
+  REQUIRE(loop.n() == 27);
+  REQUIRE(loop.constraint_rows == 10);
+  std::vector<int> shared, dependent;  // the loop's rates that the law model has, and the rest
+  for (int i = 0; i < loop.n(); ++i) {
+    const auto& names = law.coordinate_names;
+    (std::find(names.begin(), names.end(), loop.coordinate_names[i]) != names.end() ? shared
+                                                                                    : dependent)
+        .push_back(i);
+  }
+  REQUIRE(shared.size() == 17);
+  Workspace ws_law(law), ws(loop);
+  LoopWorkspace lws(loop);
+  std::mt19937 rng(5);
+  for (int k = 0; k < 3; ++k) {
+    INFO("state " << k);
+    const VecX q_law = random_posture(law, rng), v_law = random_uniform(17, 1, rng),
+               tau_law = random_uniform(17, 1e-3, rng);
+    // The loop model at the same 17 coordinates, each dip and coupler assembled by continuation
+    // from the closed posture q = 0 (Newton from a far guess may not find the branch), their
+    // rates from Φ_q v = 0.
+    VecX q = VecX::Zero(27), v = VecX::Zero(27), tau = VecX::Zero(27);
+    for (int step = 1; step <= 10; ++step) {
+      for (int i = 0; i < 17; ++i) q[shared[i]] = q_law[i] * step / 10;
+      const AssemblyReport assembled = assemble(loop, ws, lws.k, q, {.held = shared});
+      INFO("step " << step << ": " << assembled.status.message);
+      REQUIRE(assembled.status.ok);
+    }
+    for (int i = 0; i < 17; ++i) v[shared[i]] = v_law[i], tau[shared[i]] = tau_law[i];
+    constraint_kinematics(loop, ws, q, v, lws.k);
+    MatX Jd(10, 10);
+    for (int c = 0; c < 10; ++c) Jd.col(c) = lws.k.J.col(dependent[c]);
+    const VecX vd = Jd.partialPivLu().solve(-lws.k.J * v);
+    for (int c = 0; c < 10; ++c) v[dependent[c]] = vd[c];
+    REQUIRE(forward_dynamics(law, ws_law, q_law, v_law, tau_law).ok);
+    const VecX qdd_law = ws_law.qdd;
+    REQUIRE(constrained_forward_dynamics(loop, ws, lws, q, v, tau, 0).ok);
+    VecX qdd_shared(17);
+    for (int i = 0; i < 17; ++i) qdd_shared[i] = ws.qdd[shared[i]];
+    CAPTURE(qdd_law.transpose(), qdd_shared.transpose());
+    CHECK(rel_error(qdd_shared, qdd_law) < 1e-9);
+    for (const char* tip : {"index_tip", "little_tip", "thumb_tip"})
+      CHECK((frame_at(law, ws_law, q_law, tip).p - frame_at(loop, ws, q, tip).p).norm() < 1e-12);
+  }
+}
+
+TEST_CASE("four-bar finger: the plugin's closure by a constraint is finger_fourbar_loop.json",
+          "[loops][parallel]") {
+  // The plugin's generated linkage against the hand-written model file: the same equations.
+  Json j;
+  std::ifstream(model_path("finger_fourbar.json")) >> j;
+  j["params"]["coupling"]["closure"] = "constraint";
+  const Model generated = load_text(j.dump());
+  const Model file = load_model(model_path("finger_fourbar_loop.json"));
+  REQUIRE(generated.coordinate_names == file.coordinate_names);
+  REQUIRE(generated.constraint_rows == file.constraint_rows);
+  Workspace wg(generated), wf(file);
+  LoopWorkspace lg(generated), lf(file);
+  VecX q = (VecX(5) << 0.1, 0.3, 0.5, 0.5 * 2 / 3, 0).finished(), v = VecX::Zero(5);
+  REQUIRE(assemble(file, wf, lf.k, q, {.held = {0, 1, 2}}).status.ok);
+  v << 0.5, -1.0, 1.0, 0, 0;
+  const VecX tau = (VecX(5) << 2e-4, -1e-4, 5e-5, 0, 0).finished();
+  REQUIRE(constrained_forward_dynamics(file, wf, lf, q, v, tau, 20).ok);
+  REQUIRE(constrained_forward_dynamics(generated, wg, lg, q, v, tau, 20).ok);
+  CHECK(rel_error(lg.k.phi, lf.k.phi, 1e-3) < 1e-12);
+  CHECK(rel_error(lg.k.J, lf.k.J) < 1e-12);
+  CHECK(rel_error(wg.qdd, wf.qdd) < 1e-10);
+}

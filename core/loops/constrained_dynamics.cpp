@@ -2,12 +2,57 @@
 
 #include <cstdio>
 
+#include "core/articulated.hpp"
 #include "core/equations.hpp"
+#include "core/kinematics.hpp"
 
 namespace femdyn {
 
+namespace {
+
+// q̈₀, Φ, Φ_q, Φ̇_q v, Y and S factorised, on the articulated route (C = I, the body-level form
+// exact): q̈₀ by the articulated recursion, Φ_q from the rates' spatial columns it leaves, and
+// Y = M⁻¹ Φ_qᵀ by its factorisation, one O(bodies) solve a column: O(n m) in all, no n × n
+// matrix, where the Cholesky route costs O(Σ depth²) (a chain: O(n³)).
+Status articulated_constraint_space(const Model& model, Workspace& ws, LoopWorkspace& lws,
+                                    const VecX& q, const VecX& v, const VecX& tau) {
+  // The model's forward dynamics is the articulated recursion here (two-point springs added).
+  if (Status st = forward_dynamics(model, ws, q, v, tau); !st.ok) return st;
+  lws.qdd0 = ws.qdd;
+  propagate(model, ws, q, v, {.jacobian = false, .bias = true, .rows = false});
+  constraint_kinematics_by_paths(model, ws, lws.k);
+  for (int i = 0; i < model.constraint_rows; ++i) {
+    lws.column = lws.k.J.row(i).transpose();
+    articulated_solve(model, ws, lws.column);
+    lws.Y.col(i) = lws.column;
+  }
+  lws.S.noalias() = lws.k.J * lws.Y;
+  pivoted_cholesky(lws);
+  return {};
+}
+
+// The same on every other route: M^s formed and factorised (core/mass_solver.hpp), q̈₀ from one
+// inverse dynamics (Q − h = τ − τ_ID(q, v, 0)).
+Status cholesky_constraint_space(const Model& model, Workspace& ws, LoopWorkspace& lws,
+                                 const VecX& q, const VecX& v, const VecX& tau) {
+  inverse_dynamics(model, ws, q, v, lws.zero);  // τ_ID = h − Q(τ = 0)
+  lws.tau_id = ws.tau;
+  mass_matrix(model, ws, q);
+  if (Status st = ws.solver.factorize(ws.Ms); !st.ok) return st;
+  lws.qdd0 = tau - lws.tau_id;
+  ws.solver.solve_in_place(lws.qdd0);
+  constraint_kinematics(model, ws, q, v, lws.k);
+  factorize_constraint_space(model, ws, lws);
+  return {};
+}
+
+}  // namespace
+
 LoopWorkspace::LoopWorkspace(const Model& model)
-    : k(model),
+    : constraint_space(model.dynamics_route == DynamicsRoute::Articulated
+                           ? articulated_constraint_space
+                           : cholesky_constraint_space),
+      k(model),
       zero(VecX::Zero(model.n())),
       tau_id(model.n()),
       qdd0(model.n()),
@@ -98,14 +143,7 @@ Status solve_constraint_space(const Model& model, LoopWorkspace& lws, double all
 
 Status constrained_forward_dynamics(const Model& model, Workspace& ws, LoopWorkspace& lws,
                                     const VecX& q, const VecX& v, const VecX& tau, double omega) {
-  inverse_dynamics(model, ws, q, v, lws.zero);  // τ_ID = h − Q(τ = 0)
-  lws.tau_id = ws.tau;
-  mass_matrix(model, ws, q);
-  if (Status st = ws.solver.factorize(ws.Ms); !st.ok) return st;
-  lws.qdd0 = tau - lws.tau_id;
-  ws.solver.solve_in_place(lws.qdd0);
-  constraint_kinematics(model, ws, q, v, lws.k);
-  factorize_constraint_space(model, ws, lws);
+  if (Status st = lws.constraint_space(model, ws, lws, q, v, tau); !st.ok) return st;
   // r = −(Φ̇_q v + Φ_q q̈₀) − (2ω Φ_q v + ω² Φ), the second part Baumgarte's
   lws.stabilization.noalias() = 2 * omega * lws.k.J * v;
   lws.stabilization += omega * omega * lws.k.phi;

@@ -10,6 +10,11 @@
 //   Y  = M⁻¹ Φ_qᵀ,   S = Φ_q Y  (m solves, m × m)
 //   S λ = −(Φ̇_q v + Φ_q q̈₀ + 2ω Φ_q v + ω² Φ),    q̈ = q̈₀ + Y λ.
 //
+// On the articulated route (C = I, the body-level form exact) M^s is never formed: q̈₀ comes from
+// the articulated recursion, Φ_q from the rates' spatial columns it leaves, and each column of Y
+// from its factorisation (articulated_solve, O(bodies)), so a model with few loops costs O(n m)
+// plus the m × m system; on the other routes M^s is formed and factorised (the tree's LTDL).
+//
 // S is factorised by Cholesky with diagonal pivoting on the Schur complement (rank revealing on
 // a semidefinite S): it stops at pivots below ε_rank of the largest diagonal, so that redundant
 // constraints (a planar loop closed by 3-D balls, Bricard's mechanism) leave λ's redundant part
@@ -24,8 +29,16 @@
 
 namespace femdyn {
 
+struct LoopWorkspace;
+
+// q̈₀ = M⁻¹ (Q − h), Φ, Φ_q, Φ̇_q v, Y and S factorised at (q, v, τ): the model's route for the
+// solver's first half (constrained_dynamics.cpp), chosen once from Model::dynamics_route.
+using ConstraintSpaceRoute = Status (*)(const Model&, Workspace&, LoopWorkspace&, const VecX& q,
+                                        const VecX& v, const VecX& tau);
+
 struct LoopWorkspace {
   explicit LoopWorkspace(const Model& model);
+  ConstraintSpaceRoute constraint_space;
   ConstraintKinematics k;
   VecX zero, tau_id, qdd0, column;
   MatX Y;  // M⁻¹ Φ_qᵀ (n × m)

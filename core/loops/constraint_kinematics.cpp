@@ -73,12 +73,34 @@ ConstraintKinematics::ConstraintKinematics(const Model& model)
       J(MatX::Zero(model.constraint_rows, model.n())),
       bias(VecX::Zero(model.constraint_rows)) {}
 
-void constraint_kinematics(const Model& model, const Workspace& ws, ConstraintKinematics& k) {
+namespace {
+
+// Jω and Jv of the attachment's point p (world) on `body`, by the body's path to the root: each
+// rate j on it turns about or slides along its spatial column S_j = (ω_j, v_j) (world axes,
+// about the origin), so Jω_:j = ω_j and Jv_:j = v_j + ω_j × p. O(depth) after an O(n) clear.
+void path_jacobian(const Model& model, const Workspace& ws, int body, const Vec3& p,
+                   AttachmentMotion& out) {
+  out.Jw.setZero(3, model.n());
+  out.Jv.setZero(3, model.n());
+  for (int b = body; b >= 0; b = model.bodies[b].parent) {
+    const Joint& J = model.bodies[b].joint;
+    for (int k = 0; k < J.nv; ++k) {
+      const Vec6& S = J.nv == 1 ? ws.articulated[b].S : ws.subspace[J.idx_v + k];
+      out.Jw.col(J.idx_v + k) = S.head<3>();
+      out.Jv.col(J.idx_v + k) = S.tail<3>() + S.head<3>().cross(p);
+    }
+  }
+}
+
+// Each constraint's two attachments into k.A, k.B (none for a gear), then its rows.
+template <class Attach>
+void constraint_rows(const Model& model, const Workspace& ws, ConstraintKinematics& k,
+                     Attach&& attach) {
   int row = 0;
   for (const LoopConstraint& c : model.constraints) {
     if (c.type != ConstraintType::Gear) {
-      attachment_motion(model, ws, c.a, k.A);
-      attachment_motion(model, ws, c.b, k.B);
+      attach(c.a, k.A);
+      attach(c.b, k.B);
     }
     switch (c.type) {
       case ConstraintType::Ball:
@@ -104,6 +126,25 @@ void constraint_kinematics(const Model& model, const Workspace& ws, ConstraintKi
     }
     row += c.rows();
   }
+}
+
+}  // namespace
+
+void constraint_kinematics(const Model& model, const Workspace& ws, ConstraintKinematics& k) {
+  constraint_rows(model, ws, k, [&](const Attachment& a, AttachmentMotion& out) {
+    attachment_motion(model, ws, a, out);
+  });
+}
+
+void constraint_kinematics_by_paths(const Model& model, const Workspace& ws,
+                                    ConstraintKinematics& k) {
+  constraint_rows(model, ws, k, [&](const Attachment& a, AttachmentMotion& out) {
+    attachment_motion(model, ws, a, out, false);
+    if (a.body >= 0)
+      path_jacobian(model, ws, a.body, out.p, out);
+    else
+      out.Jw.setZero(3, model.n()), out.Jv.setZero(3, model.n());
+  });
 }
 
 void constraint_kinematics(const Model& model, Workspace& ws, const VecX& q, const VecX& v,

@@ -24,7 +24,13 @@ struct ConstraintKinematics {
 // Φ, Φ_q and Φ̇_q v from the body states and Jacobians of the last
 // propagate(model, ws, q, v, {.jacobian = true, .bias = true, .rows = false}).
 void constraint_kinematics(const Model& model, const Workspace& ws, ConstraintKinematics& out);
-// The same at (q, v), after its own propagate.
+// The same with each attachment's Jacobian formed from the path of its body to the root over
+// the rates' spatial columns that articulated_forward_dynamics left in ws (C = I;
+// core/articulated.hpp), and its motion from the body states of the last propagate with the
+// bias: O(n + depth) per attachment, no body Jacobians (which cost O(Σ depth) to form).
+void constraint_kinematics_by_paths(const Model& model, const Workspace& ws,
+                                    ConstraintKinematics& out);
+// The same as the first at (q, v), after its own propagate.
 void constraint_kinematics(const Model& model, Workspace& ws, const VecX& q, const VecX& v,
                            ConstraintKinematics& out);
 
