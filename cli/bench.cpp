@@ -142,8 +142,8 @@ void check_agreement(const std::string& path, const Model& m, Workspace& ws, fv:
 
 // The constrained states (a model with loop constraints): up to K, each assembled onto the loops
 // (validation's assembled_state: q a step from the neutral posture, q̇ in ±2 projected onto
-// Φ_q q̇ = 0), τ in ±1, and one where femdyn's constrained dynamics holds (not a dead point).
-// `why`: the last reason a candidate was dropped.
+// Φ_q q̇ = 0), τ in ±1, each a state where femdyn's constrained dynamics holds (not a dead
+// point); up to 4K candidates are tried. `why`: the last reason a candidate was dropped.
 struct LoopStates {
   std::vector<VecX> q, qd, tau;
   std::string why;
