@@ -1,7 +1,8 @@
 // femdyn bench MODEL: femdyn's equations of motion timed against the model's Simbody twin
 // (validation/twin.hpp, the twin femdyn validate checks against) in the same run: the median
-// ns per call of M^s, h, the forces at rest, the whole equations, q̈, τ and D, femdyn and
-// Simbody batch by batch in turn (docs/benchmarks.md). A URDF robot is also timed on MuJoCo's
+// ns per call of M^s, h, the forces at rest, the whole equations, q̈, τ and D, and on a model
+// with loop constraints the constrained q̈ (docs/loops.md), femdyn and Simbody batch by batch in
+// turn (docs/benchmarks.md). A URDF robot is also timed on MuJoCo's
 // own import of the file (M, q̈, τ) when femdyn is built with MuJoCo (validation/mujoco_peer.hpp).
 #include <algorithm>
 #include <chrono>
@@ -19,6 +20,7 @@
 
 #include "cli/commands.hpp"
 #include "core/equations.hpp"
+#include "core/loops/constrained_dynamics.hpp"
 #include "core/math.hpp"
 #include "core/sampling.hpp"
 #include "io/output.hpp"
@@ -28,6 +30,7 @@
 #endif
 #include "validation/twin.hpp"
 #include "validation/validate.hpp"
+#include "validation/validate_loops.hpp"
 
 #ifndef FEMDYN_BUILD_TYPE
 #define FEMDYN_BUILD_TYPE "unknown"
@@ -57,6 +60,12 @@ engines and the ratio Simbody / femdyn (above 1: femdyn is faster):
   qdd  femdyn forward_dynamics(), by the model's route (core/equations.hpp); Simbody: realize
        Dynamics, calcAccelerationIgnoringConstraints (calcAcceleration on a coupled model)
   tau  femdyn inverse_dynamics(); Simbody: the residual with the applied forces and q̈
+  qdd_c  (a model with loop constraints) the constrained q̈: femdyn
+       constrained_forward_dynamics() with Baumgarte off (ω = 0; Simbody has none); Simbody:
+       the loop constraints enabled, τ as mobility forces, realize Acceleration (its
+       constraint solve). At N states of their own, assembled onto the loops (q near the
+       neutral posture, q̇ projected onto Φ_q q̇ = 0), τ in ±1; the other rows keep the
+       tree's states
   D    femdyn third_order_tensor(); Simbody forms no such tensor: n + n(n+1)/2 bias
        evaluations combined by polarization, D_sym(b,c) = (h(e_b+e_c) − h(e_b) − h(e_c))/2,
        the part symmetric in (b, c) (Christoffel symbols). Skipped, for both engines, when
@@ -65,7 +74,9 @@ Method: N seeded random states (default 16: q within the joint limits, q̇ in ±
 q̈ in ±5), cycled; per engine and quantity a warm-up, then 15 batches of about 20 ms
 (--quick: 3 batches of about 2 ms), femdyn and Simbody batches alternating; a batch gives ns
 per call, the report is the median, min and max over the batches. Both engines are first
-checked to agree on M^s, h and q̈ at the first state (relative 1e-8; a warning if not).
+checked to agree on M^s, h and q̈ at the first state, and on the constrained q̈ at the first
+assembled state (relative 1e-8; a warning if not; qdd_c is left out, with a warning, where no
+state assembles or Simbody cannot pose the loops).
 A Debug build refuses to time anything.
 MuJoCo: a URDF robot (with --floating-base too) is also timed on MuJoCo's own import of the
 file, when femdyn was built with MuJoCo: M (mj_crb, mj_fullM), qdd (mj_forward with the
@@ -75,7 +86,7 @@ against femdyn at the first state like Simbody; a file MuJoCo cannot map (a <mim
 a warning, and MuJoCo is left out.
 --json: {"model", "n", "coordinates", "build", "results": [{"engine": "femdyn" | "simbody" |
 "mujoco", "quantity", "median_ns", "min_ns", "max_ns"}]} (n the number of coordinates,
-"coordinates" their names).
+"coordinates" their names; quantity "M", "h", "g", "Q", "qdd", "qdd_c", "tau" or "D").
 )";
 
 constexpr int kTensorMaxN = 40;  // D above this many coordinates takes too long to time
@@ -126,6 +137,53 @@ void check_agreement(const std::string& path, const Model& m, Workspace& ws, fv:
             << ": femdyn and Simbody differ at the first state (relative M^s " << format_short(dM)
             << ", h " << format_short(dh) << ", q̈ "
             << (st.ok ? format_short(dqdd) : "not computed: " + st.message)
+            << "); the timings compare different computations\n";
+}
+
+// The constrained states (a model with loop constraints): up to K, each assembled onto the loops
+// (validation's assembled_state: q a step from the neutral posture, q̇ in ±2 projected onto
+// Φ_q q̇ = 0), τ in ±1, each a state where femdyn's constrained dynamics holds (not a dead
+// point); up to 4K candidates are tried. `why`: the last reason a candidate was dropped.
+struct LoopStates {
+  std::vector<VecX> q, qd, tau;
+  std::string why;
+  int size() const { return static_cast<int>(q.size()); }
+};
+
+LoopStates assembled_states(const Model& m, int K) {
+  LoopStates s;
+  std::mt19937 rng(1);
+  Workspace ws(m);
+  LoopWorkspace lws(m);
+  for (int attempt = 0; attempt < 4 * K && s.size() < K; ++attempt) {
+    VecX q, qd;
+    if (!fv::assembled_state(m, rng, 2, q, qd, s.why)) continue;
+    VecX tau = random_uniform(m.n(), 1, rng);
+    const Status st = constrained_forward_dynamics(m, ws, lws, q, qd, tau, 0);
+    if (!st.ok) {
+      s.why = st.message;
+      continue;
+    }
+    s.q.push_back(std::move(q));
+    s.qd.push_back(std::move(qd));
+    s.tau.push_back(std::move(tau));
+  }
+  return s;
+}
+
+// Once, before timing: both engines compute the same constrained q̈ at the first assembled
+// state. Throws where Simbody cannot pose the loops.
+void check_loop_agreement(const std::string& path, const Model& m, fv::SimbodyTwin& twin,
+                          const LoopStates& s) {
+  const fv::TwinLoopDynamics e = twin.loop_dynamics(s.q[0], s.qd[0], s.tau[0]);
+  Workspace ws(m);
+  LoopWorkspace lws(m);
+  const Status st = constrained_forward_dynamics(m, ws, lws, s.q[0], s.qd[0], s.tau[0], 0);
+  const double d = st.ok ? relative_error(ws.qdd, e.qdd, 1e-6) : INFINITY;
+  if (d < 1e-8) return;
+  std::cerr << "femdyn bench: warning: " << escaped(path)
+            << ": femdyn and Simbody differ at the first assembled state (relative constrained q̈ "
+            << (st.ok ? format_short(d) : "not computed: " + st.message)
             << "); the timings compare different computations\n";
 }
 
@@ -220,6 +278,31 @@ Row time_both(const std::string& quantity, F&& femdyn_call, S&& simbody_call, in
   Row row{quantity, summarize(f), summarize(s), std::nullopt};
   if (mujoco_call) row.mujoco = summarize(mj);
   return row;
+}
+
+// qdd_c: femdyn's constrained_forward_dynamics (ω = 0) against Simbody's constrained forward
+// dynamics (SimbodyTwin::time_constrained) at the assembled states; nothing, with a warning,
+// where no state assembles or Simbody cannot pose the loops.
+std::optional<Row> time_constrained_row(const std::string& path, const Model& m,
+                                        fv::SimbodyTwin& twin, int K, const Method& method) {
+  const LoopStates s = assembled_states(m, K);
+  try {
+    if (s.size() == 0) throw Error("no state could be assembled onto the loops: " + s.why);
+    check_loop_agreement(path, m, twin, s);
+    Workspace ws(m);
+    LoopWorkspace lws(m);
+    return time_both(
+        "qdd_c",
+        [&](int k) {
+          const bool ok = constrained_forward_dynamics(m, ws, lws, s.q[k], s.qd[k], s.tau[k], 0).ok;
+          keep(&ok);
+          keep(ws.qdd.data());
+        },
+        [&](int k) { twin.time_constrained(s.q[k], s.qd[k], s.tau[k]); }, s.size(), method);
+  } catch (const std::exception& e) {
+    std::cerr << "femdyn bench: warning: qdd_c not timed: " << safe_message(e.what()) << "\n";
+    return std::nullopt;
+  }
 }
 
 // Why D is not timed, or empty.
@@ -381,6 +464,10 @@ int cmd_bench(int argc, char** argv) {
         keep(ws.qdd.data());
       },
       [&](int k) { twin->time_forward(s.q[k], s.qd[k], s.tau[k]); }, K, method, mj_forward));
+  // Constrained q̈ (a model with loop constraints), at states assembled onto the loops.
+  if (!m.constraints.empty())
+    if (std::optional<Row> row = time_constrained_row(path, m, *twin, K, method))
+      rows.push_back(std::move(*row));
   // τ: inverse dynamics.
   rows.push_back(time_both(
       "tau",

@@ -359,6 +359,39 @@ TEST_CASE("bench: every quantity timed on both engines, D skipped as documented,
         "femdyn bench: /nonexistent.json: cannot open file: No such file or directory\n");
 }
 
+#ifdef NDEBUG  // (bench refuses to time a build with asserts)
+TEST_CASE("bench: a model with loop constraints gains the constrained q̈ (qdd_c) on both engines",
+          "[cli][bench][loops]") {
+  const std::string delta = model_path("delta.json");
+  const Run js = run_shell("{ " + std::string(FEMDYN_BINARY) + " bench " + delta +
+                           " --quick --states 2 --json 2>/dev/null; }");
+  REQUIRE(js.code == 0);
+  const auto j = nlohmann::json::parse(js.out);
+  CHECK(j.at("n") == 9);
+  std::set<std::string> timed;
+  for (const auto& r : j.at("results")) {
+    const std::string what =
+        r.at("engine").get<std::string>() + " " + r.at("quantity").get<std::string>();
+    INFO(what);
+    const double median = r.at("median_ns"), lo = r.at("min_ns"), hi = r.at("max_ns");
+    CHECK(std::isfinite(hi));
+    CHECK(0 < lo);
+    CHECK(lo <= median);
+    CHECK(median <= hi);
+    CHECK(timed.insert(what).second);
+  }
+  for (const char* engine : {"femdyn", "simbody"})
+    for (const char* quantity : {"M", "h", "g", "Q", "qdd", "qdd_c", "tau"})
+      CHECK(timed.count(std::string(engine) + " " + quantity) == 1);
+  CHECK(timed.size() == 14);
+  // The table has the row, and no warning: the engines agree on the constrained q̈.
+  const Run table = run("bench " + delta + " --quick --states 2");
+  CHECK(table.code == 0);
+  CHECK_THAT(table.out, Catch::StartsWith(delta + " (9 coordinates) against Simbody"));
+  CHECK_THAT(table.out, Catch::Contains("\nqdd_c "));
+}
+#endif
+
 #if defined(FEMDYN_WITH_MUJOCO) && defined(NDEBUG)
 TEST_CASE("bench: a URDF robot is timed on MuJoCo too (M, qdd, tau), a mimic joint is left out",
           "[cli][bench][mujoco]") {

@@ -18,6 +18,8 @@
 //   mujoco/forward/M    mj_forward, constraints off (qacc = qacc_smooth)
 //   femdyn/forward/finger_fourbar, femdyn/constrained/finger_fourbar_loop: the finger's
 //   four-bar closed by its coupling law and by a loop constraint (register_fourbar_routes).
+//   femdyn/constrained/M   constrained_forward_dynamics(), ω = 0, on the closed-loop models
+//   simbody/constrained/M  time_constrained: loops enabled, realize Acceleration (add_loop_case)
 //   reference/{mass,bias,forward,inverse}/M: femdyn on the reference routes (Tᵀ M T, node-level
 //   sweeps, Cholesky) where n ≤ 128, for the crossovers.
 // and, for the growth of loading with n, on generated chains and binary trees of --load-sizes=
@@ -64,6 +66,7 @@
 #include "validation/scaling_models.hpp"
 #include "validation/twin.hpp"
 #include "validation/validate.hpp"
+#include "validation/validate_loops.hpp"
 
 namespace {
 
@@ -290,8 +293,13 @@ struct FourBarRoutes {
   VecX q_law, v_law, tau_law, q_loop, v_loop, tau_loop;
 };
 
-void register_fourbar_routes(const std::string& root) {
+FourBarRoutes& fourbar_routes() {
   static FourBarRoutes r;  // outlives the benchmarks
+  return r;
+}
+
+void register_fourbar_routes(const std::string& root) {
+  static FourBarRoutes& r = fourbar_routes();  // (static: the benchmarks' lambdas use it)
   r.law = load_model(root + "models/finger_fourbar.json");
   r.loop = load_model(root + "models/finger_fourbar_loop.json");
   r.ws_law = std::make_unique<Workspace>(r.law);
@@ -323,6 +331,101 @@ void register_fourbar_routes(const std::string& root) {
         constrained_forward_dynamics(r.loop, *r.ws_loop, *r.lws, r.q_loop, r.v_loop, r.tau_loop, 0)
             .ok);
   });
+}
+
+// A closed-loop model's constrained forward dynamics on both engines, at one state:
+//   femdyn/constrained/M   constrained_forward_dynamics(), Baumgarte off (ω = 0: Simbody has
+//                          none)
+//   simbody/constrained/M  SimbodyTwin::time_constrained: the loop constraints enabled, τ as
+//                          mobility forces, realize Acceleration (its constraint solve)
+// The state is assembled onto the loops (validation's assembled_state, seed 1: q a step from
+// the neutral posture, q̇ in ±2 projected onto Φ_q q̇ = 0; τ in ±1), or given; the engines are
+// checked once, outside the timing, to agree on the constrained q̈ (relative 1e-8).
+struct LoopCase {
+  std::string name;
+  Model model;
+  std::unique_ptr<Workspace> ws;
+  std::unique_ptr<LoopWorkspace> lws;
+  std::unique_ptr<fv::SimbodyTwin> twin;
+  VecX q, qd, tau;
+  bool femdyn = true;  // false: femdyn's side is registered elsewhere (register_fourbar_routes)
+};
+
+std::vector<std::unique_ptr<LoopCase>>& loop_cases() {
+  static std::vector<std::unique_ptr<LoopCase>> all;
+  return all;
+}
+
+struct LoopState {
+  VecX q, qd, tau;
+};
+
+LoopState assembled_loop_state(const Model& m, const std::string& name) {
+  std::mt19937 rng(1);
+  LoopState s;
+  std::string why;
+  if (!fv::assembled_state(m, rng, 2, s.q, s.qd, why))
+    throw std::runtime_error(name + ": no state assembled onto the loops: " + why);
+  s.tau = random_uniform(m.n(), 1, rng);
+  return s;
+}
+
+void check_loop_case(LoopCase& c) {
+  const Status st = constrained_forward_dynamics(c.model, *c.ws, *c.lws, c.q, c.qd, c.tau, 0);
+  const fv::TwinLoopDynamics s = c.twin->loop_dynamics(c.q, c.qd, c.tau);
+  const double e = st.ok ? relative_error(c.ws->qdd, s.qdd, 1e-6) : INFINITY;
+  if (!(e < 1e-8)) {
+    std::fprintf(stderr,
+                 "femdyn_bench: %s: femdyn and Simbody differ on the constrained q̈ "
+                 "(relative %.3g)\n",
+                 c.name.c_str(), e);
+    failures().insert(c.name + ": femdyn and Simbody differ (constrained)");
+  }
+}
+
+// `state` given: that state (assembled by the caller); else assembled_loop_state.
+void add_loop_case(const std::string& name, const std::string& path,
+                   const LoopState* state = nullptr, bool femdyn = true) {
+  auto c = std::make_unique<LoopCase>();
+  c->name = name;
+  c->model = load_model(path);
+  c->ws = std::make_unique<Workspace>(c->model);
+  c->lws = std::make_unique<LoopWorkspace>(c->model);
+  c->twin = std::make_unique<fv::SimbodyTwin>(fv::twin_model(c->model));
+  const LoopState s = state ? *state : assembled_loop_state(c->model, name);
+  c->q = s.q, c->qd = s.qd, c->tau = s.tau;
+  c->femdyn = femdyn;
+  check_loop_case(*c);
+  loop_cases().push_back(std::move(c));
+}
+
+void register_loop_case(LoopCase* c) {
+  const auto reg = [c](const std::string& lib, auto fn) {
+    const std::string full = lib + "/constrained/" + c->name;
+    benchmark::RegisterBenchmark(full.c_str(), [c, fn, full, lib](benchmark::State& st) {
+      timed(st, c->model.n(), full, lib == "femdyn", [&] { fn(*c); });
+    })->Unit(benchmark::kMicrosecond);
+  };
+  if (c->femdyn)
+    reg("femdyn", [](LoopCase& c) {
+      benchmark::DoNotOptimize(
+          constrained_forward_dynamics(c.model, *c.ws, *c.lws, c.q, c.qd, c.tau, 0).ok);
+    });
+  reg("simbody", [](LoopCase& c) { c.twin->time_constrained(c.q, c.qd, c.tau); });
+}
+
+// The closed-loop models. finger_fourbar_loop at register_fourbar_routes' state (that of its law
+// route), whose femdyn/constrained/finger_fourbar_loop is femdyn's side. hand_fourbar_loop
+// (the hand's fingers closed by constraints instead of their four-bar laws) where the file is
+// there, beside its law model hand_fourbar.
+void add_loop_cases(const std::string& root) {
+  for (const char* name : {"delta", "andrews", "five_bar"})
+    add_loop_case(name, root + "models/" + name + ".json");
+  const FourBarRoutes& r = fourbar_routes();
+  const LoopState fourbar{r.q_loop, r.v_loop, r.tau_loop};
+  add_loop_case("finger_fourbar_loop", root + "models/finger_fourbar_loop.json", &fourbar, false);
+  const std::string hand = root + "models/hand_fourbar_loop.json";
+  if (std::filesystem::exists(hand)) add_loop_case("hand_fourbar_loop", hand);
 }
 
 MechanismSpec random_spec(int seed, int bodies, double branching) {
@@ -381,11 +484,15 @@ int main(int argc, char** argv) {
     for (int n : sizes) add_case("chain" + std::to_string(n), random(3, n, 0));
     for (int n : sizes) add_case("tree" + std::to_string(n), random(3, n, 0.5));
     register_fourbar_routes(root);
+    add_loop_cases(root);
+    if (std::filesystem::exists(root + "models/hand_fourbar_loop.json"))
+      add_case("hand_fourbar", file(root + "models/hand_fourbar.json"));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "femdyn_bench: %s\n", e.what());
     return 1;
   }
   for (const auto& c : cases()) register_case(c.get());
+  for (const auto& c : loop_cases()) register_loop_case(c.get());
   for (const bool tree : {false, true})
     for (int n : load_sizes) register_load(tree, n);
   benchmark::Initialize(&argc, argv);

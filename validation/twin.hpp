@@ -338,8 +338,17 @@ class SimbodyTwin {
   //   tensor:        realize Position once, then n + n(n+1)/2 velocity-stage residuals with no
   //                  force and θ̈ = 0 at θ̇ = C e_b and θ̇ = C (e_b + e_c), b ≤ c, combined by
   //                  polarization into D_sym(·, b, c) = (h(e_b + e_c) − h(e_b) − h(e_c)) / 2,
-  //                  the part of D symmetric in (b, c) (Simbody forms no such tensor).
-  // (femdyn bench, cli/bench.cpp, times all seven.)
+  //                  the part of D symmetric in (b, c) (Simbody forms no such tensor);
+  //   constrained:   the loop constraints enabled (TwinModel::constraints), τ_k as discrete
+  //                  mobility forces on the joint q_k drives directly, realize Acceleration:
+  //                  Simbody's constrained forward dynamics (its constraint solve), the
+  //                  counterpart of femdyn's constrained_forward_dynamics at ω = 0. It works on
+  //                  a state of its own (a copy of the twin's made by the first call, the loops
+  //                  enabled there), so the other entry points keep the tree and neither side
+  //                  pays for Simbody's re-realization when constraints are switched; the state
+  //                  should satisfy the constraints (femdyn's assemble_state). Throws
+  //                  femdyn::Error where the twin cannot pose them (as loop_dynamics).
+  // (femdyn bench, cli/bench.cpp, times all eight; constrained on models with constraints.)
   void time_mass_and_bias(const VecX& q, const VecX& qd);
   void time_bias(const VecX& q, const VecX& qd);
   void time_forward(const VecX& q, const VecX& qd, const VecX& tau);
@@ -347,6 +356,7 @@ class SimbodyTwin {
   void time_mass(const VecX& q);
   void time_gravity(const VecX& q);
   void time_tensor(const VecX& q);
+  void time_constrained(const VecX& q, const VecX& qd, const VecX& tau);
 
  private:
   // The same without the guard that turns SimTK's exceptions into one line.

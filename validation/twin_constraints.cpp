@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <utility>
 
 #include "core/errors.hpp"
 #include "core/names.hpp"
@@ -112,17 +113,60 @@ void SimbodyTwin::Impl::enable_loops(bool on) {
 
 void SimbodyTwin::close_loops(bool closed) { impl_->simulate_closed = closed; }
 
-TwinLoopDynamics SimbodyTwin::loop_dynamics(const VecX& q, const VecX& qd, const VecX& tau) {
-  using namespace SimTK;
-  Impl& s = *impl_;
-  if (s.model.closed_loop())
+namespace {
+
+// The twin poses the loop constraints on a tree whose coordinates each drive a joint directly.
+void require_loops_posable(const TwinModel& model, bool couplers) {
+  if (model.closed_loop())
     throw femdyn::Error(
         "the Simbody twin closes loop constraints on a tree only, not with nonlinear "
         "couplings or rods");
-  if (!s.couplers)
+  if (!couplers)
     throw femdyn::Error(
         "the Simbody twin closes loop constraints only where each coordinate drives a "
         "joint directly");
+}
+
+// Exchanges two states for a scope (SimTK::State moves are pointer moves): the entry points
+// work on Impl::state, and this puts another state there and back, also on an exception.
+class SwappedState {
+ public:
+  SwappedState(SimTK::State& a, SimTK::State& b) : a_(a), b_(b) { std::swap(a_, b_); }
+  ~SwappedState() { std::swap(a_, b_); }
+  SwappedState(const SwappedState&) = delete;
+  SwappedState& operator=(const SwappedState&) = delete;
+
+ private:
+  SimTK::State& a_;
+  SimTK::State& b_;
+};
+
+}  // namespace
+
+void SimbodyTwin::Impl::prepare_loop_timing() {
+  require_loops_posable(model, couplers);
+  bench_loop_state = state;  // the tree's variables, loops disabled, no τ
+  for (const SimTK::Constraint& c : loop_constraints) c.enable(bench_loop_state);
+  bench_tau = SimTK::Vector(state.getNU(), 0.0);
+  bench_loops_ready = true;
+}
+
+void SimbodyTwin::time_constrained(const VecX& q, const VecX& qd, const VecX& tau) {
+  Impl& s = *impl_;
+  if (!s.bench_loops_ready) s.prepare_loop_timing();
+  const SwappedState loops(s.state, s.bench_loop_state);
+  // τ_k on the joint q_k drives directly, as time_forward (the rotation P of a ball's or free
+  // joint's triple left out: the same work, not the same numbers; loop_dynamics has them).
+  for (int k = 0; k < s.model.n(); ++k)
+    if (s.independent[k] >= 0) s.bench_tau[s.theta_u[s.independent[k]]] = tau[k];
+  s.tau_forces.setAllMobilityForces(s.state, s.bench_tau);
+  s.set_state(q, qd, SimTK::Stage::Acceleration, kTiming);
+}
+
+TwinLoopDynamics SimbodyTwin::loop_dynamics(const VecX& q, const VecX& qd, const VecX& tau) {
+  using namespace SimTK;
+  Impl& s = *impl_;
+  require_loops_posable(s.model, s.couplers);
   TwinLoopDynamics out;
   try {
     s.enable_loops(true);

@@ -94,6 +94,12 @@ struct SimbodyTwin::Impl {
   SimTK::Vector_<SimTK::SpatialVec> bench_A_GB;
   VecX bench_rest;                  // q̇ = 0
   SimTK::Matrix bench_h1, bench_D;  // h(e_b) by columns; D_sym(·, b, c) in column b n + c
+  // time_constrained: its own state with the loop constraints enabled (made by the first call,
+  // swapped with `state` for each call), and τ on Simbody's u layout.
+  SimTK::State bench_loop_state;
+  SimTK::Vector bench_tau;
+  bool bench_loops_ready = false;
+  void prepare_loop_timing();
 
   const VecX& rest();  // q̇ = 0, sized by the first call
 

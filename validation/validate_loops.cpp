@@ -79,10 +79,9 @@ double loop_size(const Model& m) {
   return L > 0 ? L : 1;
 }
 
-// Assembled (q, q̇) from a guess: the model's neutral posture moved by a random step of about
-// 0.3 rad in all (0.3/√n a coordinate: a long chain of loops stays in the assembly mode it was
-// described in, rather than folding some loops over, near their dead points), then, if that
-// does not assemble, a random posture.
+}  // namespace
+
+// (validate_loops.hpp)
 bool assembled_state(const Model& m, std::mt19937& rng, double qd_scale, VecX& q, VecX& qd,
                      std::string& why) {
   const double step = 0.3 / std::sqrt(static_cast<double>(std::max(m.n(), 1)));
@@ -96,8 +95,6 @@ bool assembled_state(const Model& m, std::mt19937& rng, double qd_scale, VecX& q
   }
   return false;
 }
-
-}  // namespace
 
 void add_constraints_and_springs(const Model& m, TwinModel& t) {
   for (const LoopConstraint& c : m.constraints) t.constraints.push_back(twin_constraint(m, c));

@@ -29,6 +29,15 @@ struct LoopRows {
 LoopRows compare_loops(const Model& m, SimbodyTwin& twin, const ValidationOptions& o,
                        double tolerance);
 
+// An assembled (q, q̇) from a guess drawn from `rng`: the model's neutral posture moved by a
+// random step of about 0.3 rad in all (0.3/√n a coordinate: a long chain of loops stays in the
+// assembly mode it was described in, rather than folding some loops over, near their dead
+// points), then, if that does not assemble, a random posture; q̇ in ±qd_scale, projected onto
+// Φ_q q̇ = 0 (assemble_state). False, with `why`, where neither assembles. (The constrained rows
+// here, and femdyn bench's and femdyn_bench's constrained timings.)
+bool assembled_state(const Model& m, std::mt19937& rng, double qd_scale, VecX& q, VecX& qd,
+                     std::string& why);
+
 // A consistent start for the constrained trajectory: (q0, q̇0) assembled, or the model's neutral
 // posture (its joints' "initial" values) with q̇0 assembled, whichever keeps Φ_q farther from a
 // dead point; false, with `why`, where neither assembles.
