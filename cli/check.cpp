@@ -140,18 +140,11 @@ bool diagnose_loops(const Model& m, int state, VecX& q, VecX& qd, Diagnosis& d) 
     if (d.unassembled_message.empty()) d.unassembled_message = s.assembly.status.message;
     return false;
   }
-  Workspace ws(m);
-  ConstraintKinematics k(m);
-  constraint_kinematics(m, ws, q, qd, k);
-  const Eigen::JacobiSVD<MatX> svd(k.J);
-  const VecX& sigma = svd.singularValues();
   const int rank = s.assembly.rank;
   d.rank = std::max(d.rank, rank);
   d.redundant = m.constraint_rows - d.rank;
-  if (rank > 0 && sigma[0] > 0) {
-    const double ratio = sigma[rank - 1] / sigma[0];
-    if (ratio < d.dead_ratio) d.dead_ratio = ratio, d.dead_state = state;
-  }
+  if (const double ratio = dead_point_ratio(m, q, rank); ratio < d.dead_ratio)
+    d.dead_ratio = ratio, d.dead_state = state;
   return true;
 }
 

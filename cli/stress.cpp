@@ -32,20 +32,53 @@ constexpr const char* kHelp =
 Runs the stability suite on generated cases (docs/stability.md): stiff joint springs
 (ω = 1e1…1e5 rad/s, damping ratio 0…100), mass ratios up to 1e6 and lengths 1e-4…10 m in one
 chain, joints and a gyroscopic rotor at 1e3 rad/s, slender bars with negative lumped rotary
-inertia, near-singular postures, a chain of 1000 links, zero gravity and 1000 g, and a
-zero-mass chain end. For each: cond(M^s) along the motion, symmetry and definiteness, the
-largest stable step of rk4 and euler (bisection of real runs), every integrator's error at a
-fixed step or tolerance, the energy balance, agreement with Simbody, and a verdict: stable,
-stable only with bdf (stiff and dissipative), stiff and undamped (bdf stays stable only by
-damping the fast mode numerically: remove, damp or resolve it, as femdyn check says),
-ill-conditioned, or refused with the reason.
+inertia, near-singular postures, a chain of 1000 links, zero gravity and 1000 g, a zero-mass
+chain end, and closed loops (a four-bar at its dead point and one passing near its change
+point, a parallelogram closed by a redundant 3-D ball, a four-bar with a stiff spring). For
+each: cond(M^s) along the motion, symmetry and definiteness, the largest stable step of rk4 and
+euler (bisection of real runs), every integrator's error at a fixed step or tolerance, the
+energy balance, agreement with Simbody, and a verdict: stable, stable only with bdf (stiff and
+dissipative), stiff and undamped (bdf stays stable only by damping the fast mode numerically:
+remove, damp or resolve it, as femdyn check says), ill-conditioned, dead point (the motion
+reaches a configuration where the constraint Jacobian loses rank and the constrained equations
+have no solution: the time and the constraint are named), or refused with the reason.
+A case with closed loops starts assembled onto them, moves by the constrained equations
+(Baumgarte's default rate, projection after the steps; the modes and theory steps are those of
+the constrained linearisation, as in femdyn check but without Baumgarte's pair, which the
+projection removes; also their smallest along the reference, "along") and reports its
+equations, Phi_q's rank (redundant ones), the largest residuals |Phi| of the reference and of
+rk4, and the nearest dead point (smallest sigma_min/sigma_max of Phi_q along the reference).
 Writes DIR/stress.md and DIR/stress.csv (default DIR ./stress; existing files need --force).
 --quick: a subset of each class, smaller sizes. --class NAME: one class (springs, ratios,
-speeds, slender bars, postures, size, gravity, singular). --json: the results on stdout.
+speeds, slender bars, postures, size, gravity, singular, loops). --json: the results on stdout.
 )";
 
 // A table cell: three digits, or a dash for "not measured" (−1).
 std::string g(double x) { return x < 0 ? "—" : format_short(x); }
+
+// The loops cell: "3 eq., rank 2 (1 redundant); max |Φ| 1e-15 (rk4 2e-16); σ ratio ≥ 0.1" (σ_min
+// / σ_max of Φ_q along the reference), or a dash without constraints.
+std::string loops_cell(const validation::StressResult& r) {
+  if (r.equations == 0) return "—";
+  std::string s = std::to_string(r.equations) + " eq., rank " + std::to_string(r.rank);
+  if (!r.refused.empty()) return s + " at the start";  // (at a dead point: not redundancy)
+  s += " (" + std::to_string(r.redundant) + " redundant)";
+  if (r.max_position_residual < 0) return s;
+  const double rk4 = r.integrators.empty() ? -1 : r.integrators[0].max_position_residual;
+  return s + "; max \\|Φ\\| " + g(r.max_position_residual) + " (rk4 " + g(rk4) + "); σ ratio ≥ " +
+         g(r.dead_point_ratio);
+}
+
+Json loops_json(const validation::StressResult& r) {
+  const auto number = [](double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); };
+  return {{"equations", r.equations},
+          {"rank", r.rank},
+          {"redundant", r.redundant},
+          {"max_position_residual", r.max_position_residual},
+          {"max_velocity_residual", r.max_velocity_residual},
+          {"dead_point_ratio", number(r.dead_point_ratio)},
+          {"stiffest_along", r.stiffest_along}};
+}
 
 }  // namespace
 
@@ -80,12 +113,13 @@ int cmd_stress(int argc, char** argv) {
   md << "| class | case | n | cond(M^s) along the motion | SPD | stiffest mode (rad/s) | "
         "largest stable step rk4 / euler (s), measured (linear theory) | relative error: rk4 / "
         "euler at the fixed step, "
-        "dopri / bdf at rtol 1e-6 | energy balance | Simbody (relative) | verdict "
-        "|\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "dopri / bdf at rtol 1e-6 | energy balance | Simbody (relative) | loops: equations, rank; "
+        "largest residual, nearest dead point | verdict "
+        "|\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   csv << "class,case,n,cond_min,cond_max,positive_definite,stiffest,rk4_stable_step,"
          "euler_stable_step,rk4_theory_step,euler_theory_step,dt,rk4_error,euler_error,dopri_error,"
          "bdf_error,energy_error,"
-         "simbody_error,verdict\n";
+         "simbody_error,equations,rank,redundant,max_position_residual,dead_point_ratio,verdict\n";
   for (const StressCase& c : cases) {
     const auto begin = std::chrono::steady_clock::now();
     validation::StressResult r;
@@ -119,9 +153,15 @@ int cmd_stress(int argc, char** argv) {
     const auto theory = [&](std::size_t i) {
       return i < r.integrators.size() ? r.integrators[i].theory_step : -1.0;
     };
+    // "0.417" at the start; closed loops add "; ≥ 0.0123 along" (the smallest along the motion).
+    const auto theory_cell = [&](std::size_t i) {
+      const double along = i < r.integrators.size() ? r.integrators[i].theory_step_along : -1.0;
+      return g(theory(i)) + (along >= 0 ? "; " + g(along) + " along" : std::string());
+    };
     Json j = {{"class", c.klass},     {"case", c.name},       {"description", c.description},
               {"expected", c.expect}, {"verdict", r.verdict}, {"n", r.n},
               {"seconds", seconds}};
+    if (r.equations > 0) j["loops"] = loops_json(r);
     if (r.refused.empty()) {
       j.update({{"cond_min", r.cond_min},
                 {"cond_max", r.cond_max},
@@ -139,9 +179,11 @@ int cmd_stress(int argc, char** argv) {
         its.push_back({{"integrator", it.name},
                        {"largest_stable_step", it.largest_stable_step},
                        {"theory_step", it.theory_step},
+                       {"theory_step_along", it.theory_step_along},
                        {"error", it.error},
                        {"steps", it.steps},
-                       {"failure", it.failure}});
+                       {"failure", it.failure},
+                       {"max_position_residual", it.max_position_residual}});
       j["integrators"] = its;
     }
     results.push_back(j);
@@ -149,8 +191,8 @@ int cmd_stress(int argc, char** argv) {
     if (r.refused.empty())
       md << g(r.cond_min) << " … " << g(r.cond_max) << " | " << (r.positive_definite ? "yes" : "no")
          << " | " << (r.stiffest > 0 ? g(r.stiffest) : "—") << " | "
-         << (r.search_note.empty() ? g(step(0)) + " (" + g(theory(0)) + ") / " + g(step(1)) + " (" +
-                                         g(theory(1)) + ")"
+         << (r.search_note.empty() ? g(step(0)) + " (" + theory_cell(0) + ") / " + g(step(1)) +
+                                         " (" + theory_cell(1) + ")"
                                    : r.search_note)
          << " | at " << g(c.dt) << " s: " << (err(0) < 0 ? "unstable" : g(err(0))) << " / "
          << (err(1) < 0 ? "unstable" : g(err(1))) << "; rtol 1e-6: " << g(err(2)) << " / "
@@ -158,16 +200,17 @@ int cmd_stress(int argc, char** argv) {
          << (r.simbody_error >= 0     ? g(r.simbody_error)
              : r.simbody_note.empty() ? "—"
                                       : "not run")
-         << " | " << r.verdict << " |\n";
+         << " | " << loops_cell(r) << " | " << r.verdict << " |\n";
     else
-      md << "— | — | — | — | — | — | — | " << r.verdict << " |\n";
+      md << "— | — | — | — | — | — | — | " << loops_cell(r) << " | " << r.verdict << " |\n";
     std::string verdict = r.verdict;
     std::replace(verdict.begin(), verdict.end(), ',', ';');
     csv << csv_field(c.klass) << "," << csv_field(c.name) << "," << r.n << "," << r.cond_min << ","
         << r.cond_max << "," << r.positive_definite << "," << r.stiffest << "," << step(0) << ","
         << step(1) << "," << theory(0) << "," << theory(1) << "," << c.dt << "," << err(0) << ","
         << err(1) << "," << err(2) << "," << err(3) << "," << r.energy_error << ","
-        << r.simbody_error << ",\"" << verdict << "\"\n";
+        << r.simbody_error << "," << r.equations << "," << r.rank << "," << r.redundant << ","
+        << r.max_position_residual << "," << r.dead_point_ratio << ",\"" << verdict << "\"\n";
   }
   if (write) {
     for (const auto& [name, text] : {std::pair{"stress.md", md.str()}, {"stress.csv", csv.str()}}) {

@@ -2,6 +2,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <numbers>
+
+#include "validation/stress.hpp"
 
 namespace femdyn::cli {
 namespace {
@@ -69,8 +72,140 @@ Json slender_bars() {
             {bar, rod(1e-3, 0.01, 0.005)})});
 }
 
+// A planar four-bar in the x-y plane, joints about z: ground A = 0 to D = (d, 0), crank AB (a),
+// coupler BC (b), rocker CD (c), 1 kg rods; the tree is crank → coupler → rocker and the loop is
+// closed at D by a ball between the rocker's tip and the world: in the plane (`normal`, 2
+// equations) or in space (3, one of them redundant: the planar motion never moves z).
+struct FourBar {
+  double a, b, c, d;
+};
+
+Json fourbar(const std::string& name, const FourBar& f, double gravity, bool planar) {
+  Json j = {{"name", name},
+            {"gravity", {0, -gravity, 0}},
+            {"bodies",
+             {body("crank", "world", joint("crank", "revolute", {0, 0, 1}, {0, 0, 0}),
+                   {rod(1, f.a, f.a / 20)}),
+              body("coupler", "crank", joint("coupler", "revolute", {0, 0, 1}, {f.a, 0, 0}),
+                   {rod(1, f.b, f.b / 20)}),
+              body("rocker", "coupler", joint("rocker", "revolute", {0, 0, 1}, {f.b, 0, 0}),
+                   {rod(1, f.c, f.c / 20)})}}};
+  Json ball = {{"name", "D"},
+               {"type", "ball"},
+               {"a", {{"body", "rocker"}, {"xyz", {f.c, 0, 0}}}},
+               {"b", {{"body", "world"}, {"xyz", {f.d, 0, 0}}}}};
+  if (planar) ball["normal"] = {0, 0, 1};
+  j["constraints"] = Json::array({ball});
+  return j;
+}
+
+// The four-bar's points at crank angle θ: B = a (cos θ, sin θ), and C where the circles
+// |C − B| = b and |C − D| = c meet, on the side `elbow` (±1) of BD: with e = D − B, L = |e|,
+// C = B + x ê + elbow √(b² − x²) ê⊥, x = (b² − c² + L²) / 2L.
+struct FourBarPoints {
+  double bx, by, cx, cy;
+};
+FourBarPoints fourbar_points(const FourBar& f, double theta, int elbow) {
+  const double bx = f.a * std::cos(theta), by = f.a * std::sin(theta);
+  const double ex = f.d - bx, ey = -by, L = std::hypot(ex, ey);
+  const double x = (f.b * f.b - f.c * f.c + L * L) / (2 * L);
+  const double y = elbow * std::sqrt(std::max(0.0, f.b * f.b - x * x));
+  return {bx, by, bx + (x * ex - y * ey) / L, by + (x * ey + y * ex) / L};
+}
+
+// Its tree coordinates there (each joint's angle relative to its parent).
+std::vector<double> fourbar_posture(const FourBar& f, double theta, int elbow) {
+  const FourBarPoints p = fourbar_points(f, theta, elbow);
+  const double coupler = std::atan2(p.cy - p.by, p.cx - p.bx);
+  const double rocker = std::atan2(-p.cy, f.d - p.cx);
+  return {theta, coupler - theta, rocker - coupler};
+}
+
 Json finger(double gravity) {
   return {{"model", "dexterous_finger"}, {"params", Json::object()}, {"gravity", {0, 0, -gravity}}};
+}
+
+// Closed loops (docs/loops.md): a four-bar at its dead point and one passing near its change
+// point, a redundant loop under drift, and a stiff loop.
+void loop_cases(std::vector<StressCase>& c, bool quick) {
+  (void)quick;  // every loop case is quick (n = 3)
+  {
+    // Ground = crank + coupler + rocker: the only configuration is the chain stretched straight,
+    // where Φ_q has rank 1 of 2 (every joint on the line AD). At rest the equations are
+    // consistent; gravity then bends the chain in Φ_q's null space, which the closed chain
+    // cannot follow to second order: S λ = r has no solution (a dead point).
+    const FourBar f{0.3, 0.4, 0.3, 1.0};
+    c.push_back({"loops",
+                 "four-bar at its toggle",
+                 "a four-bar whose ground equals crank + coupler + rocker (0.3 + 0.4 + 0.3 m): "
+                 "stretched straight, at rest, under gravity",
+                 fourbar("toggle", f, 9.81, true),
+                 {0, 0, 0},
+                 {},
+                 0.5,
+                 1e-3});
+    c.back().expect = validation::kDeadPointVerdict;
+  }
+  {
+    // Lengths 1e-4 m from a change point (a + b = c + d: every joint on one line, two branches
+    // crossing): the crank turns fully and passes near that line every turn, where Φ_q's
+    // σ_min/σ_max falls to about 0.02 (it goes as the square root of the 1e-4 m).
+    const FourBar f{0.2, 0.5, 0.4001, 0.3};
+    c.push_back({"loops",
+                 "four-bar near its change point",
+                 "a crank-rocker (0.2, 0.5, 0.4001 m, ground 0.3 m) 1e-4 m from the change-point "
+                 "lengths, the crank turning at 10 rad/s: it passes near its flat position every "
+                 "turn",
+                 fourbar("near toggle", f, 0, true),
+                 fourbar_posture(f, std::numbers::pi, 1),
+                 {10, 0, 0},
+                 1,
+                 1e-4});
+  }
+  {
+    // A parallelogram closed by a 3-D ball: 3 equations, rank 2 (the z row repeats: nothing
+    // moves out of the plane). Started 1e-3 rad off the loop (assembled back), swinging under
+    // gravity for 10 s: Baumgarte and the projection hold it.
+    const FourBar f{0.3, 0.5, 0.3, 0.5};
+    const double theta = -std::numbers::pi / 2 + 0.6;
+    c.push_back({"loops",
+                 "parallelogram closed by a 3-D ball",
+                 "a parallelogram (0.3 m cranks, 0.5 m coupler) closed by a ball in space (3 "
+                 "equations, 1 redundant), started 1e-3 rad off the loop, swinging 0.6 rad "
+                 "under gravity for 10 s",
+                 fourbar("parallelogram", f, 9.81, false),
+                 {theta, -theta + 1e-3, theta + std::numbers::pi},
+                 {},
+                 10,
+                 1e-3});
+  }
+  {
+    // A stiff two-point spring (1e11 N/m) from the coupler's middle to a fixed point 0.2 m
+    // away, stretched 1e-8 m: its mode dominates (ω about 9e4 rad/s, RK4's limit 3e-5 s) and is
+    // linear at that amplitude, so the measured RK4 limit is the constrained linearisation's
+    // 2.83/ω.
+    const FourBar f{0.2, 0.5, 0.45, 0.5};
+    const double theta = 2.0;
+    const FourBarPoints p = fourbar_points(f, theta, 1);
+    const double mx = (p.bx + p.cx) / 2, my = (p.by + p.cy) / 2;
+    Json m = fourbar("stiff loop", f, 0, true);
+    m["springs"] = Json::array({{{"name", "stiff"},
+                                 {"a", {{"body", "coupler"}, {"xyz", {f.b / 2, 0, 0}}}},
+                                 {"b", {{"body", "world"}, {"xyz", {mx, my + 0.2, 0}}}},
+                                 {"stiffness", 1e11},
+                                 {"rest_length", 0.2 - 1e-8}}});
+    c.push_back(
+        {"loops",
+         "four-bar with a stiff spring",
+         "a four-bar (0.2, 0.5, 0.45 m, ground 0.5 m) with a 1e11 N/m spring on its coupler, "
+         "stretched 1e-8 m: a stiff undamped loop mode",
+         m,
+         fourbar_posture(f, theta, 1),
+         {},
+         0.005,
+         1e-4});
+    c.back().expect = "stiff and undamped";
+  }
 }
 
 }  // namespace
@@ -246,6 +381,7 @@ std::vector<StressCase> stress_cases(bool quick) {
                1e-3});
   c.back().model["bodies"][1]["elements"] = Json::array();
   c.back().expect = "refused";
+  loop_cases(c, quick);
   for (auto& s : c)
     if (s.expect.empty()) s.expect = "stable";
   return c;

@@ -1,6 +1,7 @@
 #include "sim/stability.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -8,6 +9,7 @@
 #include <numbers>
 
 #include "core/joints/passive.hpp"
+#include "core/loops/constraint_kinematics.hpp"
 #include "core/sampling.hpp"
 #include "sim/motion.hpp"
 
@@ -125,15 +127,26 @@ MassMatrixHealth mass_matrix_health(const MatX& Ms) {
   return h;
 }
 
+double dead_point_ratio(const Model& m, const VecX& q, int rank) {
+  if (m.constraints.empty() || rank <= 0) return std::numeric_limits<double>::infinity();
+  Workspace ws(m);
+  ConstraintKinematics k(m);
+  constraint_kinematics(m, ws, q, VecX::Zero(m.n()), k);
+  const Eigen::JacobiSVD<MatX> svd(k.J);
+  const VecX& sigma = svd.singularValues();
+  rank = std::min(rank, static_cast<int>(sigma.size()));
+  return sigma[0] > 0 ? sigma[rank - 1] / sigma[0] : std::numeric_limits<double>::infinity();
+}
+
 Linearization linearize(const Model& m, Workspace& ws, const VecX& q, const VecX& qd,
-                        const VecX& tau) {
+                        const VecX& tau, double baumgarte) {
   const int n = m.n();
   Linearization lin;
   lin.A = MatX::Zero(2 * n, 2 * n);
   lin.A.topRightCorner(n, n).setIdentity();
   VecX qp = q, qdp = qd, plus(n);
-  // Closed loops: q̈ of the constrained equations with the default Baumgarte rate, as a run
-  // integrates them (its pair of eigenvalues −ω is then among the modes).
+  // Closed loops: q̈ of the constrained equations at Baumgarte's rate (a run integrates them at
+  // the default rate, whose pair of eigenvalues −ω is then among the modes).
   std::unique_ptr<LoopWorkspace> loops;
   if (!m.constraints.empty()) loops = std::make_unique<LoopWorkspace>(m);
   // Column j of [K D] by central differences: (q̈(y + δ e_j) − q̈(y − δ e_j)) / 2δ. With a
@@ -149,8 +162,7 @@ Linearization linearize(const Model& m, Workspace& ws, const VecX& q, const VecX
         x[i] = x0 + side * delta;
       else
         qp = integrate_posture(m, q, VecX::Unit(n, i) * (side * delta));
-      lin.status = loops ? constrained_forward_dynamics(m, ws, *loops, qp, qdp, tau,
-                                                        Motion::kDefaultBaumgarte)
+      lin.status = loops ? constrained_forward_dynamics(m, ws, *loops, qp, qdp, tau, baumgarte)
                          : forward_dynamics(m, ws, qp, qdp, tau);
       if (!lin.status.ok) return lin;
       if (side == 1)

@@ -45,8 +45,18 @@ struct Linearization {
   double max_growth = 0;          // max Re λ (≥ 0: physical instability, e.g. falling)
   Status status;                  // a failed forward dynamics on the way
 };
+// Closed loops: q̈ of the constrained equations at Baumgarte's rate `baumgarte`, whose pair −ω
+// per independent equation is then among the eigenvalues (the block of the constraint's own
+// dynamics Φ̈ + 2ωΦ̇ + ω²Φ = 0, which the tangent motion does not feed); at 0 those are zeros
+// and the rest are the mechanism's own modes on its loops.
 Linearization linearize(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
-                        const VecX& tau);
+                        const VecX& tau, double baumgarte = Motion::kDefaultBaumgarte);
+
+// Closed loops: how near q is to a dead point, σ_rank / σ_1 of the constraint Jacobian Φ_q's
+// singular values (its first `rank`: the redundant equations' zeros left out); +inf without
+// constraints or at rank 0. femdyn check reports the smallest over its states, femdyn stress
+// over a run; below about 1e-6 the constraint forces are large, and at 0 the motion fails.
+double dead_point_ratio(const Model& model, const VecX& q, int rank);
 
 // The largest stable step of an explicit fixed-step or adaptive method on the linearisation,
 // by bisection (relative precision 1e-6); +inf when every step is stable (no dynamics).

@@ -207,4 +207,55 @@ TEST_CASE("stress a zero-mass chain end is refused with its message", "[stress]"
         "singular: coordinate 'j2' moves no inertia (a massless chain end, or all its mass on "
         "the joint axis?)");
 }
+TEST_CASE("stress loops: a dead point named, a redundant loop held, a stiff loop at 2.83/ω",
+          "[stress][loops]") {
+  const auto cases = stress_class("loops");
+  REQUIRE(cases.size() == 4);
+  for (const auto& c : cases) {
+    INFO(c["case"] << ": " << c["verdict"]);
+    const std::string verdict = c["verdict"];
+    CHECK(verdict.find("nan") == std::string::npos);
+    REQUIRE(c.contains("loops"));
+    const auto& loops = c["loops"];
+    if (c["case"] == "four-bar at its toggle") {
+      // Stretched straight: Φ_q of rank 1, and the bend gravity asks for cannot be held.
+      CHECK(verdict.rfind("dead point: ", 0) == 0);
+      CHECK_THAT(verdict, Catch::Contains("constraint 'D["));
+      CHECK(loops["equations"] == 2);
+      CHECK(loops["rank"] == 1);
+      continue;
+    }
+    CHECK(loops["max_position_residual"].get<double>() >= 0);
+    CHECK(loops["max_position_residual"].get<double>() < 1e-9);
+    CHECK(c["simbody_error"].get<double>() >= 0);           // the twin ran, its loops closed
+    if (c["integrators"][0]["error"].get<double>() >= 0) {  // rk4 at the case's step held them
+      CHECK(c["integrators"][0]["max_position_residual"].get<double>() >= 0);
+      CHECK(c["integrators"][0]["max_position_residual"].get<double>() < 1e-9);
+    }
+    if (c["case"] == "four-bar near its change point") {
+      CHECK(loops["rank"] == 2);
+      CHECK(loops["redundant"] == 0);
+      CHECK(loops["dead_point_ratio"].get<double>() < 0.05);  // near its flat position
+      CHECK(loops["dead_point_ratio"].get<double>() > 0);
+      // It stiffens there: the measured RK4 step lies between the smallest linear limit along
+      // the motion (held only briefly) and the start's.
+      CHECK(loops["stiffest_along"].get<double>() > 10 * c["stiffest"].get<double>());
+      const auto& rk4 = c["integrators"][0];
+      CHECK(rk4["largest_stable_step"].get<double>() > rk4["theory_step_along"].get<double>());
+      CHECK(rk4["largest_stable_step"].get<double>() < rk4["theory_step"].get<double>());
+    } else if (c["case"] == "parallelogram closed by a 3-D ball") {
+      CHECK(loops["equations"] == 3);
+      CHECK(loops["rank"] == 2);
+      CHECK(loops["redundant"] == 1);
+    } else {
+      // The stiff loop: the measured RK4 limit against the constrained linearisation's, and
+      // that against the closed form 2√2/ω of its undamped stiffest mode (within 5 %).
+      CHECK(c["case"] == "four-bar with a stiff spring");
+      const auto& rk4 = c["integrators"][0];
+      const double w = c["stiffest"], theory = rk4["theory_step"];
+      CHECK(rk4["largest_stable_step"].get<double>() == Approx(theory).epsilon(0.05));
+      CHECK(theory * w == Approx(2 * std::sqrt(2.0)).epsilon(0.05));
+    }
+  }
+}
 #endif

@@ -5,6 +5,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "core/loops/assembly.hpp"
 #include "sim/integrator.hpp"
 #include "sim/stability.hpp"
 #include "validation/twin.hpp"
@@ -18,6 +19,8 @@ struct Run {
   std::vector<double> balance, scale;
   IntegratorStats stats;
   Status status;
+  Motion::ConstraintResidual residual;  // max |Φ|∞, |Φ_q v|∞ over the samples (closed loops)
+  std::vector<VecX> q;                  // the configurations at the samples (closed loops)
 };
 
 Run integrate(const Model& m, const IntegratorOptions& o, const StressScenario& s,
@@ -30,6 +33,12 @@ Run integrate(const Model& m, const IntegratorOptions& o, const StressScenario& 
     r.status = integ->advance_to(t);
     if (!r.status.ok) break;
     r.x.push_back(integ->y().head(2 * m.n()));
+    if (integ->motion().constrained()) {
+      const Motion::ConstraintResidual c = integ->motion().constraint_residual(integ->y().data());
+      r.residual.position = std::max(r.residual.position, c.position);
+      r.residual.velocity = std::max(r.residual.velocity, c.velocity);
+      r.q.push_back(integ->q());
+    }
     if (energies) {
       const Energy E = integ->motion().energy_at(integ->y().data());
       r.balance.push_back(std::abs(E.total() - E0 - integ->work()));
@@ -48,6 +57,51 @@ double max_error(const std::vector<VecX>& x, const std::vector<VecX>& ref) {
   return std::isfinite(e) ? e : -1;
 }
 
+// Closed loops: (q0, q̇0) moved onto the constraints (docs/loops.md#assembly), and the
+// equations and Φ_q's rank there recorded. The reason when the loops cannot close, else "".
+std::string assemble_start(const Model& m, StressScenario& s, StressResult& r) {
+  if (m.constraints.empty()) return {};
+  const StateAssembly a = assemble_state(m, s.q0, s.qd0);
+  if (!a.assembly.status.ok) return "the initial state: " + a.assembly.status.message;
+  r.equations = m.constraint_rows;
+  r.rank = a.assembly.rank;
+  r.redundant = a.assembly.redundant;
+  return {};
+}
+
+// A motion that reaches a dead point: S λ = r has no solution there (docs/loops.md#dead-points).
+StressResult dead_point_case(StressResult r, const std::string& failure) {
+  r.refused = failure;
+  r.verdict = std::string(kDeadPointVerdict) + ": " + failure;
+  return r;
+}
+
+// The constrained equations at the (assembled) start: a failure there, or ok.
+Status constrained_start(const Model& m, Workspace& ws, const StressScenario& s) {
+  if (m.constraints.empty()) return {};
+  LoopWorkspace lws(m);
+  return constrained_forward_dynamics(m, ws, lws, s.q0, s.qd0, VecX::Zero(m.n()),
+                                      Motion::kDefaultBaumgarte);
+}
+
+// Closed loops, whose stiffness changes with the posture (near a dead point most): the
+// linearisation at each of the reference's samples, its largest |λ| and the smallest theory step
+// of each fixed-step integrator (in `steps`, indexed as kIntegrators).
+double linearize_along(const Model& m, const Run& ref, std::vector<double>& steps) {
+  Workspace ws(m);
+  double stiffest = 0;
+  for (std::size_t k = 0; k < ref.q.size(); ++k) {
+    const Linearization lin =
+        linearize(m, ws, ref.q[k], ref.x[k].tail(m.n()), VecX::Zero(m.n()), 0);
+    if (!lin.status.ok) continue;
+    stiffest = std::max(stiffest, std::abs(lin.stiffest));
+    for (std::size_t i = 0; i < steps.size(); ++i)
+      if (const auto h = largest_stable_step(lin, kIntegrators[i]); h && std::isfinite(*h))
+        steps[i] = steps[i] < 0 ? *h : std::min(steps[i], *h);
+  }
+  return stiffest;
+}
+
 }  // namespace
 
 StressResult refused_case(const std::string& why) {
@@ -57,10 +111,13 @@ StressResult refused_case(const std::string& why) {
   return r;
 }
 
-StressResult run_stress(const Model& m, const StressScenario& s) {
+StressResult run_stress(const Model& m, const StressScenario& given) {
   StressResult r;
   r.n = m.n();
-  const int samples = s.large ? 2 : 10;
+  StressScenario s = given;
+  if (const std::string why = assemble_start(m, s, r); !why.empty()) return refused_case(why);
+  // (Closed loops: 100, along which the nearest dead point is looked for.)
+  const int samples = s.large ? 2 : m.constraints.empty() ? 10 : 100;
   std::vector<double> times;
   for (int k = 1; k <= samples; ++k) times.push_back(s.t_end * k / samples);
 
@@ -68,10 +125,17 @@ StressResult run_stress(const Model& m, const StressScenario& s) {
   Workspace ws(m);
   if (const Status st = forward_dynamics(m, ws, s.q0, s.qd0, VecX::Zero(m.n())); !st.ok)
     return refused_case("at the initial state: " + st.message);
+  if (const Status st = constrained_start(m, ws, s); !st.ok)
+    return at_dead_point(st) ? dead_point_case(r, "at the initial state: " + st.message)
+                             : refused_case("at the initial state: " + st.message);
   Linearization lin;
   bool stiffest_dissipative = false;  // the stiffness bdf cures (femdyn check's rule)
   if (!s.large) {
-    lin = linearize(m, ws, s.q0, s.qd0, VecX::Zero(m.n()));
+    // Closed loops: the constrained equations without Baumgarte's pair. The fixed-step runs
+    // project the state onto the loops after every step, which removes what that pair would
+    // amplify, so only the mechanism's own modes limit their step (measured: a parallelogram's
+    // rk4 stays stable at 4x the 2.785/20 s its pair −20 1/s would allow).
+    lin = linearize(m, ws, s.q0, s.qd0, VecX::Zero(m.n()), 0);
     r.stiffest = std::abs(lin.stiffest);
     if (const std::vector<Mode> md = modes(lin, has_dampers(m)); !md.empty())
       stiffest_dissipative = md.front().dissipative();
@@ -84,13 +148,25 @@ StressResult run_stress(const Model& m, const StressScenario& s) {
   if (s.large) ref_options = {.kind = IntegratorKind::Rk4, .fixed = {.dt = s.dt / 2}};
   Run ref = integrate(m, ref_options, s, times, true);
   r.reference = s.large ? "rk4 at dt/2" : "dopri rtol 1e-10";
+  // A dead point is the motion's, not a stiffness that bdf would cure.
+  if (at_dead_point(ref.status)) return dead_point_case(r, ref.status.message);
   if (!ref.status.ok && !s.large) {
     ref_options.kind = IntegratorKind::Bdf;
     ref = integrate(m, ref_options, s, times, true);
     r.reference = "bdf rtol 1e-10";
   }
+  if (at_dead_point(ref.status)) return dead_point_case(r, ref.status.message);
   if (!ref.status.ok)
     return refused_case("no integrator resolves the motion: " + ref.status.message);
+  if (!m.constraints.empty()) {
+    r.max_position_residual = ref.residual.position;
+    r.max_velocity_residual = ref.residual.velocity;
+    r.dead_point_ratio = INFINITY;
+    for (const VecX& q : ref.q)
+      r.dead_point_ratio = std::min(r.dead_point_ratio, dead_point_ratio(m, q, r.rank));
+  }
+  std::vector<double> along(2, -1.0);  // rk4, euler
+  if (!m.constraints.empty() && !s.large) r.stiffest_along = linearize_along(m, ref, along);
   double state_scale = 1;
   for (const VecX& x : ref.x) state_scale = std::max(state_scale, x.cwiseAbs().maxCoeff());
   for (std::size_t k = 0; k < ref.balance.size(); ++k)
@@ -132,13 +208,16 @@ StressResult run_stress(const Model& m, const StressScenario& s) {
       o.fixed = {.dt = s.dt};
     const Run run = integrate(m, o, s, times, false);
     it.steps = run.stats.steps;
-    if (run.status.ok)
+    if (run.status.ok) {
       it.error = max_error(run.x, ref.x) / state_scale;
-    else
+      if (!m.constraints.empty()) it.max_position_residual = run.residual.position;
+    } else {
       it.failure = run.status.message;
+    }
     if (!is_adaptive(kind) && r.stiffest > 0) {
       if (const auto h = largest_stable_step(lin, kind); h && std::isfinite(*h))
         it.theory_step = *h;
+      it.theory_step_along = along[r.integrators.size()];
       // Bracket from the linear estimate by factors of 2 (every explicit method here is
       // unstable beyond h |λ| = 10), then bisect on log h to 1 %.
       double lo = 1 / r.stiffest;
@@ -166,6 +245,7 @@ StressResult run_stress(const Model& m, const StressScenario& s) {
   } else {
     try {
       SimbodyTwin twin(twin_model(m));
+      twin.close_loops(!m.constraints.empty());  // the constrained motion, from the assembled start
       std::vector<double> with_zero = times;
       with_zero.insert(with_zero.begin(), 0.0);
       std::string why;

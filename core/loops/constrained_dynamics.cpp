@@ -108,6 +108,14 @@ void pivoted_cholesky(LoopWorkspace& lws) {
   }
 }
 
+namespace {
+constexpr const char* kDeadPoint = "the constraint Jacobian is singular at this configuration";
+}  // namespace
+
+bool at_dead_point(const Status& status) {
+  return !status.ok && status.message.find(kDeadPoint) != std::string::npos;
+}
+
 Status solve_constraint_space(const Model& model, LoopWorkspace& lws, double allowance) {
   // The basic solution: with P S Pᵀ = [L₁; L₂] [L₁; L₂]ᵀ (L₁ rank × rank), the permuted λ is
   // (L₁⁻ᵀ L₁⁻¹ (P r)₁, 0): the redundant equations' multipliers zero.
@@ -132,8 +140,8 @@ Status solve_constraint_space(const Model& model, LoopWorkspace& lws, double all
     char text[64];
     std::snprintf(text, sizeof text, "%.1e", scale > 0 ? miss / scale : miss);
     return {false,
-            "the constraint Jacobian is singular at this configuration (a dead point, or "
-            "constraints that contradict each other): constraint '" +
+            std::string(kDeadPoint) +
+                " (a dead point, or constraints that contradict each other): constraint '" +
                 constraint_row_name(model, static_cast<int>(worst)) +
                 "' cannot be held (relative residual " + text + ")",
             -1, !std::isfinite(miss)};

@@ -68,5 +68,7 @@ void factorize_constraint_space(const Model& model, Workspace& ws, LoopWorkspace
 // correction, whose components along redundant equations no λ can meet — it is then met in
 // the least-squares sense).
 Status solve_constraint_space(const Model& model, LoopWorkspace& lws, double allowance);
+// Whether a failure is solve_constraint_space's (a dead point), however its message is prefixed.
+bool at_dead_point(const Status& status);
 
 }  // namespace femdyn
