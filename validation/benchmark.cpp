@@ -20,6 +20,8 @@
 //   four-bar closed by its coupling law and by a loop constraint (register_fourbar_routes).
 //   femdyn/constrained/M   constrained_forward_dynamics(), ω = 0, on the closed-loop models
 //   simbody/constrained/M  time_constrained: loops enabled, realize Acceleration (add_loop_case)
+//   */constrained/loop_chainN: a random chain of --sizes= bodies held at its tip by a ball, and
+//   reference/constrained/loop_chainN on the Cholesky route (add_loop_chain), for the growth
 //   reference/{mass,bias,forward,inverse}/M: femdyn on the reference routes (Tᵀ M T, node-level
 //   sweeps, Cholesky) where n ≤ 128, for the crossovers.
 // and, for the growth of loading with n, on generated chains and binary trees of --load-sizes=
@@ -55,6 +57,7 @@
 
 #include "compile/compile.hpp"
 #include "core/equations.hpp"
+#include "core/kinematics.hpp"
 #include "core/loops/assembly.hpp"
 #include "core/math.hpp"
 #include "core/sampling.hpp"
@@ -349,6 +352,11 @@ struct LoopCase {
   std::unique_ptr<fv::SimbodyTwin> twin;
   VecX q, qd, tau;
   bool femdyn = true;  // false: femdyn's side is registered elsewhere (register_fourbar_routes)
+  bool simbody = true;
+  // The same mechanism on the Cholesky route (M^s formed and factorised), for the growth with n.
+  std::unique_ptr<const Model> reference;
+  std::unique_ptr<Workspace> ws_ref;
+  std::unique_ptr<LoopWorkspace> lws_ref;
 };
 
 std::vector<std::unique_ptr<LoopCase>>& loop_cases() {
@@ -411,21 +419,74 @@ void register_loop_case(LoopCase* c) {
       benchmark::DoNotOptimize(
           constrained_forward_dynamics(c.model, *c.ws, *c.lws, c.q, c.qd, c.tau, 0).ok);
     });
-  reg("simbody", [](LoopCase& c) { c.twin->time_constrained(c.q, c.qd, c.tau); });
+  if (c->simbody) reg("simbody", [](LoopCase& c) { c.twin->time_constrained(c.q, c.qd, c.tau); });
+  if (c->reference)
+    reg("reference", [](LoopCase& c) {
+      benchmark::DoNotOptimize(
+          constrained_forward_dynamics(*c.reference, *c.ws_ref, *c.lws_ref, c.q, c.qd, c.tau, 0)
+              .ok);
+    });
+}
+
+// Growth with n at a fixed number of equations: femdyn/constrained/loop_chainN, a random chain
+// of N bodies (random_spec, seed 3) whose last body's origin is held by a ball (3 equations) on
+// the world where it is at the neutral posture; reference/constrained/loop_chainN the same on
+// the Cholesky route (M^s formed and factorised by the tree LTDL) up to 256 bodies; Simbody up
+// to 64 (its constrained solve forms an n × n matrix). At the neutral posture with q̇ in ±2
+// projected onto the loop, τ in ±1; both routes checked to agree (relative 1e-8).
+MechanismSpec random_spec(int seed, int bodies, double branching);
+
+void add_loop_chain(int bodies) {
+  MechanismSpec spec = random_spec(3, bodies, 0);
+  const Model tree = compile(spec);
+  Workspace wt(tree);
+  const VecX q = neutral_posture(tree);
+  propagate(tree, wt, q, VecX::Zero(tree.n()), {.jacobian = false, .bias = false, .rows = false});
+  ConstraintSpec ball{.name = "tip", .type = "ball"};
+  ball.a.body = spec.bodies.back().name;
+  ball.b.body = "world";
+  ball.b.xyz = wt.body.back().p;
+  spec.constraints.push_back(ball);
+  auto c = std::make_unique<LoopCase>();
+  c->name = "loop_chain" + std::to_string(bodies);
+  c->model = compile(spec);
+  c->ws = std::make_unique<Workspace>(c->model);
+  c->lws = std::make_unique<LoopWorkspace>(c->model);
+  c->simbody = bodies <= 64;
+  if (c->simbody) c->twin = std::make_unique<fv::SimbodyTwin>(fv::twin_model(c->model));
+  std::mt19937 rng(1);
+  c->q = q;
+  c->qd = random_uniform(c->model.n(), 2, rng);
+  c->tau = random_uniform(c->model.n(), 1, rng);
+  if (const StateAssembly a = assemble_state(c->model, c->q, c->qd); !a.assembly.status.ok)
+    throw std::runtime_error(c->name + ": " + a.assembly.status.message);
+  if (bodies <= 256) {
+    c->reference = std::make_unique<const Model>(
+        compile(spec, {.routes = {.dynamics = DynamicsRoute::Cholesky}}));
+    c->ws_ref = std::make_unique<Workspace>(*c->reference);
+    c->lws_ref = std::make_unique<LoopWorkspace>(*c->reference);
+    const Status a =
+        constrained_forward_dynamics(c->model, *c->ws, *c->lws, c->q, c->qd, c->tau, 0);
+    const Status b = constrained_forward_dynamics(*c->reference, *c->ws_ref, *c->lws_ref, c->q,
+                                                  c->qd, c->tau, 0);
+    if (!a.ok || !b.ok || !(relative_error(c->ws->qdd, c->ws_ref->qdd, 1e-6) < 1e-8))
+      failures().insert(c->name + ": the articulated and Cholesky routes differ");
+  }
+  if (c->simbody) check_loop_case(*c);
+  loop_cases().push_back(std::move(c));
 }
 
 // The closed-loop models. finger_fourbar_loop at register_fourbar_routes' state (that of its law
-// route), whose femdyn/constrained/finger_fourbar_loop is femdyn's side. hand_fourbar_loop
-// (the hand's fingers closed by constraints instead of their four-bar laws) where the file is
-// there, beside its law model hand_fourbar.
+// route), whose femdyn/constrained/finger_fourbar_loop is femdyn's side; hand_fourbar_loop
+// (the hand's fingers closed by constraints instead of their four-bar laws) beside its law
+// model hand_fourbar.
 void add_loop_cases(const std::string& root) {
   for (const char* name : {"delta", "andrews", "five_bar"})
     add_loop_case(name, root + "models/" + name + ".json");
   const FourBarRoutes& r = fourbar_routes();
   const LoopState fourbar{r.q_loop, r.v_loop, r.tau_loop};
   add_loop_case("finger_fourbar_loop", root + "models/finger_fourbar_loop.json", &fourbar, false);
-  const std::string hand = root + "models/hand_fourbar_loop.json";
-  if (std::filesystem::exists(hand)) add_loop_case("hand_fourbar_loop", hand);
+  add_loop_case("hand_fourbar_loop", root + "models/hand_fourbar_loop.json");
 }
 
 MechanismSpec random_spec(int seed, int bodies, double branching) {
@@ -485,8 +546,8 @@ int main(int argc, char** argv) {
     for (int n : sizes) add_case("tree" + std::to_string(n), random(3, n, 0.5));
     register_fourbar_routes(root);
     add_loop_cases(root);
-    if (std::filesystem::exists(root + "models/hand_fourbar_loop.json"))
-      add_case("hand_fourbar", file(root + "models/hand_fourbar.json"));
+    add_case("hand_fourbar", file(root + "models/hand_fourbar.json"));
+    for (int n : sizes) add_loop_chain(n);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "femdyn_bench: %s\n", e.what());
     return 1;
