@@ -9,6 +9,7 @@
 #include <complex>
 #include <iostream>
 #include <limits>
+#include <optional>
 #include <random>
 
 #include "cli/commands.hpp"
@@ -18,6 +19,7 @@
 #include "core/sampling.hpp"
 #include "io/output.hpp"
 #include "sim/stability.hpp"
+#include "sim/step_trial.hpp"
 
 namespace femdyn::cli {
 namespace {
@@ -45,14 +47,18 @@ stop, at rest: a stop's stiffness is felt only there; "stop_states" in --json):
     the fastest motion to a relative error --tol per period (default 1e-3; rule in
     docs/stability.md), at most half its stability limit; bdf only where the stiffest mode is
     dissipative and limits rk4 10x below what the motion needs; an undamped fast mode is named
-    (remove, damp or resolve it: bdf does not cure it).
+    (remove, damp or resolve it: bdf does not cure it); then tried on the model's own motion:
+    rk4 at that step over 3 periods from the initial state and from a state in motion, against
+    dopri at rtol 1e-10, halved until its error per period is within 10 tol (dopri advised
+    where no step does within the trial's budget), the measured error stated.
 Work is bounded: the time of the whole check is estimated first (4n evaluations and a dense
 eigenproblem of 2n per state); beyond --budget seconds (default 120) it is refused with the
 estimate, and beyond the memory limit (--max-memory GB, default half the available memory)
 with the memory it needs. A progress line shows on a terminal.
 A model with closed loops (docs/loops.md) has each state assembled onto its constraints first
 (states where they cannot close are counted and left out), its modes are those of the
-constrained equations with the default Baumgarte rate (whose pair -20 1/s is among them), and
+constrained equations without Baumgarte's term (a fixed-step run projects onto the loops after
+every step, which removes its pair -20 1/s from the stability limits), and
 the constraint Jacobian's rank (redundant equations) and its nearness to a dead point
 (sigma_min/sigma_max of Phi_q, below 1e-6: near) are reported ("loops" in --json).
 Exit 0: no fault (notes may be printed); 1: M^s is singular at a sampled state, a body is
@@ -164,7 +170,9 @@ void diagnose_state(const Model& m, Workspace& ws, const VecX& q, const VecX& qd
     if (d.singular_message.empty()) d.singular_message = st.ok ? "λ_min ≤ 0" : st.message;
     return;
   }
-  const Linearization lin = linearize(m, ws, q, qd, tau);
+  // Closed loops at Baumgarte rate 0: a fixed-step run projects onto the loops after every step,
+  // so Baumgarte's pair −ω does not limit its step (docs/stability.md, the loops class).
+  const Linearization lin = linearize(m, ws, q, qd, tau, 0);
   if (!lin.status.ok) return;
   // Stiff and dissipative: a dissipative mode more than 100x faster than the slowest mode,
   // which decays long before the motion around it has moved. The fastest of the others is the
@@ -206,6 +214,7 @@ struct Advice {
   std::string text, integrator;
   double dt_rk4 = 0, dt_euler = 0, error_per_period = 0, period = 0;
   bool stability_limited = false;
+  std::optional<StepTrial> trial;  // the rk4 step tried on the model's own motion
 };
 
 Advice advise(const Model& m, const Diagnosis& d, double tol) {
@@ -259,6 +268,57 @@ Advice advise(const Model& m, const Diagnosis& d, double tol) {
             "must still follow or damp the oscillation)";
   a.text = text;
   return a;
+}
+
+// The advice tried on the model's own motion (sim/step_trial.hpp), over 3 periods of the fastest
+// motion from two starts: the initial state (the neutral posture at rest, what `simulate` starts
+// from; often an equilibrium that does not move) and a seeded state in motion (q within the
+// limits, q̇ in ±1). rk4's step is halved until its error per period is within 10 tol from both;
+// where no step does within the trial's budget, dopri is advised instead. The advice then states
+// what was measured.
+void verify_advice(const Model& m, double tol, unsigned seed, Advice& a) {
+  if (a.integrator != "rk4" || !(a.dt_rk4 > 0) || !(a.period > 0)) return;
+  const StepTrialOptions o{.period = a.period,
+                           .allowed = 10 * tol,
+                           .step_budget = std::max(2000L, 1'000'000L / std::max(1, m.n()))};
+  std::mt19937 rng(seed);
+  const VecX q1 = random_posture(m, rng), qd1 = random_uniform(m.n(), 1, rng);
+  StepTrial t =
+      try_fixed_step(m, IntegratorKind::Rk4, a.dt_rk4, neutral_posture(m), VecX::Zero(m.n()), o);
+  std::string starts = "from its initial state and from a state in motion";
+  if (t.verified) {
+    const StepTrial moving = try_fixed_step(m, IntegratorKind::Rk4, t.dt, q1, qd1, o);
+    if (moving.reference_failed) {  // that start's own motion cannot be followed: the first holds
+      starts = "from its initial state (the state in motion met: " + moving.failure + ")";
+    } else {
+      const int before = t.halvings;
+      t = moving;
+      t.halvings += before;
+    }
+  }
+  a.trial = t;
+  const std::string over = format_short(t.horizon) + " s of the model's motion " + starts +
+                           " (against dopri at rtol 1e-10)";
+  if (!t.verified) {
+    a.integrator = "dopri";
+    a.text = "dopri --rtol " + format_short(tol) + ": rk4 at the linear rule's " +
+             format_short(a.dt_rk4) + " s does not hold on the model's own motion: " + t.failure;
+    a.dt_rk4 = 0;
+    return;
+  }
+  const std::string measured =
+      "measured " + format_short(t.error_per_period) + " per period over " + over;
+  if (t.halvings == 0) {
+    a.text += "; " + measured;
+    return;
+  }
+  a.text =
+      "rk4 --dt " + format_short(t.dt) + " (the linear rule's " + format_short(a.dt_rk4) +
+      " s halved " + std::to_string(t.halvings) +
+      " times: the model's motion is faster or stiffer than at the sampled states): " + measured +
+      "; or dopri --rtol " + format_short(tol);
+  a.dt_rk4 = t.dt;
+  a.error_per_period = t.error_per_period;
 }
 
 Json mode_json(const Model& m, const Mode& md) {
@@ -326,7 +386,9 @@ int cmd_check(int argc, char** argv) {
   const std::vector<SuspiciousBody> bodies = suspicious_bodies(m);
   bool flagged = false;
   for (const auto& b : bodies) flagged = flagged || !b.note;
-  const Advice advice = advise(m, d, tol);
+  Advice advice = advise(m, d, tol);
+  verify_advice(m, tol, static_cast<unsigned>(integer_option(a, "seed", 1, 0, 4294967295.0)),
+                advice);
 
   if (a.has("json")) {
     Json j = {
@@ -351,6 +413,14 @@ int cmd_check(int argc, char** argv) {
           {"rk4_error_per_period", advice.error_per_period},
           {"period", advice.period},
           {"stability_limited", advice.stability_limited}}}};
+    if (advice.trial)
+      j["recommended"]["trial"] = {
+          {"verified", advice.trial->verified},
+          {"rk4_dt", advice.trial->dt},
+          {"halvings", advice.trial->halvings},
+          {"horizon", advice.trial->horizon},
+          {"error_per_period", finite_or_null(advice.trial->error_per_period)},
+          {"failure", advice.trial->failure}};
     Json steps = Json::object();
     for (int i = 0; i < 3; ++i)
       steps[integrator_name(kExplicit[i])] =

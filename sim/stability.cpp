@@ -320,7 +320,8 @@ std::string divergence_cause(const Model& m, IntegratorKind kind, double dt,
            std::to_string(m.n()) + " is too large to find it here; femdyn check --states 1 " +
            "estimates it); use a smaller dt or dopri";
   Workspace ws(m);
-  const Linearization lin = linearize(m, ws, q0, qd0, tau0);
+  // Closed loops at Baumgarte rate 0: the fixed-step run projected after every step.
+  const Linearization lin = linearize(m, ws, q0, qd0, tau0, 0);
   if (!lin.status.ok)
     return method + " diverged from a start state whose dynamics cannot be linearised (" +
            lin.status.message + "); use a smaller dt or dopri";

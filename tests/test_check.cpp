@@ -177,3 +177,38 @@ TEST_CASE("check: a thin disc is a note with exit 0, work beyond the budget is r
   CHECK(big.code == 1);
   CHECK_THAT(big.out, Catch::Contains("would take about") && Catch::Contains("--states"));
 }
+
+TEST_CASE("check: advice tried on the model's own motion, halved where that outruns the states",
+          "[check][loops]") {
+  // The five-bar (models/five_bar.json) falls from rest and whirls at up to 30 rad/s, far faster
+  // than the sampled states (q̇ in ±1): the linear rule's step diverges within a second. check
+  // runs its advice over 3 periods from the initial state and a state in motion, and halves it
+  // until the error per period is within 10 tol.
+  const nlohmann::json j = check_json(model_path("five_bar.json"));
+  const auto& rec = j["recommended"];
+  REQUIRE(rec["integrator"] == "rk4");
+  const auto& trial = rec["trial"];
+  REQUIRE(trial["verified"] == true);
+  const double dt = rec["rk4_dt"], linear = dt * std::pow(2.0, trial["halvings"].get<int>());
+  CHECK(trial["rk4_dt"].get<double>() == dt);
+  CHECK(trial["halvings"].get<int>() >= 1);
+  CHECK(trial["error_per_period"].get<double>() <= 10 * 1e-3);
+  CHECK_THAT(j["recommendation"].get<std::string>(), Catch::Contains("halved"));
+  // The linear rule's step does not hold from the initial state: a run of 10 s diverges or
+  // misses; the advised one runs the 10 s.
+  const auto simulate = [](double step) {
+    return run("simulate " + model_path("five_bar.json") +
+               " --t-end 10 --integrator rk4 --json --dt " + std::to_string(step));
+  };
+  const Run coarse = simulate(linear);
+  INFO(coarse.out);
+  CHECK(coarse.code == 1);
+  const Run fine = simulate(dt);
+  INFO(fine.out);
+  CHECK(fine.code == 0);
+  // A model whose motion the linear rule already resolves keeps its step, and says what it
+  // measured.
+  const nlohmann::json b = check_json(model_path("branched_tree.json"));
+  CHECK(b["recommended"]["trial"]["halvings"] == 0);
+  CHECK_THAT(b["recommendation"].get<std::string>(), Catch::Contains("measured"));
+}
