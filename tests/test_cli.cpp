@@ -296,6 +296,29 @@ TEST_CASE("validate: a 10000-body chain is refused up front in seconds, with the
   std::filesystem::remove(path);
 }
 
+namespace {
+
+// The engine and quantity of each row of `femdyn bench --json`, each row checked to be a finite,
+// positive, ordered min ≤ median ≤ max and to appear once.
+std::set<std::string> bench_rows(const nlohmann::json& j) {
+  std::set<std::string> timed;
+  for (const auto& r : j.at("results")) {
+    const std::string what =
+        r.at("engine").get<std::string>() + " " + r.at("quantity").get<std::string>();
+    INFO(what);
+    const double median = r.at("median_ns"), lo = r.at("min_ns"), hi = r.at("max_ns");
+    CHECK(std::isfinite(lo));
+    CHECK(std::isfinite(hi));
+    CHECK(0 < lo);
+    CHECK(lo <= median);
+    CHECK(median <= hi);
+    CHECK(timed.insert(what).second);  // once each
+  }
+  return timed;
+}
+
+}  // namespace
+
 TEST_CASE("bench: every quantity timed on both engines, D skipped as documented, bad input",
           "[cli][bench]") {
 #ifndef NDEBUG  // a Debug build (as this test's): bench refuses to time it
@@ -314,19 +337,7 @@ TEST_CASE("bench: every quantity timed on both engines, D skipped as documented,
   CHECK(j.at("model") == model_path("finger.json"));
   CHECK(j.at("n") == 4);
   CHECK(j.at("build") != "Debug");
-  std::set<std::string> timed;
-  for (const auto& r : j.at("results")) {
-    const std::string what =
-        r.at("engine").get<std::string>() + " " + r.at("quantity").get<std::string>();
-    INFO(what);
-    const double median = r.at("median_ns"), lo = r.at("min_ns"), hi = r.at("max_ns");
-    CHECK(std::isfinite(lo));
-    CHECK(std::isfinite(hi));
-    CHECK(0 < lo);
-    CHECK(lo <= median);
-    CHECK(median <= hi);
-    CHECK(timed.insert(what).second);  // once each
-  }
+  const std::set<std::string> timed = bench_rows(j);
   for (const char* engine : {"femdyn", "simbody"})
     for (const char* quantity : {"M", "h", "g", "Q", "qdd", "tau"})
       CHECK(timed.count(std::string(engine) + " " + quantity) == 1);
@@ -368,18 +379,7 @@ TEST_CASE("bench: a model with loop constraints gains the constrained q̈ (qdd_c
   REQUIRE(js.code == 0);
   const auto j = nlohmann::json::parse(js.out);
   CHECK(j.at("n") == 9);
-  std::set<std::string> timed;
-  for (const auto& r : j.at("results")) {
-    const std::string what =
-        r.at("engine").get<std::string>() + " " + r.at("quantity").get<std::string>();
-    INFO(what);
-    const double median = r.at("median_ns"), lo = r.at("min_ns"), hi = r.at("max_ns");
-    CHECK(std::isfinite(hi));
-    CHECK(0 < lo);
-    CHECK(lo <= median);
-    CHECK(median <= hi);
-    CHECK(timed.insert(what).second);
-  }
+  const std::set<std::string> timed = bench_rows(j);
   for (const char* engine : {"femdyn", "simbody"})
     for (const char* quantity : {"M", "h", "g", "Q", "qdd", "qdd_c", "tau"})
       CHECK(timed.count(std::string(engine) + " " + quantity) == 1);
