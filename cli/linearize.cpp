@@ -1,4 +1,5 @@
-// femdyn linearize: the state-space linearisation of the dynamics at a state (core/derivatives.hpp),
+// femdyn linearize: the state-space linearisation of the dynamics at a state
+// (core/derivatives.hpp),
 //   d/dt (ξ, v) = A (ξ, v) + B τ,   A = ∂(ξ̇, v̇)/∂(ξ, v),   B = ∂(ξ̇, v̇)/∂τ,
 // ξ the tangent coordinates q ⊕ ξ around the state's q (ξ = q − q₀ on flat joints).
 #include <cmath>

@@ -265,8 +265,7 @@ Status forward_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWor
   return st;
 }
 
-void linearization(const Model& m, const DerivativeWorkspace& d, const VecX& qd, MatX& A,
-                   MatX& B) {
+void linearization(const Model& m, const DerivativeWorkspace& d, const VecX& qd, MatX& A, MatX& B) {
   const int n = m.n();
   A.setZero(2 * n, 2 * n);
   B.setZero(2 * n, n);

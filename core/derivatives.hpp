@@ -55,9 +55,9 @@ using Mat63 = Eigen::Matrix<double, 6, 3>;
 struct DerivativeWorkspace {
   explicit DerivativeWorkspace(const Model& model);  // throws ModelError if not covered
 
-  MatX dtau_dq, dtau_dv;          // ∂τ/∂q, ∂τ/∂v (n × n)
-  MatX dqdd_dq, dqdd_dv, Minv;    // ∂q̈/∂q, ∂q̈/∂v, ∂q̈/∂τ = (M^s)⁻¹ (n × n)
-  VecX qdd;                       // q̈ of the last forward derivatives
+  MatX dtau_dq, dtau_dv;        // ∂τ/∂q, ∂τ/∂v (n × n)
+  MatX dqdd_dq, dqdd_dv, Minv;  // ∂q̈/∂q, ∂q̈/∂v, ∂q̈/∂τ = (M^s)⁻¹ (n × n)
+  VecX qdd;                     // q̈ of the last forward derivatives
 
   // Per body (world axes about the origin).
   std::vector<Vec6> V, a, V_bar, a_bar, F;

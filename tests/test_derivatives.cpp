@@ -108,7 +108,8 @@ void check_model(const Model& m, unsigned seed, Agreement& worst) {
 
 }  // namespace
 
-TEST_CASE("derivatives agree with differences on random trees of every joint type", "[derivatives]") {
+TEST_CASE("derivatives agree with differences on random trees of every joint type",
+          "[derivatives]") {
   // Revolute, prismatic, fixed; universal, planar, spherical, free (odd seeds float); springs,
   // dampers, point loads and torques, gravity; friction, rotors and stops by with_actuators.
   Agreement worst;
@@ -116,8 +117,8 @@ TEST_CASE("derivatives agree with differences on random trees of every joint typ
     for (const int bodies : {1, 3, 8, 16}) {
       INFO("seed " << seed << ", " << bodies << " bodies");
       const bool several = seed % 4 != 0;
-      const Model m = load_text(
-          with_actuators(mixed_tree_json(seed, bodies, seed % 2 ? 0.6 : 0.0, false, several), seed));
+      const Model m = load_text(with_actuators(
+          mixed_tree_json(seed, bodies, seed % 2 ? 0.6 : 0.0, false, several), seed));
       check_model(m, seed, worst);
     }
   WARN("random trees: central " << worst.central << ", Richardson " << worst.richardson);
@@ -164,12 +165,14 @@ TEST_CASE("dtau/dv is the contraction of the tensor D without dampers", "[deriva
     inverse_dynamics_derivatives(m, ws, d, q, v, qdd);
     const std::vector<MatX> D = third_order_tensor(m, ws, q);
     MatX contraction(m.n(), m.n());
-    for (int a = 0; a < m.n(); ++a) contraction.row(a) = ((D[a] + D[a].transpose()) * v).transpose();
+    for (int a = 0; a < m.n(); ++a)
+      contraction.row(a) = ((D[a] + D[a].transpose()) * v).transpose();
     CHECK(rel_error(d.dtau_dv, contraction, contraction.cwiseAbs().maxCoeff()) < 1e-12);
   }
 }
 
-TEST_CASE("linearization: A's chart block against differences of the chart rates", "[derivatives]") {
+TEST_CASE("linearization: A's chart block against differences of the chart rates",
+          "[derivatives]") {
   // ∂ξ̇/∂ξ at ξ = 0 (spherical and free joints turn it), and A, B assembled from the forward
   // derivatives: A = [[∂ξ̇/∂ξ, I], [∂q̈/∂q, ∂q̈/∂v]], B = [0; (M^s)⁻¹].
   for (unsigned seed = 1; seed <= 4; ++seed) {
@@ -186,7 +189,8 @@ TEST_CASE("linearization: A's chart block against differences of the chart rates
     MatX chart(n, n);
     for (int k = 0; k < n; ++k)
       chart.col(k) = (chart_rates(m, q, h * VecX::Unit(n, k), v) -
-                      chart_rates(m, q, -h * VecX::Unit(n, k), v)) / (2 * h);
+                      chart_rates(m, q, -h * VecX::Unit(n, k), v)) /
+                     (2 * h);
     CHECK(rel_error(A.topLeftCorner(n, n), chart, v.cwiseAbs().maxCoeff()) < 1e-8);
     CHECK(A.topRightCorner(n, n) == MatX::Identity(n, n));
     CHECK(A.bottomLeftCorner(n, n) == d.dqdd_dq);
