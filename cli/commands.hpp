@@ -50,6 +50,7 @@ int cmd_import(int argc, char** argv);
 int cmd_simulate(int argc, char** argv);
 int cmd_check(int argc, char** argv);
 int cmd_kinematics(int argc, char** argv);
+int cmd_linearize(int argc, char** argv);
 int cmd_study(int argc, char** argv);   // only with FEMDYN_WITH_SIMBODY
 int cmd_stress(int argc, char** argv);  // only with FEMDYN_WITH_SIMBODY
 int cmd_bench(int argc, char** argv);   // only with FEMDYN_WITH_SIMBODY

@@ -88,6 +88,7 @@ PYBIND11_MODULE(_femdyn, m) {
       "batches, simulate, validate without max_memory=); None: half the available memory.");
   bind_model(m);
   bind_loops(m);
+  bind_derivatives(m);
   bind_batch(m);
   bind_simulate(m);
   bind_simulator(m);

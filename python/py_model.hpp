@@ -5,6 +5,7 @@
 #pragma once
 #include <memory>
 
+#include "core/derivatives.hpp"
 #include "core/memory.hpp"
 #include "core/workspace.hpp"
 #include "python/arrays.hpp"
@@ -15,6 +16,7 @@ struct PyModel {
   explicit PyModel(Model m) : model(std::make_shared<const Model>(std::move(m))), ws(*model) {}
   std::shared_ptr<const Model> model;
   Workspace ws;
+  std::unique_ptr<DerivativeWorkspace> derivatives;  // made by the first derivatives call
 };
 
 // M, h, Q and q̈ at one state; qdd is absent when forward dynamics failed (then `failure`
@@ -44,5 +46,6 @@ void bind_simulator(py::module_& m);
 void bind_validate(py::module_& m);
 void bind_builder(py::module_& m);
 void bind_loops(py::module_& m);
+void bind_derivatives(py::module_& m);  // after bind_model: methods of Model
 
 }  // namespace femdyn::python

@@ -14,6 +14,7 @@
 #include "models/random_tree.hpp"
 
 namespace femdyn::test {
+using Json = nlohmann::json;
 
 std::string model_path(const std::string& name) {
   return std::string(FEMDYN_SOURCE_DIR) + "/models/" + name;
@@ -70,6 +71,86 @@ std::string arm_json(double k, double c, double g) {
     << k << R"(}, "damping": )" << c << R"(}, "elements": [{"type": "lumped_point",
     "node": [1, 0, 0], "mass": 1.0}]}]})";
   return s.str();
+}
+
+std::string mixed_tree_json(unsigned seed, int bodies, double branching, bool couplings,
+                            bool several_rates) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), pos(0.2, 1.0);
+  const auto v3 = [&](double s) { return Json::array({s * u(rng), s * u(rng), s * u(rng)}); };
+  Json list = Json::array(), loads = Json::array(), coupled = Json::array();
+  std::vector<int> movable;
+  for (int b = 0; b < bodies; ++b) {
+    int parent = b - 1;
+    if (b > 1 && pos(rng) < 0.2 + 0.8 * branching) parent = static_cast<int>(rng() % b);
+    const int kind = static_cast<int>(rng() % 8);
+    Json joint = {{"name", "j" + std::to_string(b)},
+                  {"origin", {{"xyz", v3(0.4)}, {"rpy", v3(2.0)}}}};
+    if (several_rates && (kind >= 4 || (b == 0 && seed % 2))) {
+      static constexpr const char* kTypes[] = {"universal", "planar", "spherical", "free"};
+      joint["type"] = b == 0 && seed % 2 ? "free" : kTypes[kind - 4];
+      if (joint["type"] == "universal") {
+        joint["axis"] = {1, 0, 0};
+        joint["axis2"] = {0, 0.6, 0.8};
+      }
+      if (joint["type"] == "planar") joint["axis"] = v3(1.0);
+      movable.push_back(b);
+    } else if (kind == 0 && b > 0) {
+      joint["type"] = "fixed";
+    } else {
+      joint["type"] = kind == 1 ? "prismatic" : "revolute";
+      joint["axis"] = v3(1.0);
+      if (kind == 2) joint["spring"] = {{"stiffness", 3 * pos(rng)}, {"rest", u(rng)}};
+      if (kind == 3) joint["damping"] = pos(rng);
+      movable.push_back(b);
+    }
+    Json elements = Json::array();
+    const double mass = pos(rng);
+    elements.push_back({{"type", "lumped_point"}, {"node", v3(0.3)}, {"mass", mass}});
+    if (rng() % 2)
+      elements.push_back(
+          {{"type", "rotary_node"},
+           {"node", v3(0.3)},
+           {"inertia", {{"ixx", 0.02}, {"iyy", 0.03}, {"izz", 0.04}, {"ixy", 0.004}}}});
+    if (rng() % 2)
+      elements.push_back({{"type", "space_bar"},
+                          {"nodes", {v3(0.2), v3(0.5)}},
+                          {"density", 2700},
+                          {"area", 2e-4},
+                          {"Iy", 2e-9},
+                          {"Iz", 3e-9}});
+    else
+      elements.push_back(
+          {{"type", "rigid_body"},
+           {"mass", mass},
+           {"com", v3(0.2)},
+           {"inertia", {{"ixx", 0.05}, {"iyy", 0.06}, {"izz", 0.07}, {"iyz", -0.01}}}});
+    list.push_back({{"name", "b" + std::to_string(b)},
+                    {"parent", parent < 0 ? std::string("world") : "b" + std::to_string(parent)},
+                    {"joint", joint},
+                    {"elements", elements}});
+    if (rng() % 4 == 0)
+      loads.push_back({{"body", "b" + std::to_string(b)},
+                       {"point", v3(0.3)},
+                       {"force", v3(2.0)},
+                       {"torque", v3(0.5)}});
+  }
+  // Couplings: about one movable joint in five follows an earlier one (or two).
+  if (couplings)
+    for (std::size_t k = 2; k < movable.size(); k += 5) {
+      const std::string a = "j" + std::to_string(movable[k - 1]),
+                        c = "j" + std::to_string(movable[k - 2]);
+      coupled.push_back(
+          {{"joint", "j" + std::to_string(movable[k])},
+           {"follows", {{{"joint", a}, {"ratio", u(rng)}}, {{"joint", c}, {"ratio", u(rng)}}}},
+           {"offset", 0.1 * u(rng)}});
+    }
+  return Json{{"name", "mixed tree " + std::to_string(seed)},
+              {"gravity", {0.3, -0.2, -9.81}},
+              {"bodies", list},
+              {"loads", loads},
+              {"couplings", coupled}}
+      .dump();
 }
 
 std::string random_tree_json(unsigned seed, int bodies, double branching, bool prismatic,

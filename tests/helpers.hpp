@@ -35,6 +35,13 @@ std::string arm_json(double k, double c = 0, double g = 0);
 std::string random_tree_json(unsigned seed, int bodies, double branching, bool prismatic,
                              double gravity = 9.81);
 
+// A random tree with every element type, fixed joints, springs, dampers, point loads and
+// torques, and (with `couplings`) joints that follow others linearly; with `several_rates`,
+// universal, planar, spherical and free joints in place of half the plain revolute ones, and a
+// free-floating base for odd seeds.
+std::string mixed_tree_json(unsigned seed, int bodies, double branching, bool couplings,
+                            bool several_rates = false);
+
 // A seeded random 6-body tree whose joints j2, j4, j5 follow the coordinates j0, j1, j3 through
 // nonlinear laws: a four-bar (j2 of j1), a polynomial in two joints (j4 of j0 and j3) and a
 // spline of a coupled joint (j5 of j2).

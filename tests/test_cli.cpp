@@ -13,6 +13,7 @@
 #include <regex>
 #include <set>
 
+#include "core/derivatives.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;
@@ -92,7 +93,7 @@ TEST_CASE("bad command lines and bad models: one line, non-zero exit", "[cli]") 
 
 TEST_CASE("every command has --help, info lists the correlation table", "[cli]") {
   for (const char* cmd : {"info", "equations", "compare", "track", "validate", "import", "simulate",
-                          "check", "study", "stress", "bench"}) {
+                          "check", "study", "stress", "bench", "linearize"}) {
     const Run r = run(std::string(cmd) + " --help");
     CHECK(r.code == 0);
     CHECK_THAT(r.out, Catch::StartsWith("usage: femdyn " + std::string(cmd)));
@@ -440,6 +441,54 @@ TEST_CASE("import writes JSON that loads back, atomically, or nothing at all", "
   CHECK(run("import " + model_path("urdf/arm7.urdf")).code == 2);  // no -o
 }
 
+TEST_CASE("linearize --json equals the library on the space robot; bad input in one line",
+          "[cli][derivatives]") {
+  // A free-floating base: A's chart block, the forward derivatives and M⁻¹, as the library
+  // computes them; the text form names its sizes.
+  const std::string path = model_path("space_robot.json");
+  const Model m = load_model(path);
+  const int n = m.n();
+  std::mt19937 rng(3);
+  VecX q = random_posture(m, rng);
+  const VecX qd = random_uniform(n, 0.5, rng), tau = random_uniform(n, 1, rng);
+  const auto list = [](const VecX& v) {
+    std::string s;
+    char buf[32];
+    for (Eigen::Index i = 0; i < v.size(); ++i) {
+      std::snprintf(buf, sizeof buf, "%s%.17g", i ? "," : "", v[i]);
+      s += buf;
+    }
+    return s;
+  };
+  const Run r = run("linearize " + path + " --q " + list(q) + " --qd " + list(qd) + " --tau " +
+                    list(tau) + " --json");
+  REQUIRE(r.code == 0);
+  const auto j = nlohmann::json::parse(r.out);
+  Workspace ws(m);
+  DerivativeWorkspace d(m);
+  normalize_quaternions(m, q);  // as the command does with what it reads
+  REQUIRE(forward_dynamics_derivatives(m, ws, d, q, qd, tau).ok);
+  MatX A, B;
+  linearization(m, d, qd, A, B);
+  CHECK(j["n"] == n);
+  REQUIRE(j["A"].size() == static_cast<std::size_t>(2 * n));
+  REQUIRE(j["B"].size() == static_cast<std::size_t>(2 * n));
+  for (int a = 0; a < 2 * n; ++a) {
+    CHECK(rel_error(vec(j["A"][a]), A.row(a).transpose(), 1e-300) == 0.0);
+    CHECK(rel_error(vec(j["B"][a]), B.row(a).transpose(), 1e-300) == 0.0);
+  }
+  const Run text = run("linearize " + model_path("finger.json"));
+  CHECK(text.code == 0);
+  CHECK_THAT(text.out, Catch::Contains("A = d(xi', v')/d(xi, v) (8 x 8)"));
+  Run bad = run("linearize " + model_path("finger_fourbar.json"));
+  CHECK(bad.code == 1);
+  CHECK(std::count(bad.out.begin(), bad.out.end(), '\n') == 1);
+  CHECK_THAT(bad.out, Catch::Contains("coupling laws"));
+  bad = run("linearize " + model_path("finger.json") + " --qd 1,2");
+  CHECK(bad.code == 2);
+  CHECK_THAT(bad.out, Catch::StartsWith("femdyn linearize: --qd has 2 values, expected 4"));
+}
+
 TEST_CASE("femdyn --version prints the version of CMakeLists.txt's project()", "[cli]") {
   std::ifstream f(std::string(FEMDYN_SOURCE_DIR) + "/CMakeLists.txt");
   const std::string cmake((std::istreambuf_iterator<char>(f)), {});
@@ -513,7 +562,8 @@ TEST_CASE("every --json output: \"coordinates\" the names, \"n\" how many", "[cl
       "simulate " + finger + " --t-end 0.01",
       "check " + finger + " --states 2",
       "compare " + finger + " " + finger + " --states 2",
-      "track " + finger + " --to 0.1,0.2,0.3,0.4 --duration 0.1 --steps 10"};
+      "track " + finger + " --to 0.1,0.2,0.3,0.4 --duration 0.1 --steps 10",
+      "linearize " + finger};
 #ifdef FEMDYN_WITH_SIMBODY
   commands.push_back("validate " + finger + " --states 2 --t-end 0");
 #ifdef NDEBUG  // (bench refuses to time a build with asserts)

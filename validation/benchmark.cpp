@@ -10,6 +10,8 @@
 //   femdyn/forward/M    forward_dynamics(): q̈
 //   simbody/forward/M   calcAccelerationIgnoringConstraints
 //   femdyn/inverse/M    inverse_dynamics(): τ
+//   femdyn/derivatives/M forward_dynamics_derivatives(): q̈, ∂q̈/∂q, ∂q̈/∂v and M⁻¹ (models the
+//                       analytic derivatives cover, core/derivatives.hpp)
 //   simbody/inverse/M   residual with θ̈
 //   femdyn/rest/M       evaluate() at q̇ = 0 (h not computed)
 //   femdyn/weightless/M evaluate() on the model without gravity (models with gravity only)
@@ -56,6 +58,7 @@
 #include <vector>
 
 #include "compile/compile.hpp"
+#include "core/derivatives.hpp"
 #include "core/equations.hpp"
 #include "core/kinematics.hpp"
 #include "core/loops/assembly.hpp"
@@ -94,6 +97,7 @@ struct Case {
   // need" measured, against evaluate() with gravity.
   std::unique_ptr<const Model> weightless;
   std::unique_ptr<Workspace> ws_weightless;
+  std::unique_ptr<DerivativeWorkspace> derivatives;  // where core/derivatives.hpp covers it
 };
 
 // What makes the run fail (exit 1): engines that disagree, femdyn allocating in its hot path.
@@ -136,6 +140,7 @@ void add_case(std::string name, Spec spec, const Urdf& urdf = {}) {
     c->ws_ref = std::make_unique<Workspace>(*c->reference);
   }
   c->ws = std::make_unique<Workspace>(m);
+  if (derivatives_unsupported(m).empty()) c->derivatives = std::make_unique<DerivativeWorkspace>(m);
   c->twin = std::make_unique<fv::SimbodyTwin>(fv::twin_model(m));
   std::mt19937 rng(1);
   c->q = random_posture(m, rng);
@@ -231,6 +236,11 @@ void register_case(Case* c) {
   });
   reg("simbody", "forward", [](Case& c) { c.twin->time_forward(c.q, c.qd, c.tau); });
   reg_mujoco("forward");
+  if (c->derivatives)
+    reg("femdyn", "derivatives", [](Case& c) {
+      benchmark::DoNotOptimize(
+          forward_dynamics_derivatives(c.model, *c.ws, *c.derivatives, c.q, c.qd, c.tau).ok);
+    });
   reg("femdyn", "inverse", [](Case& c) { inverse_dynamics(c.model, *c.ws, c.q, c.qd, c.qdd); });
   reg("simbody", "inverse", [](Case& c) { c.twin->time_inverse(c.q, c.qd, c.qdd); });
   reg_mujoco("inverse");

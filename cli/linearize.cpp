@@ -1,0 +1,85 @@
+// femdyn linearize: the state-space linearisation of the dynamics at a state
+// (core/derivatives.hpp),
+//   d/dt (ξ, v) = A (ξ, v) + B τ,   A = ∂(ξ̇, v̇)/∂(ξ, v),   B = ∂(ξ̇, v̇)/∂τ,
+// ξ the tangent coordinates q ⊕ ξ around the state's q (ξ = q − q₀ on flat joints).
+#include <cmath>
+#include <iostream>
+#include <sstream>
+
+#include "cli/commands.hpp"
+#include "core/derivatives.hpp"
+#include "core/equations.hpp"
+#include "core/names.hpp"
+#include "io/output.hpp"
+
+namespace femdyn::cli {
+namespace {
+
+constexpr const char* kHelp =
+    R"(usage: femdyn linearize MODEL [--q …] [--qd …] [--tau …] [--json] [--gravity gx,gy,gz]
+
+The linearisation of the equations of motion at the state (--q: n_q values, default the neutral
+configuration; --qd, --tau: n values each, default 0):
+  d/dt (ξ, v) = A (ξ, v) + B τ,   A = ∂(ξ̇, v̇)/∂(ξ, v) (2n × 2n),   B = ∂(ξ̇, v̇)/∂τ (2n × n),
+with v̇ = q̈ and ξ the tangent coordinates around q: q + ξ on a flat joint; q ⊗ exp(ξ) on a
+spherical joint, whose ξ̇ = J_r(ξ)⁻¹ ω turns A's top-left block (−½ [ω]×); (p + R ξ_p,
+q ⊗ exp(ξ_r)) on a free joint (also −[v]× from ξ̇_p = exp(ξ_r) v). By analytic derivatives of
+the dynamics (docs/derivatives.md): trees with linear couplings, springs, dampers, friction,
+rotors, stops and loads; other models are refused in one line.
+
+--json prints {"n", "coordinates", "q", "qd", "tau", "A", "B"}, A and B as lists of rows.
+)";
+
+Json vector_json(const VecX& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+Json matrix_json(const MatX& m) {
+  Json rows = Json::array();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) rows.push_back(vector_json(m.row(r).transpose()));
+  return rows;
+}
+
+}  // namespace
+
+int cmd_linearize(int argc, char** argv) {
+  const Args a = parse_args(argc, argv, 2, {"help", "json"}, {"gravity", "q", "qd", "tau"});
+  if (a.has("help")) {
+    std::cout << kHelp;
+    return 0;
+  }
+  const Model m = load(a);
+  const VecX q = configuration_vector(a, "q", m), qd = state_vector(a, "qd", m),
+             tau = state_vector(a, "tau", m);
+  Workspace ws(m);
+  DerivativeWorkspace d(m);  // a model it does not cover: one line, exit 1
+  const Status st = forward_dynamics_derivatives(m, ws, d, q, qd, tau);
+  if (!st.ok) {
+    std::cerr << "femdyn linearize: " << escaped(a.positional[0]) << ": at this state "
+              << safe_message(st.message) << "\n";
+    return 1;
+  }
+  MatX A, B;
+  linearization(m, d, qd, A, B);
+  if (!A.allFinite() || !B.allFinite()) {
+    std::cerr << "femdyn linearize: " << escaped(a.positional[0])
+              << ": at this state A or B is NaN or Inf (the state overflows double precision)\n";
+    return 1;
+  }
+  if (a.has("json")) {
+    std::cout << readable_json(Json{{"n", m.n()},
+                                    {"coordinates", m.coordinate_names},
+                                    {"q", vector_json(q)},
+                                    {"qd", vector_json(qd)},
+                                    {"tau", vector_json(tau)},
+                                    {"A", matrix_json(A)},
+                                    {"B", matrix_json(B)}});
+    return 0;
+  }
+  std::ostringstream text;
+  text.precision(10);
+  text << "n = " << m.n() << "; state (xi, v), xi the tangent coordinates around q\n";
+  text << "A = d(xi', v')/d(xi, v) (" << 2 * m.n() << " x " << 2 * m.n() << ") =\n" << A << "\n";
+  text << "B = d(xi', v')/d tau (" << 2 * m.n() << " x " << m.n() << ") =\n" << B << "\n";
+  std::cout << text.str();
+  return 0;
+}
+
+}  // namespace femdyn::cli

@@ -1,0 +1,287 @@
+#include "core/derivatives.hpp"
+
+#include <cmath>
+
+#include "core/articulated.hpp"
+#include "core/body_loads.hpp"
+#include "core/coupling.hpp"
+#include "core/equations.hpp"
+#include "core/errors.hpp"
+#include "core/joints/kernel.hpp"
+#include "core/joints/passive.hpp"
+#include "core/kinematics.hpp"
+
+namespace femdyn {
+namespace {
+
+// Whether column k of the joint is fixed in the parent's joint frame (else in B).
+bool column_in_parent(const Joint& j, int k) {
+  return visit_joint(j.type, [&]<class J>(J) { return J::in_parent(k); });
+}
+
+// The motion cross-product matrix: crm(V) x = V × x.
+Mat6 motion_cross_matrix(const Vec6& V) {
+  Mat6 X = Mat6::Zero();
+  X.topLeftCorner<3, 3>() = skew(V.head<3>());
+  X.bottomRightCorner<3, 3>() = X.topLeftCorner<3, 3>();
+  X.bottomLeftCorner<3, 3>() = skew(V.tail<3>());
+  return X;
+}
+
+// B x = V ×* (I x) − I (V × x) + x ×* h with h = I V:
+//   B = −crm(V)ᵀ I − I crm(V) − H(h),   H(h) = [[ [h_n]×, [h_f]× ], [ [h_f]×, 0 ]].
+Mat6 velocity_inertia(const RigidInertia& I, const Vec6& V) {
+  const Mat6 Im = I.matrix(), X = motion_cross_matrix(V);
+  const Vec6 h = I * V;
+  Mat6 B;
+  B.noalias() = -X.transpose() * Im;
+  B.noalias() -= Im * X;
+  const Mat3 hn = skew(h.head<3>()), hf = skew(h.tail<3>());
+  B.topLeftCorner<3, 3>() -= hn;
+  B.topRightCorner<3, 3>() -= hf;
+  B.bottomLeftCorner<3, 3>() -= hf;
+  return B;
+}
+
+// L s: how the world-fixed loads on a body turn when it turns by s (force deviation from a rigid
+// wrench): a point load f at x gives (x × (s × f), s × f), a body torque t gives (s × t, 0).
+void add_load_turning(const Model& m, const Workspace& ws, DerivativeWorkspace& d) {
+  for (Mat63& L : d.Lc) L.setZero();
+  for (const PointLoad& l : m.point_loads) {
+    const BodyState& B = ws.body[l.body];
+    const Vec3 x = B.p + B.R * l.point;
+    d.Lc[l.body].topRows<3>() -= skew(x) * skew(l.force);
+    d.Lc[l.body].bottomRows<3>() -= skew(l.force);
+  }
+  for (const BodyTorque& t : m.torques) d.Lc[t.body].topRows<3>() -= skew(t.torque);
+}
+
+// Root to leaves for body b: S, V̄, ā, V, a, the rates' y, δV, z, and its own I, B, f.
+void forward_body(const Model& m, const Workspace& ws, DerivativeWorkspace& d, int b,
+                  const Vec6& a_base) {
+  const Body& body = m.bodies[b];
+  const Joint& J = body.joint;
+  const BodyState& Bs = ws.body[b];
+  const Vec6 V_P = body.parent >= 0 ? d.V[body.parent] : Vec6::Zero();
+  const Vec6 a_P = body.parent >= 0 ? d.a[body.parent] : a_base;
+  Vec6 Vbar = V_P, abar = a_P;
+  if (moves(J)) {
+    spatial_columns(J, Bs.R, parent_rotation(m, ws.body, b), Bs.p, d.S.data() + J.idx_v);
+    for (int k = 0; k < J.nv; ++k)  // columns fixed in the parent: they do not move with q_J
+      if (column_in_parent(J, k)) {
+        const int r = J.idx_v + k;
+        Vbar += d.S[r] * d.theta_dot[r];
+        abar += d.S[r] * d.theta_ddot[r] + cross_motion(V_P, d.S[r]) * d.theta_dot[r];
+      }
+  }
+  Vec6 V = Vbar, a = abar;
+  for (int k = 0; k < J.nv; ++k)
+    if (!column_in_parent(J, k)) V += d.S[J.idx_v + k] * d.theta_dot[J.idx_v + k];
+  for (int k = 0; k < J.nv; ++k) {
+    const int r = J.idx_v + k;
+    const bool in_parent = column_in_parent(J, k);
+    if (!in_parent) a += d.S[r] * d.theta_ddot[r] + cross_motion(V, d.S[r]) * d.theta_dot[r];
+    d.dV[r] = cross_motion(Vbar, d.S[r]);
+    d.y[r] = -cross_motion(d.S[r], abar) - cross_motion(d.dV[r], Vbar);
+    d.z[r] = cross_motion(in_parent ? V_P : V, d.S[r]) - cross_motion(d.S[r], Vbar);
+  }
+  d.V[b] = V, d.a[b] = a, d.V_bar[b] = Vbar, d.a_bar[b] = abar;
+  d.Ic[b] = inertia_at_origin(m.body_inertia[b], Bs.R, Bs.p);
+  d.F[b] = d.Ic[b] * a + cross_force(V, d.Ic[b] * V);
+  d.Bc[b] = velocity_inertia(d.Ic[b], V);
+}
+
+// The external wrenches subtracted from each body's own force (as Newton–Euler does).
+void subtract_loads(const Model& m, const Workspace& ws, DerivativeWorkspace& d) {
+  for (const PointLoad& l : m.point_loads) {
+    const BodyState& B = ws.body[l.body];
+    d.F[l.body] -= wrench_at_origin(B.p + B.R * l.point, l.force);
+  }
+  for (const BodyTorque& t : m.torques) d.F[t.body].head<3>() -= t.torque;
+}
+
+// Leaves to root at body b, its subtree's I^c, B^c, L^c, F complete: the pairs (c, m) with c or
+// m a rate of b and the other on b's path to the root (or b's own).
+void backward_body(const Model& m, DerivativeWorkspace& d, int b, MatX& Kq, MatX& Kv) {
+  const Joint& J = m.bodies[b].joint;
+  const RigidInertia& Ic = d.Ic[b];
+  const Mat6& Bc = d.Bc[b];
+  for (int k = 0; k < J.nv; ++k) {  // m own: c own or above (b is the deeper)
+    const int mr = J.idx_v + k;
+    Vec6 Xq = Ic * d.y[mr] + Bc * d.dV[mr];
+    if (d.loads) Xq += d.Lc[b] * d.S[mr].head<3>();
+    const Vec6 Xv = Ic * d.z[mr] + Bc * d.S[mr];
+    const Vec6 SF = cross_force(d.S[mr], d.F[b]);  // the rigid part S_m ×* F_b
+    for (int c = J.idx_v + J.nv - 1; c >= 0; c = m.rate_parent[c]) {
+      const bool own = c >= J.idx_v;
+      const bool moves_with = own && !column_in_parent(J, c - J.idx_v);
+      Kq(c, mr) = d.S[c].dot(Xq) + (moves_with ? 0.0 : d.S[c].dot(SF));
+      Kv(c, mr) = d.S[c].dot(Xv);
+    }
+  }
+  for (int k = 0; k < J.nv; ++k) {  // c own, m strictly above: b is the deeper
+    const int c = J.idx_v + k;
+    d.uI[c] = Ic * d.S[c];
+    d.uB[c].noalias() = Bc.transpose() * d.S[c];
+    if (d.loads) d.uL[c].noalias() = d.Lc[b].transpose() * d.S[c];
+    for (int mr = m.rate_parent[J.idx_v]; mr >= 0; mr = m.rate_parent[mr]) {
+      double q = d.uI[c].dot(d.y[mr]) + d.uB[c].dot(d.dV[mr]);
+      if (d.loads) q += d.uL[c].dot(d.S[mr].head<3>());
+      Kq(c, mr) = q;
+      Kv(c, mr) = d.uI[c].dot(d.z[mr]) + d.uB[c].dot(d.S[mr]);
+    }
+  }
+}
+
+// The composites of b into its parent's.
+void accumulate(const Model& m, DerivativeWorkspace& d, int b) {
+  const int p = m.bodies[b].parent;
+  if (p < 0) return;
+  d.Ic[p] += d.Ic[b];
+  d.Bc[p] += d.Bc[b];
+  d.F[p] += d.F[b];
+  if (d.loads) d.Lc[p] += d.Lc[b];
+}
+
+// The joints' own forces f(θ, θ̇) enter τ_θ as −f: ∂τ_θ/∂θ −= ∂f/∂θ, ∂τ_θ/∂θ̇ −= ∂f/∂θ̇.
+void add_passive(const Model& m, const Workspace& ws, const DerivativeWorkspace& d, MatX& Kq,
+                 MatX& Kv) {
+  for (int j = 0; j < m.n_theta(); ++j) {
+    const Joint& J = m.bodies[m.theta_joint[j]].joint;
+    if (J.nv != 1) continue;
+    const double th = ws.theta[J.idx_q], w = d.theta_dot[j];
+    Kq(j, j) += J.stiffness;  // −∂(−k (θ − θ_rest))/∂θ
+    Kv(j, j) += J.damping;
+    if (J.friction != 0) {  // −F_c tanh(θ̇/v_s): slope F_c/v_s sech²
+      const double t = std::tanh(w / J.friction_velocity);
+      Kv(j, j) += J.friction / J.friction_velocity * (1 - t * t);
+    }
+    if (!J.stop) continue;
+    const StopForce s = stop_force(J, th, w);
+    if (s.force == 0) continue;  // inside the limits, or the clamp holds it at 0
+    const double x = th > J.upper ? th - J.upper : th - J.lower;
+    const double sign = th > J.upper ? 1.0 : -1.0;  // f = −k_s x (1 ± d θ̇)
+    Kq(j, j) += J.stop_stiffness * (1 + sign * J.stop_dissipation * w);
+    Kv(j, j) += J.stop_stiffness * x * sign * J.stop_dissipation;
+  }
+}
+
+// ∂τ_θ/∂θ, ∂τ_θ/∂θ̇ (nθ × nθ) into Kq, Kv.
+void joint_level(const Model& m, Workspace& ws, DerivativeWorkspace& d, const VecX& q,
+                 const VecX& qd, const VecX& qdd, MatX& Kq, MatX& Kv) {
+  const int nb = static_cast<int>(m.bodies.size());
+  propagate(m, ws, q, qd, {.jacobian = false, .bias = false, .rows = false});  // poses, θ
+  coupling_apply(m, qd, d.theta_dot);
+  coupling_apply(m, qdd, d.theta_ddot);
+  const Vec6 a_base = gravity_base_acceleration(m);
+  for (int b = 0; b < nb; ++b) forward_body(m, ws, d, b, a_base);
+  subtract_loads(m, ws, d);
+  if (d.loads) add_load_turning(m, ws, d);
+  for (int b = nb - 1; b >= 0; --b) {
+    backward_body(m, d, b, Kq, Kv);
+    accumulate(m, d, b);
+  }
+  add_passive(m, ws, d, Kq, Kv);
+}
+
+// x ← (M^s)⁻¹ x by the factorisation forward_dynamics left.
+void solve_column(const Model& m, Workspace& ws, VecX& x) {
+  if (m.dynamics_route == DynamicsRoute::Articulated)
+    articulated_solve(m, ws, x);
+  else
+    ws.solver.solve_in_place(x);
+}
+
+// Y ← −(M^s)⁻¹ Y column by column (sign −1), or (M^s)⁻¹ Y.
+void solve_columns(const Model& m, Workspace& ws, DerivativeWorkspace& d, MatX& Y, double sign) {
+  for (Eigen::Index k = 0; k < Y.cols(); ++k) {
+    d.column = sign * Y.col(k);
+    solve_column(m, ws, d.column);
+    Y.col(k) = d.column;
+  }
+}
+
+}  // namespace
+
+std::string derivatives_unsupported(const Model& m) {
+  if (m.coupling_level) return "derivatives need linear couplings; this model has coupling laws";
+  if (!m.constraints.empty()) return "derivatives of a model with closed loops are not available";
+  if (!m.springs.empty()) return "derivatives of two-point springs are not available";
+  if (!m.condensable || !m.velocity_forces_rigid || m.body_inertia.size() != m.bodies.size())
+    return "derivatives need an exact body-level form (no spanning elements, no explicit "
+           "correlation table, rigid velocity forces)";
+  return "";
+}
+
+DerivativeWorkspace::DerivativeWorkspace(const Model& m) {
+  if (const std::string why = derivatives_unsupported(m); !why.empty())
+    throw ModelError(m.where, why);
+  const int n = m.n(), nt = m.n_theta(), nb = static_cast<int>(m.bodies.size());
+  for (MatX* M : {&dtau_dq, &dtau_dv, &dqdd_dq, &dqdd_dv, &Minv}) M->setZero(n, n);
+  qdd = VecX::Zero(n);
+  for (auto* v : {&V, &a, &V_bar, &a_bar, &F}) v->assign(nb, Vec6::Zero());
+  Ic.assign(nb, RigidInertia{});
+  Bc.assign(nb, Mat6::Zero());
+  loads = !m.point_loads.empty() || !m.torques.empty();
+  Lc.assign(loads ? nb : 0, Mat63::Zero());
+  for (auto* v : {&S, &dV, &y, &z, &uI, &uB}) v->assign(nt, Vec6::Zero());
+  uL.assign(nt, Vec3::Zero());
+  theta_dot = VecX::Zero(nt);
+  theta_ddot = VecX::Zero(nt);
+  column = VecX::Zero(n);
+  if (!m.identity_coupling) {
+    Kq.setZero(nt, nt);
+    Kv.setZero(nt, nt);
+    KC.setZero(nt, n);
+  }
+}
+
+void inverse_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d,
+                                  const VecX& q, const VecX& qd, const VecX& qdd) {
+  MatX& Kq = m.identity_coupling ? d.dtau_dq : d.Kq;
+  MatX& Kv = m.identity_coupling ? d.dtau_dv : d.Kv;
+  Kq.setZero();
+  Kv.setZero();
+  joint_level(m, ws, d, q, qd, qdd, Kq, Kv);
+  if (m.identity_coupling) return;
+  d.KC.noalias() = Kq * m.C;  // ∂τ_q/∂q = Cᵀ (∂τ_θ/∂θ) C
+  d.dtau_dq.noalias() = m.C.transpose() * d.KC;
+  d.KC.noalias() = Kv * m.C;
+  d.dtau_dv.noalias() = m.C.transpose() * d.KC;
+}
+
+Status forward_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d,
+                                    const VecX& q, const VecX& qd, const VecX& tau) {
+  const Status st = forward_dynamics(m, ws, q, qd, tau);
+  if (!st.ok) return st;
+  d.qdd = ws.qdd;
+  inverse_dynamics_derivatives(m, ws, d, q, qd, d.qdd);
+  d.dqdd_dq = d.dtau_dq;
+  solve_columns(m, ws, d, d.dqdd_dq, -1.0);
+  d.dqdd_dv = d.dtau_dv;
+  solve_columns(m, ws, d, d.dqdd_dv, -1.0);
+  d.Minv.setIdentity();
+  solve_columns(m, ws, d, d.Minv, 1.0);
+  return st;
+}
+
+void linearization(const Model& m, const DerivativeWorkspace& d, const VecX& qd, MatX& A, MatX& B) {
+  const int n = m.n();
+  A.setZero(2 * n, 2 * n);
+  B.setZero(2 * n, n);
+  A.topRightCorner(n, n).setIdentity();
+  A.bottomLeftCorner(n, n) = d.dqdd_dq;
+  A.bottomRightCorner(n, n) = d.dqdd_dv;
+  B.bottomRows(n) = d.Minv;
+  for (const CoordinateJoint& c : m.coordinate_joints) {
+    const Joint& J = m.bodies[c.body].joint;
+    if (J.type == JointType::Spherical) {  // ξ̇ = J_r(ξ)⁻¹ ω: −½ [ω]×
+      A.block<3, 3>(c.v, c.v) = -0.5 * skew(qd.segment<3>(c.v));
+    } else if (J.type == JointType::Free) {  // ξ̇_p = exp(ξ_r) v_p: −[v_p]×; ξ̇_r as above
+      A.block<3, 3>(c.v, c.v + 3) = -skew(qd.segment<3>(c.v));
+      A.block<3, 3>(c.v + 3, c.v + 3) = -0.5 * skew(qd.segment<3>(c.v + 3));
+    }
+  }
+}
+
+}  // namespace femdyn

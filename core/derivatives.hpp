@@ -1,0 +1,94 @@
+// Analytic derivatives of the dynamics (Carpentier and Mansard, "Analytical Derivatives of Rigid
+// Body Dynamics Algorithms", RSS 2018), over the element-assembled body inertias Λ_b in world
+// axes about the world origin (core/spatial.hpp), as the Newton–Euler recursion
+// (core/newton_euler.hpp) computes τ.
+//
+// Convention. Every derivative is n × n over the rates v, one column per rate. A column with
+// respect to q is the derivative along the tangent: ∂f/∂q_m = d/dε f(q ⊕ ε e_m) at ε = 0, with
+// q ⊕ ξ of `integrate_posture` (core/sampling.hpp): q + ξ on a flat joint; on a spherical joint
+// q ⊗ exp(ξ), on a free joint (p + R ξ_p, q ⊗ exp(ξ_r)) — the body turns and moves in its own
+// axes. v, q̈ and τ are held fixed along it.
+//
+// Inverse dynamics τ(q, v, q̈) = M^s q̈ + h − Q|_{τ=0}. For a rate m of body b(m), moving q_m
+// moves the subtree of b(m) rigidly by the twist S_m (its column, world axes about the origin).
+// With V̄, ā the joint's velocity and acceleration before its columns that move with it (the
+// parent's, plus the columns fixed in the parent's frame), the bodies i below b(m) see
+//   ∂V_i/∂q_m = S_m × V_i + δV_m,                δV_m = V̄ × S_m,
+//   ∂a_i/∂q_m = S_m × a_i − S_m × ā + δV_m × (V_i − V̄),
+//   ∂I_i/∂q_m = S_m ×* I_i − I_i S_m×,
+// so that the subtree's force F_b = Σ_{i ⪰ b} f_i (f_i = I_i a_i + V_i ×* I_i V_i − f^ext_i)
+// changes by S_m ×* F_b plus
+//   Dev_m(b) = I^c_b y_m + B^c_b δV_m + L^c_b S_m,ω,     y_m = −S_m × ā − δV_m × V̄,
+//   B_i x = V_i ×* I_i x − I_i (V_i × x) + x ×* (I_i V_i)       (B^c_b = Σ_{i ⪰ b} B_i),
+//   L_i: a point load f at x gives (x × (s × f), s × f), a body torque t gives (s × t, 0);
+// and ∂a_i/∂v_m = V_f × S_m + S_m × (V_i − V̄) (V_f the velocity of the frame S_m is fixed in),
+//   ∂F_b/∂v_m = I^c_b z_m + B^c_b S_m,     z_m = V_f × S_m − S_m × V̄.
+// With τ_c = S_cᵀ F_b(c), and b the deeper of b(c), b(m):
+//   ∂τ_c/∂q_m = S_cᵀ Dev_m(b) + [S_c does not move with q_m] S_cᵀ (S_m ×* F_b(m)),
+//   ∂τ_c/∂v_m = S_cᵀ (I^c_b z_m + B^c_b S_m),
+// then the joints' own forces (spring k, damper c, Coulomb F_c/v_s sech²(θ̇/v_s), stop) and the
+// coupling level, ∂τ_q/∂q = Cᵀ (∂τ_θ/∂θ) C. O(n · depth): two dot products per pair.
+//
+// Forward dynamics q̈ = (M^s)⁻¹ (τ − (h − Q|_{τ=0})):
+//   ∂q̈/∂q = −(M^s)⁻¹ ∂τ/∂q|_{q̈},   ∂q̈/∂v = −(M^s)⁻¹ ∂τ/∂v|_{q̈},   ∂q̈/∂τ = (M^s)⁻¹,
+// (M^s)⁻¹ applied column by column by the factorisation forward_dynamics leaves: the articulated
+// recursion's (articulated_solve, O(bodies) a column) or ws.solver's.
+//
+// Covered: every model on the body-level force route whose coupling level is linear — trees of
+// every joint type, free bases, joint springs, dampers, Coulomb friction, stops, rotors, gravity,
+// point loads and body torques. Refused with a one-line ModelError: nonlinear coupling laws,
+// closed loops, two-point springs, and a body-level form that is not exact (spanning elements,
+// an explicit correlation table).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "core/status.hpp"
+#include "core/workspace.hpp"
+
+namespace femdyn {
+
+using Mat63 = Eigen::Matrix<double, 6, 3>;
+
+// The results and buffers of the derivatives, sized once for a model: no allocation per call
+// after the first.
+struct DerivativeWorkspace {
+  explicit DerivativeWorkspace(const Model& model);  // throws ModelError if not covered
+
+  MatX dtau_dq, dtau_dv;        // ∂τ/∂q, ∂τ/∂v (n × n)
+  MatX dqdd_dq, dqdd_dv, Minv;  // ∂q̈/∂q, ∂q̈/∂v, ∂q̈/∂τ = (M^s)⁻¹ (n × n)
+  VecX qdd;                     // q̈ of the last forward derivatives
+
+  // Per body (world axes about the origin).
+  std::vector<Vec6> V, a, V_bar, a_bar, F;
+  std::vector<RigidInertia> Ic;
+  std::vector<Mat6> Bc;
+  std::vector<Mat63> Lc;
+  // Per rate of θ̇.
+  std::vector<Vec6> S, dV, y, z, uI, uB;
+  std::vector<Vec3> uL;
+  VecX theta_dot, theta_ddot, column;
+  MatX Kq, Kv, KC;  // the joint-level ∂τ_θ/∂θ, ∂τ_θ/∂θ̇ and K C (coupled models only)
+  bool loads = false;
+};
+
+// "" if the derivatives cover `model`, else why not (one line).
+std::string derivatives_unsupported(const Model& model);
+
+// ∂τ/∂q, ∂τ/∂v of inverse dynamics at (q, v, q̈) into d.dtau_dq, d.dtau_dv. Leaves the body
+// poses in ws and nothing else of ws changed (a factorisation there stays valid).
+void inverse_dynamics_derivatives(const Model& model, Workspace& ws, DerivativeWorkspace& d,
+                                  const VecX& q, const VecX& qd, const VecX& qdd);
+
+// q̈ (into ws.qdd and d.qdd), then ∂q̈/∂q, ∂q̈/∂v and (M^s)⁻¹ into d. A failed forward dynamics
+// (singular M^s) is returned as is.
+Status forward_dynamics_derivatives(const Model& model, Workspace& ws, DerivativeWorkspace& d,
+                                    const VecX& q, const VecX& qd, const VecX& tau);
+
+// A = ∂(ξ̇, v̇)/∂(ξ, v) at ξ = 0 (2n × 2n) and B = ∂(ξ̇, v̇)/∂τ (2n × n) from the forward
+// derivatives in d at (q, v): ξ̇ = v on flat joints; in the chart ξ ↦ q ⊕ ξ a spherical joint has
+// ξ̇ = J_r(ξ)⁻¹ ω, so ∂ξ̇/∂ξ = −½ [ω]×, and a free joint also ξ̇_p = exp(ξ_r) v_p, −[v_p]×.
+void linearization(const Model& model, const DerivativeWorkspace& d, const VecX& qd, MatX& A,
+                   MatX& B);
+
+}  // namespace femdyn

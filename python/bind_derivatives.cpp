@@ -1,0 +1,96 @@
+// Model.derivatives, Model.inverse_derivatives and Model.linearize: the analytic derivatives of
+// the dynamics at one state (core/derivatives.hpp, docs/derivatives.md).
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include "core/derivatives.hpp"
+#include "core/equations.hpp"
+#include "python/py_model.hpp"
+
+namespace femdyn::python {
+namespace {
+
+using OptArray = std::optional<Array>;
+
+// The model's derivative buffers, made on first use (a model they do not cover: ModelError).
+DerivativeWorkspace& derivative_workspace(PyModel& self) {
+  if (!self.derivatives) self.derivatives = std::make_unique<DerivativeWorkspace>(*self.model);
+  return *self.derivatives;
+}
+
+void require_finite(const MatX& x, const char* what) {
+  if (!x.allFinite())
+    throw NumericalError(std::string("at this state ") + what +
+                         " is NaN or Inf (the state overflows double precision)");
+}
+
+// q̈ and its derivatives at (q, q̇, τ), after forward dynamics.
+DerivativeWorkspace& forward_at(PyModel& self, const Array& q, const OptArray& qd,
+                                const OptArray& tau, VecX& v) {
+  const Model& m = *self.model;
+  DerivativeWorkspace& d = derivative_workspace(self);
+  v = vector_arg(qd, "qd", m);
+  const Status st = forward_dynamics_derivatives(m, self.ws, d, configuration_arg(q, "q", m), v,
+                                                 vector_arg(tau, "tau", m, Entries::Bounded));
+  if (!st.ok) throw NumericalError("at this state " + st.message);
+  require_finite(d.dqdd_dq, "dqdd_dq");
+  require_finite(d.dqdd_dv, "dqdd_dv");
+  return d;
+}
+
+py::dict forward(PyModel& self, const Array& q, const OptArray& qd, const OptArray& tau) {
+  VecX v;
+  const DerivativeWorkspace& d = forward_at(self, q, qd, tau, v);
+  py::dict out;
+  out["qdd"] = d.qdd;
+  out["dqdd_dq"] = d.dqdd_dq;
+  out["dqdd_dv"] = d.dqdd_dv;
+  out["Minv"] = d.Minv;
+  return out;
+}
+
+py::dict inverse(PyModel& self, const Array& q, const OptArray& qd, const OptArray& qdd) {
+  const Model& m = *self.model;
+  DerivativeWorkspace& d = derivative_workspace(self);
+  const VecX qv = configuration_arg(q, "q", m), v = vector_arg(qd, "qd", m),
+             a = vector_arg(qdd, "qdd", m);
+  inverse_dynamics_derivatives(m, self.ws, d, qv, v, a);
+  require_finite(d.dtau_dq, "dtau_dq");
+  require_finite(d.dtau_dv, "dtau_dv");
+  inverse_dynamics(m, self.ws, qv, v, a);
+  py::dict out;
+  out["tau"] = VecX(self.ws.tau);
+  out["dtau_dq"] = d.dtau_dq;
+  out["dtau_dv"] = d.dtau_dv;
+  return out;
+}
+
+std::pair<MatX, MatX> linearize(PyModel& self, const Array& q, const OptArray& qd,
+                                const OptArray& tau) {
+  VecX v;
+  const DerivativeWorkspace& d = forward_at(self, q, qd, tau, v);
+  MatX A, B;
+  linearization(*self.model, d, v, A, B);
+  return {A, B};
+}
+
+}  // namespace
+
+void bind_derivatives(py::module_& m) {
+  auto cls = py::reinterpret_borrow<py::class_<PyModel>>(m.attr("Model"));
+  cls.def("derivatives", &forward, py::arg("q"), py::arg("qd") = py::none(),
+          py::arg("tau") = py::none(),
+          "Forward dynamics and its analytic derivatives at (q, q̇, τ) as a dict: qdd (n,), "
+          "dqdd_dq, dqdd_dv, Minv = dqdd_dtau (n, n); columns over the rates, q moved along "
+          "its tangent q ⊕ ξ on spherical and free joints (docs/derivatives.md)")
+      .def("inverse_derivatives", &inverse, py::arg("q"), py::arg("qd") = py::none(),
+           py::arg("qdd") = py::none(),
+           "Inverse dynamics and its analytic derivatives at (q, q̇, q̈) as a dict: tau (n,), "
+           "dtau_dq, dtau_dv (n, n)")
+      .def("linearize", &linearize, py::arg("q"), py::arg("qd") = py::none(),
+           py::arg("tau") = py::none(),
+           "(A, B): d/dt (ξ, v) = A (ξ, v) + B τ at the state, A (2n, 2n), B (2n, n), as "
+           "`femdyn linearize` prints them");
+}
+
+}  // namespace femdyn::python

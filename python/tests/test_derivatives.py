@@ -1,0 +1,62 @@
+"""Model.derivatives, inverse_derivatives and linearize against numpy central differences (flat
+models: q + h e_k), the CLI's `femdyn linearize --json`, and the refusal of uncovered models."""
+import numpy as np
+import pytest
+
+import femdyn
+from conftest import cli_json, model_path, numbers, state
+
+FLAT = ["models/finger.json", "models/finger_coupled.json", "models/branched_tree.json",
+        "models/urdf/arm7.urdf"]
+
+
+def central(f, x, h=1e-6):
+    cols = []
+    for k in range(x.size):
+        e = np.zeros_like(x)
+        e[k] = h
+        cols.append((f(x + e) - f(x - e)) / (2 * h))
+    return np.stack(cols, axis=1)
+
+
+def rel(a, b):
+    return np.abs(a - b).max() / max(np.abs(b).max(), 1e-12)
+
+
+@pytest.mark.parametrize("name", FLAT)
+def test_forward_and_inverse_derivatives_against_differences(name):
+    m = femdyn.load(model_path(name))
+    q, qd, qdd0 = state(m.n, seed=5)
+    # τ of a moderate q̈: a random τ on the light finger makes q̈ ~1e6 and its differences noise.
+    tau = m.inverse_dynamics(q, qd, qdd0)
+    d = m.derivatives(q, qd, tau)
+    assert np.array_equal(d["qdd"], m.forward_dynamics(q, qd, tau))
+    assert rel(d["dqdd_dq"], central(lambda x: m.forward_dynamics(x, qd, tau), q)) < 1e-7
+    assert rel(d["dqdd_dv"], central(lambda x: m.forward_dynamics(q, x, tau), qd)) < 1e-7
+    assert rel(d["Minv"] @ m.mass_matrix(q), np.eye(m.n)) < 1e-10
+    qdd = d["qdd"]
+    i = m.inverse_derivatives(q, qd, qdd)
+    assert rel(i["tau"], tau) < 1e-10
+    assert rel(i["dtau_dq"], central(lambda x: m.inverse_dynamics(x, qd, qdd), q)) < 1e-7
+    assert rel(i["dtau_dv"], central(lambda x: m.inverse_dynamics(q, x, qdd), qd)) < 1e-7
+    # ∂q̈/∂q = −M⁻¹ ∂τ/∂q at the q̈ of the state.
+    assert rel(d["dqdd_dq"], -d["Minv"] @ i["dtau_dq"]) < 1e-10
+
+
+def test_linearize_equals_the_cli():
+    m = femdyn.load(model_path("models/finger.json"))
+    q, qd, tau = state(m.n, seed=7)
+    A, B = m.linearize(q, qd, tau)
+    n = m.n
+    assert A.shape == (2 * n, 2 * n) and B.shape == (2 * n, n)
+    assert np.array_equal(A[:n, n:], np.eye(n)) and np.all(A[:n, :n] == 0)
+    out = cli_json("linearize", "models/finger.json", "--q", numbers(q), "--qd", numbers(qd),
+                   "--tau", numbers(tau), "--json")
+    assert out["n"] == n and out["coordinates"] == m.coordinates
+    assert np.array_equal(np.array(out["A"]), A) and np.array_equal(np.array(out["B"]), B)
+
+
+def test_uncovered_model_is_refused():
+    m = femdyn.load(model_path("models/finger_fourbar.json"))
+    with pytest.raises(femdyn.ModelError, match="coupling laws"):
+        m.derivatives(np.zeros(m.n))

@@ -1,0 +1,207 @@
+// The analytic derivatives of the dynamics (core/derivatives.hpp) against independent numbers:
+// central differences along the tangent q ⊕ ε e_m (step 1e-6: truncation ~1e-12, round-off
+// ~1e-10 of the scale) and a Richardson extrapolation of them (steps 1e-3 and 5e-4: error
+// O(h⁴)); against the tensor D (∂h/∂v = (D + D over its last two indices swapped) q̇); and
+// ∂q̈/∂τ M^s = I. On seeded random trees of every joint type with springs, dampers, Coulomb
+// friction, rotors, stops, loads and couplings, and on the bundled and URDF robots.
+#include <catch2/catch.hpp>
+#include <functional>
+#include <nlohmann/json.hpp>
+
+#include "core/derivatives.hpp"
+#include "tests/helpers.hpp"
+
+using namespace femdyn;
+using namespace femdyn::test;
+using Json = nlohmann::json;
+
+namespace {
+
+using Function = std::function<VecX(const VecX& q, const VecX& v)>;
+
+// Central difference with step h along q ⊕ ε e_m (wrt_q) or v + ε e_m.
+MatX central(const Model& m, const Function& f, const VecX& q, const VecX& v, bool wrt_q,
+             double h) {
+  const int n = m.n();
+  MatX J(n, n);
+  for (int k = 0; k < n; ++k) {
+    const VecX e = VecX::Unit(n, k);
+    const VecX plus = wrt_q ? f(integrate_posture(m, q, h * e), v) : f(q, v + h * e);
+    const VecX minus = wrt_q ? f(integrate_posture(m, q, -h * e), v) : f(q, v - h * e);
+    J.col(k) = (plus - minus) / (2 * h);
+  }
+  return J;
+}
+
+// Richardson: (4 D(h/2) − D(h)) / 3 cancels the h² term of the central difference.
+MatX richardson(const Model& m, const Function& f, const VecX& q, const VecX& v, bool wrt_q) {
+  const double h = 1e-3;
+  return (4 * central(m, f, q, v, wrt_q, h / 2) - central(m, f, q, v, wrt_q, h)) / 3;
+}
+
+// Every joint of one coordinate gets, by a seeded draw, Coulomb friction, a rotor, a stop.
+std::string with_actuators(const std::string& text, unsigned seed) {
+  Json j = Json::parse(text);
+  std::mt19937 rng(seed);
+  for (Json& b : j["bodies"]) {
+    Json& joint = b["joint"];
+    if (joint["type"] != "revolute" && joint["type"] != "prismatic") continue;
+    if (rng() % 2) joint["friction"] = 0.4, joint["friction_velocity"] = 0.7;
+    if (rng() % 2) joint["armature"] = 0.02, joint["gear"] = 3;
+    if (rng() % 3 == 0)
+      joint["limits"] = {-0.4, 0.4}, joint["stop"] = {{"stiffness", 50}, {"dissipation", 0.1}};
+  }
+  return j.dump();
+}
+
+// The worst relative error of each derivative against both differences.
+struct Agreement {
+  double central = 0, richardson = 0;
+};
+
+void check_model(const Model& m, unsigned seed, Agreement& worst) {
+  Workspace ws(m), wf(m);
+  DerivativeWorkspace d(m);
+  std::mt19937 rng(seed);
+  // Joints beyond their limits too (random_posture stays inside them): stops engaged.
+  const VecX q = integrate_posture(m, random_posture(m, rng), random_uniform(m.n(), 0.5, rng));
+  const VecX v = random_uniform(m.n(), 1.5, rng), qdd = random_uniform(m.n(), 2, rng);
+  // τ of a moderate q̈ (a given τ on a light finger would make q̈ ~1e6 and its differences noise).
+  inverse_dynamics(m, wf, q, v, random_uniform(m.n(), 2, rng));
+  const VecX tau = wf.tau;
+  const Function tau_of = [&](const VecX& x, const VecX& y) {
+    inverse_dynamics(m, wf, x, y, qdd);
+    return wf.tau;
+  };
+  const Function qdd_of = [&](const VecX& x, const VecX& y) {
+    REQUIRE(forward_dynamics(m, wf, x, y, tau).ok);
+    return wf.qdd;
+  };
+  inverse_dynamics_derivatives(m, ws, d, q, v, qdd);
+  const MatX dtau_dq = d.dtau_dq, dtau_dv = d.dtau_dv;
+  REQUIRE(forward_dynamics_derivatives(m, ws, d, q, v, tau).ok);
+  struct Case {
+    const char* name;
+    const MatX *analytic, *other;  // the function's other derivative, for the scale
+    const Function* f;
+    bool wrt_q;
+  };
+  for (const auto& [name, analytic, other, f, wrt_q] :
+       {Case{"dtau_dq", &dtau_dq, &dtau_dv, &tau_of, true},
+        Case{"dtau_dv", &dtau_dv, &dtau_dq, &tau_of, false},
+        Case{"dqdd_dq", &d.dqdd_dq, &d.dqdd_dv, &qdd_of, true},
+        Case{"dqdd_dv", &d.dqdd_dv, &d.dqdd_dq, &qdd_of, false}}) {
+    INFO(name);
+    const MatX c = central(m, *f, q, v, wrt_q, 1e-6), r = richardson(m, *f, q, v, wrt_q);
+    // Relative to the larger of the function's two derivatives (∂τ/∂v of one hinge is 0).
+    const double scale = std::max({r.cwiseAbs().maxCoeff(), other->cwiseAbs().maxCoeff(), 1e-12});
+    const double ec = rel_error(*analytic, c, scale), er = rel_error(*analytic, r, scale);
+    worst.central = std::max(worst.central, ec);
+    worst.richardson = std::max(worst.richardson, er);
+    CHECK(ec < 1e-7);
+    CHECK(er < 1e-9);
+  }
+  // ∂q̈/∂τ = (M^s)⁻¹: (M^s)⁻¹ M^s = I.
+  mass_matrix(m, wf, q);
+  CHECK(rel_error(d.Minv * wf.Ms, MatX::Identity(m.n(), m.n()), 1.0) < 1e-10);
+}
+
+}  // namespace
+
+TEST_CASE("derivatives agree with differences on random trees of every joint type",
+          "[derivatives]") {
+  // Revolute, prismatic, fixed; universal, planar, spherical, free (odd seeds float); springs,
+  // dampers, point loads and torques, gravity; friction, rotors and stops by with_actuators.
+  Agreement worst;
+  for (unsigned seed = 1; seed <= 8; ++seed)
+    for (const int bodies : {1, 3, 8, 16}) {
+      INFO("seed " << seed << ", " << bodies << " bodies");
+      const bool several = seed % 4 != 0;
+      const Model m = load_text(with_actuators(
+          mixed_tree_json(seed, bodies, seed % 2 ? 0.6 : 0.0, false, several), seed));
+      check_model(m, seed, worst);
+    }
+  WARN("random trees: central " << worst.central << ", Richardson " << worst.richardson);
+}
+
+TEST_CASE("derivatives agree with differences on coupled random trees", "[derivatives]") {
+  Agreement worst;
+  for (unsigned seed = 1; seed <= 6; ++seed)
+    for (const int bodies : {6, 14}) {
+      INFO("seed " << seed << ", " << bodies << " bodies");
+      const Model m = load_text(with_actuators(mixed_tree_json(seed, bodies, 0.5, true), seed));
+      REQUIRE(!m.identity_coupling);
+      check_model(m, seed, worst);
+    }
+  WARN("coupled trees: central " << worst.central << ", Richardson " << worst.richardson);
+}
+
+TEST_CASE("derivatives agree with differences on the bundled and URDF robots", "[derivatives]") {
+  Agreement worst;
+  for (const char* name : {"finger.json", "finger_coupled.json", "hand.json", "space_robot.json"}) {
+    INFO(name);
+    check_model(load_model(model_path(name)), 3, worst);
+  }
+  const std::string robots = std::string(FEMDYN_SOURCE_DIR) + "/tests/robots/";
+  check_model(load_model(robots + "iiwa.urdf"), 4, worst);
+  check_model(load_model(robots + "atlas.urdf", {.floating_base = true}), 5, worst);
+  WARN("robots: central " << worst.central << ", Richardson " << worst.richardson);
+}
+
+TEST_CASE("dtau/dv is the contraction of the tensor D without dampers", "[derivatives]") {
+  // ∂h/∂v_b = Σ_c (D_abc + D_acb) q̇_c; and ∂τ/∂v = 0 at q̇ = 0.
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    INFO("seed " << seed);
+    Json j = Json::parse(mixed_tree_json(seed, 7, 0.5, seed % 2 == 0));
+    for (Json& b : j["bodies"]) b["joint"].erase("damping");
+    const Model m = load_text(j.dump());
+    Workspace ws(m);
+    DerivativeWorkspace d(m);
+    std::mt19937 rng(seed);
+    const VecX q = random_posture(m, rng), v = random_uniform(m.n(), 1.5, rng);
+    const VecX qdd = random_uniform(m.n(), 2, rng);
+    inverse_dynamics_derivatives(m, ws, d, q, VecX::Zero(m.n()), qdd);
+    CHECK(d.dtau_dv.cwiseAbs().maxCoeff() == 0.0);
+    inverse_dynamics_derivatives(m, ws, d, q, v, qdd);
+    const std::vector<MatX> D = third_order_tensor(m, ws, q);
+    MatX contraction(m.n(), m.n());
+    for (int a = 0; a < m.n(); ++a)
+      contraction.row(a) = ((D[a] + D[a].transpose()) * v).transpose();
+    CHECK(rel_error(d.dtau_dv, contraction, contraction.cwiseAbs().maxCoeff()) < 1e-12);
+  }
+}
+
+TEST_CASE("linearization: A's chart block against differences of the chart rates",
+          "[derivatives]") {
+  // ∂ξ̇/∂ξ at ξ = 0 (spherical and free joints turn it), and A, B assembled from the forward
+  // derivatives: A = [[∂ξ̇/∂ξ, I], [∂q̈/∂q, ∂q̈/∂v]], B = [0; (M^s)⁻¹].
+  for (unsigned seed = 1; seed <= 4; ++seed) {
+    const Model m = load_text(mixed_tree_json(seed, 10, 0.5, false, true));
+    Workspace ws(m);
+    DerivativeWorkspace d(m);
+    std::mt19937 rng(seed);
+    const int n = m.n();
+    const VecX q = random_posture(m, rng), v = random_uniform(n, 1.5, rng);
+    REQUIRE(forward_dynamics_derivatives(m, ws, d, q, v, VecX::Zero(n)).ok);
+    MatX A, B;
+    linearization(m, d, v, A, B);
+    const double h = 1e-6;
+    MatX chart(n, n);
+    for (int k = 0; k < n; ++k)
+      chart.col(k) = (chart_rates(m, q, h * VecX::Unit(n, k), v) -
+                      chart_rates(m, q, -h * VecX::Unit(n, k), v)) /
+                     (2 * h);
+    CHECK(rel_error(A.topLeftCorner(n, n), chart, v.cwiseAbs().maxCoeff()) < 1e-8);
+    CHECK(A.topRightCorner(n, n) == MatX::Identity(n, n));
+    CHECK(A.bottomLeftCorner(n, n) == d.dqdd_dq);
+    CHECK(B.bottomRows(n) == d.Minv);
+    CHECK(B.topRows(n).cwiseAbs().maxCoeff() == 0.0);
+  }
+}
+
+TEST_CASE("derivatives refuse the models they do not cover in one line", "[derivatives]") {
+  const Model laws = load_text(nonlinear_coupled_tree_json(2));
+  CHECK_THROWS_WITH(DerivativeWorkspace(laws), Catch::Contains("coupling laws"));
+  const Model spans = load_model(model_path("finger_paper.json"));
+  CHECK_THROWS_WITH(DerivativeWorkspace(spans), Catch::Contains("body-level form"));
+}
