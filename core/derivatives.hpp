@@ -31,8 +31,11 @@
 //
 // Forward dynamics q̈ = (M^s)⁻¹ (τ − (h − Q|_{τ=0})):
 //   ∂q̈/∂q = −(M^s)⁻¹ ∂τ/∂q|_{q̈},   ∂q̈/∂v = −(M^s)⁻¹ ∂τ/∂v|_{q̈},   ∂q̈/∂τ = (M^s)⁻¹,
-// (M^s)⁻¹ applied column by column by the factorisation forward_dynamics leaves: the articulated
-// recursion's (articulated_solve, O(bodies) a column) or ws.solver's.
+// On the articulated route (rates numbered depth first) (M^s)⁻¹ is formed in one O(n · bodies)
+// sweep over the factorisation forward_dynamics leaves (Carpentier, "Analytical inverse of the
+// joint space inertia matrix", 2018), then ∂q̈/∂· as dense products up to n = 96 and above that by
+// the factorisation eight columns at a time. Otherwise (M^s)⁻¹ is applied column by column by the
+// factorisation forward_dynamics leaves: articulated_solve's or ws.solver's.
 //
 // Covered: every model on the body-level force route whose coupling level is linear — trees of
 // every joint type, free bases, joint springs, dampers, Coulomb friction, stops, rotors, gravity,
@@ -70,6 +73,17 @@ struct DerivativeWorkspace {
   VecX theta_dot, theta_ddot, column;
   MatX Kq, Kv, KC;  // the joint-level ∂τ_θ/∂θ, ∂τ_θ/∂θ̇ and K C (coupled models only)
   bool loads = false;
+  // (M^s)⁻¹ in one O(n²) sweep over the articulated factorisation (articulated route, rates
+  // numbered depth first so that a subtree's rates are contiguous): per body its subtree's
+  // first rate and count, the slot of its accelerations' block; the 6 × n forces P and the
+  // slots' 6 × n accelerations (a body that is its parent's last child reuses its parent's).
+  bool minv_sweep = false;
+  std::vector<int> sub_first, sub_count, slot;
+  MatX P, A, rows;  // rows: a joint's rows of (M^s)⁻¹ while they are formed (n × 6)
+  // Above a size, (M^s)⁻¹ ∂τ/∂· by the articulated factorisation eight columns at a time (per
+  // body a 6 × 8 force and acceleration) instead of a dense product.
+  std::vector<Eigen::Matrix<double, 6, 8>> chunk_force, chunk_acceleration;
+  Eigen::Matrix<double, Eigen::Dynamic, 8, Eigen::RowMajor> chunk;
 };
 
 // "" if the derivatives cover `model`, else why not (one line).

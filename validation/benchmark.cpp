@@ -12,6 +12,7 @@
 //   femdyn/inverse/M    inverse_dynamics(): τ
 //   femdyn/derivatives/M forward_dynamics_derivatives(): q̈, ∂q̈/∂q, ∂q̈/∂v and M⁻¹ (models the
 //                       analytic derivatives cover, core/derivatives.hpp)
+//   femdyn/inverse_derivatives/M  inverse_dynamics_derivatives(): ∂τ/∂q and ∂τ/∂v alone
 //   simbody/inverse/M   residual with θ̈
 //   femdyn/rest/M       evaluate() at q̇ = 0 (h not computed)
 //   femdyn/weightless/M evaluate() on the model without gravity (models with gravity only)
@@ -240,6 +241,10 @@ void register_case(Case* c) {
     reg("femdyn", "derivatives", [](Case& c) {
       benchmark::DoNotOptimize(
           forward_dynamics_derivatives(c.model, *c.ws, *c.derivatives, c.q, c.qd, c.tau).ok);
+    });
+  if (c->derivatives)
+    reg("femdyn", "inverse_derivatives", [](Case& c) {
+      inverse_dynamics_derivatives(c.model, *c.ws, *c.derivatives, c.q, c.qd, c.qdd);
     });
   reg("femdyn", "inverse", [](Case& c) { inverse_dynamics(c.model, *c.ws, c.q, c.qd, c.qdd); });
   reg("simbody", "inverse", [](Case& c) { c.twin->time_inverse(c.q, c.qd, c.qdd); });
