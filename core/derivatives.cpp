@@ -173,10 +173,13 @@ void add_passive(const Model& m, const Workspace& ws, const DerivativeWorkspace&
 }
 
 // ∂τ_θ/∂θ, ∂τ_θ/∂θ̇ (nθ × nθ) into Kq, Kv.
+// With poses_ready, the body poses and θ in ws are those at q already (the articulated forward
+// dynamics just left them).
 void joint_level(const Model& m, Workspace& ws, DerivativeWorkspace& d, const VecX& q,
-                 const VecX& qd, const VecX& qdd, MatX& Kq, MatX& Kv) {
+                 const VecX& qd, const VecX& qdd, MatX& Kq, MatX& Kv, bool poses_ready = false) {
   const int nb = static_cast<int>(m.bodies.size());
-  propagate(m, ws, q, qd, {.jacobian = false, .bias = false, .rows = false});  // poses, θ
+  if (!poses_ready)
+    propagate(m, ws, q, qd, {.jacobian = false, .bias = false, .rows = false});  // poses, θ
   coupling_apply(m, qd, d.theta_dot);
   coupling_apply(m, qdd, d.theta_ddot);
   const Vec6 a_base = gravity_base_acceleration(m);
@@ -427,13 +430,15 @@ DerivativeWorkspace::DerivativeWorkspace(const Model& m) {
   plan_inverse_sweep(m, *this);
 }
 
-void inverse_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d,
-                                  const VecX& q, const VecX& qd, const VecX& qdd) {
+namespace {
+
+void inverse_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d, const VecX& q,
+                         const VecX& qd, const VecX& qdd, bool poses_ready) {
   MatX& Kq = m.identity_coupling ? d.dtau_dq : d.Kq;
   MatX& Kv = m.identity_coupling ? d.dtau_dv : d.Kv;
   Kq.setZero();
   Kv.setZero();
-  joint_level(m, ws, d, q, qd, qdd, Kq, Kv);
+  joint_level(m, ws, d, q, qd, qdd, Kq, Kv, poses_ready);
   if (m.identity_coupling) return;
   d.KC.noalias() = Kq * m.C;  // ∂τ_q/∂q = Cᵀ (∂τ_θ/∂θ) C
   d.dtau_dq.noalias() = m.C.transpose() * d.KC;
@@ -441,12 +446,20 @@ void inverse_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWorks
   d.dtau_dv.noalias() = m.C.transpose() * d.KC;
 }
 
+}  // namespace
+
+void inverse_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d,
+                                  const VecX& q, const VecX& qd, const VecX& qdd) {
+  inverse_derivatives(m, ws, d, q, qd, qdd, false);
+}
+
 Status forward_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d,
                                     const VecX& q, const VecX& qd, const VecX& tau) {
   const Status st = forward_dynamics(m, ws, q, qd, tau);
   if (!st.ok) return st;
   d.qdd = ws.qdd;
-  inverse_dynamics_derivatives(m, ws, d, q, qd, d.qdd);
+  inverse_derivatives(m, ws, d, q, qd, d.qdd,
+                      m.dynamics_route == DynamicsRoute::Articulated);  // poses at q in ws
   if (d.minv_sweep) {
     inverse_mass_sweep(m, ws, d);
     if (m.n() <= kDenseProductSize) {
