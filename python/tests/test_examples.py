@@ -25,3 +25,30 @@ def test_python_example_on_urdf():
 def test_benchmark_smoke():
     out = run(ROOT / "tools" / "bench_python.py", "--quick")
     assert out.count("| forward_dynamics |") == 3
+
+
+def load_example(name):
+    import importlib.util
+    spec = importlib.util.spec_from_file_location(name, ROOT / "examples" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_lqr_holds_the_finger():
+    import numpy as np
+    r = load_example("lqr_finger").run(t_end=3.0)
+    assert r["eigenvalues"].real.max() < -1.0  # A − BK strictly in the left half-plane
+    t, e = r["t"], r["error"]
+    assert e[0] > 0.09
+    assert e[t >= 2.0].max() < 1e-6  # converged within 2 s
+    assert np.all(np.diff(e[t >= 1.0]) <= 1e-12)  # and shrinking (to round-off)
+
+
+def test_ilqr_swings_the_double_pendulum_up():
+    import numpy as np
+    example = load_example("ilqr_swingup")
+    r = example.run()
+    assert r["history"][-1] < 1e-2 * r["history"][0]
+    xf = np.r_[r["q"][-1], r["qd"][-1]]
+    assert np.abs(xf - example.GOAL).max() < 1e-2  # upright and at rest on femdyn.Simulator
