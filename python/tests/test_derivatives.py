@@ -95,6 +95,9 @@ def test_batches_refuse_and_name_the_row():
     q = np.zeros((3, m.n))
     assert m.derivatives_batch(np.zeros((0, m.n)))["Minv"].shape == (0, m.n, m.n)
     qd = np.zeros((3, m.n))
-    qd[2, 0] = 1e100  # overflows the dynamics: the row is named
-    with pytest.raises(femdyn.NumericalError, match="row 2"):
+    qd[2, 0] = np.nan  # a bad row is named
+    with pytest.raises(ValueError, match="row 2, entry 0"):
         m.derivatives_batch(q, qd)
+    qd[2, 0] = 1e101  # beyond the range the equations' products stay finite in
+    with pytest.raises(ValueError, match="row 2, entry 0"):
+        m.linearize_batch(q, qd)

@@ -42,7 +42,12 @@ def test_lqr_holds_the_finger():
     t, e = r["t"], r["error"]
     assert e[0] > 0.09
     assert e[t >= 2.0].max() < 1e-6  # converged within 2 s
-    assert np.all(np.diff(e[t >= 1.0]) <= 1e-12)  # and shrinking (to round-off)
+    # and within the envelope the closed-loop eigenvalues allow, e ≤ 100 e0 exp(−σ t / 2), σ the
+    # slowest decay rate −max Re λ of A − BK, down to round-off: the decay is oscillatory, and
+    # A − BK is not normal, so e first grows (measured: 19 times the envelope's e0 exp(−σt/2)
+    # at 0.05 s, the start's velocity carrying the finger on)
+    sigma = -r["eigenvalues"].real.max()
+    assert np.all(e <= 100 * e[0] * np.exp(-0.5 * sigma * t) + 1e-13)
 
 
 def test_ilqr_swings_the_double_pendulum_up():
