@@ -27,6 +27,7 @@ constexpr const char* kHelp =
                         [--dt h | --rtol r --atol a] [--q0 …] [--qd0 …] [--tau … | --tau-csv FILE]
                         [--out traj.csv] [--every k | --sample-dt s] [--max-steps N] [--force]
                         [--max-memory GB] [--json] [--gravity gx,gy,gz] [--baumgarte W]
+                        [--jacobian analytic|differences]
 
 Integrates M^s q̈ + h = Q from (q0, q̇0) (default 0) over [0, T] and prints a summary:
 integrator, steps, rejected steps, evaluations of forward dynamics, Jacobians, wall time,
@@ -46,7 +47,9 @@ integrators (docs/simulation.md):
   rk4    classical Runge–Kutta 4, fixed step --dt (default 1e-3 s)
   euler  semi-implicit (symplectic) Euler, fixed step --dt (default 1e-3 s)
   dopri  Dormand–Prince 5(4), adaptive (SUNDIALS ARKODE), --rtol (1e-6) --atol (1e-8); default
-  bdf    BDF orders 1–5 with Newton (SUNDIALS CVODE), for stiff models; --rtol --atol
+  bdf    BDF orders 1–5 with Newton (SUNDIALS CVODE), for stiff models; --rtol --atol;
+         --jacobian analytic (default: the analytic derivatives where they cover the model,
+         else differences) or differences (forward differences of forward dynamics always)
 --tau a,b,… is a constant actuation on the coordinates; --tau-csv FILE a time table with the
 header t,<coordinate>,… (or tau_<coordinate>), interpolated linearly; it must cover [0, T].
 --out writes t, q_*, qd_*, kinetic, potential, total, work every k-th step (--every, default 1;
@@ -147,6 +150,14 @@ IntegratorOptions integrator_options(const Args& a) {
                      integrator_name(o.kind) + " has a fixed step: use --dt");
     o.fixed.dt = number_option(a, "dt", o.fixed.dt);
   }
+  if (a.has("jacobian")) {
+    const std::string& how = a.options.at("jacobian");
+    if (o.kind != IntegratorKind::Bdf)
+      throw CliError("--jacobian applies to bdf, the one integrator that uses a Jacobian");
+    if (how != "analytic" && how != "differences")
+      throw CliError("--jacobian: " + quoted_text(how) + " is not one of analytic, differences");
+    o.adaptive.analytic_jacobian = how == "analytic";
+  }
   const long max_steps = static_cast<long>(integer_option(a, "max-steps", 1e7, 1, 1e15));
   o.fixed.max_steps = max_steps;
   if (a.has("max-steps")) o.adaptive.max_steps = max_steps;
@@ -155,10 +166,10 @@ IntegratorOptions integrator_options(const Args& a) {
 }
 
 int cmd_simulate(int argc, char** argv) {
-  const Args a =
-      parse_args(argc, argv, 2, {"help", "json", "force"},
-                 {"gravity", "t-end", "integrator", "dt", "rtol", "atol", "q0", "qd0", "tau",
-                  "tau-csv", "out", "every", "sample-dt", "max-steps", "max-memory", "baumgarte"});
+  const Args a = parse_args(
+      argc, argv, 2, {"help", "json", "force"},
+      {"gravity", "t-end", "integrator", "dt", "rtol", "atol", "q0", "qd0", "tau", "tau-csv", "out",
+       "every", "sample-dt", "max-steps", "max-memory", "baumgarte", "jacobian"});
   if (a.has("help")) {
     std::cout << kHelp;
     return 0;

@@ -12,6 +12,7 @@
 #include "core/momentum.hpp"
 #include "core/names.hpp"
 #include "core/sampling.hpp"
+#include "python/derivative_rows.hpp"
 #include "python/parallel.hpp"
 #include "python/py_model.hpp"
 #include "sim/integrator.hpp"
@@ -171,6 +172,84 @@ void require_finite_row(bool finite, Eigen::Index i, const std::string& what) {
                          " is NaN or Inf (the state overflows double precision)");
 }
 
+// A thread's buffers for the derivatives (their workspace; A, B of the linearisation).
+struct DerivativeScratch {
+  DerivativeWorkspace d;
+  MatX A, B;
+  explicit DerivativeScratch(const Model& m) : d(m) {}
+};
+
+// The analytic derivatives at k states (forward_derivatives_at per row, as Model.derivatives):
+// qdd (k, n), dqdd_dq, dqdd_dv, Minv (k, n, n).
+py::dict derivatives_batch(const PyModel& self, const Array& q, const OptArray& qd,
+                           const OptArray& tau, int threads) {
+  const Model& m = *self.model;
+  const Batch b(m, q, qd, tau, "tau", Entries::Bounded);
+  const py::ssize_t k = b.k, n = b.n;
+  const int nthreads = batch_threads(k, threads);
+  require_batch_memory("derivatives_batch", m, k, nthreads, dense_bytes(3 * n + 1, n),
+                       evaluation_bytes(m) + dense_bytes(8 * n, n));
+  py::array_t<double> qdd = new_array({k, n}), dq = new_array({k, n, n}), dv = new_array({k, n, n}),
+                      Minv = new_array({k, n, n});
+  double *pqdd = qdd.mutable_data(), *pq = dq.mutable_data(), *pv = dv.mutable_data(),
+         *pM = Minv.mutable_data();
+  {
+    py::gil_scoped_release release;
+    for_each_row_with(
+        m, k, nthreads, [&] { return DerivativeScratch(m); },
+        [&](Workspace& ws, DerivativeScratch& s, Eigen::Index i) {
+          thread_local RowState r;
+          r.load(b, i);
+          try {
+            forward_derivatives_at(m, ws, s.d, r.q, r.qd, r.x);
+          } catch (const NumericalError& e) {
+            throw NumericalError("row " + std::to_string(i) + ": " + e.what());
+          }
+          store(pqdd, i, s.d.qdd);
+          store(pq, i, s.d.dqdd_dq);
+          store(pv, i, s.d.dqdd_dv);
+          store(pM, i, s.d.Minv);
+        });
+  }
+  py::dict out;
+  out["qdd"] = qdd;
+  out["dqdd_dq"] = dq;
+  out["dqdd_dv"] = dv;
+  out["Minv"] = Minv;
+  return out;
+}
+
+// (A (k, 2n, 2n), B (k, 2n, n)) at k states, as Model.linearize.
+std::pair<py::array_t<double>, py::array_t<double>> linearize_batch(
+    const PyModel& self, const Array& q, const OptArray& qd, const OptArray& tau, int threads) {
+  const Model& m = *self.model;
+  const Batch b(m, q, qd, tau, "tau", Entries::Bounded);
+  const py::ssize_t k = b.k, n = b.n;
+  const int nthreads = batch_threads(k, threads);
+  require_batch_memory("linearize_batch", m, k, nthreads, dense_bytes(6 * n, n),
+                       evaluation_bytes(m) + dense_bytes(14 * n, n));
+  py::array_t<double> A = new_array({k, 2 * n, 2 * n}), B = new_array({k, 2 * n, n});
+  double *pA = A.mutable_data(), *pB = B.mutable_data();
+  {
+    py::gil_scoped_release release;
+    for_each_row_with(
+        m, k, nthreads, [&] { return DerivativeScratch(m); },
+        [&](Workspace& ws, DerivativeScratch& s, Eigen::Index i) {
+          thread_local RowState r;
+          r.load(b, i);
+          try {
+            forward_derivatives_at(m, ws, s.d, r.q, r.qd, r.x);
+          } catch (const NumericalError& e) {
+            throw NumericalError("row " + std::to_string(i) + ": " + e.what());
+          }
+          linearization(m, s.d, r.qd, s.A, s.B);
+          store(pA, i, s.A);
+          store(pB, i, s.B);
+        });
+  }
+  return {A, B};
+}
+
 // A frame's kinematics at k states: p (k, 3), R (k, 3, 3), J (k, 6, n), velocity, bias (k, 6).
 py::dict frame_kinematics_batch(const PyModel& self, const std::string& name, const Array& q,
                                 const OptArray& qd, const std::string& axes_text, int threads) {
@@ -277,6 +356,15 @@ void bind_batch(py::module_& m) {
            py::arg("threads") = 0,
            "frame_kinematics at k states: dict of p (k, 3), R (k, 3, 3), J (k, 6, n), velocity "
            "and bias (k, 6)")
+      .def("derivatives_batch", &derivatives_batch, py::arg("q"), py::arg("qd") = py::none(),
+           py::arg("tau") = py::none(), py::arg("threads") = 0,
+           "Model.derivatives at k states (q (k, n_q), qd, tau (k, n)) as a dict: qdd (k, n), "
+           "dqdd_dq, dqdd_dv, Minv (k, n, n); each row bit-for-bit the single call; threads 0 "
+           "= all cores; GIL released")
+      .def("linearize_batch", &linearize_batch, py::arg("q"), py::arg("qd") = py::none(),
+           py::arg("tau") = py::none(), py::arg("threads") = 0,
+           "Model.linearize at k states: (A (k, 2n, 2n), B (k, 2n, n)); each row bit-for-bit "
+           "the single call; threads 0 = all cores; GIL released")
       .def("centroidal_batch", &centroidal_batch, py::arg("q"), py::arg("qd") = py::none(),
            py::arg("threads") = 0,
            "centroidal at k states: each entry with a leading axis of k (mass (k,), A (k, 6, n), "

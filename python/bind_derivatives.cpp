@@ -5,6 +5,7 @@
 
 #include "core/derivatives.hpp"
 #include "core/equations.hpp"
+#include "python/derivative_rows.hpp"
 #include "python/py_model.hpp"
 
 namespace femdyn::python {
@@ -18,23 +19,14 @@ DerivativeWorkspace& derivative_workspace(PyModel& self) {
   return *self.derivatives;
 }
 
-void require_finite(const MatX& x, const char* what) {
-  if (!x.allFinite())
-    throw NumericalError(std::string("at this state ") + what +
-                         " is NaN or Inf (the state overflows double precision)");
-}
-
 // q̈ and its derivatives at (q, q̇, τ), after forward dynamics.
 DerivativeWorkspace& forward_at(PyModel& self, const Array& q, const OptArray& qd,
                                 const OptArray& tau, VecX& v) {
   const Model& m = *self.model;
   DerivativeWorkspace& d = derivative_workspace(self);
   v = vector_arg(qd, "qd", m);
-  const Status st = forward_dynamics_derivatives(m, self.ws, d, configuration_arg(q, "q", m), v,
-                                                 vector_arg(tau, "tau", m, Entries::Bounded));
-  if (!st.ok) throw NumericalError("at this state " + st.message);
-  require_finite(d.dqdd_dq, "dqdd_dq");
-  require_finite(d.dqdd_dv, "dqdd_dv");
+  forward_derivatives_at(m, self.ws, d, configuration_arg(q, "q", m), v,
+                         vector_arg(tau, "tau", m, Entries::Bounded));
   return d;
 }
 

@@ -25,16 +25,20 @@ inline int batch_threads(Eigen::Index k, int requested) {
   return static_cast<int>(std::max<Eigen::Index>(1, std::min<Eigen::Index>(t, k)));
 }
 
-// Calls row(ws, i) for i in [0, k) on `threads` threads. An exception in a thread stops that
-// thread's block; the one of the lowest block is rethrown after every thread has joined.
-template <class Row>
-void for_each_row(const Model& model, Eigen::Index k, int threads, const Row& row) {
+// Calls row(ws, scratch, i) for i in [0, k) on `threads` threads, each with a Workspace and a
+// `make()` of its own (per-thread buffers beside the Workspace, e.g. a DerivativeWorkspace). An
+// exception in a thread stops that thread's block; the one of the lowest block is rethrown after
+// every thread has joined.
+template <class Make, class Row>
+void for_each_row_with(const Model& model, Eigen::Index k, int threads, const Make& make,
+                       const Row& row) {
   std::vector<std::exception_ptr> errors(threads);
   const auto block = [&](int t) {
     try {
       Workspace ws(model);
+      auto scratch = make();
       const Eigen::Index begin = k * t / threads, end = k * (t + 1) / threads;
-      for (Eigen::Index i = begin; i < end; ++i) row(ws, i);
+      for (Eigen::Index i = begin; i < end; ++i) row(ws, scratch, i);
     } catch (...) {
       errors[t] = std::current_exception();
     }
@@ -45,6 +49,13 @@ void for_each_row(const Model& model, Eigen::Index k, int threads, const Row& ro
   pool.clear();  // joins
   for (const std::exception_ptr& e : errors)
     if (e) std::rethrow_exception(e);
+}
+
+// Calls row(ws, i) for i in [0, k) on `threads` threads (for_each_row_with, no scratch).
+template <class Row>
+void for_each_row(const Model& model, Eigen::Index k, int threads, const Row& row) {
+  for_each_row_with(
+      model, k, threads, [] { return 0; }, [&](Workspace& ws, int, Eigen::Index i) { row(ws, i); });
 }
 
 }  // namespace femdyn::python

@@ -8,6 +8,7 @@
 #include <memory>
 #include <numbers>
 
+#include "core/derivatives.hpp"
 #include "core/joints/passive.hpp"
 #include "core/loops/constraint_kinematics.hpp"
 #include "core/sampling.hpp"
@@ -138,8 +139,44 @@ double dead_point_ratio(const Model& m, const VecX& q, int rank) {
   return sigma[0] > 0 ? sigma[rank - 1] / sigma[0] : std::numeric_limits<double>::infinity();
 }
 
+namespace {
+
+// A's eigenvalues, the stiffest and the largest growth rate; a NaN or Inf in A a failed Status.
+void analyse(Linearization& lin) {
+  if (!lin.A.allFinite()) {  // (an eigensolver given NaN may never return)
+    lin.status = {false,
+                  "the linearised dynamics are NaN or Inf at this state (the state or the "
+                  "forces overflow double precision)",
+                  -1, true};
+    return;
+  }
+  lin.eigenvalues = Eigen::EigenSolver<MatX>(lin.A, false).eigenvalues();
+  for (Eigen::Index i = 0; i < lin.eigenvalues.size(); ++i) {
+    if (std::abs(lin.eigenvalues[i]) > std::abs(lin.stiffest)) lin.stiffest = lin.eigenvalues[i];
+    lin.max_growth = std::max(lin.max_growth, lin.eigenvalues[i].real());
+  }
+}
+
+}  // namespace
+
+// A = [[∂ξ̇/∂ξ, 1], [∂q̈/∂q, ∂q̈/∂v]] from the analytic derivatives (docs/derivatives.md): one
+// pass of the derivative recursion instead of 4n evaluations of forward dynamics.
 Linearization linearize(const Model& m, Workspace& ws, const VecX& q, const VecX& qd,
                         const VecX& tau, double baumgarte) {
+  if (!m.constraints.empty() || !derivatives_unsupported(m).empty())
+    return difference_linearization(m, ws, q, qd, tau, baumgarte);
+  Linearization lin;
+  DerivativeWorkspace d(m);
+  lin.status = forward_dynamics_derivatives(m, ws, d, q, qd, tau);
+  if (!lin.status.ok) return lin;
+  MatX B;
+  linearization(m, d, qd, lin.A, B);
+  analyse(lin);
+  return lin;
+}
+
+Linearization difference_linearization(const Model& m, Workspace& ws, const VecX& q, const VecX& qd,
+                                       const VecX& tau, double baumgarte) {
   const int n = m.n();
   Linearization lin;
   lin.A = MatX::Zero(2 * n, 2 * n);
@@ -180,18 +217,7 @@ Linearization linearize(const Model& m, Workspace& ws, const VecX& q, const VecX
       const VecX e = VecX::Unit(n, j) * 1e-6;
       lin.A.block(0, j, n, 1) = (chart_rates(m, q, e, qd) - chart_rates(m, q, -e, qd)) / 2e-6;
     }
-  if (!lin.A.allFinite()) {  // (an eigensolver given NaN may never return)
-    lin.status = {false,
-                  "the linearised dynamics are NaN or Inf at this state (the state or the "
-                  "forces overflow double precision)",
-                  -1, true};
-    return lin;
-  }
-  lin.eigenvalues = Eigen::EigenSolver<MatX>(lin.A, false).eigenvalues();
-  for (Eigen::Index i = 0; i < lin.eigenvalues.size(); ++i) {
-    if (std::abs(lin.eigenvalues[i]) > std::abs(lin.stiffest)) lin.stiffest = lin.eigenvalues[i];
-    lin.max_growth = std::max(lin.max_growth, lin.eigenvalues[i].real());
-  }
+  analyse(lin);
   return lin;
 }
 

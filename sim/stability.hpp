@@ -49,8 +49,16 @@ struct Linearization {
 // per independent equation is then among the eigenvalues (the block of the constraint's own
 // dynamics Φ̈ + 2ωΦ̇ + ω²Φ = 0, which the tangent motion does not feed); at 0 those are zeros
 // and the rest are the mechanism's own modes on its loops.
+// A is analytic (core/derivatives.hpp: ∂q̈/∂q, ∂q̈/∂v and the chart block, in the chart
+// ξ ↦ q ⊕ ξ) where the derivatives cover the model, which excludes closed loops; otherwise
+// difference_linearization's.
 Linearization linearize(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                         const VecX& tau, double baumgarte = Motion::kDefaultBaumgarte);
+// A by central differences of forward dynamics (2n pairs of evaluations, step 1e-6 relative),
+// in the same chart, for every model.
+Linearization difference_linearization(const Model& model, Workspace& ws, const VecX& q,
+                                       const VecX& qd, const VecX& tau,
+                                       double baumgarte = Motion::kDefaultBaumgarte);
 
 // Closed loops: how near q is to a dead point, σ_rank / σ_1 of the constraint Jacobian Φ_q's
 // singular values (its first `rank`: the redundant equations' zeros left out); +inf without

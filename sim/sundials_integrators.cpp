@@ -11,6 +11,10 @@
 #include <cstdio>
 #include <limits>
 
+#include "core/derivatives.hpp"
+#include "core/joints/kernel.hpp"
+#include "core/joints/rotation.hpp"
+
 namespace femdyn {
 
 // One run's SUNDIALS objects; y wraps the integrator's own y_ (no copy).
@@ -256,7 +260,21 @@ double DormandPrince::current_step() const {
 Bdf::Bdf(const Model& model, const AdaptiveOptions& options, Actuation tau)
     : Adaptive(model, options, std::move(tau)),
       y_pert_(VecX::Zero(y_.size())),
-      f_pert_(VecX::Zero(y_.size())) {}
+      f_pert_(VecX::Zero(y_.size())),
+      q_(VecX::Zero(model.n_q())),
+      v_(VecX::Zero(model.n())),
+      tau_(VecX::Zero(model.n())),
+      unit_(VecX::Zero(model.n())),
+      rate_plus_(VecX::Zero(model.n())),
+      rate_minus_(VecX::Zero(model.n())) {
+  // Once per integrator: whether the derivatives cover the model (not per Jacobian).
+  if (options.analytic_jacobian && derivatives_unsupported(model).empty()) {
+    derivatives_ = std::make_unique<DerivativeWorkspace>(model);
+    derivative_ws_ = std::make_unique<Workspace>(model);
+  }
+}
+
+Bdf::~Bdf() = default;
 
 void Bdf::start() {
   if (!restarting_) restarted_ = {};  // a new run, not a restart on a moved chart
@@ -274,6 +292,8 @@ void Bdf::start() {
   r.LS = SUNLinSol_Dense(r.y, r.A, r.ctx);
   CVodeSetLinearSolver(r.cvode, r.LS, r.A);
   CVodeSetJacFn(r.cvode, jacobian_callback);
+  // A controller's τ(q, v) is part of f, and its derivatives are not known here.
+  analytic_ = derivatives_ && !motion_.controlled();
   CVodeSetMaxNumSteps(r.cvode, options_.max_steps);
   if (options_.h_max > 0) CVodeSetMaxStep(r.cvode, options_.h_max);
   if (std::isfinite(t_stop_)) CVodeSetStopTime(r.cvode, t_stop_);
@@ -281,10 +301,39 @@ void Bdf::start() {
 }
 
 int Bdf::jacobian(double t, const double* y, const double* fy, double* J) {
+  return analytic_ ? analytic_jacobian(t, y, J) : difference_jacobian(t, y, fy, J);
+}
+
+// f = (ξ̇, v̇, P) at y = (ξ, v, W), J = ∂f/∂y:
+//   ∂ξ̇/∂(ξ, v) from the chart (chart_rows), ∂v̇/∂v = ∂q̈/∂v, ∂v̇/∂ξ = ∂q̈/∂q T(ξ)
+// (chart_columns), ∂f/∂W = 0. The row of P = q̇ᵀτ + Σ P_j + Σ τ_b·ω_b is left 0: W is a
+// quadrature, fed by the other rows and feeding none, so Newton's W lags by one iteration.
+int Bdf::analytic_jacobian(double t, const double* y, double* J) {
   const int n = motion_.n(), N = 2 * n + 1;
   Eigen::Map<MatX> Jm(J, N, N);  // column-major, as SUNDIALS' dense matrix
   Jm.setZero();
-  for (int i = 0; i < n; ++i) Jm(i, n + i) = 1;  // ∂q̇/∂q̇ = I
+  motion_.configuration(y, q_);
+  v_ = Eigen::Map<const VecX>(y + n, n);
+  motion_.actuation(t, tau_);  // τ(t), saturated as f applies it (no controller here)
+  const Status st =
+      forward_dynamics_derivatives(motion_.model(), *derivative_ws_, *derivatives_, q_, v_, tau_);
+  if (!st.ok) {
+    rhs_failure_ = st;
+    rhs_failure_.message = at_time(t) + st.message;
+    return -1;
+  }
+  Jm.block(n, 0, n, n) = derivatives_->dqdd_dq;
+  Jm.block(n, n, n, n) = derivatives_->dqdd_dv;
+  chart_rows(y, J);
+  chart_columns(y, J);
+  return 0;
+}
+
+int Bdf::difference_jacobian(double t, const double* y, const double* fy, double* J) {
+  const int n = motion_.n(), N = 2 * n + 1;
+  Eigen::Map<MatX> Jm(J, N, N);
+  Jm.setZero();
+  chart_rows(y, J);
   const Eigen::Map<const VecX> y0(y, N), f0(fy, N);
   y_pert_ = y0;
   // Columns of q and q̇: forward differences of (q̈, P_nc); W moves nothing (its column is 0).
@@ -296,6 +345,61 @@ int Bdf::jacobian(double t, const double* y, const double* fy, double* J) {
     y_pert_[j] = y0[j];
   }
   return 0;
+}
+
+// The top rows, ∂ξ̇/∂(ξ, v) of the chart rate ξ̇ = g(ξ, v) (Motion::chart_rates): [0, 1] when
+// every joint is flat. Otherwise g is linear in v, so ∂g/∂v_j = g(ξ, e_j); ∂g/∂ξ_j by central
+// differences of g (O(joints) each, no dynamics; smooth, so a step of 1e-6 leaves ~1e-12).
+void Bdf::chart_rows(const double* y, double* J) {
+  const int n = motion_.n(), N = 2 * n + 1;
+  Eigen::Map<MatX> Jm(J, N, N);
+  if (motion_.flat()) {
+    for (int i = 0; i < n; ++i) Jm(i, n + i) = 1;
+    return;
+  }
+  constexpr double h = 1e-6;
+  y_pert_.head(n) = Eigen::Map<const VecX>(y, n);
+  unit_.setZero();
+  for (int j = 0; j < n; ++j) {
+    unit_[j] = 1;
+    motion_.chart_rates(y, unit_.data(), rate_plus_.data());
+    Jm.block(0, n + j, n, 1) = rate_plus_;
+    unit_[j] = 0;
+    const double xj = y_pert_[j];
+    y_pert_[j] = xj + h;
+    motion_.chart_rates(y_pert_.data(), y + n, rate_plus_.data());
+    y_pert_[j] = xj - h;
+    motion_.chart_rates(y_pert_.data(), y + n, rate_minus_.data());
+    y_pert_[j] = xj;
+    Jm.block(0, j, n, 1) = (rate_plus_ - rate_minus_) / (2 * h);
+  }
+}
+
+// ∂v̇/∂ξ in the chart around q_c from ∂q̈/∂q along the tangent at q = q_c ⊕ ξ (the derivatives'
+// convention): q_c ⊕ (ξ + dξ) = q ⊕ T(ξ) dξ to first order, per manifold joint
+//   rotation:  q_c ⊗ exp(ξ_r + dξ_r) = q ⊗ exp(J_r(ξ_r) dξ_r),                T_r = J_r(ξ_r);
+//   position (free):  p_c + R_c (ξ_p + dξ_p) = p + R exp(ξ_r)ᵀ dξ_p,          T_p = exp(ξ_r)ᵀ;
+// so the joint's columns of the rows of v̇ are ∂q̈/∂q T. Nothing on flat joints (T = 1).
+void Bdf::chart_columns(const double* y, double* J) {
+  if (motion_.flat()) return;
+  const Model& m = motion_.model();
+  const int n = motion_.n(), N = 2 * n + 1;
+  Eigen::Map<MatX> Jm(J, N, N);
+  const MatX& dq = derivatives_->dqdd_dq;
+  for (const CoordinateJoint& c : m.coordinate_joints) {
+    const Joint& joint = m.bodies[c.body].joint;
+    if (is_flat(joint)) continue;
+    const int r = c.v + joint.nv - 3;  // the rotation's rates: the joint's last three
+    const Vec3 xi(y[r], y[r + 1], y[r + 2]);
+    Mat3 Jr_inv;
+    for (int k = 0; k < 3; ++k) Jr_inv.col(k) = inverse_right_jacobian_times(xi, Vec3::Unit(k));
+    Jm.block(n, r, n, 3).noalias() = dq.middleCols(r, 3) * Jr_inv.inverse();
+    if (joint.nv == 6) {  // free: the position's rates first
+      const double angle = xi.norm();
+      const Mat3 E = angle > 0 ? axis_rotation(xi / angle, angle) : Mat3::Identity();
+      Jm.block(n, c.v, n, 3).noalias() = dq.middleCols(c.v, 3) * E.transpose();
+    }
+  }
 }
 
 void Bdf::reinit() { CVodeReInit(run_->cvode, t_, run_->y); }

@@ -4,8 +4,11 @@
 //   Bdf            CVODE variable-order BDF (1–5) with CVODE's Newton iteration and a dense
 //                  direct linear solver; the Jacobian of f is
 //                    ∂f/∂y = [[0, I, 0], [∂q̈/∂q, ∂q̈/∂q̇, 0], [∂P/∂q, ∂P/∂q̇, 0]]
-//                  with the lower rows by forward differences of forward dynamics (2n
-//                  evaluations, buffers owned here).
+//                  in the state's chart (q is ξ on a manifold joint, Motion): analytic
+//                  where core/derivatives.hpp covers the model and τ does not depend on the
+//                  state (decided per run, at start), with the rows of ∂P omitted; otherwise
+//                  the lower rows by forward differences of forward dynamics (2n evaluations).
+//                  Buffers owned here.
 // The SUNDIALS memory is created by reset() (per run, not per step); SUNDIALS' own messages are
 // captured and folded into the Status, never printed.
 #pragma once
@@ -18,6 +21,7 @@ namespace femdyn {
 // SUNDIALS handles owned by an adaptive integrator (opaque here: the SUNDIALS headers stay in
 // the .cpp).
 struct SundialsRun;
+struct DerivativeWorkspace;
 
 // The shortest run an adaptive integrator takes (s): SUNDIALS' first-step estimate divides by
 // the span squared, which overflows double precision below about 1e-154 s; the bound mirrors
@@ -86,11 +90,22 @@ class DormandPrince final : public Adaptive {
 class Bdf final : public Adaptive {
  public:
   Bdf(const Model& model, const AdaptiveOptions& options, Actuation tau = {});
+  ~Bdf() override;
   IntegratorKind kind() const override { return IntegratorKind::Bdf; }
-  // ∂f/∂y by forward differences into the column-major (2n+1)² array J, f(y) = fy given.
+  // ∂f/∂y into the column-major (2n+1)² array J at y, f(y) = fy given: analytic_jacobian or
+  // difference_jacobian, as chosen for the run. 0, or −1 after recording the failure.
   int jacobian(double t, const double* y, const double* fy, double* J);
+  // Whether this run's Jacobian is analytic (set by reset).
+  bool analytic() const { return analytic_; }
+  // The rows of (ξ̇, v̇) from the derivatives of forward dynamics at (t, y); the row of P is 0.
+  // Requires a model the derivatives cover.
+  int analytic_jacobian(double t, const double* y, double* J);
+  // The rows of v̇ and P by forward differences of f (2n evaluations).
+  int difference_jacobian(double t, const double* y, const double* fy, double* J);
 
  private:
+  void chart_rows(const double* y, double* J);
+  void chart_columns(const double* xi, double* J);
   void start() override;
   void reinit() override;
   int evolve(double t_out, double& t_reached, bool one_step) override;
@@ -99,6 +114,11 @@ class Bdf final : public Adaptive {
   void set_stop_time(double t) override;
   void set_initial_step(double h) override;
   VecX y_pert_, f_pert_;  // Jacobian buffers
+  // The derivatives, when they cover the model: their workspace and buffers for q, v, τ.
+  std::unique_ptr<DerivativeWorkspace> derivatives_;
+  std::unique_ptr<Workspace> derivative_ws_;
+  VecX q_, v_, tau_, unit_, rate_plus_, rate_minus_;
+  bool analytic_ = false;
 };
 
 }  // namespace femdyn

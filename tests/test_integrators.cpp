@@ -4,7 +4,9 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "core/sampling.hpp"
 #include "sim/integrator.hpp"
+#include "sim/sundials_integrators.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;
@@ -291,4 +293,67 @@ TEST_CASE("a singular M^s stops the run with the time and the coordinate", "[int
                                Catch::Contains("singular"));
     CHECK(integ->t() == 0);
   }
+}
+
+namespace {
+
+// The analytic BDF Jacobian against central differences of the integrator's own right-hand side
+// at its current y (the same chart centre), step 1e-5 max(1, |y_i|) (at 1e-6 the round-off of the
+// light fingers' large q̈ shows); returns max |J_a − J_c| over the rows of (ξ̇, v̇) relative to the
+// largest entry of each row block. (The integrator's own difference Jacobian is one-sided, accurate
+// only to about 1e-4 here: the space robot's light fingers make q̈ strongly curved.)
+double jacobian_mismatch(Bdf& bdf, double t) {
+  const int n = bdf.motion().n(), N = 2 * n + 1;
+  VecX y = bdf.y(), fp(N), fm(N);
+  MatX Ja(N, N), Jc(N, N);
+  REQUIRE(bdf.analytic_jacobian(t, y.data(), Ja.data()) == 0);
+  for (int j = 0; j < 2 * n; ++j) {
+    const double y0 = y[j], h = 1e-5 * std::max(1.0, std::abs(y0));
+    y[j] = y0 + h;
+    REQUIRE(bdf.rhs(t, y.data(), fp.data()) == 0);
+    y[j] = y0 - h;
+    REQUIRE(bdf.rhs(t, y.data(), fm.data()) == 0);
+    y[j] = y0;
+    Jc.col(j) = (fp - fm) / (2 * h);
+  }
+  double worst = 0;
+  for (int rows : {0, n}) {
+    const MatX a = Ja.block(rows, 0, n, 2 * n), c = Jc.block(rows, 0, n, 2 * n);
+    worst = std::max(worst, (a - c).cwiseAbs().maxCoeff() / std::max(1.0, a.cwiseAbs().maxCoeff()));
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("bdf: the analytic Jacobian equals the difference Jacobian in the chart",
+          "[integrators][derivatives]") {
+  // The space robot's free base (chart coordinates ξ, away from ξ = 0 after some steps) and the
+  // finger (flat, gravity, springs).
+  for (const char* name : {"space_robot.json", "finger.json"}) {
+    INFO(name);
+    const Model m = load_model(model_path(name));
+    auto integ = make_integrator(m, adaptive(IntegratorKind::Bdf, 1e-8, 1e-10));
+    auto& bdf = dynamic_cast<Bdf&>(*integ);
+    const VecX q0 = neutral_posture(m), qd0 = VecX::LinSpaced(m.n(), 0.3, -0.4);
+    integ->reset(0, q0, qd0, 1);
+    REQUIRE(bdf.analytic());
+    CHECK(jacobian_mismatch(bdf, 0) < 1e-6);
+    REQUIRE(integ->advance_to(0.3).ok);
+    if (!bdf.motion().flat()) CHECK(bdf.motion().chart_extent(bdf.y().data()) > 0.05);
+    CHECK(jacobian_mismatch(bdf, 0.3) < 1e-6);
+  }
+}
+
+TEST_CASE("bdf: a model the derivatives refuse, or a controller, falls back to differences",
+          "[integrators][derivatives]") {
+  const Model loop = load_model(model_path("finger_fourbar_loop.json"));
+  auto a = make_integrator(loop, adaptive(IntegratorKind::Bdf, 1e-6, 1e-8));
+  a->reset(0, neutral_posture(loop), VecX::Zero(loop.n()), 1);
+  CHECK_FALSE(dynamic_cast<Bdf&>(*a).analytic());
+  const Model finger = load_model(model_path("finger.json"));
+  auto b = make_integrator(finger, adaptive(IntegratorKind::Bdf, 1e-6, 1e-8));
+  b->set_control([](double, const VecX&, const VecX& v, VecX& tau) { tau = -v; });
+  b->reset(0, neutral_posture(finger), VecX::Zero(finger.n()), 1);
+  CHECK_FALSE(dynamic_cast<Bdf&>(*b).analytic());
 }

@@ -6,7 +6,10 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <random>
 
+#include "core/derivatives.hpp"
+#include "core/sampling.hpp"
 #include "sim/stability.hpp"
 #include "tests/helpers.hpp"
 
@@ -259,3 +262,59 @@ TEST_CASE("stress loops: a dead point named, a redundant loop held, a stiff loop
   }
 }
 #endif
+
+namespace {
+
+// A from the analytic derivatives against A by central differences, relative to max |A|.
+double linearization_mismatch(const Model& m, const VecX& q, const VecX& v, const VecX& tau) {
+  Workspace ws(m);
+  const Linearization a = linearize(m, ws, q, v, tau),
+                      d = difference_linearization(m, ws, q, v, tau);
+  REQUIRE(a.status.ok);
+  REQUIRE(d.status.ok);
+  return rel_error(a.A, d.A, std::max(a.A.cwiseAbs().maxCoeff(), 1e-300));
+}
+
+}  // namespace
+
+TEST_CASE("linearize: the analytic A equals the difference A on random trees",
+          "[stability][derivatives]") {
+  double worst = 0;
+  for (unsigned seed = 1; seed <= 6; ++seed)
+    for (const int bodies : {2, 7, 12}) {
+      INFO("seed " << seed << ", " << bodies << " bodies");
+      const Model m = load_text(mixed_tree_json(seed, bodies, seed % 2 ? 0.6 : 0.0, false, true));
+      REQUIRE(derivatives_unsupported(m).empty());
+      std::mt19937 rng(seed);
+      const VecX q = random_posture(m, rng), v = random_uniform(m.n(), 1, rng);
+      const double e = linearization_mismatch(m, q, v, VecX::Zero(m.n()));
+      worst = std::max(worst, e);
+      CHECK(e < 1e-6);
+    }
+  WARN("analytic against difference A, random trees: worst " << worst);
+}
+
+TEST_CASE("check's stable steps are the same from the analytic A on the bundled models",
+          "[stability][derivatives]") {
+  int covered = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(model_path(""))) {
+    if (entry.path().extension() != ".json") continue;
+    const Model m = load_model(entry.path().string());
+    if (!derivatives_unsupported(m).empty() || m.n() > 40) continue;
+    INFO(entry.path().filename().string());
+    ++covered;
+    std::mt19937 rng(3);
+    const VecX q = random_posture(m, rng), v = random_uniform(m.n(), 1, rng);
+    Workspace ws(m);
+    const Linearization a = linearize(m, ws, q, v, VecX::Zero(m.n()));
+    const Linearization d = difference_linearization(m, ws, q, v, VecX::Zero(m.n()));
+    for (IntegratorKind kind :
+         {IntegratorKind::Rk4, IntegratorKind::Euler, IntegratorKind::Dopri}) {
+      const std::optional<double> ha = largest_stable_step(a, kind),
+                                  hd = largest_stable_step(d, kind);
+      REQUIRE(ha.has_value() == hd.has_value());
+      if (ha && std::isfinite(*hd)) CHECK(std::abs(*ha - *hd) <= 1e-3 * *hd);
+    }
+  }
+  CHECK(covered >= 6);
+}

@@ -60,3 +60,44 @@ def test_uncovered_model_is_refused():
     m = femdyn.load(model_path("models/finger_fourbar.json"))
     with pytest.raises(femdyn.ModelError, match="coupling laws"):
         m.derivatives(np.zeros(m.n))
+
+
+@pytest.mark.parametrize("threads", [1, 3])
+@pytest.mark.parametrize("name", ["models/finger.json", "models/space_robot.json"])
+def test_batches_equal_single_calls(name, threads):
+    m = femdyn.load(model_path(name))
+    rng = np.random.default_rng(8)
+    k = 7
+    q = np.tile(m.neutral_configuration(), (k, 1))
+    if m.n_q == m.n:
+        q += rng.uniform(-0.5, 0.5, q.shape)
+    else:  # the free base's position, then the arm's joints (its quaternion kept)
+        q[:, :3] += rng.uniform(-0.5, 0.5, (k, 3))
+        q[:, 7:] += rng.uniform(-0.5, 0.5, (k, m.n_q - 7))
+    qd = rng.uniform(-1, 1, (k, m.n))
+    tau = rng.uniform(-1e-3, 1e-3, (k, m.n))
+    d = m.derivatives_batch(q, qd, tau, threads=threads)
+    A, B = m.linearize_batch(q, qd, tau, threads=threads)
+    assert d["dqdd_dq"].shape == (k, m.n, m.n) and A.shape == (k, 2 * m.n, 2 * m.n)
+    assert B.shape == (k, 2 * m.n, m.n)
+    for i in range(k):
+        one = m.derivatives(q[i], qd[i], tau[i])
+        for key in ("qdd", "dqdd_dq", "dqdd_dv", "Minv"):
+            assert np.array_equal(d[key][i], one[key]), key
+        a, b = m.linearize(q[i], qd[i], tau[i])
+        assert np.array_equal(A[i], a) and np.array_equal(B[i], b)
+
+
+def test_batches_refuse_and_name_the_row():
+    with pytest.raises(femdyn.ModelError):
+        femdyn.load(model_path("models/finger_paper.json")).derivatives_batch(np.zeros((2, 4)))
+    m = femdyn.load(model_path("models/finger.json"))
+    q = np.zeros((3, m.n))
+    assert m.derivatives_batch(np.zeros((0, m.n)))["Minv"].shape == (0, m.n, m.n)
+    qd = np.zeros((3, m.n))
+    qd[2, 0] = np.nan  # a bad row is named
+    with pytest.raises(ValueError, match="row 2, entry 0"):
+        m.derivatives_batch(q, qd)
+    qd[2, 0] = 1e101  # beyond the range the equations' products stay finite in
+    with pytest.raises(ValueError, match="row 2, entry 0"):
+        m.linearize_batch(q, qd)

@@ -25,3 +25,35 @@ def test_python_example_on_urdf():
 def test_benchmark_smoke():
     out = run(ROOT / "tools" / "bench_python.py", "--quick")
     assert out.count("| forward_dynamics |") == 3
+
+
+def load_example(name):
+    import importlib.util
+    spec = importlib.util.spec_from_file_location(name, ROOT / "examples" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_lqr_holds_the_finger():
+    import numpy as np
+    r = load_example("lqr_finger").run(t_end=3.0)
+    assert r["eigenvalues"].real.max() < -1.0  # A − BK strictly in the left half-plane
+    t, e = r["t"], r["error"]
+    assert e[0] > 0.09
+    assert e[t >= 2.0].max() < 1e-6  # converged within 2 s
+    # and within the envelope the closed-loop eigenvalues allow, e ≤ 100 e0 exp(−σ t / 2), σ the
+    # slowest decay rate −max Re λ of A − BK, down to round-off: the decay is oscillatory, and
+    # A − BK is not normal, so e first grows (measured: 19 times the envelope's e0 exp(−σt/2)
+    # at 0.05 s, the start's velocity carrying the finger on)
+    sigma = -r["eigenvalues"].real.max()
+    assert np.all(e <= 100 * e[0] * np.exp(-0.5 * sigma * t) + 1e-13)
+
+
+def test_ilqr_swings_the_double_pendulum_up():
+    import numpy as np
+    example = load_example("ilqr_swingup")
+    r = example.run()
+    assert r["history"][-1] < 1e-2 * r["history"][0]
+    xf = np.r_[r["q"][-1], r["qd"][-1]]
+    assert np.abs(xf - example.GOAL).max() < 1e-2  # upright and at rest on femdyn.Simulator
