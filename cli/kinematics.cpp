@@ -42,13 +42,6 @@ J* v_m + drift with the base floating, v_m the rates of every joint but the base
 "A", "bias"}}.
 )";
 
-Json vector_json(const VecX& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
-Json matrix_json(const MatX& m) {
-  Json rows = Json::array();
-  for (Eigen::Index r = 0; r < m.rows(); ++r) rows.push_back(vector_json(m.row(r).transpose()));
-  return rows;
-}
-
 // The frames asked for, by name; by default the named frames, else the leaf bodies.
 std::vector<int> chosen_frames(const Args& a, const Model& m) {
   std::vector<int> out;

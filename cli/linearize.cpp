@@ -30,13 +30,6 @@ rotors, stops and loads; other models are refused in one line.
 --json prints {"n", "coordinates", "q", "qd", "tau", "A", "B"}, A and B as lists of rows.
 )";
 
-Json vector_json(const VecX& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
-Json matrix_json(const MatX& m) {
-  Json rows = Json::array();
-  for (Eigen::Index r = 0; r < m.rows(); ++r) rows.push_back(vector_json(m.row(r).transpose()));
-  return rows;
-}
-
 }  // namespace
 
 int cmd_linearize(int argc, char** argv) {

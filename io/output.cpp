@@ -11,23 +11,20 @@
 #include "io/atomic_file.hpp"
 
 namespace femdyn {
-namespace {
 
-Json vec_json(const VecX& v) {
+Json vector_json(const VecX& v) {
   Json a = Json::array();
   for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v[i]);
   return a;
 }
 
-Json mat_json(const MatX& m) {
+Json matrix_json(const MatX& m) {
   Json a = Json::array();
-  for (Eigen::Index r = 0; r < m.rows(); ++r) {
-    Json row = Json::array();
-    for (Eigen::Index c = 0; c < m.cols(); ++c) row.push_back(m(r, c));
-    a.push_back(row);
-  }
+  for (Eigen::Index r = 0; r < m.rows(); ++r) a.push_back(vector_json(m.row(r).transpose()));
   return a;
 }
+
+namespace {
 
 std::string num(double x) {
   char buf[32];
@@ -77,16 +74,16 @@ Json equations_json(const Model& model, const Workspace& ws, const VecX& q, cons
   Json j;
   j["n"] = model.n();
   j["coordinates"] = model.coordinate_names;
-  j["q"] = vec_json(q);
-  j["qd"] = vec_json(qd);
-  j["tau"] = vec_json(tau);
-  j["M"] = mat_json(ws.Ms);
-  j["h"] = vec_json(ws.h);
-  j["Q"] = vec_json(ws.Q);
-  j["qdd"] = have_qdd ? vec_json(ws.qdd) : Json();
+  j["q"] = vector_json(q);
+  j["qd"] = vector_json(qd);
+  j["tau"] = vector_json(tau);
+  j["M"] = matrix_json(ws.Ms);
+  j["h"] = vector_json(ws.h);
+  j["Q"] = vector_json(ws.Q);
+  j["qdd"] = have_qdd ? vector_json(ws.qdd) : Json();
   if (!D.empty()) {
     Json d = Json::array();
-    for (const MatX& Da : D) d.push_back(mat_json(Da));
+    for (const MatX& Da : D) d.push_back(matrix_json(Da));
     j["D"] = d;
   }
   return j;
@@ -299,8 +296,8 @@ Json info_json(const Model& model) {
   for (const Frame& F : model.frames)
     frames.push_back({{"name", F.name},
                       {"body", model.bodies[F.body].name},
-                      {"xyz", vec_json(F.p_BF)},
-                      {"R", mat_json(F.R_BF)}});
+                      {"xyz", vector_json(F.p_BF)},
+                      {"R", matrix_json(F.R_BF)}});
   j["frames"] = frames;
   Json joints = Json::array();  // every joint, with its own forces and limits
   for (const Body& b : model.bodies) {

@@ -9,6 +9,10 @@
 
 namespace femdyn {
 
+// A vector as a JSON array, a matrix as an array of its rows.
+Json vector_json(const VecX& v);
+Json matrix_json(const MatX& m);
+
 // {"n", "coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd"} (+ "D" when D is non-empty):
 // n the number of coordinates, "coordinates" their names (as in every JSON output of femdyn).
 // qdd is null when M^s is singular at the state.

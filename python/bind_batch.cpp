@@ -179,6 +179,17 @@ struct DerivativeScratch {
   explicit DerivativeScratch(const Model& m) : d(m) {}
 };
 
+// Row i's derivatives into s.d (its state loaded into r), a failure naming the row.
+void row_derivatives(const Model& m, const Batch& b, Eigen::Index i, Workspace& ws,
+                     DerivativeScratch& s, RowState& r) {
+  r.load(b, i);
+  try {
+    forward_derivatives_at(m, ws, s.d, r.q, r.qd, r.x);
+  } catch (const NumericalError& e) {
+    throw NumericalError("row " + std::to_string(i) + ": " + e.what());
+  }
+}
+
 // The analytic derivatives at k states (forward_derivatives_at per row, as Model.derivatives):
 // qdd (k, n), dqdd_dq, dqdd_dv, Minv (k, n, n).
 py::dict derivatives_batch(const PyModel& self, const Array& q, const OptArray& qd,
@@ -199,12 +210,7 @@ py::dict derivatives_batch(const PyModel& self, const Array& q, const OptArray& 
         m, k, nthreads, [&] { return DerivativeScratch(m); },
         [&](Workspace& ws, DerivativeScratch& s, Eigen::Index i) {
           thread_local RowState r;
-          r.load(b, i);
-          try {
-            forward_derivatives_at(m, ws, s.d, r.q, r.qd, r.x);
-          } catch (const NumericalError& e) {
-            throw NumericalError("row " + std::to_string(i) + ": " + e.what());
-          }
+          row_derivatives(m, b, i, ws, s, r);
           store(pqdd, i, s.d.qdd);
           store(pq, i, s.d.dqdd_dq);
           store(pv, i, s.d.dqdd_dv);
@@ -236,12 +242,7 @@ std::pair<py::array_t<double>, py::array_t<double>> linearize_batch(
         m, k, nthreads, [&] { return DerivativeScratch(m); },
         [&](Workspace& ws, DerivativeScratch& s, Eigen::Index i) {
           thread_local RowState r;
-          r.load(b, i);
-          try {
-            forward_derivatives_at(m, ws, s.d, r.q, r.qd, r.x);
-          } catch (const NumericalError& e) {
-            throw NumericalError("row " + std::to_string(i) + ": " + e.what());
-          }
+          row_derivatives(m, b, i, ws, s, r);
           linearization(m, s.d, r.qd, s.A, s.B);
           store(pA, i, s.A);
           store(pB, i, s.B);

@@ -10,6 +10,18 @@ namespace femdyn {
 
 namespace {
 
+// Y = M⁻¹ Φ_qᵀ column by column by `solve` (x ← M⁻¹ x), S = Φ_q Y, and S factorised.
+template <class Solve>
+void fill_constraint_space(LoopWorkspace& lws, Solve&& solve) {
+  for (Eigen::Index i = 0; i < lws.k.J.rows(); ++i) {
+    lws.column = lws.k.J.row(i).transpose();
+    solve(lws.column);
+    lws.Y.col(i) = lws.column;
+  }
+  lws.S.noalias() = lws.k.J * lws.Y;
+  pivoted_cholesky(lws);
+}
+
 // q̈₀, Φ, Φ_q, Φ̇_q v, Y and S factorised, on the articulated route (C = I, the body-level form
 // exact): q̈₀ by the articulated recursion, Φ_q from the rates' spatial columns it leaves, and
 // Y = M⁻¹ Φ_qᵀ by its factorisation, one O(bodies) solve a column: O(n m) in all, no n × n
@@ -21,13 +33,7 @@ Status articulated_constraint_space(const Model& model, Workspace& ws, LoopWorks
   lws.qdd0 = ws.qdd;
   propagate(model, ws, q, v, {.jacobian = false, .bias = true, .rows = false});
   constraint_kinematics_by_paths(model, ws, lws.k);
-  for (int i = 0; i < model.constraint_rows; ++i) {
-    lws.column = lws.k.J.row(i).transpose();
-    articulated_solve(model, ws, lws.column);
-    lws.Y.col(i) = lws.column;
-  }
-  lws.S.noalias() = lws.k.J * lws.Y;
-  pivoted_cholesky(lws);
+  fill_constraint_space(lws, [&](VecX& x) { articulated_solve(model, ws, x); });
   return {};
 }
 
@@ -67,14 +73,8 @@ LoopWorkspace::LoopWorkspace(const Model& model)
       y(model.constraint_rows),
       perm(model.constraint_rows) {}
 
-void factorize_constraint_space(const Model& model, Workspace& ws, LoopWorkspace& lws) {
-  for (int i = 0; i < model.constraint_rows; ++i) {
-    lws.column = lws.k.J.row(i).transpose();
-    ws.solver.solve_in_place(lws.column);
-    lws.Y.col(i) = lws.column;
-  }
-  lws.S.noalias() = lws.k.J * lws.Y;
-  pivoted_cholesky(lws);
+void factorize_constraint_space(const Model&, Workspace& ws, LoopWorkspace& lws) {
+  fill_constraint_space(lws, [&](VecX& x) { ws.solver.solve_in_place(x); });
 }
 
 // P S Pᵀ = L Lᵀ by Cholesky with diagonal pivoting on the Schur complement (Higham, "Accuracy
