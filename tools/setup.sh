@@ -8,7 +8,7 @@ packages=(cmake g++ make libeigen3-dev libsuitesparse-dev nlohmann-json3-dev cat
           libsimbody-dev libmujoco-dev libtinyxml2-dev libbenchmark-dev libsundials-dev gnuplot-nox
           fonts-dejavu-core clang libclang-rt-14-dev clang-format
           pybind11-dev python3-dev python3-numpy python3-pytest python3-pandas
-          python3-matplotlib python3-distributed python3-jsonschema)
+          python3-matplotlib python3-distributed python3-jsonschema python3-scipy)
 
 missing=()
 for p in "${packages[@]}"; do
