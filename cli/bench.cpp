@@ -4,6 +4,7 @@
 // with loop constraints the constrained q̈ (docs/loops.md), femdyn and Simbody batch by batch in
 // turn (docs/benchmarks.md). A URDF robot is also timed on MuJoCo's
 // own import of the file (M, q̈, τ) when femdyn is built with MuJoCo (validation/mujoco_peer.hpp).
+// The analytic derivatives (core/derivatives.hpp) are timed on femdyn alone: neither peer has them.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "core/derivatives.hpp"
 #include "core/equations.hpp"
 #include "core/loops/constrained_dynamics.hpp"
 #include "core/math.hpp"
@@ -66,6 +68,11 @@ engines and the ratio Simbody / femdyn (above 1: femdyn is faster):
        constraint solve). At N states of their own, assembled onto the loops (q near the
        neutral posture, q̇ projected onto Φ_q q̇ = 0), τ in ±1; the other rows keep the
        tree's states
+  dtau femdyn inverse_dynamics_derivatives(): ∂τ/∂q and ∂τ/∂v (docs/derivatives.md)
+  dqdd femdyn forward_dynamics_derivatives(): q̈, ∂q̈/∂q, ∂q̈/∂v and (M^s)⁻¹
+       Both on femdyn alone (Simbody has no derivatives of its dynamics, MuJoCo 2.2 only
+       differences its whole time step): the table gives their ratio to femdyn's qdd instead.
+       Left out, with a note, on a model the derivatives do not cover.
   D    femdyn third_order_tensor(); Simbody forms no such tensor: n + n(n+1)/2 bias
        evaluations combined by polarization, D_sym(b,c) = (h(e_b+e_c) − h(e_b) − h(e_c))/2,
        the part symmetric in (b, c) (Christoffel symbols). Skipped, for both engines, when
@@ -86,7 +93,8 @@ against femdyn at the first state like Simbody; a file MuJoCo cannot map (a <mim
 a warning, and MuJoCo is left out.
 --json: {"model", "n", "coordinates", "build", "results": [{"engine": "femdyn" | "simbody" |
 "mujoco", "quantity", "median_ns", "min_ns", "max_ns"}]} (n the number of coordinates,
-"coordinates" their names; quantity "M", "h", "g", "Q", "qdd", "qdd_c", "tau" or "D").
+"coordinates" their names; quantity "M", "h", "g", "Q", "qdd", "qdd_c", "tau", "dtau", "dqdd"
+or "D"; dtau and dqdd have no "simbody" entry).
 )";
 
 constexpr int kTensorMaxN = 40;  // D above this many coordinates takes too long to time
@@ -256,8 +264,9 @@ struct Method {
 
 struct Row {
   std::string quantity;
-  Timing femdyn, simbody;
-  std::optional<Timing> mujoco;  // M, qdd and tau of a URDF robot, built with MuJoCo
+  Timing femdyn;
+  std::optional<Timing> simbody;  // none for the derivatives
+  std::optional<Timing> mujoco;   // M, qdd and tau of a URDF robot, built with MuJoCo
 };
 
 // One quantity on both engines (and MuJoCo when `mujoco_call` is given): each calibrated, then
@@ -278,6 +287,42 @@ Row time_both(const std::string& quantity, F&& femdyn_call, S&& simbody_call, in
   Row row{quantity, summarize(f), summarize(s), std::nullopt};
   if (mujoco_call) row.mujoco = summarize(mj);
   return row;
+}
+
+// One quantity on femdyn alone: calibrated, then `batches` batches.
+template <class F>
+Row time_femdyn(const std::string& quantity, F&& femdyn_call, int K, const Method& method) {
+  const long nf = calls_per_batch(femdyn_call, K, method.batch_time_ns);
+  std::vector<double> f;
+  for (int b = 0; b < method.batches; ++b) f.push_back(batch_ns(femdyn_call, nf, K));
+  return {quantity, summarize(f), std::nullopt, std::nullopt};
+}
+
+// dtau and dqdd (femdyn alone); none, with a note, on a model the derivatives do not cover.
+std::vector<Row> time_derivative_rows(const Model& m, Workspace& ws, const States& s, int K,
+                                      const Method& method) {
+  if (const std::string why = derivatives_unsupported(m); !why.empty()) {
+    std::cerr << "femdyn bench: note: dtau and dqdd not timed: " << why << "\n";
+    return {};
+  }
+  DerivativeWorkspace d(m);
+  std::vector<Row> rows;
+  rows.push_back(time_femdyn(
+      "dtau",
+      [&](int k) {
+        inverse_dynamics_derivatives(m, ws, d, s.q[k], s.qd[k], s.qdd[k]);
+        keep(d.dtau_dq.data());
+      },
+      K, method));
+  rows.push_back(time_femdyn(
+      "dqdd",
+      [&](int k) {
+        const bool ok = forward_dynamics_derivatives(m, ws, d, s.q[k], s.qd[k], s.tau[k]).ok;
+        keep(&ok);
+        keep(d.dqdd_dq.data());
+      },
+      K, method));
+  return rows;
 }
 
 // qdd_c: femdyn's constrained_forward_dynamics (ω = 0) against Simbody's constrained forward
@@ -315,6 +360,29 @@ std::string tensor_skipped(int n, bool quick) {
 
 std::string ns_text(double x) { return format_number(x, "%.0f"); }
 
+// The rows timed on femdyn alone (the derivatives), with their ratio to femdyn's own qdd.
+void print_femdyn_only(const std::vector<Row>& rows) {
+  const auto qdd =
+      std::find_if(rows.begin(), rows.end(), [](const Row& r) { return r.quantity == "qdd"; });
+  char line[200];
+  bool header = false;
+  for (const Row& r : rows) {
+    if (r.simbody) continue;
+    if (!header) {
+      std::snprintf(line, sizeof line, "%-8s %10s %15s   %s\n", "quantity", "femdyn", "femdyn/qdd",
+                    "femdyn min-max");
+      std::cout << line;
+      header = true;
+    }
+    const std::string ratio =
+        qdd == rows.end() ? "-" : format_number(r.femdyn.median / qdd->femdyn.median, "%.2f");
+    std::snprintf(line, sizeof line, "%-8s %10s %15s   %s\n", r.quantity.c_str(),
+                  ns_text(r.femdyn.median).c_str(), ratio.c_str(),
+                  (ns_text(r.femdyn.min) + "-" + ns_text(r.femdyn.max)).c_str());
+    std::cout << line;
+  }
+}
+
 void print_table(const std::string& path, int n, int K, const Method& method,
                  const std::vector<Row>& rows, const std::string& skipped) {
   const bool mujoco = std::any_of(rows.begin(), rows.end(), [](const Row& r) { return r.mujoco; });
@@ -327,11 +395,12 @@ void print_table(const std::string& path, int n, int K, const Method& method,
                 "Simbody", "Simbody/femdyn", "femdyn min-max", "Simbody min-max");
   std::cout << line;
   for (const Row& r : rows) {
+    if (!r.simbody) continue;
     const std::string fr = ns_text(r.femdyn.min) + "-" + ns_text(r.femdyn.max);
-    const std::string sr = ns_text(r.simbody.min) + "-" + ns_text(r.simbody.max);
+    const std::string sr = ns_text(r.simbody->min) + "-" + ns_text(r.simbody->max);
     std::snprintf(line, sizeof line, "%-8s %10s %10s %15s   %-21s %s\n", r.quantity.c_str(),
-                  ns_text(r.femdyn.median).c_str(), ns_text(r.simbody.median).c_str(),
-                  format_number(r.simbody.median / r.femdyn.median, "%.2f").c_str(), fr.c_str(),
+                  ns_text(r.femdyn.median).c_str(), ns_text(r.simbody->median).c_str(),
+                  format_number(r.simbody->median / r.femdyn.median, "%.2f").c_str(), fr.c_str(),
                   sr.c_str());
     std::cout << line;
   }
@@ -348,6 +417,7 @@ void print_table(const std::string& path, int n, int K, const Method& method,
       std::cout << line;
     }
   }
+  print_femdyn_only(rows);
   if (!skipped.empty()) std::cout << "D        skipped (" << skipped << ")\n";
 }
 
@@ -363,7 +433,7 @@ nlohmann::ordered_json report_json(const std::string& path, const Model& m,
   };
   for (const Row& r : rows) {
     add("femdyn", r.quantity, r.femdyn);
-    add("simbody", r.quantity, r.simbody);
+    if (r.simbody) add("simbody", r.quantity, *r.simbody);
     if (r.mujoco) add("mujoco", r.quantity, *r.mujoco);
   }
   return {{"model", path},
@@ -476,6 +546,8 @@ int cmd_bench(int argc, char** argv) {
         keep(ws.tau.data());
       },
       [&](int k) { twin->time_inverse(s.q[k], s.qd[k], s.qdd[k]); }, K, method, mj_inverse));
+  // The analytic derivatives, femdyn alone.
+  for (Row& row : time_derivative_rows(m, ws, s, K, method)) rows.push_back(std::move(row));
   // D: femdyn's tensor / Simbody's symmetric part by polarization of h.
   const std::string skipped = tensor_skipped(n, quick);
   if (skipped.empty())

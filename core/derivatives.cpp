@@ -25,27 +25,20 @@ bool column_in_parent(const Joint& j, int k) {
   return visit_joint(j.type, [&]<class J>(J) { return J::in_parent(k); });
 }
 
-// The motion cross-product matrix: crm(V) x = V × x.
-Mat6 motion_cross_matrix(const Vec6& V) {
-  Mat6 X = Mat6::Zero();
-  X.topLeftCorner<3, 3>() = skew(V.head<3>());
-  X.bottomRightCorner<3, 3>() = X.topLeftCorner<3, 3>();
-  X.bottomLeftCorner<3, 3>() = skew(V.tail<3>());
-  return X;
-}
-
-// B x = V ×* (I x) − I (V × x) + x ×* h with h = I V:
-//   B = −crm(V)ᵀ I − I crm(V) − H(h),   H(h) = [[ [h_n]×, [h_f]× ], [ [h_f]×, 0 ]].
-Mat6 velocity_inertia(const RigidInertia& I, const Vec6& V) {
-  const Mat6 Im = I.matrix(), X = motion_cross_matrix(V);
-  const Vec6 h = I * V;
-  Mat6 B;
-  B.noalias() = -X.transpose() * Im;
-  B.noalias() -= Im * X;
-  const Mat3 hn = skew(h.head<3>()), hf = skew(h.tail<3>());
-  B.topLeftCorner<3, 3>() -= hn;
-  B.topRightCorner<3, 3>() -= hf;
-  B.bottomLeftCorner<3, 3>() -= hf;
+// B = −crm(V)ᵀ I − I crm(V) − H(I V) for I = [[A, [h]×], [[h]×ᵀ, m 1]], V = (ω, v), the map
+// B x = V ×* (I x) − I (V × x) + x ×* (I V). Written out by blocks (with the Jacobi identity)
+// its right column vanishes:
+//   B = [[ [ω]× A − A [ω]× − (h vᵀ + v hᵀ − 2 (v·h) 1) − [A ω + h × v]×,  0 ],
+//        [ −2 [m v + ω × h]×,                                            0 ]],
+// about 70 operations instead of the 6 × 6 products' 430.
+VelocityInertia velocity_inertia(const RigidInertia& I, const Vec3& w, const Vec3& v) {
+  VelocityInertia B;
+  const Mat3 wA = skew(w) * I.I;
+  B.top = wA + wA.transpose();  // [ω]× A − A [ω]× with A symmetric
+  B.top.noalias() -= I.h * v.transpose() + v * I.h.transpose();
+  B.top.diagonal().array() += 2 * v.dot(I.h);
+  B.top -= skew(I.I * w + cross3(I.h, v));
+  B.hf = I.m * v + cross3(w, I.h);
   return B;
 }
 
@@ -62,17 +55,35 @@ void add_load_turning(const Model& m, const Workspace& ws, DerivativeWorkspace& 
   for (const BodyTorque& t : m.torques) d.Lc[t.body].topRows<3>() -= skew(t.torque);
 }
 
-// Root to leaves for body b: S, V̄, ā, V, a, the rates' y, δV, z, and its own I, B, f.
-void forward_body(const Model& m, const Workspace& ws, DerivativeWorkspace& d, int b,
-                  const Vec6& a_base) {
+// Body b's columns S (world axes about the origin) and its inertia I_b there, from its pose.
+void columns_and_inertia(const Model& m, const Workspace& ws, DerivativeWorkspace& d, int b) {
+  const Joint& J = m.bodies[b].joint;
+  const BodyState& Bs = ws.body[b];
+  if (moves(J))
+    spatial_columns(J, Bs.R, parent_rotation(m, ws.body, b), Bs.p, d.S.data() + J.idx_v);
+  d.Ic[b] = inertia_at_origin(m.body_inertia[b], Bs.R, Bs.p);
+}
+
+// The same, as the articulated forward dynamics just formed them at this q.
+void articulated_columns_and_inertia(const Model& m, const Workspace& ws, DerivativeWorkspace& d,
+                                     int b) {
+  const Joint& J = m.bodies[b].joint;
+  if (J.nv == 1)
+    d.S[J.idx_v] = ws.articulated[b].S;
+  else
+    for (int k = 0; k < J.nv; ++k) d.S[J.idx_v + k] = ws.subspace[J.idx_v + k];
+  d.Ic[b] = ws.articulated[b].I;
+}
+
+// Root to leaves for body b, its S and I_b in place: V̄, ā, V, a, the rates' y, δV, z, and its
+// own B and f.
+void forward_body(const Model& m, DerivativeWorkspace& d, int b, const Vec6& a_base) {
   const Body& body = m.bodies[b];
   const Joint& J = body.joint;
-  const BodyState& Bs = ws.body[b];
   const Vec6 V_P = body.parent >= 0 ? d.V[body.parent] : Vec6::Zero();
   const Vec6 a_P = body.parent >= 0 ? d.a[body.parent] : a_base;
   Vec6 Vbar = V_P, abar = a_P;
   if (moves(J)) {
-    spatial_columns(J, Bs.R, parent_rotation(m, ws.body, b), Bs.p, d.S.data() + J.idx_v);
     for (int k = 0; k < J.nv; ++k)  // columns fixed in the parent: they do not move with q_J
       if (column_in_parent(J, k)) {
         const int r = J.idx_v + k;
@@ -92,9 +103,8 @@ void forward_body(const Model& m, const Workspace& ws, DerivativeWorkspace& d, i
     d.z[r] = cross_motion(in_parent ? V_P : V, d.S[r]) - cross_motion(d.S[r], Vbar);
   }
   d.V[b] = V, d.a[b] = a, d.V_bar[b] = Vbar, d.a_bar[b] = abar;
-  d.Ic[b] = inertia_at_origin(m.body_inertia[b], Bs.R, Bs.p);
   d.F[b] = d.Ic[b] * a + cross_force(V, d.Ic[b] * V);
-  d.Bc[b] = velocity_inertia(d.Ic[b], V);
+  d.Bc[b] = velocity_inertia(d.Ic[b], V.head<3>(), V.tail<3>());
 }
 
 // The external wrenches subtracted from each body's own force (as Newton–Euler does).
@@ -111,30 +121,30 @@ void subtract_loads(const Model& m, const Workspace& ws, DerivativeWorkspace& d)
 void backward_body(const Model& m, DerivativeWorkspace& d, int b, MatX& Kq, MatX& Kv) {
   const Joint& J = m.bodies[b].joint;
   const RigidInertia& Ic = d.Ic[b];
-  const Mat6& Bc = d.Bc[b];
+  const VelocityInertia& Bc = d.Bc[b];
   for (int k = 0; k < J.nv; ++k) {  // m own: c own or above (b is the deeper)
     const int mr = J.idx_v + k;
     Vec6 Xq = Ic * d.y[mr] + Bc * d.dV[mr];
     if (d.loads) Xq += d.Lc[b] * d.S[mr].head<3>();
     const Vec6 Xv = Ic * d.z[mr] + Bc * d.S[mr];
-    const Vec6 SF = cross_force(d.S[mr], d.F[b]);  // the rigid part S_m ×* F_b
+    const Vec6 XqF = Xq + cross_force(d.S[mr], d.F[b]);  // with the rigid part S_m ×* F_b
     for (int c = J.idx_v + J.nv - 1; c >= 0; c = m.rate_parent[c]) {
       const bool own = c >= J.idx_v;
       const bool moves_with = own && !column_in_parent(J, c - J.idx_v);
-      Kq(c, mr) = d.S[c].dot(Xq) + (moves_with ? 0.0 : d.S[c].dot(SF));
+      Kq(c, mr) = d.S[c].dot(moves_with ? Xq : XqF);
       Kv(c, mr) = d.S[c].dot(Xv);
     }
   }
   for (int k = 0; k < J.nv; ++k) {  // c own, m strictly above: b is the deeper
     const int c = J.idx_v + k;
     d.uI[c] = Ic * d.S[c];
-    d.uB[c].noalias() = Bc.transpose() * d.S[c];
+    d.uB[c] = Bc.transpose_times(d.S[c]);
     if (d.loads) d.uL[c].noalias() = d.Lc[b].transpose() * d.S[c];
     for (int mr = m.rate_parent[J.idx_v]; mr >= 0; mr = m.rate_parent[mr]) {
-      double q = d.uI[c].dot(d.y[mr]) + d.uB[c].dot(d.dV[mr]);
+      double q = d.uI[c].dot(d.y[mr]) + d.uB[c].dot(d.dV[mr].head<3>());
       if (d.loads) q += d.uL[c].dot(d.S[mr].head<3>());
       Kq(c, mr) = q;
-      Kv(c, mr) = d.uI[c].dot(d.z[mr]) + d.uB[c].dot(d.S[mr]);
+      Kv(c, mr) = d.uI[c].dot(d.z[mr]) + d.uB[c].dot(d.S[mr].head<3>());
     }
   }
 }
@@ -173,17 +183,24 @@ void add_passive(const Model& m, const Workspace& ws, const DerivativeWorkspace&
 }
 
 // ∂τ_θ/∂θ, ∂τ_θ/∂θ̇ (nθ × nθ) into Kq, Kv.
-// With poses_ready, the body poses and θ in ws are those at q already (the articulated forward
-// dynamics just left them).
+// With articulated_ready, the articulated forward dynamics has just run at q: the body poses, θ,
+// the columns S and the inertias I_b in ws are those at q.
 void joint_level(const Model& m, Workspace& ws, DerivativeWorkspace& d, const VecX& q,
-                 const VecX& qd, const VecX& qdd, MatX& Kq, MatX& Kv, bool poses_ready = false) {
+                 const VecX& qd, const VecX& qdd, MatX& Kq, MatX& Kv,
+                 bool articulated_ready = false) {
   const int nb = static_cast<int>(m.bodies.size());
-  if (!poses_ready)
+  if (!articulated_ready)
     propagate(m, ws, q, qd, {.jacobian = false, .bias = false, .rows = false});  // poses, θ
   coupling_apply(m, qd, d.theta_dot);
   coupling_apply(m, qdd, d.theta_ddot);
   const Vec6 a_base = gravity_base_acceleration(m);
-  for (int b = 0; b < nb; ++b) forward_body(m, ws, d, b, a_base);
+  for (int b = 0; b < nb; ++b) {
+    if (articulated_ready)
+      articulated_columns_and_inertia(m, ws, d, b);
+    else
+      columns_and_inertia(m, ws, d, b);
+    forward_body(m, d, b, a_base);
+  }
   subtract_loads(m, ws, d);
   if (d.loads) add_load_turning(m, ws, d);
   for (int b = nb - 1; b >= 0; --b) {
@@ -349,6 +366,50 @@ void solve_chunks(const Model& m, const Workspace& ws, DerivativeWorkspace& d, M
   }
 }
 
+// The rows where a column of ∂τ/∂q or ∂τ/∂v of body b's rates can be non-zero: the rates of b's
+// ancestors and of b's subtree (a pair (c, m) couples only along one path to the root), as runs
+// of consecutive rates, merged. Needs the sweep's depth-first numbering (sub_first, sub_count).
+void plan_row_runs(const Model& m, DerivativeWorkspace& d) {
+  const int nb = static_cast<int>(m.bodies.size());
+  d.run_begin.assign(nb + 1, 0);
+  d.runs.clear();
+  std::vector<std::pair<int, int>> rows;  // (first, count), root first
+  for (int b = 0; b < nb; ++b) {
+    d.run_begin[b] = static_cast<int>(d.runs.size());
+    if (!moves(m.bodies[b].joint)) continue;
+    rows.clear();
+    rows.emplace_back(d.sub_first[b], d.sub_count[b]);
+    for (int a = m.bodies[b].parent; a >= 0; a = m.bodies[a].parent)
+      if (moves(m.bodies[a].joint))
+        rows.emplace_back(m.bodies[a].joint.idx_v, m.bodies[a].joint.nv);
+    std::sort(rows.begin(), rows.end());
+    for (const auto& [first, count] : rows)
+      if (!d.runs.empty() && static_cast<int>(d.runs.size()) > d.run_begin[b] &&
+          d.runs.back().first + d.runs.back().second == first)
+        d.runs.back().second += count;
+      else
+        d.runs.emplace_back(first, count);
+  }
+  d.run_begin[nb] = static_cast<int>(d.runs.size());
+}
+
+// Y = −(M^s)⁻¹ K over K's non-zero rows only (plan_row_runs): per column a few products.
+void minus_minv_times(const Model& m, DerivativeWorkspace& d, const MatX& K, MatX& Y) {
+  const int nb = static_cast<int>(m.bodies.size());
+  for (int b = 0; b < nb; ++b) {
+    const Joint& J = m.bodies[b].joint;
+    if (!moves(J)) continue;
+    for (int c = J.idx_v; c < J.idx_v + J.nv; ++c) {
+      auto y = Y.col(c);
+      y.setZero();
+      for (int r = d.run_begin[b]; r < d.run_begin[b + 1]; ++r) {
+        const auto [first, count] = d.runs[r];
+        y.noalias() -= d.Minv.middleCols(first, count) * K.col(c).segment(first, count);
+      }
+    }
+  }
+}
+
 // Whether the sweep applies (articulated route, every subtree's rates contiguous with the
 // joint's own first), and its per-body layout.
 void plan_inverse_sweep(const Model& m, DerivativeWorkspace& d) {
@@ -385,6 +446,7 @@ void plan_inverse_sweep(const Model& m, DerivativeWorkspace& d) {
     const int p = m.bodies[b].parent;
     d.slot[b] = p >= 0 && d.slot[p] >= 0 && last[p] == b ? d.slot[p] : slots++;
   }
+  plan_row_runs(m, d);
   d.P.setZero(6, n);
   d.A.setZero(6, static_cast<Eigen::Index>(slots) * n);
   d.rows.setZero(n, 6);
@@ -414,11 +476,11 @@ DerivativeWorkspace::DerivativeWorkspace(const Model& m) {
   qdd = VecX::Zero(n);
   for (auto* v : {&V, &a, &V_bar, &a_bar, &F}) v->assign(nb, Vec6::Zero());
   Ic.assign(nb, RigidInertia{});
-  Bc.assign(nb, Mat6::Zero());
+  Bc.assign(nb, VelocityInertia{});
   loads = !m.point_loads.empty() || !m.torques.empty();
   Lc.assign(loads ? nb : 0, Mat63::Zero());
-  for (auto* v : {&S, &dV, &y, &z, &uI, &uB}) v->assign(nt, Vec6::Zero());
-  uL.assign(nt, Vec3::Zero());
+  for (auto* v : {&S, &dV, &y, &z, &uI}) v->assign(nt, Vec6::Zero());
+  for (auto* v : {&uB, &uL}) v->assign(nt, Vec3::Zero());
   theta_dot = VecX::Zero(nt);
   theta_ddot = VecX::Zero(nt);
   column = VecX::Zero(n);
@@ -433,12 +495,12 @@ DerivativeWorkspace::DerivativeWorkspace(const Model& m) {
 namespace {
 
 void inverse_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d, const VecX& q,
-                         const VecX& qd, const VecX& qdd, bool poses_ready) {
+                         const VecX& qd, const VecX& qdd, bool articulated_ready) {
   MatX& Kq = m.identity_coupling ? d.dtau_dq : d.Kq;
   MatX& Kv = m.identity_coupling ? d.dtau_dv : d.Kv;
   Kq.setZero();
   Kv.setZero();
-  joint_level(m, ws, d, q, qd, qdd, Kq, Kv, poses_ready);
+  joint_level(m, ws, d, q, qd, qdd, Kq, Kv, articulated_ready);
   if (m.identity_coupling) return;
   d.KC.noalias() = Kq * m.C;  // ∂τ_q/∂q = Cᵀ (∂τ_θ/∂θ) C
   d.dtau_dq.noalias() = m.C.transpose() * d.KC;
@@ -463,8 +525,8 @@ Status forward_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWor
   if (d.minv_sweep) {
     inverse_mass_sweep(m, ws, d);
     if (m.n() <= kDenseProductSize) {
-      d.dqdd_dq.noalias() = -d.Minv * d.dtau_dq;
-      d.dqdd_dv.noalias() = -d.Minv * d.dtau_dv;
+      minus_minv_times(m, d, d.dtau_dq, d.dqdd_dq);
+      minus_minv_times(m, d, d.dtau_dv, d.dqdd_dv);
     } else {
       d.dqdd_dq = d.dtau_dq;
       solve_chunks(m, ws, d, d.dqdd_dq, -1.0);

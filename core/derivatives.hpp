@@ -44,6 +44,7 @@
 // an explicit correlation table).
 #pragma once
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/status.hpp"
@@ -52,6 +53,33 @@
 namespace femdyn {
 
 using Mat63 = Eigen::Matrix<double, 6, 3>;
+
+// A body's (or a subtree's) velocity inertia B = [[top, 0], [−2 [h_f]×, 0]] (derivatives.cpp,
+// velocity_inertia): only its left column is non-zero, so it is kept as a 3 × 3 and a 3-vector.
+struct VelocityInertia {
+  Mat3 top = Mat3::Zero();
+  Vec3 hf = Vec3::Zero();
+
+  // B x = (top x_ω, −2 h_f × x_ω).
+  Vec6 operator*(const Vec6& x) const {
+    Vec6 f;
+    f.head<3>().noalias() = top * x.head<3>();
+    f.tail<3>() = -2 * cross3(hf, x.head<3>());
+    return f;
+  }
+  // The angular part of Bᵀ s = (topᵀ s_ω + 2 h_f × s_v, 0).
+  Vec3 transpose_times(const Vec6& s) const {
+    Vec3 u;
+    u.noalias() = top.transpose() * s.head<3>();
+    u += 2 * cross3(hf, s.tail<3>());
+    return u;
+  }
+  VelocityInertia& operator+=(const VelocityInertia& o) {
+    top += o.top;
+    hf += o.hf;
+    return *this;
+  }
+};
 
 // The results and buffers of the derivatives, sized once for a model: no allocation per call
 // after the first.
@@ -65,11 +93,11 @@ struct DerivativeWorkspace {
   // Per body (world axes about the origin).
   std::vector<Vec6> V, a, V_bar, a_bar, F;
   std::vector<RigidInertia> Ic;
-  std::vector<Mat6> Bc;
+  std::vector<VelocityInertia> Bc;
   std::vector<Mat63> Lc;
   // Per rate of θ̇.
-  std::vector<Vec6> S, dV, y, z, uI, uB;
-  std::vector<Vec3> uL;
+  std::vector<Vec6> S, dV, y, z, uI;
+  std::vector<Vec3> uB, uL;  // uB: the angular part of B^cᵀ S (its linear part is 0)
   VecX theta_dot, theta_ddot, column;
   MatX Kq, Kv, KC;  // the joint-level ∂τ_θ/∂θ, ∂τ_θ/∂θ̇ and K C (coupled models only)
   bool loads = false;
@@ -80,6 +108,10 @@ struct DerivativeWorkspace {
   bool minv_sweep = false;
   std::vector<int> sub_first, sub_count, slot;
   MatX P, A, rows;  // rows: a joint's rows of (M^s)⁻¹ while they are formed (n × 6)
+  // Per body b, runs[run_begin[b] .. run_begin[b + 1]) = (first, count): the rows where its
+  // rates' columns of ∂τ/∂· can be non-zero (its ancestors' and its subtree's rates).
+  std::vector<std::pair<int, int>> runs;
+  std::vector<int> run_begin;
   // Above a size, (M^s)⁻¹ ∂τ/∂· by the articulated factorisation eight columns at a time (per
   // body a 6 × 8 force and acceleration) instead of a dense product.
   std::vector<Eigen::Matrix<double, 6, 8>> chunk_force, chunk_acceleration;
