@@ -107,7 +107,8 @@ struct DerivativeWorkspace {
   // slots' 6 × n accelerations (a body that is its parent's last child reuses its parent's).
   bool minv_sweep = false;
   std::vector<int> sub_first, sub_count, slot;
-  MatX P, A, rows;  // rows: a joint's rows of (M^s)⁻¹ while they are formed (n × 6)
+  Eigen::Matrix<double, 6, Eigen::Dynamic> P, A;  // six rows known at compile time
+  MatX rows;  // a joint's rows of (M^s)⁻¹ while they are formed (n × 6)
   // Per body b, runs[run_begin[b] .. run_begin[b + 1]) = (first, count): the rows where its
   // rates' columns of ∂τ/∂· can be non-zero (its ancestors' and its subtree's rates).
   std::vector<std::pair<int, int>> runs;
