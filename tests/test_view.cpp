@@ -90,6 +90,27 @@ TEST_CASE("view: each body's pose per frame is the kinematics' at that frame's q
   CHECK(std::abs(drift) < 1e-3 * (1 + std::abs(E["potential"][0].get<double>())));
 }
 
+TEST_CASE("view: every bundled model and URDF robot has a page of its posture", "[view]") {
+  std::vector<std::string> paths;
+  for (const std::string& name : bundled_models()) paths.push_back(model_path(name));
+  for (const char* robot : {"urdf/arm7.urdf", "urdf/hand16.urdf", "urdf/gantry.urdf"})
+    paths.push_back(model_path(robot));
+  for (const char* robot : {"iiwa.urdf", "hyq.urdf", "atlas.urdf"})
+    paths.push_back(std::string(FEMDYN_SOURCE_DIR) + "/tests/robots/" + robot);
+  for (const std::string& path : paths) {
+    INFO(path);
+    const Model m = load_model(path);
+    const std::string page = view::page_html(view::scene_json(
+        m, view::posture(m, neutral_posture(m)),
+        is_urdf_path(path) ? urdf_visuals(read_file(path), path) : std::vector<UrdfVisual>{},
+        path));
+    const nlohmann::json scene = scene_of_page(page);
+    CHECK(scene["bodies"].size() == m.bodies.size());
+    CHECK(scene["elements"].size() == m.elements.size());
+    CHECK(scene["motion"]["poses"][0].size() == 7 * m.bodies.size());
+  }
+}
+
 TEST_CASE("view: the page is whole, offline, and holds the scene it was given", "[view]") {
   const Model m = load_model(model_path("finger.json"));
   const nlohmann::json scene =
@@ -97,8 +118,8 @@ TEST_CASE("view: the page is whole, offline, and holds the scene it was given", 
   const std::string page = view::page_html(scene);
   CHECK(page.find("<!--femdyn:") == std::string::npos);  // every placeholder filled
   CHECK(page.find("OrbitControls") != std::string::npos);
-  CHECK(page.find("http://") == std::string::npos);  // nothing to fetch
-  CHECK(page.find("<script src") == std::string::npos);
+  for (const char* fetch : {"<script src", "src=\"http", "href=\"http", "<link ", "@import"})
+    CHECK(page.find(fetch) == std::string::npos);  // nothing to fetch
   CHECK(scene_of_page(page) == scene);
   // No name can end a script early: 4 scripts, 4 ends, whatever the model is called.
   nlohmann::json named = scene;

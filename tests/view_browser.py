@@ -34,7 +34,8 @@ BACKGROUND = (0xF4, 0xF6, 0xF8)  # the 3-D view's clear colour (web/view.js)
 CASES = {
     "finger": ("models/finger.json", ["--t-end", "0.3", "--tau-each", "0.002", "--every", "10"]),
     "hand": ("models/hand.json", ["--t-end", "0.6", "--every", "10"]),
-    "arm7": ("models/urdf/arm7.urdf", ["--t-end", "0.6", "--every", "10"]),
+    "arm7": ("models/urdf/arm7.urdf",
+             ["--t-end", "0.6", "--q0", "0.3,0.6,0,0.8,0,0,0", "--every", "10"]),
 }
 
 

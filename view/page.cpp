@@ -20,10 +20,11 @@ void fill(std::string& page, const std::string& name, std::string_view text) {
   page.replace(at, mark.size(), text);
 }
 
-// JSON inside <script>: '<' only occurs in strings, where \u003c reads back the same and no
-// name can end the script early ("</script>") or open a comment ("<!--").
+// JSON inside <script>, compact, invalid UTF-8 replaced: '<' only occurs in strings, where
+// \u003c reads back the same and no name can end the script early ("</script>") or open a
+// comment ("<!--").
 std::string script_safe_json(const Json& doc) {
-  const std::string text = json_text(doc);
+  const std::string text = doc.dump(-1, ' ', false, Json::error_handler_t::replace);
   std::string out;
   out.reserve(text.size());
   for (const char c : text) {
