@@ -143,6 +143,12 @@ class Chromium:
         with open(path, "wb") as f:
             f.write(base64.b64decode(shot))
 
+    def hover(self, x, y):
+        """Moves the mouse to (x, y); the text of the page's tooltip then, or None."""
+        self.call("Input.dispatchMouseEvent", type="mouseMoved", x=x, y=y)
+        return self.evaluate("(() => { const t = document.getElementById('tooltip');"
+                             " return t.style.display === 'block' ? t.textContent : null; })()")
+
     def close(self):
         try:
             self.session = None
@@ -233,6 +239,18 @@ def check_screenshots(case, shots, times):
     return share
 
 
+def check_hover(browser, info, case):
+    """The mouse over an element names it and its body (a body of the model)."""
+    bodies = {j["body"] for j in info["joints"]}
+    spots = [s for s in browser.evaluate("window.femdynView.labelsOnScreen()")
+             if 0 < s["x"] < VIEW3D and 0 < s["y"] < HEIGHT]
+    assert spots, f"{case}: nothing named on the screen"
+    names = [browser.hover(s["x"], s["y"]) for s in spots[:5]]
+    named = [n for n in names if n and any(b in n for b in bodies)]
+    assert named, f"{case}: hovering named no body of the model: {names}"
+    return named[0]
+
+
 def main():
     if len(sys.argv) != 5 or sys.argv[4] not in CASES:
         print(__doc__)
@@ -269,12 +287,14 @@ def main():
             png = os.path.join(work, f"t{t:g}.png")
             browser.screenshot_at(t, png)
             shots.append(png_pixels(png)[2])
+        hovered = check_hover(browser, info, case)
         assert not browser.status()["errors"], f"{case}: JavaScript errors while playing"
     finally:
         browser.close()
     share = check_screenshots(case, shots, times)
     print(f"{case}: {counts}; page {os.path.getsize(moving) / 1e6:.2f} MB; {share:.1%} of the "
-          f"view changed from t = 0 to {times[1]}; {time.monotonic() - start:.1f} s")
+          f"view changed from t = 0 to {times[1]}; hover: {hovered!r}; "
+          f"{time.monotonic() - start:.1f} s")
     return 0
 
 

@@ -159,7 +159,9 @@
   const nodeMaterial = material(0x111111);
   const nodesSeen = new Set();
   data.elements.forEach((e, k) => {
-    const label = `${bodyName(e.body)}: ${e.type} #${k}, ${e.mass.toPrecision(3)} kg`;
+    const amount = e.type === 'rotary_node' ? `I ${Math.max(...e.moments).toPrecision(3)} kg·m²`
+                                            : `${e.mass.toPrecision(3)} kg`;
+    const label = `${bodyName(e.body)}: ${e.type} #${k}, ${amount}`;
     const mesh = labelled(elementMesh(e, label), label);
     (mesh.userData.spans ? world : groupOf(e.body)).add(mesh);
     counts.elements += 1;
@@ -364,6 +366,16 @@
     requestAnimationFrame(tick);
   }
   show();
+
+  // Where each named object is on the screen (CSS pixels), for the hover test.
+  window.femdynView = {
+    labelsOnScreen: () => pickable.map((mesh) => {
+      const p = mesh.getWorldPosition(new THREE.Vector3()).project(camera);
+      const r = renderer.domElement.getBoundingClientRect();
+      return { label: mesh.userData.label, x: r.left + (p.x + 1) / 2 * r.width,
+               y: r.top + (1 - p.y) / 2 * r.height };
+    }),
+  };
 
   // What the page holds, for its reader and its tests (tests/view_browser.py).
   const gl = renderer.getContext();
