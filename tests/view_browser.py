@@ -4,13 +4,14 @@
 usage: view_browser.py FEMDYN SOURCE_DIR WORK_DIR CASE      (CASE: finger, hand or arm7)
 
 For the case's model it simulates a short trajectory, writes the page of one posture and the
-page of the trajectory, and in Chromium:
-  - loads each page (--dump-dom) and reads the status element the page fills
-    (web/view.js): no JavaScript error, WebGL up, and the numbers of bodies, moving joints,
-    elements, named frames and URDF visuals it drew equal to those femdyn reports for the model
-    (`femdyn info --json`; the visuals counted in the URDF here);
-  - takes screenshots of the trajectory's page at #t=0 and at its last time: the 3-D view is
-    not blank and differs between the two.
+page of the trajectory, and in one headless Chromium (driven over the DevTools protocol):
+  - loads each page and reads the status element the page fills (web/view.js): no JavaScript
+    error, WebGL up, and the numbers of bodies, moving joints, elements, named frames and URDF
+    visuals it drew equal to those femdyn reports for the model (`femdyn info --json`; the
+    visuals counted in the URDF here);
+  - takes screenshots of the trajectory's 3-D view at #t=0 and at its last time: not blank,
+    and different from each other;
+  - moves the mouse over named objects: the tooltip names a body of the model.
 Exit 77 (ctest's SKIP_RETURN_CODE) when Chromium is absent; tools/setup.sh installs it.
 """
 import base64

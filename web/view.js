@@ -79,8 +79,10 @@
   data.bodies.forEach((body, b) => {
     const axes = new THREE.AxesHelper(0.06 * L);
     groups[b].add(axes);
-    const link = new THREE.BufferGeometry().setFromPoints([new THREE.Vector3(), v3(body.joint.origin)]);
-    groupOf(body.parent).add(new THREE.Line(link, new THREE.LineBasicMaterial({ color: bodyColor(body.parent) })));
+    const link = new THREE.BufferGeometry().setFromPoints(
+        [new THREE.Vector3(), v3(body.joint.origin)]);
+    const linkMaterial = new THREE.LineBasicMaterial({ color: bodyColor(body.parent) });
+    groupOf(body.parent).add(new THREE.Line(link, linkMaterial));
   });
 
   // The joints and their axes (in the body frame: the joint frame after its motion).
@@ -108,8 +110,8 @@
     grp.position.copy(v3(fr.p));
     grp.quaternion.copy(quat(fr.quaternion));
     grp.add(new THREE.AxesHelper(0.05 * L));
-    grp.add(labelled(new THREE.Mesh(new THREE.SphereGeometry(0.01 * L, 8, 6),
-                                    material(0x222222)), `frame ${fr.name} on ${bodyName(fr.body)}`));
+    const dot = new THREE.Mesh(new THREE.SphereGeometry(0.01 * L, 8, 6), material(0x222222));
+    grp.add(labelled(dot, `frame ${fr.name} on ${bodyName(fr.body)}`));
     groupOf(fr.body).add(grp);
     counts.frames += 1;
   }
@@ -124,11 +126,12 @@
     mesh.scale.set(radius, Math.max(d.length(), 1e-9), radius);
   }
   const massRadius = (m) => R0 * Math.max(0.25, Math.cbrt(m / maxMass));
-  function elementMesh(e, label) {
+  function elementMesh(e) {
     const color = bodyColor(e.body);
     const n0 = e.nodes[0];
     if (e.type === 'lumped_point' || e.type === 'rigid_body') {
-      const mesh = new THREE.Mesh(new THREE.SphereGeometry(massRadius(e.mass), 20, 14), material(color));
+      const sphere = new THREE.SphereGeometry(massRadius(e.mass), 20, 14);
+      const mesh = new THREE.Mesh(sphere, material(color));
       mesh.position.copy(v3(e.type === 'lumped_point' ? n0.p : e.com));
       return mesh;
     }
@@ -162,7 +165,7 @@
     const amount = e.type === 'rotary_node' ? `I ${Math.max(...e.moments).toPrecision(3)} kg·m²`
                                             : `${e.mass.toPrecision(3)} kg`;
     const label = `${bodyName(e.body)}: ${e.type} #${k}, ${amount}`;
-    const mesh = labelled(elementMesh(e, label), label);
+    const mesh = labelled(elementMesh(e), label);
     (mesh.userData.spans ? world : groupOf(e.body)).add(mesh);
     counts.elements += 1;
     for (const n of e.nodes) {  // the nodes each element uses, once per place
@@ -180,7 +183,8 @@
     let geometry = null;
     if (v.shape === 'box') geometry = new THREE.BoxGeometry(v.size[0], v.size[1], v.size[2]);
     else if (v.shape === 'cylinder')
-      geometry = new THREE.CylinderGeometry(v.size[0], v.size[0], v.size[1], 24).rotateX(Math.PI / 2);
+      geometry = new THREE.CylinderGeometry(v.size[0], v.size[0], v.size[1], 24)
+          .rotateX(Math.PI / 2);  // three.js's cylinders lie along y, URDF's along z
     else if (v.shape === 'sphere') geometry = new THREE.SphereGeometry(v.size[0], 24, 16);
     if (!geometry) { counts.meshes_skipped += 1; continue; }
     const color = v.rgba ? new THREE.Color(v.rgba[0], v.rgba[1], v.rgba[2]) : bodyColor(v.body);
@@ -255,7 +259,11 @@
     ctx.scale(ratio, ratio);
     const w = c.clientWidth, h = c.clientHeight, m = 6;
     let lo = Infinity, hi = -Infinity;
-    for (const s of plot.series) for (const y of s.y) { lo = Math.min(lo, y); hi = Math.max(hi, y); }
+    for (const s of plot.series)
+      for (const y of s.y) {
+        lo = Math.min(lo, y);
+        hi = Math.max(hi, y);
+      }
     if (!(hi > lo)) { lo -= 1; hi += 1; }
     const span = t1 > t0 ? t1 - t0 : 1;
     const X = (x) => m + (w - 2 * m) * (x - t0) / span;
@@ -287,17 +295,23 @@
     if (Math.abs(side.dot(up)) > 0.9) side.set(0, 1, 0);
     const across = up.clone().cross(side).normalize();
     side.crossVectors(across, up).normalize();
-    const dir = side.multiplyScalar(1).add(across.multiplyScalar(-1.2)).add(up.clone().multiplyScalar(0.8)).normalize();
+    const dir = side.add(across.multiplyScalar(-1.2)).add(up.clone().multiplyScalar(0.8))
+        .normalize();
     const radius = Math.max(0.5 * L, 0.03);
-    camera.position.copy(center).addScaledVector(dir, radius / Math.sin(THREE.MathUtils.degToRad(20)) * 1.05);
+    const distance = 1.05 * radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2));
+    camera.position.copy(center).addScaledVector(dir, distance);
     controls.target.copy(center);
     controls.update();
   }
   const playButton = document.getElementById('play');
   const slider = document.getElementById('time');
   const timeLabel = document.getElementById('time-label');
-  document.getElementById('speed').addEventListener('change', (e) => { state.speed = +e.target.value; });
-  document.getElementById('loop').addEventListener('change', (e) => { state.loop = e.target.checked; });
+  document.getElementById('speed').addEventListener('change', (e) => {
+    state.speed = +e.target.value;
+  });
+  document.getElementById('loop').addEventListener('change', (e) => {
+    state.loop = e.target.checked;
+  });
   playButton.disabled = slider.disabled = !(motion.trajectory && T.length > 1);
   playButton.addEventListener('click', () => {
     if (!state.playing && state.t >= t1) state.t = t0;
