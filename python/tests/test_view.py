@@ -1,5 +1,6 @@
 """Model.view: the page of `femdyn view` from Python (docs/view.md). The page in a browser is
 tests/view_browser.py's; here: what the page holds, that it equals the command's, and errors."""
+import html
 import json
 import re
 import subprocess
@@ -96,3 +97,29 @@ def test_errors(tmp_path):
         run["q"][-1, 1] = np.nan
         model.view(traj=run, path=tmp_path / "x.html")
     assert not (tmp_path / "x.html").exists()
+
+
+def test_inline_in_a_notebook(tmp_path, monkeypatch):
+    """In a Jupyter kernel the page is displayed as an iframe holding the whole page."""
+    import sys
+    import types
+
+    from femdyn import _view
+    shown = []
+    display_module = types.ModuleType("IPython.display")
+    display_module.HTML = lambda text: ("HTML", text)
+    display_module.display = shown.append
+    monkeypatch.setitem(sys.modules, "IPython", types.ModuleType("IPython"))
+    monkeypatch.setitem(sys.modules, "IPython.display", display_module)
+    monkeypatch.setattr(_view, "_in_notebook", lambda: True)
+    path = femdyn.load(model_path("models/pendulum.json")).view(path=tmp_path / "p.html")
+    assert len(shown) == 1 and shown[0][0] == "HTML"
+    frame = shown[0][1]
+    assert frame.startswith("<iframe srcdoc=\"") and "</script>" not in frame
+    page = open(path, encoding="utf-8").read()
+    assert html.unescape(frame[len('<iframe srcdoc="'):frame.index('" style=')]) == page
+
+
+def test_not_in_a_notebook_here():
+    from femdyn import _view
+    assert not _view._in_notebook()
