@@ -60,6 +60,8 @@ class Chromium:
     for every page of a case. Software WebGL (SwiftShader); a fixed WIDTH x HEIGHT view."""
 
     def __init__(self, exe, profile):
+        self.log = profile + ".log"  # Chromium's messages, quoted when it fails
+        self._log = open(self.log, "w")
         to_chrome, self._out = os.pipe()
         self._in, from_chrome = os.pipe()
 
@@ -68,12 +70,13 @@ class Chromium:
             os.dup2(from_chrome, 4)
 
         self.proc = subprocess.Popen(
-            [exe, "--headless", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
+            [exe, "--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+             "--use-angle=swiftshader",
              "--enable-unsafe-swiftshader", "--no-first-run", "--disable-extensions",
              "--remote-debugging-pipe", f"--user-data-dir={profile}",
              f"--window-size={WIDTH},{HEIGHT}",
              "--hide-scrollbars", "about:blank"],
-            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=self._log,
             preexec_fn=child_fds, pass_fds=(3, 4))
         os.close(to_chrome)
         os.close(from_chrome)
@@ -98,7 +101,8 @@ class Chromium:
                     raise AssertionError(f"chromium: no answer to {method} in {timeout} s")
                 chunk = os.read(self._in, 1 << 20)
                 if not chunk:
-                    raise AssertionError(f"chromium exited while answering {method}")
+                    tail = open(self.log).read().strip().splitlines()[-5:]
+                    raise AssertionError(f"chromium exited while answering {method}: {tail}")
                 self._buffer += chunk
             raw, self._buffer = self._buffer.split(b"\0", 1)
             reply = json.loads(raw)
@@ -163,6 +167,7 @@ class Chromium:
             self.proc.wait()
         os.close(self._out)
         os.close(self._in)
+        self._log.close()
 
 
 def png_pixels(path):
