@@ -30,6 +30,7 @@ commands:
   track       computed-torque feed-forward along a smooth motion, replayed in simulation
   validate    the model against its Simbody twin, pointwise and along a trajectory
   import      a URDF robot (or a plugin model) as femdyn JSON
+  view        the model and its motion in 3-D: one self-contained HTML page (docs/view.md)
 
 every command takes --help, and --gravity gx,gy,gz to override the model's gravity (m/s^2).
 models: JSON files (docs/model-format.md) or URDF files (*.urdf; gravity (0, 0, -9.81) unless
@@ -72,6 +73,14 @@ int main(int argc, char** argv) {
     if (cmd == "kinematics") return cmd_kinematics(argc, argv);
     if (cmd == "linearize") return cmd_linearize(argc, argv);
     if (cmd == "import") return cmd_import(argc, argv);
+#ifdef FEMDYN_WITH_VIEW
+    if (cmd == "view") return cmd_view(argc, argv);
+#else
+    if (cmd == "view")
+      throw CliError(
+          "this femdyn was built without the 3-D view (web/node_modules missing: run "
+          "tools/setup.sh)");
+#endif
 #ifdef FEMDYN_WITH_SIMBODY
     if (cmd == "validate") return cmd_validate(argc, argv);
     if (cmd == "study") return cmd_study(argc, argv);

@@ -99,7 +99,86 @@ Json inertial_element(const Ctx& c, const XMLElement* link, const std::string& w
   return {{"type", "rigid_body"}, {"mass", m}, {"com", vec3_json(o.xyz)}, {"inertia", rows}};
 }
 
+// The document's <robot>; plain URDF only (xacro is refused).
+const XMLElement* robot_element(tinyxml2::XMLDocument& doc, const std::string& text,
+                                const std::string& source) {
+  if (text.find("xmlns:xacro") != std::string::npos || text.find("<xacro:") != std::string::npos)
+    throw ModelError(source,
+                     "xacro is not supported: expand it first (xacro robot.urdf.xacro > "
+                     "robot.urdf)");
+  if (doc.Parse(text.c_str(), text.size()) != tinyxml2::XML_SUCCESS)
+    throw ModelError(source, std::string("malformed XML at line ") +
+                                 std::to_string(doc.ErrorLineNum()) + ": " + doc.ErrorName());
+  const XMLElement* robot = doc.FirstChildElement("robot");
+  if (!robot) throw ModelError(source, "no <robot> element");
+  return robot;
+}
+
+// A <material>'s colour: its own <color rgba>, else that of the robot's material of its name.
+std::optional<Eigen::Vector4d> material_color(const Ctx& c, const XMLElement* robot,
+                                              const XMLElement* material, const std::string& who) {
+  if (!material) return std::nullopt;
+  if (const XMLElement* color = material->FirstChildElement("color")) {
+    std::istringstream in(color->Attribute("rgba") ? color->Attribute("rgba") : "");
+    Eigen::Vector4d rgba;
+    for (int i = 0; i < 4; ++i)
+      if (!(in >> rgba[i]) || !std::isfinite(rgba[i])) c.fail(who, "<color rgba> needs 4 numbers");
+    return rgba;
+  }
+  const char* name = material->Attribute("name");
+  for (const XMLElement* m = robot->FirstChildElement("material"); m && name;
+       m = m->NextSiblingElement("material"))
+    if (m != material && m->Attribute("name", name)) return material_color(c, robot, m, who);
+  return std::nullopt;
+}
+
+UrdfVisual visual_of(const Ctx& c, const XMLElement* robot, const XMLElement* visual,
+                     const std::string& link) {
+  const std::string who = "link " + quoted_text(link) + " <visual>";
+  const XMLElement* geometry = visual->FirstChildElement("geometry");
+  const XMLElement* shape = geometry ? geometry->FirstChildElement() : nullptr;
+  if (!shape) c.fail(who, "no <geometry>");
+  const Origin o = origin_of(c, visual, who);
+  UrdfVisual v{link,
+               shape->Name(),
+               Vec3::Zero(),
+               "",
+               o.xyz,
+               o.rpy,
+               material_color(c, robot, visual->FirstChildElement("material"), who)};
+  if (v.shape == "box") {
+    v.size = vec_attr(c, shape, "size", Vec3::Zero(), who);
+  } else if (v.shape == "cylinder") {
+    v.size = {number_attr(c, shape, "radius", 0, who, true),
+              number_attr(c, shape, "length", 0, who, true), 0};
+  } else if (v.shape == "sphere") {
+    v.size = {number_attr(c, shape, "radius", 0, who, true), 0, 0};
+  } else if (v.shape == "mesh") {
+    v.size = vec_attr(c, shape, "scale", Vec3::Ones(), who);
+    v.mesh = shape->Attribute("filename") ? shape->Attribute("filename") : "";
+  } else {
+    c.fail(who, "unknown geometry <" + echo_text(v.shape) + ">");
+  }
+  if ((v.size.array() < 0).any()) c.fail(who, "a negative size");
+  return v;
+}
+
 }  // namespace
+
+std::vector<UrdfVisual> urdf_visuals(const std::string& text, const std::string& source) {
+  const Ctx c{source};
+  tinyxml2::XMLDocument doc;
+  const XMLElement* robot = robot_element(doc, text, source);
+  std::vector<UrdfVisual> out;
+  for (const XMLElement* link = robot->FirstChildElement("link"); link;
+       link = link->NextSiblingElement("link")) {
+    const char* name = link->Attribute("name");
+    for (const XMLElement* v = link->FirstChildElement("visual"); v && name;
+         v = v->NextSiblingElement("visual"))
+      out.push_back(visual_of(c, robot, v, name));
+  }
+  return out;
+}
 
 bool is_urdf_path(const std::string& path) {
   return path.size() >= 5 && path.compare(path.size() - 5, 5, ".urdf") == 0;
@@ -108,16 +187,8 @@ bool is_urdf_path(const std::string& path) {
 UrdfResult urdf_to_model(const std::string& text, const std::string& source,
                          const UrdfOptions& options) {
   const Ctx c{source};
-  if (text.find("xmlns:xacro") != std::string::npos || text.find("<xacro:") != std::string::npos)
-    throw ModelError(source,
-                     "xacro is not supported: expand it first (xacro robot.urdf.xacro > "
-                     "robot.urdf)");
   tinyxml2::XMLDocument doc;
-  if (doc.Parse(text.c_str(), text.size()) != tinyxml2::XML_SUCCESS)
-    throw ModelError(source, std::string("malformed XML at line ") +
-                                 std::to_string(doc.ErrorLineNum()) + ": " + doc.ErrorName());
-  const XMLElement* robot = doc.FirstChildElement("robot");
-  if (!robot) throw ModelError(source, "no <robot> element");
+  const XMLElement* robot = robot_element(doc, text, source);
 
   UrdfResult out;
   // Links.

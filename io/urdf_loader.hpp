@@ -9,9 +9,11 @@
 //   `floating_base` a body of its own on a free joint named after it (a floating base).
 // Errors: ModelError "file.urdf: joint 'elbow': axis is zero" (the element and the problem).
 #pragma once
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/math.hpp"
 #include "io/params.hpp"
 
 namespace femdyn {
@@ -29,5 +31,19 @@ UrdfResult urdf_to_model(const std::string& xml_text, const std::string& source,
 UrdfResult read_urdf(const std::string& path, const UrdfOptions& options = {});
 
 bool is_urdf_path(const std::string& path);  // by extension (.urdf)
+
+// A link's <visual>, in the link frame: a primitive (box: size x y z; cylinder: radius, length
+// along z; sphere: radius) or a mesh (its filename; size holds its scale). Read for the 3-D
+// view (view/scene.hpp); the equations never see it.
+struct UrdfVisual {
+  std::string link;
+  std::string shape;  // box, cylinder, sphere or mesh
+  Vec3 size = Vec3::Zero();
+  std::string mesh;
+  Vec3 xyz = Vec3::Zero(), rpy = Vec3::Zero();
+  std::optional<Eigen::Vector4d>
+      rgba;  // <material><color>, or that of the robot's material of its name
+};
+std::vector<UrdfVisual> urdf_visuals(const std::string& xml_text, const std::string& source);
 
 }  // namespace femdyn

@@ -51,6 +51,7 @@ std::unique_ptr<PyModel> load(const std::string& path, const OptArray& gravity,
     py::gil_scoped_release release;
     model = std::make_unique<PyModel>(load_model(text_arg(path, "path"), options));
   }
+  model->source = path;
   for (const std::string& w : warnings)
     if (PyErr_WarnEx(PyExc_UserWarning, safe_message(w).c_str(), 1) != 0)
       throw py::error_already_set();

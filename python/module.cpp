@@ -89,6 +89,9 @@ PYBIND11_MODULE(_femdyn, m) {
   bind_model(m);
   bind_loops(m);
   bind_derivatives(m);
+#ifdef FEMDYN_WITH_VIEW
+  bind_view(m);
+#endif
   bind_batch(m);
   bind_simulate(m);
   bind_simulator(m);

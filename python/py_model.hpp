@@ -17,6 +17,7 @@ struct PyModel {
   std::shared_ptr<const Model> model;
   Workspace ws;
   std::unique_ptr<DerivativeWorkspace> derivatives;  // made by the first derivatives call
+  std::string source;  // the file it was loaded from (femdyn.load), else ""
 };
 
 // M, h, Q and q̈ at one state; qdd is absent when forward dynamics failed (then `failure`
@@ -47,5 +48,6 @@ void bind_validate(py::module_& m);
 void bind_builder(py::module_& m);
 void bind_loops(py::module_& m);
 void bind_derivatives(py::module_& m);  // after bind_model: methods of Model
+void bind_view(py::module_& m);         // after bind_model; only with FEMDYN_WITH_VIEW
 
 }  // namespace femdyn::python

@@ -64,6 +64,12 @@ if with_simbody:
 __all__ = ["Builder", "Equations", "Model", "ModelError", "NumericalError", "grid", "load",
            "set_max_memory", "simulate", "sweep", "with_simbody"] + (["validate"] if with_simbody else [])
 
+if hasattr(Model, "_write_view"):  # built with the 3-D view (web/node_modules, docs/view.md)
+    from ._view import view as _view
+
+    Model.view = _view
+    del _view
+
 for _cls in (Builder, Equations, Model, ModelError, NumericalError):
     _cls.__module__ = "femdyn"
 del _cls

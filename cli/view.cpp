@@ -1,0 +1,54 @@
+// femdyn view: the model and its motion as one self-contained 3-D page (view/, docs/view.md).
+#include <filesystem>
+#include <iostream>
+
+#include "cli/commands.hpp"
+#include "core/names.hpp"
+#include "view/page.hpp"
+
+namespace femdyn::cli {
+namespace {
+
+constexpr const char* kHelp =
+    R"(usage: femdyn view MODEL [--traj TRAJ.csv | --q …] [--out view.html] [--force]
+                    [--gravity gx,gy,gz] [--floating-base]
+
+Writes one HTML page (default view.html) that shows the model in 3-D in any browser, offline:
+the bodies, each in its colour and named on hover; the joints and their axes; the body frames
+and the named frames; the elements as the method sees them (lumped points as spheres sized by
+mass, space bars and rods as cylinders, rotary nodes as discs, each element's nodes); a URDF
+robot's visual boxes, cylinders and spheres. With --traj (a trajectory CSV of femdyn simulate)
+the page plays the motion: play and pause, a time slider, the speed, loop, and beside the view
+the coordinates and the energy balance against time; the URL's #t=SECONDS opens it paused at
+that time. --q shows one posture (n_q values; default the neutral configuration). At most 1500
+frames of a trajectory are kept (evenly spaced). Each body's pose is computed here, by femdyn's
+kinematics; the page only draws. The page holds three.js (docs/view.md): about 2 MB.
+The file is written atomically, and an existing one is replaced only with --force.
+)";
+
+}  // namespace
+
+int cmd_view(int argc, char** argv) {
+  const Args a = parse_args(argc, argv, 2, {"help", "force"}, {"traj", "q", "out", "gravity"});
+  if (a.has("help")) {
+    std::cout << kHelp;
+    return 0;
+  }
+  if (a.has("traj") && a.has("q")) throw CliError("--traj and --q: give one of them");
+  const Model m = load(a);
+  const std::string out = a.has("out") ? a.options.at("out") : "view.html";
+  std::error_code ec;
+  for (const std::string& input : {a.positional[0], a.has("traj") ? a.options.at("traj") : ""})
+    if (std::filesystem::equivalent(out, input, ec))
+      throw CliError("--out " + out + " is an input file itself");
+  if (std::filesystem::exists(out, ec) && !a.has("force"))
+    throw CliError(out + ": exists (use --force to replace it)");
+  const view::Motion motion = a.has("traj") ? view::read_trajectory(m, a.options.at("traj"))
+                                            : view::posture(m, configuration_vector(a, "q", m));
+  view::write_model_page(out, m, a.positional[0], motion, a.has("force"));
+  std::cerr << "femdyn view: wrote " << escaped(out) << " (" << m.bodies.size() << " bodies, "
+            << m.elements.size() << " elements, " << motion.frames.size() << " frames)\n";
+  return 0;
+}
+
+}  // namespace femdyn::cli

@@ -1,0 +1,231 @@
+// femdyn view, its C++ side (view/): the scene holds the model's bodies, elements and poses as
+// the kinematics give them; the page is whole and its scene readable; the command refuses bad
+// trajectories in one line, never replaces a file without --force and never leaves half a
+// file. The page in a browser: tests/view_browser.py.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "core/frames.hpp"
+#include "io/urdf_loader.hpp"
+#include "tests/helpers.hpp"
+#include "view/page.hpp"
+#include "view/scene.hpp"
+
+using namespace femdyn;
+using namespace femdyn::test;
+
+namespace {
+
+// A trajectory CSV as femdyn simulate writes it, made by the command.
+std::string simulated(const Scratch& dir, const std::string& model, const std::string& options) {
+  const std::string out = dir / "traj.csv";
+  const Run r = run("simulate " + model_path(model) + " " + options + " --out " + out);
+  REQUIRE(r.code == 0);
+  return out;
+}
+
+// The scene a page holds, read back from its <script type="application/json">.
+nlohmann::json scene_of_page(const std::string& page) {
+  const std::string open = "<script type=\"application/json\" id=\"femdyn-scene\">";
+  const std::size_t from = page.find(open);
+  REQUIRE(from != std::string::npos);
+  const std::size_t start = from + open.size(), end = page.find("</script>", start);
+  REQUIRE(end != std::string::npos);
+  return nlohmann::json::parse(page.substr(start, end - start));
+}
+
+std::size_t count_of(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+// The one line of a failed command: non-zero exit, a single line naming `file` and `problem`.
+void check_one_line_error(const Run& r, const std::string& file, const std::string& problem) {
+  CHECK(r.code != 0);
+  CHECK(count_of(r.out, "\n") == 1);
+  CHECK(r.out.find(file) != std::string::npos);
+  CHECK(r.out.find(problem) != std::string::npos);
+}
+
+}  // namespace
+
+TEST_CASE("view: each body's pose per frame is the kinematics' at that frame's q", "[view]") {
+  Scratch dir("view_poses");
+  const Model m = load_model(model_path("hand.json"));
+  const view::Motion motion =
+      view::read_trajectory(m, simulated(dir, "hand.json", "--t-end 0.2 --every 20"));
+  REQUIRE(motion.frames.size() > 2);
+  const nlohmann::json scene = view::scene_json(m, motion, {}, "hand.json");
+  CHECK(scene["counts"]["bodies"] == m.bodies.size());
+  CHECK(scene["counts"]["elements"] == m.elements.size());
+  CHECK(scene["counts"]["frames"] == m.frames.size() - m.bodies.size());
+  CHECK(scene["counts"]["motion_frames"] == motion.frames.size());
+  Workspace ws(m);
+  FrameKinematics k;
+  for (std::size_t f = 0; f < motion.frames.size(); f += motion.frames.size() - 1) {
+    const VecX& q = motion.frames[f].q;
+    const auto& poses = scene["motion"]["poses"][f];
+    REQUIRE(poses.size() == 7 * m.bodies.size());
+    for (std::size_t b = 0; b < m.bodies.size(); ++b) {
+      frame_kinematics(m, ws, q, VecX::Zero(m.n()), static_cast<int>(b),
+                       FrameAxes::LocalWorldAligned, k);
+      for (int i = 0; i < 3; ++i) CHECK(std::abs(poses[7 * b + i].get<double>() - k.p[i]) < 2e-6);
+      const Eigen::Quaterniond page(poses[7 * b + 6].get<double>(), poses[7 * b + 3].get<double>(),
+                                    poses[7 * b + 4].get<double>(), poses[7 * b + 5].get<double>());
+      CHECK((page.toRotationMatrix() - k.R).cwiseAbs().maxCoeff() < 1e-5);
+    }
+  }
+  // The energy balance comes from the trajectory's columns: E − W stays at E(0).
+  const auto& E = scene["motion"]["energy"];
+  CHECK(E["source"] == "trajectory");
+  const std::size_t last = motion.frames.size() - 1;
+  const double drift = E["kinetic"][last].get<double>() + E["potential"][last].get<double>() -
+                       E["work"][last].get<double>() - E["kinetic"][0].get<double>() -
+                       E["potential"][0].get<double>();
+  CHECK(std::abs(drift) < 1e-3 * (1 + std::abs(E["potential"][0].get<double>())));
+}
+
+TEST_CASE("view: every bundled model and URDF robot has a page of its posture", "[view]") {
+  std::vector<std::string> paths;
+  for (const std::string& name : bundled_models()) paths.push_back(model_path(name));
+  for (const char* robot : {"urdf/arm7.urdf", "urdf/hand16.urdf", "urdf/gantry.urdf"})
+    paths.push_back(model_path(robot));
+  for (const char* robot : {"iiwa.urdf", "hyq.urdf", "atlas.urdf"})
+    paths.push_back(std::string(FEMDYN_SOURCE_DIR) + "/tests/robots/" + robot);
+  for (const std::string& path : paths) {
+    INFO(path);
+    const Model m = load_model(path);
+    const std::string page = view::page_html(view::scene_json(
+        m, view::posture(m, neutral_posture(m)),
+        is_urdf_path(path) ? urdf_visuals(read_file(path), path) : std::vector<UrdfVisual>{},
+        path));
+    const nlohmann::json scene = scene_of_page(page);
+    CHECK(scene["bodies"].size() == m.bodies.size());
+    CHECK(scene["elements"].size() == m.elements.size());
+    CHECK(scene["motion"]["poses"][0].size() == 7 * m.bodies.size());
+  }
+}
+
+TEST_CASE("view: the page is whole, offline, and holds the scene it was given", "[view]") {
+  const Model m = load_model(model_path("finger.json"));
+  const nlohmann::json scene =
+      view::scene_json(m, view::posture(m, neutral_posture(m)), {}, "finger.json");
+  const std::string page = view::page_html(scene);
+  CHECK(page.find("<!--femdyn:") == std::string::npos);  // every placeholder filled
+  CHECK(page.find("OrbitControls") != std::string::npos);
+  for (const char* fetch : {"<script src", "src=\"http", "href=\"http", "<link ", "@import"})
+    CHECK(page.find(fetch) == std::string::npos);  // nothing to fetch
+  CHECK(scene_of_page(page) == scene);
+  // No name can end a script early: 4 scripts, 4 ends, whatever the model is called.
+  nlohmann::json named = scene;
+  named["model"] = "</script><script>alert(1)</script><!--";
+  const std::string hostile = view::page_html(named);
+  CHECK(count_of(hostile, "</script>") == 4);
+  CHECK(scene_of_page(hostile)["model"] == named["model"]);
+}
+
+TEST_CASE("view: a long trajectory keeps at most kMaxFrames, its first and last rows", "[view]") {
+  const Model m = load_model(model_path("pendulum.json"));
+  TrajectoryTable table;
+  table.columns = {"t"};
+  for (const std::string& c : m.configuration_names) table.columns.push_back("q_" + c);
+  const std::size_t rows = 4 * view::kMaxFrames + 3;
+  for (std::size_t r = 0; r < rows; ++r) {
+    std::vector<double> row(table.columns.size(), std::sin(0.001 * r));
+    row[0] = 0.001 * r;
+    table.rows.push_back(row);
+  }
+  const view::Motion motion = view::trajectory(m, table, "long.csv");
+  CHECK(motion.frames.size() == view::kMaxFrames);
+  CHECK(motion.frames.front().t == 0);
+  CHECK(motion.frames.back().t == Approx(0.001 * (rows - 1)));
+  CHECK(motion.energy_source == "computed");  // no energy columns: femdyn computes them
+}
+
+TEST_CASE("view: a URDF's visual primitives and their colours are read", "[view]") {
+  const std::string path = model_path("urdf/arm7.urdf");
+  const std::string text = read_file(path);
+  const std::vector<UrdfVisual> visuals = urdf_visuals(text, path);
+  CHECK(visuals.size() == count_of(text, "<visual>"));
+  std::set<std::string> shapes;
+  for (const UrdfVisual& v : visuals) {
+    shapes.insert(v.shape);
+    CHECK(v.rgba.has_value());  // inline, or by the robot's material of that name
+  }
+  CHECK(shapes == std::set<std::string>{"box", "cylinder", "sphere"});
+  const std::string bad = R"(<robot name="r"><link name="a"><visual><geometry>
+      <cylinder radius="x" length="1"/></geometry></visual></link></robot>)";
+  CHECK_THROWS_WITH(urdf_visuals(bad, "bad.urdf"),
+                    Catch::Contains("bad.urdf") && Catch::Contains("link 'a'"));
+}
+
+TEST_CASE("femdyn view writes the page once, replaces it only with --force", "[view][cli]") {
+  Scratch dir("view_cli");
+  const std::string out = dir / "finger.html";
+  const Run first = run("view " + model_path("finger.json") + " --out " + out);
+  REQUIRE(first.code == 0);
+  const std::string page = read_file(out);
+  const nlohmann::json scene = scene_of_page(page);
+  const Model m = load_model(model_path("finger.json"));
+  CHECK(scene["counts"]["bodies"] == m.bodies.size());
+  CHECK(scene["counts"]["elements"] == m.elements.size());
+
+  std::ofstream(out) << "mine";
+  const Run again = run("view " + model_path("finger.json") + " --out " + out);
+  check_one_line_error(again, out, "exists (use --force");
+  CHECK(read_file(out) == "mine");
+  CHECK(run("view " + model_path("finger.json") + " --out " + out + " --force").code == 0);
+  CHECK(read_file(out).size() == page.size());
+  CHECK(dir.files() == 1);  // no temporary file left beside it
+}
+
+TEST_CASE("femdyn view refuses a bad trajectory in one line and writes nothing", "[view][cli]") {
+  Scratch dir("view_bad");
+  const std::string finger = model_path("finger.json"), out = dir / "page.html";
+  const std::string traj = simulated(dir, "finger.json", "--t-end 0.01 --every 5");
+  std::vector<std::string> lines;
+  {
+    std::istringstream in(read_file(traj));
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+  }
+  REQUIRE(lines.size() > 2);
+  const auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name) << text;
+    return dir / name;
+  };
+  std::string header = lines[0], renamed = header;
+  renamed.replace(renamed.find(",q_"), 3, ",x_");  // the first coordinate's column renamed
+  std::string nan_row = lines[2];                  // its first coordinate NaN
+  const std::size_t q0 = nan_row.find(',') + 1;
+  nan_row.replace(q0, nan_row.find(',', q0) - q0, "nan");
+  const std::string missing = write("missing.csv", renamed + "\n" + lines[1] + "\n");
+  const std::string backwards =
+      write("back.csv", header + "\n" + lines[2] + "\n" + lines[1] + "\n");
+  const std::string empty = write("empty.csv", header + "\n");
+  const std::string nan = write("nan.csv", header + "\n" + lines[1] + "\n" + nan_row + "\n");
+  const std::string text =
+      write("text.csv", header + "\n" + lines[1].substr(0, 2) + "x" + lines[1].substr(2) + "\n");
+  check_one_line_error(run("view " + finger + " --traj " + missing + " --out " + out),
+                       "missing.csv", "no column 'q_");
+  check_one_line_error(run("view " + finger + " --traj " + backwards + " --out " + out), "back.csv",
+                       "t goes back");
+  check_one_line_error(run("view " + finger + " --traj " + empty + " --out " + out), "empty.csv",
+                       "no rows");
+  check_one_line_error(run("view " + finger + " --traj " + nan + " --out " + out), "nan.csv: row 2",
+                       "is NaN or Inf");
+  check_one_line_error(run("view " + finger + " --traj " + text + " --out " + out), "text.csv",
+                       "is not a number");
+  check_one_line_error(run("view " + finger + " --traj " + (dir / "none.csv") + " --out " + out),
+                       "none.csv", "cannot open");
+  check_one_line_error(run("view " + finger + " --traj " + traj + " --q 0,0,0,0 --out " + out),
+                       "view", "--traj and --q");
+  check_one_line_error(run("view " + finger + " --q 0,nan,0,0 --out " + out), "--q", "NaN");
+  check_one_line_error(run("view " + finger + " --out " + finger + " --force"), "--out",
+                       "is an input file");
+  CHECK(!std::filesystem::exists(out));
+}

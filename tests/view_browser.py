@@ -1,0 +1,312 @@
+#!/usr/bin/env python3
+"""The page of `femdyn view` in a real browser: headless Chromium (Debian's `chromium`).
+
+usage: view_browser.py FEMDYN SOURCE_DIR WORK_DIR CASE      (CASE: finger, hand or arm7)
+
+For the case's model it simulates a short trajectory, writes the page of one posture and the
+page of the trajectory, and in one headless Chromium (driven over the DevTools protocol):
+  - loads each page and reads the status element the page fills (web/view.js): no JavaScript
+    error, WebGL up, and the numbers of bodies, moving joints, elements, named frames and URDF
+    visuals it drew equal to those femdyn reports for the model (`femdyn info --json`; the
+    visuals counted in the URDF here);
+  - takes screenshots of the trajectory's 3-D view at #t=0 and at its last time: not blank,
+    and different from each other;
+  - moves the mouse over named objects: the tooltip names a body of the model.
+Exit 77 (ctest's SKIP_RETURN_CODE) when Chromium is absent; tools/setup.sh installs it.
+"""
+import base64
+import json
+import os
+import select
+import shutil
+import struct
+import subprocess
+import sys
+import time
+import xml.etree.ElementTree as ET
+import zlib
+
+SKIP = 77
+WIDTH, HEIGHT = 960, 600  # the browser's view
+VIEW3D = 960 - 340  # the 3-D view's width: left of the side panel (web/view.html #side, 340 px)
+BACKGROUND = (0xF4, 0xF6, 0xF8)  # the 3-D view's clear colour (web/view.js)
+
+# Each case: the model, and the simulate options of its trajectory (enough motion to see).
+CASES = {
+    "finger": ("models/finger.json", ["--t-end", "0.3", "--tau-each", "0.002", "--every", "10"]),
+    "hand": ("models/hand.json", ["--t-end", "0.6", "--every", "10"]),
+    "arm7": ("models/urdf/arm7.urdf",
+             ["--t-end", "0.6", "--q0", "0.3,0.6,0,0.8,0,0,0", "--every", "10"]),
+}
+
+
+def chromium():
+    for name in (os.environ.get("FEMDYN_CHROMIUM"), "chromium", "chromium-browser"):
+        if name and shutil.which(name):
+            return shutil.which(name)
+    return None
+
+
+def run(cmd, **kw):
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=120, **kw)
+    if r.returncode != 0:
+        raise AssertionError(f"{' '.join(cmd)} failed ({r.returncode}): {r.stderr.strip()}")
+    return r.stdout
+
+
+class Chromium:
+    """Headless Chromium driven over the DevTools protocol on a pipe (--remote-debugging-pipe:
+    JSON messages ending in a NUL byte, written to its fd 3 and read from its fd 4): one browser
+    for every page of a case. Software WebGL (SwiftShader); a fixed WIDTH x HEIGHT view."""
+
+    def __init__(self, exe, profile):
+        self.log = profile + ".log"  # Chromium's messages, quoted when it fails
+        self._log = open(self.log, "w")
+        to_chrome, self._out = os.pipe()
+        self._in, from_chrome = os.pipe()
+
+        def child_fds():  # the protocol's fds 3 and 4 in the child
+            os.dup2(to_chrome, 3)
+            os.dup2(from_chrome, 4)
+
+        self.proc = subprocess.Popen(
+            [exe, "--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+             "--use-angle=swiftshader",
+             "--enable-unsafe-swiftshader", "--no-first-run", "--disable-extensions",
+             "--remote-debugging-pipe", f"--user-data-dir={profile}",
+             f"--window-size={WIDTH},{HEIGHT}",
+             "--hide-scrollbars", "about:blank"],
+            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=self._log,
+            preexec_fn=child_fds, pass_fds=(3, 4))
+        os.close(to_chrome)
+        os.close(from_chrome)
+        self._buffer, self._id, self.session = b"", 0, None
+        target = self.call("Target.createTarget", url="about:blank")["targetId"]
+        self.session = self.call("Target.attachToTarget", targetId=target,
+                                 flatten=True)["sessionId"]
+        self.call("Emulation.setDeviceMetricsOverride", width=WIDTH, height=HEIGHT,
+                  deviceScaleFactor=1, mobile=False)
+
+    def call(self, method, timeout=60, **params):
+        self._id += 1
+        message = {"id": self._id, "method": method, "params": params}
+        if self.session:
+            message["sessionId"] = self.session
+        os.write(self._out, json.dumps(message).encode() + b"\0")
+        deadline = time.monotonic() + timeout
+        while True:
+            while b"\0" not in self._buffer:
+                left = deadline - time.monotonic()
+                if left <= 0 or not select.select([self._in], [], [], left)[0]:
+                    raise AssertionError(f"chromium: no answer to {method} in {timeout} s")
+                chunk = os.read(self._in, 1 << 20)
+                if not chunk:
+                    tail = open(self.log).read().strip().splitlines()[-5:]
+                    raise AssertionError(f"chromium exited while answering {method}: {tail}")
+                self._buffer += chunk
+            raw, self._buffer = self._buffer.split(b"\0", 1)
+            reply = json.loads(raw)
+            if reply.get("id") == self._id:  # events (no id) are passed over
+                if "error" in reply:
+                    raise AssertionError(f"chromium: {method}: {reply['error']}")
+                return reply["result"]
+
+    def evaluate(self, expression):
+        result = self.call("Runtime.evaluate", expression=expression, returnByValue=True,
+                           awaitPromise=True)
+        if "exceptionDetails" in result:
+            raise AssertionError(f"{expression}: {result['exceptionDetails']}")
+        return result["result"].get("value")
+
+    def open(self, url):
+        """Loads the page and waits until its script has set its status (at most 30 s)."""
+        self.call("Page.navigate", url=url)
+        deadline, state = time.monotonic() + 30, ""
+        while time.monotonic() < deadline:
+            state = self.evaluate("document.readyState + ' ' + (document.getElementById("
+                                  "'femdyn-status') || {dataset: {}}).dataset.status")
+            if state.startswith("complete") and not state.endswith(("loading", "undefined")):
+                return
+            time.sleep(0.05)
+        raise AssertionError(f"{url}: the page did not finish loading in 30 s ({state})")
+
+    def status(self):
+        """The status element's data attributes and text, and window.femdynErrors."""
+        return self.evaluate("""(() => {
+            const s = document.getElementById('femdyn-status');
+            return {data: Object.assign({}, s.dataset), text: s.textContent,
+                    errors: window.femdynErrors};
+        })()""")
+
+    def screenshot_at(self, t, path):
+        """The 3-D view at time t (the page's #t= hash: paused there) after two animation
+        frames, at half scale (enough to see it move, and quick to read)."""
+        self.evaluate(f"window.location.hash = 't={t}'")
+        self.evaluate("new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))")
+        clip = {"x": 0, "y": 0, "width": VIEW3D, "height": HEIGHT, "scale": 0.5}
+        shot = self.call("Page.captureScreenshot", format="png", clip=clip)["data"]
+        with open(path, "wb") as f:
+            f.write(base64.b64decode(shot))
+
+    def hover(self, x, y):
+        """Moves the mouse to (x, y); the text of the page's tooltip then, or None."""
+        self.call("Input.dispatchMouseEvent", type="mouseMoved", x=x, y=y)
+        return self.evaluate("(() => { const t = document.getElementById('tooltip');"
+                             " return t.style.display === 'block' ? t.textContent : null; })()")
+
+    def close(self):
+        try:
+            self.session = None
+            self.call("Browser.close", timeout=10)
+        except AssertionError:
+            pass
+        try:
+            self.proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait()
+        os.close(self._out)
+        os.close(self._in)
+        self._log.close()
+
+
+def png_pixels(path):
+    """(width, height, rows of RGB tuples) of an 8-bit RGB or RGBA PNG (Chromium's screenshots)."""
+    data = open(path, "rb").read()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", f"{path}: not a PNG"
+    pos, idat = 8, b""
+    while pos < len(data):
+        (length,), kind = struct.unpack(">I", data[pos:pos + 4]), data[pos + 4:pos + 8]
+        body = data[pos + 8:pos + 8 + length]
+        if kind == b"IHDR":
+            width, height, depth, color = struct.unpack(">IIBB", body[:10])
+        elif kind == b"IDAT":
+            idat += body
+        pos += 12 + length
+    assert depth == 8 and color in (2, 6), f"{path}: PNG colour type {color}, depth {depth}"
+    step = 3 if color == 2 else 4
+    raw, stride = zlib.decompress(idat), width * step
+    rows, prev = [], bytearray(stride)
+    for y in range(height):
+        f, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):  # PNG filters: None, Sub, Up, Average, Paeth
+            a = line[i - step] if i >= step else 0
+            b, c = prev[i], prev[i - step] if i >= step else 0
+            if f == 1:
+                line[i] = (line[i] + a) & 255
+            elif f == 2:
+                line[i] = (line[i] + b) & 255
+            elif f == 3:
+                line[i] = (line[i] + (a + b) // 2) & 255
+            elif f == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        rows.append([tuple(line[x * step:x * step + 3]) for x in range(width)])
+        prev = line
+    return width, height, rows
+
+
+def expected_counts(femdyn, model, source_dir):
+    info = json.loads(run([femdyn, "info", model, "--json"], cwd=source_dir))
+    bodies = len(info["joints"])  # one joint per body
+    counts = {
+        "bodies": bodies,
+        "joints": sum(j["type"] != "fixed" for j in info["joints"]),
+        "elements": len(info["elements"]),
+        "frames": len(info["frames"]) - bodies,  # the named ones, after the bodies' own
+        "visuals": 0,
+    }
+    if model.endswith(".urdf"):
+        robot = ET.parse(os.path.join(source_dir, model)).getroot()
+        counts["visuals"] = len(robot.findall("./link/visual"))
+    return info, counts
+
+
+def check_status(status, counts, frames_min, page):
+    where, data = os.path.basename(page), status["data"]
+    assert not status["errors"], f"{where}: JavaScript errors: {status['errors']}"
+    assert data.get("status") == "ok", f"{where}: status {data.get('status')}: {status['text']}"
+    assert data.get("webgl") == "true", f"{where}: no WebGL context"
+    for key, want in counts.items():
+        got = data.get(key)
+        assert got == str(want), f"{where}: the page drew {got} {key}, femdyn reports {want}"
+    assert int(data["motionFrames"]) >= frames_min, f"{where}: {data['motionFrames']} frames"
+
+
+def check_screenshots(case, shots, times):
+    for t, shot in zip(times, shots):
+        pixels = [p for row in shot for p in row]
+        drawn = sum(p != BACKGROUND for p in pixels) / len(pixels)
+        assert drawn > 0.005, f"{case}: the 3-D view at t = {t} is blank ({drawn:.2%} drawn)"
+    changed = sum(a != b for ra, rb in zip(*shots) for a, b in zip(ra, rb))
+    share = changed / sum(len(r) for r in shots[0])
+    assert share > 0.002, f"{case}: the 3-D view at t = {times[0]} and {times[1]} are the same"
+    return share
+
+
+def check_hover(browser, info, case):
+    """The mouse over an element names it and its body (a body of the model)."""
+    bodies = {j["body"] for j in info["joints"]}
+    spots = [s for s in browser.evaluate("window.femdynView.labelsOnScreen()")
+             if 0 < s["x"] < VIEW3D and 0 < s["y"] < HEIGHT]
+    assert spots, f"{case}: nothing named on the screen"
+    names = [browser.hover(s["x"], s["y"]) for s in spots[:5]]
+    named = [n for n in names if n and any(b in n for b in bodies)]
+    assert named, f"{case}: hovering named no body of the model: {names}"
+    return named[0]
+
+
+def main():
+    if len(sys.argv) != 5 or sys.argv[4] not in CASES:
+        print(__doc__)
+        return 2
+    femdyn, source_dir, work, case = sys.argv[1:]
+    exe = chromium()
+    if exe is None:
+        print("SKIP: chromium not found (Debian's chromium; tools/setup.sh installs it)")
+        return SKIP
+    start = time.monotonic()
+    work = os.path.join(os.path.abspath(work), case)
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    model, simulate = CASES[case]
+    info, counts = expected_counts(femdyn, model, source_dir)
+    if "--tau-each" in simulate:  # the same actuation on every coordinate
+        k = simulate.index("--tau-each")
+        simulate[k:k + 2] = ["--tau", ",".join([simulate[k + 1]] * info["n"])]
+
+    traj = os.path.join(work, "traj.csv")
+    run([femdyn, "simulate", model, *simulate, "--out", traj], cwd=source_dir)
+    times = (0.0, float(open(traj).read().strip().splitlines()[-1].split(",")[0]))
+    posture, moving = os.path.join(work, "posture.html"), os.path.join(work, "motion.html")
+    run([femdyn, "view", model, "--out", posture], cwd=source_dir)
+    run([femdyn, "view", model, "--traj", traj, "--out", moving], cwd=source_dir)
+
+    browser = Chromium(exe, os.path.join(work, "profile"))
+    try:
+        shots = []
+        for page, frames_min in ((posture, 1), (moving, 2)):
+            browser.open(f"file://{page}")
+            check_status(browser.status(), counts, frames_min, page)
+        for t in times:
+            png = os.path.join(work, f"t{t:g}.png")
+            browser.screenshot_at(t, png)
+            shots.append(png_pixels(png)[2])
+        hovered = check_hover(browser, info, case)
+        assert not browser.status()["errors"], f"{case}: JavaScript errors while playing"
+    finally:
+        browser.close()
+    share = check_screenshots(case, shots, times)
+    print(f"{case}: {counts}; page {os.path.getsize(moving) / 1e6:.2f} MB; {share:.1%} of the "
+          f"view changed from t = 0 to {times[1]}; hover: {hovered!r}; "
+          f"{time.monotonic() - start:.1f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    try:
+        sys.exit(main())
+    except AssertionError as e:
+        print(f"FAIL: {e}")
+        sys.exit(1)
