@@ -20,11 +20,6 @@ namespace {
 // against 506 µs.
 constexpr int kDenseProductSize = 96;
 
-// Whether column k of the joint is fixed in the parent's joint frame (else in B).
-bool column_in_parent(const Joint& j, int k) {
-  return visit_joint(j.type, [&]<class J>(J) { return J::in_parent(k); });
-}
-
 // The motion cross-product matrix: crm(V) x = V × x.
 Mat6 motion_cross_matrix(const Vec6& V) {
   Mat6 X = Mat6::Zero();
@@ -397,13 +392,13 @@ void plan_inverse_sweep(const Model& m, DerivativeWorkspace& d) {
 }  // namespace
 
 std::string derivatives_unsupported(const Model& m) {
-  if (m.coupling_level) return "derivatives need linear couplings; this model has coupling laws";
+  if (m.coupling_level) return law_derivatives_unsupported(m);
   if (!m.constraints.empty()) return "derivatives of a model with closed loops are not available";
-  if (!m.springs.empty()) return "derivatives of two-point springs are not available";
-  if (!m.condensable || !m.velocity_forces_rigid || m.body_inertia.size() != m.bodies.size())
-    return "derivatives need an exact body-level form (no spanning elements, no explicit "
-           "correlation table, rigid velocity forces)";
-  return "";
+  if (!m.condensable_off_spans || !m.velocity_forces_rigid ||
+      m.body_inertia.size() != m.bodies.size())
+    return "derivatives need an exact body-level form (no explicit correlation table, rigid "
+           "velocity forces)";
+  return span_derivatives_unsupported(m);
 }
 
 DerivativeWorkspace::DerivativeWorkspace(const Model& m) {
@@ -427,6 +422,9 @@ DerivativeWorkspace::DerivativeWorkspace(const Model& m) {
     Kv.setZero(nt, nt);
     KC.setZero(nt, n);
   }
+  if (!m.springs.empty()) springs.size_for(m);
+  if (!m.condensable) spans.size_for(m);
+  if (m.coupling_level) law = std::make_unique<LawDerivatives>(m);
   plan_inverse_sweep(m, *this);
 }
 
@@ -439,6 +437,8 @@ void inverse_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d, 
   Kq.setZero();
   Kv.setZero();
   joint_level(m, ws, d, q, qd, qdd, Kq, Kv, poses_ready);
+  if (!m.springs.empty()) add_spring_derivatives(m, ws, d, Kq, Kv);
+  if (!d.spans.elements.empty()) add_span_derivatives(m, ws, d, Kq, Kv);
   if (m.identity_coupling) return;
   d.KC.noalias() = Kq * m.C;  // ∂τ_q/∂q = Cᵀ (∂τ_θ/∂θ) C
   d.dtau_dq.noalias() = m.C.transpose() * d.KC;
@@ -450,11 +450,13 @@ void inverse_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d, 
 
 void inverse_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d,
                                   const VecX& q, const VecX& qd, const VecX& qdd) {
+  if (m.coupling_level) return law_inverse_derivatives(m, ws, d, q, qd, qdd);
   inverse_derivatives(m, ws, d, q, qd, qdd, false);
 }
 
 Status forward_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d,
                                     const VecX& q, const VecX& qd, const VecX& tau) {
+  if (m.coupling_level) return law_forward_derivatives(m, ws, d, q, qd, tau);
   const Status st = forward_dynamics(m, ws, q, qd, tau);
   if (!st.ok) return st;
   d.qdd = ws.qdd;
