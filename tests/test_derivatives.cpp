@@ -277,26 +277,49 @@ TEST_CASE("derivatives agree with differences through nonlinear coupling laws",
                                                 << bundled.richardson);
 }
 
+// ∂τ/∂v(q, v) − ∂τ/∂v(q, 0) against Σ_c (D_abc + D_acb) q̇_c from `third_order_tensor` (the
+// dampers' constant part cancels; no Coulomb friction, whose slope depends on q̇); returns
+// ∂τ/∂v at q̇ = 0.
+MatX check_against_tensor(const Model& m, unsigned seed) {
+  for (const Body& b : m.bodies) REQUIRE(b.joint.friction == 0);
+  Workspace ws(m);
+  DerivativeWorkspace d(m);
+  std::mt19937 rng(seed);
+  const VecX q = random_posture(m, rng), v = random_uniform(m.n(), 1.5, rng);
+  const VecX qdd = random_uniform(m.n(), 2, rng);
+  inverse_dynamics_derivatives(m, ws, d, q, VecX::Zero(m.n()), qdd);
+  const MatX at_rest = d.dtau_dv;
+  inverse_dynamics_derivatives(m, ws, d, q, v, qdd);
+  const std::vector<MatX> D = third_order_tensor(m, ws, q);
+  MatX contraction(m.n(), m.n());
+  for (int a = 0; a < m.n(); ++a) contraction.row(a) = ((D[a] + D[a].transpose()) * v).transpose();
+  CHECK(rel_error(d.dtau_dv - at_rest, contraction, contraction.cwiseAbs().maxCoeff()) < 1e-12);
+  return at_rest;
+}
+
 TEST_CASE("dtau/dv is the contraction of the tensor D without dampers", "[derivatives]") {
   // ∂h/∂v_b = Σ_c (D_abc + D_acb) q̇_c; and ∂τ/∂v = 0 at q̇ = 0.
   for (unsigned seed = 1; seed <= 6; ++seed) {
     INFO("seed " << seed);
     Json j = Json::parse(mixed_tree_json(seed, 7, 0.5, seed % 2 == 0));
     for (Json& b : j["bodies"]) b["joint"].erase("damping");
-    const Model m = load_text(j.dump());
-    Workspace ws(m);
-    DerivativeWorkspace d(m);
-    std::mt19937 rng(seed);
-    const VecX q = random_posture(m, rng), v = random_uniform(m.n(), 1.5, rng);
-    const VecX qdd = random_uniform(m.n(), 2, rng);
-    inverse_dynamics_derivatives(m, ws, d, q, VecX::Zero(m.n()), qdd);
-    CHECK(d.dtau_dv.cwiseAbs().maxCoeff() == 0.0);
-    inverse_dynamics_derivatives(m, ws, d, q, v, qdd);
-    const std::vector<MatX> D = third_order_tensor(m, ws, q);
-    MatX contraction(m.n(), m.n());
-    for (int a = 0; a < m.n(); ++a)
-      contraction.row(a) = ((D[a] + D[a].transpose()) * v).transpose();
-    CHECK(rel_error(d.dtau_dv, contraction, contraction.cwiseAbs().maxCoeff()) < 1e-12);
+    CHECK(check_against_tensor(load_text(j.dump()), seed).cwiseAbs().maxCoeff() == 0.0);
+  }
+}
+
+TEST_CASE("dtau/dv is the contraction of the tensor D through coupling laws and spanning rods",
+          "[derivatives][laws][spans]") {
+  // The law chain's D (G, M_θ H) against the chain's ∂τ/∂v = Gᵀ (K_v G + 2 M_θ Θ); the node-level
+  // D of the four-bar trees (their rods) against the rods' point terms.
+  for (unsigned seed = 1; seed <= 4; ++seed) {
+    INFO("seed " << seed);
+    check_against_tensor(load_text(nonlinear_coupled_tree_json(seed)), seed);
+  }
+  for (const char* name : {"finger_fourbar.json", "hand_fourbar.json"}) {
+    INFO(name);
+    const Model law = load_model(model_path(name));
+    check_against_tensor(law, 3);
+    check_against_tensor(*law.tree, 3);
   }
 }
 
