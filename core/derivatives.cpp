@@ -423,7 +423,7 @@ DerivativeWorkspace::DerivativeWorkspace(const Model& m) {
     KC.setZero(nt, n);
   }
   if (!m.springs.empty()) springs.size_for(m);
-  if (!m.condensable) spans.size_for(m);
+  if (!m.condensable && !m.coupling_level) spans.size_for(m);  // (a law model: its tree's)
   if (m.coupling_level) law = std::make_unique<LawDerivatives>(m);
   plan_inverse_sweep(m, *this);
 }
