@@ -50,6 +50,7 @@ void condense_body_inertia(Model& m) {
   const int nb = static_cast<int>(m.bodies.size());
   std::vector<Mat6> L(nb, Mat6::Zero());
   m.condensable = !m.explicit_table;
+  bool spans = false;
   m.velocity_forces_rigid = true;
   // Λ_b at the rest orientation and at a tilted one: equal iff orientation-independent.
   const Mat3 tilt = rpy_to_rotation(Vec3(0.3, -0.7, 1.1));
@@ -58,7 +59,7 @@ void condense_body_inertia(Model& m) {
     for (Eigen::Index k = 0; k < me.size(); ++k)
       check_magnitude(me.data()[k], e.where, "element mass matrix entry");
     if (e.spans) {  // not rigid with one body: only the node-level route is exact
-      m.condensable = false;
+      spans = true;
       continue;
     }
     const MatX X0 = twist_map(*e.element, Mat3::Identity()), X1 = twist_map(*e.element, tilt);
@@ -79,6 +80,8 @@ void condense_body_inertia(Model& m) {
         1e-12 * std::max(L[b].cwiseAbs().maxCoeff(), 1e-300))
       m.condensable = false;
   }
+  m.condensable_off_spans = m.condensable;  // Λ_b exact for the elements rigid with b
+  if (spans) m.condensable = false;
 }
 
 void choose_routes(Model& m, const RouteChoice& asked) {

@@ -34,6 +34,28 @@ bool LinearCoupling::evaluate(std::span<const double> x, double& f, std::span<do
   return true;
 }
 
+void LinearCoupling::third_derivatives(std::span<const double>, std::span<double> d3f) const {
+  std::fill(d3f.begin(), d3f.end(), 0.0);
+}
+
+namespace {
+
+// c Π_k x_k^{p_k} with the factors of d1, d2, d3 differentiated once each (−1: none).
+double term_derivative(const PolynomialCoupling::Term& t, std::span<const double> x, int d1,
+                       int d2 = -1, int d3 = -1) {
+  double r = t.coefficient;
+  for (std::size_t k = 0; k < t.powers.size(); ++k) {
+    int p = t.powers[k];
+    double c = 1;
+    for (const int d : {d1, d2, d3})
+      if (static_cast<int>(k) == d) c *= p, --p;
+    r *= c * power(x[k], p);
+  }
+  return r;
+}
+
+}  // namespace
+
 bool PolynomialCoupling::evaluate(std::span<const double> x, double& f, std::span<double> df,
                                   std::span<double> d2f) const {
   const int n = arity_;
@@ -41,26 +63,25 @@ bool PolynomialCoupling::evaluate(std::span<const double> x, double& f, std::spa
   std::fill(df.begin(), df.end(), 0.0);
   std::fill(d2f.begin(), d2f.end(), 0.0);
   for (const Term& t : terms_) {
-    // Π_k x_k^{p_k} with one or two factors differentiated.
-    const auto product = [&](int d1, int d2) {
-      double r = t.coefficient;
-      for (int k = 0; k < n; ++k) {
-        int p = t.powers[k];
-        double c = 1;
-        if (k == d1) c *= p, --p;
-        if (k == d2) c *= p, --p;
-        r *= c * power(x[k], p);
-      }
-      return r;
-    };
-    f += product(-1, -1);
+    f += term_derivative(t, x, -1);
     for (int k = 0; k < n; ++k) {
       if (t.powers[k] == 0) continue;
-      df[k] += product(k, -1);
-      for (int l = 0; l < n; ++l) d2f[k * n + l] += product(k, l);
+      df[k] += term_derivative(t, x, k);
+      for (int l = 0; l < n; ++l) d2f[k * n + l] += term_derivative(t, x, k, l);
     }
   }
   return true;
+}
+
+void PolynomialCoupling::third_derivatives(std::span<const double> x, std::span<double> d3f) const {
+  const int n = arity_;
+  std::fill(d3f.begin(), d3f.end(), 0.0);
+  for (const Term& t : terms_)
+    for (int k = 0; k < n; ++k) {
+      if (t.powers[k] == 0) continue;
+      for (int l = 0; l < n; ++l)
+        for (int p = 0; p < n; ++p) d3f[(k * n + l) * n + p] += term_derivative(t, x, k, l, p);
+    }
 }
 
 SplineCoupling::SplineCoupling(std::vector<double> x, std::vector<double> y)
@@ -110,7 +131,17 @@ bool SplineCoupling::evaluate(std::span<const double> xs, double& f, std::span<d
   return true;
 }
 
-bool FourBarCoupling::solve(double phi, double& psi, double& dpsi, double& d2psi) const {
+void SplineCoupling::third_derivatives(std::span<const double> xs, std::span<double> d3f) const {
+  const double x = xs[0];
+  d3f[0] = 0;  // the straight lines beyond the ends
+  if (x <= x_.front() || x >= x_.back()) return;
+  const std::size_t i =  // the interval evaluate takes: S''' = (m_{i+1} − m_i) / h on it
+      static_cast<std::size_t>(std::upper_bound(x_.begin(), x_.end(), x) - x_.begin() - 1);
+  d3f[0] = (m_[i + 1] - m_[i]) / (x_[i + 1] - x_[i]);
+}
+
+bool FourBarCoupling::solve(double phi, double& psi, double& dpsi, double& d2psi,
+                            double* d3psi) const {
   const double a = g_.input, b = g_.coupler, c = g_.output, d = g_.ground;
   const double cf = std::cos(phi), sf = std::sin(phi);
   const double A = 2 * c * (a * cf - d), B = 2 * a * c * sf;
@@ -128,6 +159,15 @@ bool FourBarCoupling::solve(double phi, double& psi, double& dpsi, double& d2psi
   const double F_psipsi = -A * cp - B * sp;
   dpsi = -F_phi / F_psi;
   d2psi = -(F_phiphi + 2 * F_phipsi * dpsi + F_psipsi * dpsi * dpsi) / F_psi;
+  if (!d3psi) return true;
+  // The third total derivative of F(φ, ψ(φ)) = 0:
+  //   F_φφφ + 3 F_φφψ ψ' + 3 F_φψψ ψ'² + F_ψψψ ψ'³ + 3 (F_φψ + F_ψψ ψ') ψ'' + F_ψ ψ''' = 0.
+  const double d3A = 2 * a * c * sf, d3B = -2 * a * c * cf, d3C = -2 * a * d * sf;
+  const double F_3phi = d3A * cp + d3B * sp - d3C, F_2phipsi = -d2A * sp + d2B * cp;
+  const double F_phi2psi = -dA * cp - dB * sp, F_3psi = A * sp - B * cp;
+  *d3psi = -(F_3phi + 3 * F_2phipsi * dpsi + 3 * F_phi2psi * dpsi * dpsi +
+             F_3psi * dpsi * dpsi * dpsi + 3 * (F_phipsi + F_psipsi * dpsi) * d2psi) /
+           F_psi;
   return true;
 }
 
@@ -139,6 +179,12 @@ bool FourBarCoupling::evaluate(std::span<const double> x, double& f, std::span<d
   df[0] = g_.output_sign * dpsi * g_.input_sign;
   d2f[0] = g_.output_sign * d2psi * g_.input_sign * g_.input_sign;
   return true;
+}
+
+void FourBarCoupling::third_derivatives(std::span<const double> x, std::span<double> d3f) const {
+  double psi, dpsi, d2psi, d3psi = NAN;  // (NaN where evaluate is false)
+  solve(g_.input_offset + g_.input_sign * x[0], psi, dpsi, d2psi, &d3psi);
+  d3f[0] = g_.output_sign * d3psi * g_.input_sign * g_.input_sign * g_.input_sign;
 }
 
 std::optional<double> FourBarCoupling::output_angle_at_zero(Geometry g) {

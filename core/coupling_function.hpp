@@ -17,6 +17,9 @@ class CouplingFunction {
   // not defined (a linkage that cannot assemble there); the outputs are then unspecified.
   virtual bool evaluate(std::span<const double> x, double& f, std::span<double> df,
                         std::span<double> d2f) const = 0;
+  // ∂³f/∂x_k∂x_l∂x_p into d3f[(k * arity + l) * arity + p], where evaluate is true (the analytic
+  // derivatives of the dynamics chain them through the level: core/derivatives_coupling.hpp).
+  virtual void third_derivatives(std::span<const double> x, std::span<double> d3f) const = 0;
   // The law's form and parameters for reports, e.g. "four-bar (ground 0.03, …)".
   virtual std::string form() const = 0;
   // The first x in [lo, hi] of a one-argument law where it is not defined (to 1e-9), or
@@ -35,6 +38,7 @@ class LinearCoupling final : public CouplingFunction {
   int arity() const override { return static_cast<int>(ratios_.size()); }
   bool evaluate(std::span<const double> x, double& f, std::span<double> df,
                 std::span<double> d2f) const override;
+  void third_derivatives(std::span<const double> x, std::span<double> d3f) const override;
 
  private:
   std::vector<double> ratios_;
@@ -54,6 +58,7 @@ class PolynomialCoupling final : public CouplingFunction {
   int arity() const override { return arity_; }
   bool evaluate(std::span<const double> x, double& f, std::span<double> df,
                 std::span<double> d2f) const override;
+  void third_derivatives(std::span<const double> x, std::span<double> d3f) const override;
 
  private:
   int arity_;
@@ -69,6 +74,7 @@ class SplineCoupling final : public CouplingFunction {
   int arity() const override { return 1; }
   bool evaluate(std::span<const double> x, double& f, std::span<double> df,
                 std::span<double> d2f) const override;
+  void third_derivatives(std::span<const double> x, std::span<double> d3f) const override;
 
  private:
   std::vector<double> x_, y_, m_;  // m_: S'' at the knots
@@ -79,8 +85,8 @@ class SplineCoupling final : public CouplingFunction {
 // angle ψ at P. Loop closure |O + a e(φ) − P − c e(ψ)| = b, solved in closed form:
 //   A cos ψ + B sin ψ = C,  A = 2c(a cos φ − d),  B = 2ac sin φ,  C = a² + c² + d² − b² − 2ad cos φ
 //   ψ = atan2(B, A) + σ acos(C / √(A² + B²)),   σ = ±1 the assembly branch,
-// with ψ' and ψ'' by implicit differentiation of F(φ, ψ) = A cos ψ + B sin ψ − C = 0. The joint
-// angles map as φ = φ0 + s_in θ_in and θ_out = s_out (ψ − ψ0).
+// with ψ', ψ'' and ψ''' by implicit differentiation of F(φ, ψ) = A cos ψ + B sin ψ − C = 0. The
+// joint angles map as φ = φ0 + s_in θ_in and θ_out = s_out (ψ − ψ0).
 class FourBarCoupling final : public CouplingFunction {
  public:
   std::string form() const override;
@@ -94,6 +100,7 @@ class FourBarCoupling final : public CouplingFunction {
   int arity() const override { return 1; }
   bool evaluate(std::span<const double> x, double& f, std::span<double> df,
                 std::span<double> d2f) const override;
+  void third_derivatives(std::span<const double> x, std::span<double> d3f) const override;
   // The loop-closure residual |O + a e(φ) − P − c e(ψ)| − b at θ_in, for tests.
   double closure_residual(double theta_in) const;
   // The first input angle in [lo, hi] (finite) where the linkage cannot assemble or locks (its
@@ -106,8 +113,8 @@ class FourBarCoupling final : public CouplingFunction {
   static std::optional<double> output_angle_at_zero(Geometry g);
 
  private:
-  // ψ, ψ', ψ'' at φ; false where it cannot assemble or locks.
-  bool solve(double phi, double& psi, double& dpsi, double& d2psi) const;
+  // ψ, ψ', ψ'' (and with d3psi ψ''') at φ; false where it cannot assemble or locks.
+  bool solve(double phi, double& psi, double& dpsi, double& d2psi, double* d3psi = nullptr) const;
   Geometry g_;
 };
 

@@ -20,11 +20,6 @@ namespace {
 // against 506 µs.
 constexpr int kDenseProductSize = 96;
 
-// Whether column k of the joint is fixed in the parent's joint frame (else in B).
-bool column_in_parent(const Joint& j, int k) {
-  return visit_joint(j.type, [&]<class J>(J) { return J::in_parent(k); });
-}
-
 // B = −crm(V)ᵀ I − I crm(V) − H(I V) for I = [[A, [h]×], [[h]×ᵀ, m 1]], V = (ω, v), the map
 // B x = V ×* (I x) − I (V × x) + x ×* (I V). Written out by blocks (with the Jacobi identity)
 // its right column vanishes:
@@ -369,6 +364,8 @@ void solve_chunks(const Model& m, const Workspace& ws, DerivativeWorkspace& d, M
 // The rows where a column of ∂τ/∂q or ∂τ/∂v of body b's rates can be non-zero: the rates of b's
 // ancestors and of b's subtree (a pair (c, m) couples only along one path to the root), as runs
 // of consecutive rates, merged. Needs the sweep's depth-first numbering (sub_first, sub_count).
+// A two-point spring couples the rates of its two bodies' paths across branches: with springs
+// every column is taken whole.
 void plan_row_runs(const Model& m, DerivativeWorkspace& d) {
   const int nb = static_cast<int>(m.bodies.size());
   d.run_begin.assign(nb + 1, 0);
@@ -377,6 +374,10 @@ void plan_row_runs(const Model& m, DerivativeWorkspace& d) {
   for (int b = 0; b < nb; ++b) {
     d.run_begin[b] = static_cast<int>(d.runs.size());
     if (!moves(m.bodies[b].joint)) continue;
+    if (!m.springs.empty()) {
+      d.runs.emplace_back(0, m.n());
+      continue;
+    }
     rows.clear();
     rows.emplace_back(d.sub_first[b], d.sub_count[b]);
     for (int a = m.bodies[b].parent; a >= 0; a = m.bodies[a].parent)
@@ -459,13 +460,13 @@ void plan_inverse_sweep(const Model& m, DerivativeWorkspace& d) {
 }  // namespace
 
 std::string derivatives_unsupported(const Model& m) {
-  if (m.coupling_level) return "derivatives need linear couplings; this model has coupling laws";
+  if (m.coupling_level) return law_derivatives_unsupported(m);
   if (!m.constraints.empty()) return "derivatives of a model with closed loops are not available";
-  if (!m.springs.empty()) return "derivatives of two-point springs are not available";
-  if (!m.condensable || !m.velocity_forces_rigid || m.body_inertia.size() != m.bodies.size())
-    return "derivatives need an exact body-level form (no spanning elements, no explicit "
-           "correlation table, rigid velocity forces)";
-  return "";
+  if (!m.condensable_off_spans || !m.velocity_forces_rigid ||
+      m.body_inertia.size() != m.bodies.size())
+    return "derivatives need an exact body-level form (no explicit correlation table, rigid "
+           "velocity forces)";
+  return span_derivatives_unsupported(m);
 }
 
 DerivativeWorkspace::DerivativeWorkspace(const Model& m) {
@@ -489,6 +490,9 @@ DerivativeWorkspace::DerivativeWorkspace(const Model& m) {
     Kv.setZero(nt, nt);
     KC.setZero(nt, n);
   }
+  if (!m.springs.empty()) springs.size_for(m);
+  if (!m.condensable && !m.coupling_level) spans.size_for(m);  // (a law model: its tree's)
+  if (m.coupling_level) law = std::make_unique<LawDerivatives>(m);
   plan_inverse_sweep(m, *this);
 }
 
@@ -501,6 +505,8 @@ void inverse_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d, 
   Kq.setZero();
   Kv.setZero();
   joint_level(m, ws, d, q, qd, qdd, Kq, Kv, articulated_ready);
+  if (!m.springs.empty()) add_spring_derivatives(m, ws, d, Kq, Kv);
+  if (!d.spans.elements.empty()) add_span_derivatives(m, ws, d, Kq, Kv);
   if (m.identity_coupling) return;
   d.KC.noalias() = Kq * m.C;  // ∂τ_q/∂q = Cᵀ (∂τ_θ/∂θ) C
   d.dtau_dq.noalias() = m.C.transpose() * d.KC;
@@ -512,11 +518,13 @@ void inverse_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d, 
 
 void inverse_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d,
                                   const VecX& q, const VecX& qd, const VecX& qdd) {
+  if (m.coupling_level) return law_inverse_derivatives(m, ws, d, q, qd, qdd);
   inverse_derivatives(m, ws, d, q, qd, qdd, false);
 }
 
 Status forward_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d,
                                     const VecX& q, const VecX& qd, const VecX& tau) {
+  if (m.coupling_level) return law_forward_derivatives(m, ws, d, q, qd, tau);
   const Status st = forward_dynamics(m, ws, q, qd, tau);
   if (!st.ok) return st;
   d.qdd = ws.qdd;

@@ -37,16 +37,26 @@
 // the factorisation eight columns at a time. Otherwise (M^s)⁻¹ is applied column by column by the
 // factorisation forward_dynamics leaves: articulated_solve's or ws.solver's.
 //
-// Covered: every model on the body-level force route whose coupling level is linear — trees of
-// every joint type, free bases, joint springs, dampers, Coulomb friction, stops, rotors, gravity,
-// point loads and body torques. Refused with a one-line ModelError: nonlinear coupling laws,
-// closed loops, two-point springs, and a body-level form that is not exact (spanning elements,
-// an explicit correlation table).
+// Two-point springs (core/derivatives_springs.hpp) and elements spanning bodies
+// (core/derivatives_spans.hpp) add their terms to ∂τ_θ/∂θ, ∂τ_θ/∂θ̇ as forces at body points;
+// a nonlinear coupling level θ = g(q) chains the tree's derivatives through g
+// (core/derivatives_coupling.hpp).
+//
+// Covered: trees of every joint type, free bases, joint springs, dampers, Coulomb friction,
+// stops, rotors, gravity, point loads and body torques, linear couplings and coupling laws
+// (linear, polynomial, spline, four-bar), two-point springs, and elements spanning bodies that use
+// only their nodes' translations (the rod). Refused with a one-line ModelError: closed loops, an
+// explicit correlation table, an element whose velocity forces are not rigid, and a spanning
+// element with rotations or a velocity force.
 #pragma once
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "core/derivatives_coupling.hpp"
+#include "core/derivatives_spans.hpp"
+#include "core/derivatives_springs.hpp"
 #include "core/status.hpp"
 #include "core/workspace.hpp"
 
@@ -117,6 +127,9 @@ struct DerivativeWorkspace {
   // body a 6 × 8 force and acceleration) instead of a dense product.
   std::vector<Eigen::Matrix<double, 6, 8>> chunk_force, chunk_acceleration;
   Eigen::Matrix<double, Eigen::Dynamic, 8, Eigen::RowMajor> chunk;
+  SpringDerivatives springs;  // the two-point springs' buffers (core/derivatives_springs.hpp)
+  SpanDerivatives spans;      // the spanning elements' (core/derivatives_spans.hpp)
+  std::unique_ptr<LawDerivatives> law;  // a coupling law's chain (core/derivatives_coupling.hpp)
 };
 
 // "" if the derivatives cover `model`, else why not (one line).

@@ -209,6 +209,7 @@ struct Model {
   SpRowMat C_configuration;
   VecX theta0_configuration;
   bool condensable = false;            // the body-level form is exact for this model
+  bool condensable_off_spans = false;  // exact for every element but those spanning bodies
   bool velocity_forces_rigid = false;  // every g_e is its element's gyroscopic term (checked)
   MassRoute mass_route = MassRoute::Transform;             // how evaluate() forms M^s
   ForceRoute force_route = ForceRoute::Nodes;              // how h and τ are computed

@@ -20,24 +20,27 @@ namespace {
 
 struct Value {
   bool ok = false;
-  double f = 0, df = 0, d2f = 0;
+  double f = 0, df = 0, d2f = 0, d3f = 0;
 };
 
 Value at(const CouplingFunction& g, double x) {
   Value v;
-  double df[1], d2f[1];
+  double df[1], d2f[1], d3f[1];
   v.ok = g.evaluate({&x, 1}, v.f, df, d2f);
+  if (v.ok) g.third_derivatives({&x, 1}, d3f);
   v.df = df[0];
   v.d2f = d2f[0];
+  v.d3f = d3f[0];
   return v;
 }
 
-// g' and g'' against central differences of g and g' at x (step h).
+// g', g'' and g''' against central differences of g, g' and g'' at x (step h).
 void check_derivatives(const CouplingFunction& g, double x, double h = 1e-5) {
   const Value v = at(g, x), p = at(g, x + h), m = at(g, x - h);
   REQUIRE((v.ok && p.ok && m.ok));
   CHECK(std::abs(v.df - (p.f - m.f) / (2 * h)) <= 1e-8 * std::max(1.0, std::abs(v.df)));
   CHECK(std::abs(v.d2f - (p.df - m.df) / (2 * h)) <= 1e-7 * std::max(1.0, std::abs(v.d2f)));
+  CHECK(std::abs(v.d3f - (p.d2f - m.d2f) / (2 * h)) <= 1e-7 * std::max(1.0, std::abs(v.d3f)));
 }
 
 FourBarCoupling::Geometry crank_rocker(int branch) {
@@ -98,6 +101,13 @@ TEST_CASE("polynomial and spline laws: derivatives, knots and continuity", "[cou
   CHECK(d2f[1] == Approx(0.2).epsilon(1e-15));
   CHECK(d2f[2] == Approx(0.2).epsilon(1e-15));
   CHECK(d2f[3] == Approx(-0.2).epsilon(1e-15));
+  // Third derivatives of 0.4 x0² x1 + 0.05 x0³: ∂³/∂x0³ = 0.3, ∂³/∂x0²∂x1 = 0.8 (in each
+  // order), the rest 0; d3f[(k * 2 + l) * 2 + p].
+  const PolynomialCoupling p3(2, {{0.4, {2, 1}}, {0.05, {3, 0}}});
+  double d3f[8];
+  p3.third_derivatives(x, d3f);
+  const double expected[8] = {0.3, 0.8, 0.8, 0, 0.8, 0, 0, 0};
+  for (int k = 0; k < 8; ++k) CHECK(d3f[k] == Approx(expected[k]).margin(1e-15));
 
   const std::vector<double> xs = {-3, -1, 0, 1, 3}, ys = {-1, 0.2, 0, 0.7, 1.2};
   const SplineCoupling s(xs, ys);

@@ -6,6 +6,7 @@
 // friction, rotors, stops, loads and couplings, and on the bundled and URDF robots.
 #include <catch2/catch.hpp>
 #include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "core/derivatives.hpp"
@@ -54,17 +55,68 @@ std::string with_actuators(const std::string& text, unsigned seed) {
   return j.dump();
 }
 
+// `count` two-point springs between random bodies (or the world) at random points, with seeded
+// stiffness, rest length and damping (core/springs.hpp).
+std::string with_springs(const std::string& text, unsigned seed, int count) {
+  Json j = Json::parse(text);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), pos(0.0, 1.0);
+  const auto v3 = [&](double s) { return Json::array({s * u(rng), s * u(rng), s * u(rng)}); };
+  const int nb = static_cast<int>(j["bodies"].size());
+  const auto end = [&](int b) {
+    return b < 0 ? Json{{"body", "world"}, {"xyz", v3(1.0)}}
+                 : Json{{"body", j["bodies"][b]["name"]}, {"xyz", v3(0.3)}};
+  };
+  Json springs = Json::array();
+  for (int s = 0; s < count; ++s) {
+    const int a = static_cast<int>(rng() % nb);  // and b another body, or the world (−1)
+    int b = static_cast<int>(rng() % nb) - 1;
+    if (b >= a) ++b;
+    springs.push_back({{"a", end(a)},
+                       {"b", end(b)},
+                       {"stiffness", 5 + 35 * pos(rng)},
+                       {"rest_length", 0.6 * pos(rng)},
+                       {"damping", s % 3 == 2 ? 0.0 : 1.5 * pos(rng)}});
+  }
+  j["springs"] = springs;
+  return j.dump();
+}
+
+// A rod (core/derivatives_spans.hpp) from every body on a fixed joint under another body to a
+// node of that parent: elements spanning two bodies that keep their length.
+std::string with_rods(const std::string& text, unsigned seed, int& rods) {
+  Json j = Json::parse(text);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  const auto v3 = [&] { return Json::array({u(rng), u(rng), u(rng)}); };
+  std::map<std::string, Json*> by_name;
+  for (Json& b : j["bodies"]) by_name[b["name"]] = &b;
+  for (Json& b : j["bodies"]) {
+    if (b["joint"]["type"] != "fixed" || b["parent"] == "world") continue;
+    Json& parent = *by_name.at(b["parent"]);
+    parent["nodes"]["rod_end"] = v3();
+    b["nodes"]["rod_start"] = v3();
+    b["elements"].push_back({{"type", "rod"},
+                             {"nodes", {"rod_start", b["parent"].get<std::string>() + "/rod_end"}},
+                             {"mass", 0.3}});
+    ++rods;
+  }
+  return j.dump();
+}
+
 // The worst relative error of each derivative against both differences.
 struct Agreement {
   double central = 0, richardson = 0;
 };
 
-void check_model(const Model& m, unsigned seed, Agreement& worst) {
+// `beyond`: how far (rad or m) the state may leave the joints' limits, so that stops engage; 0
+// for a four-bar law, which may not assemble outside its input's range.
+void check_model(const Model& m, unsigned seed, Agreement& worst, double beyond = 0.5) {
   Workspace ws(m), wf(m);
   DerivativeWorkspace d(m);
   std::mt19937 rng(seed);
   // Joints beyond their limits too (random_posture stays inside them): stops engaged.
-  const VecX q = integrate_posture(m, random_posture(m, rng), random_uniform(m.n(), 0.5, rng));
+  const VecX q = integrate_posture(m, random_posture(m, rng), random_uniform(m.n(), beyond, rng));
   const VecX v = random_uniform(m.n(), 1.5, rng), qdd = random_uniform(m.n(), 2, rng);
   // τ of a moderate q̈ (a given τ on a light finger would make q̈ ~1e6 and its differences noise).
   inverse_dynamics(m, wf, q, v, random_uniform(m.n(), 2, rng));
@@ -148,26 +200,126 @@ TEST_CASE("derivatives agree with differences on the bundled and URDF robots", "
   WARN("robots: central " << worst.central << ", Richardson " << worst.richardson);
 }
 
+TEST_CASE("derivatives agree with differences on random trees with two-point springs",
+          "[derivatives][springs]") {
+  // Springs between random bodies and the world, on trees of every joint type (odd seeds on a
+  // free base), plain and with linear couplings: the springs' Q_s(q, v) on top of the rest.
+  Agreement worst;
+  for (unsigned seed = 1; seed <= 8; ++seed)
+    for (const int bodies : {1, 4, 9}) {
+      INFO("seed " << seed << ", " << bodies << " bodies");
+      const bool coupled = seed % 3 == 0 && bodies > 1;
+      const Model m = load_text(
+          with_springs(mixed_tree_json(seed, bodies, seed % 2 ? 0.6 : 0.0, coupled, !coupled), seed,
+                       1 + bodies / 2));
+      REQUIRE(m.springs.size() == static_cast<std::size_t>(1 + bodies / 2));
+      check_model(m, seed, worst);
+    }
+  WARN("random trees with springs: central " << worst.central << ", Richardson "
+                                             << worst.richardson);
+}
+
+TEST_CASE("derivatives agree with differences on the flyball governor's stiff couplers",
+          "[derivatives][springs]") {
+  // Two spring-dampers of 8e5 N/m and 4e4 N s/m from the slider to the rods.
+  const Model m = load_model(model_path("iftomm_a05_flyball.json"));
+  REQUIRE(m.springs.size() == 2);
+  Agreement worst;
+  for (unsigned seed = 1; seed <= 4; ++seed) check_model(m, seed, worst);
+  WARN("flyball: central " << worst.central << ", Richardson " << worst.richardson);
+}
+
+TEST_CASE("derivatives agree with differences on elements spanning bodies",
+          "[derivatives][spans]") {
+  // The four-bar fingers' trees (every joint a coordinate): their coupler rods join two bodies
+  // that move apart there, so the rods' ends move on two paths and the rods' lengths change.
+  Agreement worst;
+  for (const char* name : {"finger_fourbar.json", "hand_fourbar.json"}) {
+    INFO(name);
+    const Model law = load_model(model_path(name));
+    const Model& tree = *law.tree;
+    REQUIRE_FALSE(tree.condensable);  // the rods
+    for (unsigned seed = 1; seed <= 3; ++seed) check_model(tree, seed, worst);
+  }
+  // Rods across fixed joints on random trees (with springs, so the rods' nodes and the springs'
+  // ends share paths).
+  int rods = 0;
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    INFO("seed " << seed);
+    const Model m = load_text(
+        with_springs(with_rods(mixed_tree_json(seed, 12, 0.5, false, true), seed, rods), seed, 2));
+    check_model(m, seed, worst);
+  }
+  CHECK(rods >= 4);
+  WARN("spanning rods: central " << worst.central << ", Richardson " << worst.richardson);
+}
+
+TEST_CASE("derivatives agree with differences through nonlinear coupling laws",
+          "[derivatives][laws]") {
+  // Random trees whose joints follow others by a four-bar, a polynomial in two joints and a
+  // spline of a coupled joint (the chain through θ = g(q): G, H and g's third derivatives).
+  Agreement worst;
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    INFO("seed " << seed);
+    const Model m = load_text(nonlinear_coupled_tree_json(seed));
+    REQUIRE(m.coupling_level);
+    check_model(m, seed, worst, 0.0);
+  }
+  WARN("law-coupled trees: central " << worst.central << ", Richardson " << worst.richardson);
+  Agreement bundled;
+  for (const char* name : {"finger_fourbar.json", "hand_fourbar.json"}) {
+    INFO(name);
+    const Model m = load_model(model_path(name));
+    REQUIRE(m.coupling_level);
+    for (unsigned seed = 1; seed <= 3; ++seed) check_model(m, seed, bundled, 0.0);
+  }
+  WARN("finger_fourbar, hand_fourbar: central " << bundled.central << ", Richardson "
+                                                << bundled.richardson);
+}
+
+// ∂τ/∂v(q, v) − ∂τ/∂v(q, 0) against Σ_c (D_abc + D_acb) q̇_c from `third_order_tensor` (the
+// dampers' constant part cancels; no Coulomb friction, whose slope depends on q̇); returns
+// ∂τ/∂v at q̇ = 0.
+MatX check_against_tensor(const Model& m, unsigned seed) {
+  for (const Body& b : m.bodies) REQUIRE(b.joint.friction == 0);
+  Workspace ws(m);
+  DerivativeWorkspace d(m);
+  std::mt19937 rng(seed);
+  const VecX q = random_posture(m, rng), v = random_uniform(m.n(), 1.5, rng);
+  const VecX qdd = random_uniform(m.n(), 2, rng);
+  inverse_dynamics_derivatives(m, ws, d, q, VecX::Zero(m.n()), qdd);
+  const MatX at_rest = d.dtau_dv;
+  inverse_dynamics_derivatives(m, ws, d, q, v, qdd);
+  const std::vector<MatX> D = third_order_tensor(m, ws, q);
+  MatX contraction(m.n(), m.n());
+  for (int a = 0; a < m.n(); ++a) contraction.row(a) = ((D[a] + D[a].transpose()) * v).transpose();
+  CHECK(rel_error(d.dtau_dv - at_rest, contraction, contraction.cwiseAbs().maxCoeff()) < 1e-12);
+  return at_rest;
+}
+
 TEST_CASE("dtau/dv is the contraction of the tensor D without dampers", "[derivatives]") {
   // ∂h/∂v_b = Σ_c (D_abc + D_acb) q̇_c; and ∂τ/∂v = 0 at q̇ = 0.
   for (unsigned seed = 1; seed <= 6; ++seed) {
     INFO("seed " << seed);
     Json j = Json::parse(mixed_tree_json(seed, 7, 0.5, seed % 2 == 0));
     for (Json& b : j["bodies"]) b["joint"].erase("damping");
-    const Model m = load_text(j.dump());
-    Workspace ws(m);
-    DerivativeWorkspace d(m);
-    std::mt19937 rng(seed);
-    const VecX q = random_posture(m, rng), v = random_uniform(m.n(), 1.5, rng);
-    const VecX qdd = random_uniform(m.n(), 2, rng);
-    inverse_dynamics_derivatives(m, ws, d, q, VecX::Zero(m.n()), qdd);
-    CHECK(d.dtau_dv.cwiseAbs().maxCoeff() == 0.0);
-    inverse_dynamics_derivatives(m, ws, d, q, v, qdd);
-    const std::vector<MatX> D = third_order_tensor(m, ws, q);
-    MatX contraction(m.n(), m.n());
-    for (int a = 0; a < m.n(); ++a)
-      contraction.row(a) = ((D[a] + D[a].transpose()) * v).transpose();
-    CHECK(rel_error(d.dtau_dv, contraction, contraction.cwiseAbs().maxCoeff()) < 1e-12);
+    CHECK(check_against_tensor(load_text(j.dump()), seed).cwiseAbs().maxCoeff() == 0.0);
+  }
+}
+
+TEST_CASE("dtau/dv is the contraction of the tensor D through coupling laws and spanning rods",
+          "[derivatives][laws][spans]") {
+  // The law chain's D (G, M_θ H) against the chain's ∂τ/∂v = Gᵀ (K_v G + 2 M_θ Θ); the node-level
+  // D of the four-bar trees (their rods) against the rods' point terms.
+  for (unsigned seed = 1; seed <= 4; ++seed) {
+    INFO("seed " << seed);
+    check_against_tensor(load_text(nonlinear_coupled_tree_json(seed)), seed);
+  }
+  for (const char* name : {"finger_fourbar.json", "hand_fourbar.json"}) {
+    INFO(name);
+    const Model law = load_model(model_path(name));
+    check_against_tensor(law, 3);
+    check_against_tensor(*law.tree, 3);
   }
 }
 
@@ -200,8 +352,8 @@ TEST_CASE("linearization: A's chart block against differences of the chart rates
 }
 
 TEST_CASE("derivatives refuse the models they do not cover in one line", "[derivatives]") {
-  const Model laws = load_text(nonlinear_coupled_tree_json(2));
-  CHECK_THROWS_WITH(DerivativeWorkspace(laws), Catch::Contains("coupling laws"));
+  const Model loops = load_model(model_path("finger_fourbar_loop.json"));
+  CHECK_THROWS_WITH(DerivativeWorkspace(loops), Catch::Contains("closed loops"));
   const Model spans = load_model(model_path("finger_paper.json"));
   CHECK_THROWS_WITH(DerivativeWorkspace(spans), Catch::Contains("body-level form"));
 }

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 #include <cstdlib>
 
+#include "core/derivatives.hpp"
 #include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
 #include "validation/alloc_counter.hpp"
@@ -38,6 +39,33 @@ TEST_CASE("no heap allocation in evaluate, forward and inverse dynamics", "[hot-
     const bool ok = forward_dynamics(m, ws, q, qd, tau).ok;
     inverse_dynamics(m, ws, q, qd, qdd);
     evaluate_bias(m, ws, q, qd);
+    const long mallocs = alloc_counter::stop();
+    CHECK(ok);
+    CHECK(mallocs == 0);
+  }
+}
+
+TEST_CASE("no heap allocation in the analytic derivatives after the first call", "[hot-path]") {
+  if (!kAvailable) {
+    WARN(kSkipped);
+    return;
+  }
+  // Trees, a free base, linear couplings, two-point springs, coupling laws (over a tree with
+  // spanning rods).
+  for (const char* name : {"hand.json", "space_robot.json", "finger_coupled.json",
+                           "iftomm_a05_flyball.json", "finger_fourbar.json", "hand_fourbar.json"}) {
+    INFO(name);
+    const Model m = load_model(model_path(name));
+    Workspace ws(m);
+    DerivativeWorkspace d(m);
+    std::mt19937 rng(3);
+    const VecX q = random_posture(m, rng), qd = random_uniform(m.n(), 1, rng),
+               tau = random_uniform(m.n(), 1e-3, rng), qdd = random_uniform(m.n(), 1, rng);
+    REQUIRE(forward_dynamics_derivatives(m, ws, d, q, qd, tau).ok);  // warm-up
+    inverse_dynamics_derivatives(m, ws, d, q, qd, qdd);
+    alloc_counter::start();
+    const bool ok = forward_dynamics_derivatives(m, ws, d, q, qd, tau).ok;
+    inverse_dynamics_derivatives(m, ws, d, q, qd, qdd);
     const long mallocs = alloc_counter::stop();
     CHECK(ok);
     CHECK(mallocs == 0);

@@ -328,9 +328,11 @@ double jacobian_mismatch(Bdf& bdf, double t) {
 
 TEST_CASE("bdf: the analytic Jacobian equals the difference Jacobian in the chart",
           "[integrators][derivatives]") {
-  // The space robot's free base (chart coordinates ξ, away from ξ = 0 after some steps) and the
-  // finger (flat, gravity, springs).
-  for (const char* name : {"space_robot.json", "finger.json"}) {
+  // The space robot's free base (chart coordinates ξ, away from ξ = 0 after some steps), the
+  // finger (flat, gravity, springs), the four-bar finger (a coupling law) and the flyball
+  // governor (two-point spring-dampers).
+  for (const char* name :
+       {"space_robot.json", "finger.json", "finger_fourbar.json", "iftomm_a05_flyball.json"}) {
     INFO(name);
     const Model m = load_model(model_path(name));
     auto integ = make_integrator(m, adaptive(IntegratorKind::Bdf, 1e-8, 1e-10));

@@ -65,6 +65,11 @@ template <class F>
 
 inline bool moves(const Joint& j) { return j.nv > 0; }
 
+// Whether column k of the joint is fixed in the parent's joint frame (else in B).
+inline bool column_in_parent(const Joint& j, int k) {
+  return visit_joint(j.type, [&]<class J>(J) { return J::in_parent(k); });
+}
+
 // B's orientation and origin in its parent's frame at the joint coordinates θ (all of them).
 inline void joint_pose(const Joint& j, const VecX& theta, Mat3& R, Vec3& p) {
   const double* q = j.idx_q >= 0 ? theta.data() + j.idx_q : nullptr;

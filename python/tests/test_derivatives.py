@@ -7,7 +7,8 @@ import femdyn
 from conftest import cli_json, model_path, numbers, state
 
 FLAT = ["models/finger.json", "models/finger_coupled.json", "models/branched_tree.json",
-        "models/urdf/arm7.urdf"]
+        "models/urdf/arm7.urdf", "models/finger_fourbar.json", "models/hand_fourbar.json",
+        "models/iftomm_a05_flyball.json"]
 
 
 def central(f, x, h=1e-6):
@@ -43,22 +44,24 @@ def test_forward_and_inverse_derivatives_against_differences(name):
     assert rel(d["dqdd_dq"], -d["Minv"] @ i["dtau_dq"]) < 1e-10
 
 
-def test_linearize_equals_the_cli():
-    m = femdyn.load(model_path("models/finger.json"))
+@pytest.mark.parametrize("name", ["models/finger.json", "models/finger_fourbar.json",
+                                  "models/iftomm_a05_flyball.json"])
+def test_linearize_equals_the_cli(name):
+    m = femdyn.load(model_path(name))
     q, qd, tau = state(m.n, seed=7)
     A, B = m.linearize(q, qd, tau)
     n = m.n
     assert A.shape == (2 * n, 2 * n) and B.shape == (2 * n, n)
     assert np.array_equal(A[:n, n:], np.eye(n)) and np.all(A[:n, :n] == 0)
-    out = cli_json("linearize", "models/finger.json", "--q", numbers(q), "--qd", numbers(qd),
+    out = cli_json("linearize", name, "--q", numbers(q), "--qd", numbers(qd),
                    "--tau", numbers(tau), "--json")
     assert out["n"] == n and out["coordinates"] == m.coordinates
     assert np.array_equal(np.array(out["A"]), A) and np.array_equal(np.array(out["B"]), B)
 
 
 def test_uncovered_model_is_refused():
-    m = femdyn.load(model_path("models/finger_fourbar.json"))
-    with pytest.raises(femdyn.ModelError, match="coupling laws"):
+    m = femdyn.load(model_path("models/finger_fourbar_loop.json"))
+    with pytest.raises(femdyn.ModelError, match="closed loops"):
         m.derivatives(np.zeros(m.n))
 
 
