@@ -179,7 +179,7 @@ Status articulated_forward_dynamics(const Model& model, Workspace& ws, const Vec
       block_motion(model, ws, b);
     }
     B.w = A.V.head<3>();
-    const RigidInertia& I = A.I = inertia_at_origin(model.body_inertia[b], B.R, B.p);
+    const RigidInertia I = inertia_at_origin(model.body_inertia[b], B.R, B.p);
     A.IA = I.matrix();
     A.trace = I.I.trace() + 3 * I.m;
     A.pA = cross_force(A.V, I * A.V);

@@ -59,15 +59,16 @@ void columns_and_inertia(const Model& m, const Workspace& ws, DerivativeWorkspac
   d.Ic[b] = inertia_at_origin(m.body_inertia[b], Bs.R, Bs.p);
 }
 
-// The same, as the articulated forward dynamics just formed them at this q.
+// The same, with the columns the articulated forward dynamics just formed at this q.
 void articulated_columns_and_inertia(const Model& m, const Workspace& ws, DerivativeWorkspace& d,
                                      int b) {
   const Joint& J = m.bodies[b].joint;
+  const BodyState& Bs = ws.body[b];
   if (J.nv == 1)
     d.S[J.idx_v] = ws.articulated[b].S;
   else
     for (int k = 0; k < J.nv; ++k) d.S[J.idx_v + k] = ws.subspace[J.idx_v + k];
-  d.Ic[b] = ws.articulated[b].I;
+  d.Ic[b] = inertia_at_origin(m.body_inertia[b], Bs.R, Bs.p);
 }
 
 // Root to leaves for body b, its S and I_b in place: V̄, ā, V, a, the rates' y, δV, z, and its

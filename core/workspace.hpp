@@ -31,7 +31,6 @@ inline const Mat3& parent_rotation(const Model& m, const std::vector<BodyState>&
 }
 
 struct ArticulatedBody {
-  RigidInertia I;          // the body's own inertia I_b about the origin, world axes
   Mat6 IA = Mat6::Zero();  // articulated inertia I^A
   Vec6 S = Vec6::Zero();   // joint motion subspace
   Vec6 V = Vec6::Zero();   // spatial velocity
