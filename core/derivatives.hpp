@@ -33,8 +33,9 @@
 //   ∂q̈/∂q = −(M^s)⁻¹ ∂τ/∂q|_{q̈},   ∂q̈/∂v = −(M^s)⁻¹ ∂τ/∂v|_{q̈},   ∂q̈/∂τ = (M^s)⁻¹,
 // On the articulated route (rates numbered depth first) (M^s)⁻¹ is formed in one O(n · bodies)
 // sweep over the factorisation forward_dynamics leaves (Carpentier, "Analytical inverse of the
-// joint space inertia matrix", 2018), then ∂q̈/∂· as dense products up to n = 96 and above that by
-// the factorisation eight columns at a time. Otherwise (M^s)⁻¹ is applied column by column by the
+// joint space inertia matrix", 2018), then ∂q̈/∂· as products with (M^s)⁻¹ over each column's
+// non-zero rows (its body's ancestors' and subtree's rates) up to n = 96 and above that by the
+// factorisation eight columns at a time. Otherwise (M^s)⁻¹ is applied column by column by the
 // factorisation forward_dynamics leaves: articulated_solve's or ws.solver's.
 //
 // Two-point springs (core/derivatives_springs.hpp) and elements spanning bodies
