@@ -179,15 +179,23 @@ struct DerivativeScratch {
   explicit DerivativeScratch(const Model& m) : d(m) {}
 };
 
-// Row i's derivatives into s.d (its state loaded into r), a failure naming the row.
-void row_derivatives(const Model& m, const Batch& b, Eigen::Index i, Workspace& ws,
-                     DerivativeScratch& s, RowState& r) {
-  r.load(b, i);
-  try {
-    forward_derivatives_at(m, ws, s.d, r.q, r.qd, r.x);
-  } catch (const NumericalError& e) {
-    throw NumericalError("row " + std::to_string(i) + ": " + e.what());
-  }
+// Every row's derivatives into a thread's s.d (the row's state loaded into r), on `nthreads`
+// threads with the GIL released, then put(i, s, r); a failure names the row.
+template <class Put>
+void for_each_derivative_row(const Model& m, const Batch& b, int nthreads, Put&& put) {
+  py::gil_scoped_release release;
+  for_each_row_with(
+      m, b.k, nthreads, [&] { return DerivativeScratch(m); },
+      [&](Workspace& ws, DerivativeScratch& s, Eigen::Index i) {
+        thread_local RowState r;
+        r.load(b, i);
+        try {
+          forward_derivatives_at(m, ws, s.d, r.q, r.qd, r.x);
+        } catch (const NumericalError& e) {
+          throw NumericalError("row " + std::to_string(i) + ": " + e.what());
+        }
+        put(i, s, r);
+      });
 }
 
 // The analytic derivatives at k states (forward_derivatives_at per row, as Model.derivatives):
@@ -204,19 +212,12 @@ py::dict derivatives_batch(const PyModel& self, const Array& q, const OptArray& 
                       Minv = new_array({k, n, n});
   double *pqdd = qdd.mutable_data(), *pq = dq.mutable_data(), *pv = dv.mutable_data(),
          *pM = Minv.mutable_data();
-  {
-    py::gil_scoped_release release;
-    for_each_row_with(
-        m, k, nthreads, [&] { return DerivativeScratch(m); },
-        [&](Workspace& ws, DerivativeScratch& s, Eigen::Index i) {
-          thread_local RowState r;
-          row_derivatives(m, b, i, ws, s, r);
-          store(pqdd, i, s.d.qdd);
-          store(pq, i, s.d.dqdd_dq);
-          store(pv, i, s.d.dqdd_dv);
-          store(pM, i, s.d.Minv);
-        });
-  }
+  for_each_derivative_row(m, b, nthreads, [&](Eigen::Index i, DerivativeScratch& s, RowState&) {
+    store(pqdd, i, s.d.qdd);
+    store(pq, i, s.d.dqdd_dq);
+    store(pv, i, s.d.dqdd_dv);
+    store(pM, i, s.d.Minv);
+  });
   py::dict out;
   out["qdd"] = qdd;
   out["dqdd_dq"] = dq;
@@ -236,18 +237,11 @@ std::pair<py::array_t<double>, py::array_t<double>> linearize_batch(
                        evaluation_bytes(m) + dense_bytes(14 * n, n));
   py::array_t<double> A = new_array({k, 2 * n, 2 * n}), B = new_array({k, 2 * n, n});
   double *pA = A.mutable_data(), *pB = B.mutable_data();
-  {
-    py::gil_scoped_release release;
-    for_each_row_with(
-        m, k, nthreads, [&] { return DerivativeScratch(m); },
-        [&](Workspace& ws, DerivativeScratch& s, Eigen::Index i) {
-          thread_local RowState r;
-          row_derivatives(m, b, i, ws, s, r);
-          linearization(m, s.d, r.qd, s.A, s.B);
-          store(pA, i, s.A);
-          store(pB, i, s.B);
-        });
-  }
+  for_each_derivative_row(m, b, nthreads, [&](Eigen::Index i, DerivativeScratch& s, RowState& r) {
+    linearization(m, s.d, r.qd, s.A, s.B);
+    store(pA, i, s.A);
+    store(pB, i, s.B);
+  });
   return {A, B};
 }
 
