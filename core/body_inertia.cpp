@@ -85,12 +85,19 @@ void condense_body_inertia(Model& m) {
 }
 
 void choose_routes(Model& m, const RouteChoice& asked) {
+  // Elements spanning bodies that use only their nodes' translations (a coupler rod) keep the
+  // rest of the tree on the body-level routes, their own terms added (core/span_inertia.hpp),
+  // where the rest is exact and there is no coupling level to map them through.
+  const bool spans_on_bodies = !m.condensable && m.condensable_off_spans &&
+                               m.velocity_forces_rigid && m.identity_coupling &&
+                               span_inertia_unsupported(m).empty();
+  const bool body_level = m.condensable || spans_on_bodies;
   // M^s by composite inertias wherever the body-level form is exact: measured faster than
   // Tᵀ (M T) on every model, from the 1-DOF pendulum up (docs/performance.md).
-  m.mass_route = m.condensable ? MassRoute::Composite : MassRoute::Transform;
+  m.mass_route = body_level ? MassRoute::Composite : MassRoute::Transform;
   // h and τ: the body-level recursion is exact under the same conditions (couplings are
   // linear), and it is O(bodies) instead of O(N_u) (measured faster on every model).
-  m.force_route = m.condensable && m.velocity_forces_rigid ? ForceRoute::Bodies : ForceRoute::Nodes;
+  m.force_route = body_level && m.velocity_forces_rigid ? ForceRoute::Bodies : ForceRoute::Nodes;
   // The articulated recursion pivots on each joint's block of rates (core/articulated.hpp);
   // couplings (C ≠ I) it cannot eliminate joint by joint.
   m.dynamics_route = m.condensable && m.velocity_forces_rigid && m.identity_coupling
@@ -117,6 +124,9 @@ void choose_routes(Model& m, const RouteChoice& asked) {
       refuse("articulated");
     m.dynamics_route = *asked.dynamics;
   }
+  // The spanning masses where a body-level route carries them (never with the coupling level).
+  const bool carried = m.mass_route == MassRoute::Composite || m.force_route == ForceRoute::Bodies;
+  m.spanning_masses = spans_on_bodies && carried ? spanning_masses(m) : std::vector<SpanningMass>{};
   m.routes = choose_equation_routes(m);
 }
 

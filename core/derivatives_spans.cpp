@@ -6,42 +6,21 @@
 
 namespace femdyn {
 
-namespace {
-
-// Whether node l of the element uses only its translation.
-bool translations_only(const ElementNode& node) {
-  return std::none_of(node.uses.begin() + 3, node.uses.end(), [](bool u) { return u; });
-}
-
-}  // namespace
-
 std::string span_derivatives_unsupported(const Model& m) {
-  for (const ElementEntry& e : m.elements) {
-    if (!e.spans) continue;
-    const auto nodes = e.element->nodes();
-    if (e.element->has_velocity_force() ||
-        !std::all_of(nodes.begin(), nodes.end(), translations_only))
-      return e.where +
-             ": derivatives of an element spanning bodies need it to use only its "
-             "nodes' translations, with no velocity force";
-  }
-  return "";
+  const std::string why = span_inertia_unsupported(m);  // "<where>: an element spanning …"
+  return why.empty() ? ""
+                     : "derivatives need " + why.substr(0, why.find(": ")) +
+                           " to use only its nodes' translations, with no velocity force";
 }
 
 void SpanDerivatives::size_for(const Model& m) {
   const int nt = m.n_theta();
   int most = 0;
-  for (std::size_t i = 0; i < m.elements.size(); ++i) {
-    const ElementEntry& e = m.elements[i];
-    if (!e.spans) continue;
-    const MatX me = e.element->local_mass();
-    const int k = static_cast<int>(e.element->nodes().size());
-    MatX Mt(3 * k, 3 * k);  // the translation rows and columns of m_e
-    for (int l = 0; l < k; ++l)
-      for (int j = 0; j < k; ++j) Mt.block<3, 3>(3 * l, 3 * j) = me.block<3, 3>(6 * l, 6 * j);
-    elements.push_back(static_cast<int>(i));
-    mass.push_back(std::move(Mt));
-    most = std::max(most, k);
+  for (std::size_t i = 0; i < m.elements.size(); ++i)
+    if (m.elements[i].spans) elements.push_back(static_cast<int>(i));
+  for (SpanningMass& s : spanning_masses(m)) {  // in the same order
+    most = std::max(most, static_cast<int>(s.body.size()));
+    mass.push_back(std::move(s.mass));
   }
   node.assign(most, PointMotion{});
   path.assign(most, {});

@@ -14,6 +14,7 @@
 #include "core/kinematics.hpp"
 #include "core/mass_solver.hpp"
 #include "core/newton_euler.hpp"
+#include "core/span_inertia.hpp"
 #include "core/springs.hpp"
 
 namespace femdyn {
@@ -92,6 +93,7 @@ bool is_zero(const VecX& v) { return v.size() == 0 || v.cwiseAbs().maxCoeff() ==
 void form_mass_matrix(const Model& model, Workspace& ws) {
   if (ws.Ms.rows() != model.n()) ws.Ms.setZero(model.n(), model.n());  // first use only
   if (model.mass_route == MassRoute::Composite) {
+    if (!model.spanning_masses.empty()) ws.Ms.setZero();  // their entries lie off the paths
     composite_mass(model, ws);  // M^s by composite inertias; T is not formed
   } else {
     // M^s = Tᵀ (M T)
@@ -104,6 +106,7 @@ void form_mass_matrix(const Model& model, Workspace& ws) {
     return;
   }
   mirror_upper(ws.Ms);  // (the composite route has the rotor inertia on its diagonal)
+  add_span_mass(model, ws);
 }
 
 // M^s alone: the body poses (composite) or T (transform), then form_mass_matrix.
@@ -253,6 +256,7 @@ Energy energy_levels(const Model& model, Workspace& ws, const VecX& q, const Vec
       V << B.R.transpose() * B.w, B.R.transpose() * B.v;
       E.kinetic += 0.5 * V.dot(model.body_inertia[b] * V);
     }
+    E.kinetic += span_kinetic_energy(model, ws);
     if (model.has_armature)  // the rotors: ½ Σ I_a G² θ̇² (the other route has them in M^s)
       for (int j = 0; j < model.n_theta(); ++j)
         E.kinetic += 0.5 * model.bodies[model.theta_joint[j]].joint.reflected_inertia *
@@ -305,7 +309,7 @@ EquationRoutes choose_equation_routes(const Model& model) {
   r.inverse_dynamics = by_bodies ? inverse_by_bodies : inverse_by_nodes;
   if (model.dynamics_route == DynamicsRoute::Articulated)
     r.forward_dynamics = articulated_forward_dynamics;
-  else if (by_bodies && model.mass_route == MassRoute::Composite)
+  else if (by_bodies && model.mass_route == MassRoute::Composite && model.spanning_masses.empty())
     r.forward_dynamics = coupled_forward_dynamics;
   else
     r.forward_dynamics = forward_by_cholesky;

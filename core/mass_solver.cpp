@@ -47,6 +47,19 @@ Pattern coordinate_pattern(const Model& model) {
       for (SpRowMat::InnerIterator it(model.C_sparse, t); it; ++it)
         for (std::size_t k = 0; k < w; ++k) p.bits[it.col() * w + k] |= row(sub, b)[k];
   }
+  // An element spanning bodies couples every coordinate that moves one of its nodes with every
+  // other (its nodes may lie on different branches).
+  std::vector<std::uint64_t> span(w);
+  for (const ElementEntry& e : model.elements) {
+    if (!e.spans) continue;
+    std::fill(span.begin(), span.end(), 0);
+    for (const int b : e.node_body)
+      if (b >= 0)
+        for (std::size_t k = 0; k < w; ++k) span[k] |= row(moves, b)[k];
+    for (int a = 0; a < n; ++a)
+      if (span[a / 64] >> (a % 64) & 1)
+        for (std::size_t k = 0; k < w; ++k) p.bits[a * w + k] |= span[k];
+  }
   return p;
 }
 
@@ -119,8 +132,11 @@ double mass_matrix_fill(const Model& model) {
 std::vector<int> coordinate_tree(const Model& model) {
   const int n = model.n();
   if (model.explicit_table || n == 0) return {};
-  // Without couplings q = θ̇: λ is compile's, over the joints' rates (Model::rate_parent).
-  if (model.identity_coupling) return model.rate_parent;
+  // Without couplings or spanning elements q = θ̇ and M^s is the tree's: λ is compile's, over the
+  // joints' rates (Model::rate_parent).
+  const bool spans = std::any_of(model.elements.begin(), model.elements.end(),
+                                 [](const ElementEntry& e) { return e.spans; });
+  if (model.identity_coupling && !spans) return model.rate_parent;
   const Pattern p = coordinate_pattern(model);
   std::vector<int> lambda(n, -1);
   for (int a = 0; a < n; ++a) {

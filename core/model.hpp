@@ -19,6 +19,7 @@
 #include "core/joints/joint_type.hpp"
 #include "core/loops/constraint.hpp"
 #include "core/routes.hpp"
+#include "core/span_inertia.hpp"
 #include "core/spatial.hpp"
 #include "core/springs.hpp"
 
@@ -210,6 +211,9 @@ struct Model {
   VecX theta0_configuration;
   bool condensable = false;            // the body-level form is exact for this model
   bool condensable_off_spans = false;  // exact for every element but those spanning bodies
+  // Elements spanning bodies kept on the body-level routes as their own terms
+  // (core/span_inertia.hpp); empty unless the routes are body-level and the model has some.
+  std::vector<SpanningMass> spanning_masses;
   bool velocity_forces_rigid = false;  // every g_e is its element's gyroscopic term (checked)
   MassRoute mass_route = MassRoute::Transform;             // how evaluate() forms M^s
   ForceRoute force_route = ForceRoute::Nodes;              // how h and τ are computed

@@ -4,6 +4,7 @@
 #include "core/coupling.hpp"
 #include "core/joints/kernel.hpp"
 #include "core/kinematics.hpp"
+#include "core/span_inertia.hpp"
 
 namespace femdyn {
 namespace {
@@ -74,6 +75,7 @@ void newton_euler(const Model& model, Workspace& ws, const VecX& q, const VecX& 
     if (body.parent >= 0) ws.articulated[body.parent].pA += A.pA;
   }
   coupling_apply_transpose(model, ws.tau_theta, y);
+  add_span_forces(model, ws, y);  // (spanning masses come only with C = I: y is on θ)
 }
 
 }  // namespace femdyn

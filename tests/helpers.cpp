@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -197,6 +198,26 @@ double translation_value(const Model& m, const Workspace& ws, int i) {
   const SystemNode& n = m.nodes[d.carrier];
   const BodyState& B = ws.body[n.body];
   return (B.p + B.R * n.r)[d.axis];
+}
+
+std::string with_rods(const std::string& text, unsigned seed, int& rods) {
+  nlohmann::json j = nlohmann::json::parse(text);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-0.3, 0.3);
+  const auto v3 = [&] { return nlohmann::json::array({u(rng), u(rng), u(rng)}); };
+  std::map<std::string, nlohmann::json*> by_name;
+  for (nlohmann::json& b : j["bodies"]) by_name[b["name"]] = &b;
+  for (nlohmann::json& b : j["bodies"]) {
+    if (b["joint"]["type"] != "fixed" || b["parent"] == "world") continue;
+    nlohmann::json& parent = *by_name.at(b["parent"]);
+    parent["nodes"]["rod_end"] = v3();
+    b["nodes"]["rod_start"] = v3();
+    b["elements"].push_back({{"type", "rod"},
+                             {"nodes", {"rod_start", b["parent"].get<std::string>() + "/rod_end"}},
+                             {"mass", 0.3}});
+    ++rods;
+  }
+  return j.dump();
 }
 
 }  // namespace femdyn::test

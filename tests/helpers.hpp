@@ -47,6 +47,11 @@ std::string mixed_tree_json(unsigned seed, int bodies, double branching, bool co
 // spline of a coupled joint (j5 of j2).
 std::string nonlinear_coupled_tree_json(unsigned seed);
 
+// `text` with a rod of 0.3 kg from every body on a fixed joint under another body to a node of
+// that parent (seeded random nodes): elements spanning two bodies that keep their length. Counts
+// them into `rods`.
+std::string with_rods(const std::string& text, unsigned seed, int& rods);
+
 // max |a − b| / max(|b|, floor)
 double rel_error(const MatX& a, const MatX& b, double floor = 1e-12);
 

@@ -82,28 +82,6 @@ std::string with_springs(const std::string& text, unsigned seed, int count) {
   return j.dump();
 }
 
-// A rod (core/derivatives_spans.hpp) from every body on a fixed joint under another body to a
-// node of that parent: elements spanning two bodies that keep their length.
-std::string with_rods(const std::string& text, unsigned seed, int& rods) {
-  Json j = Json::parse(text);
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-0.3, 0.3);
-  const auto v3 = [&] { return Json::array({u(rng), u(rng), u(rng)}); };
-  std::map<std::string, Json*> by_name;
-  for (Json& b : j["bodies"]) by_name[b["name"]] = &b;
-  for (Json& b : j["bodies"]) {
-    if (b["joint"]["type"] != "fixed" || b["parent"] == "world") continue;
-    Json& parent = *by_name.at(b["parent"]);
-    parent["nodes"]["rod_end"] = v3();
-    b["nodes"]["rod_start"] = v3();
-    b["elements"].push_back({{"type", "rod"},
-                             {"nodes", {"rod_start", b["parent"].get<std::string>() + "/rod_end"}},
-                             {"mass", 0.3}});
-    ++rods;
-  }
-  return j.dump();
-}
-
 // The worst relative error of each derivative against both differences.
 struct Agreement {
   double central = 0, richardson = 0;

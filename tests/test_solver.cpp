@@ -147,8 +147,10 @@ TEST_CASE("M^s by composite inertias (composite route) equals Tᵀ M T", "[solve
     const bool spans = std::any_of(m.elements.begin(), m.elements.end(),
                                    [](const ElementEntry& e) { return e.spans; });
     CHECK(m.condensable == (!m.explicit_table && !spans));
-    // The composite route wherever it is exact (compile's choice).
-    CHECK((m.mass_route == MassRoute::Composite) == m.condensable);
+    // The composite route wherever it is exact (compile's choice), or exact but for spanning
+    // rods that it then carries as their own terms (core/span_inertia.hpp).
+    CHECK((m.mass_route == MassRoute::Composite) == (m.condensable || !m.spanning_masses.empty()));
+    CHECK(m.spanning_masses.empty() == !spans);
     condensed += m.mass_route == MassRoute::Composite;
     Workspace ws(m);
     const VecX q = random_posture(m, rng), qd = random_uniform(m.n(), 1.0, rng);
