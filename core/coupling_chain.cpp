@@ -1,6 +1,10 @@
 #include "core/coupling_chain.hpp"
 
+#include "core/body_inertia.hpp"
+#include "core/coupled_dynamics.hpp"
 #include "core/errors.hpp"
+#include "core/newton_euler.hpp"
+#include "core/span_inertia.hpp"
 
 namespace femdyn::chain {
 
@@ -29,17 +33,42 @@ CouplingLevelState& level_at(const Model& m, Workspace& ws, const VecX& q, const
 // The body states of the tree are this model's.
 void share_bodies(Workspace& ws) { ws.body = ws.tree->body; }
 
-// M^s = Gᵀ M_θ G from the tree's M_θ.
-void reduce_mass(Workspace& ws, CouplingLevelState& s) {
-  s.MG.noalias() = ws.tree->Ms * s.G;
-  ws.Ms.noalias() = s.G.transpose() * s.MG;
+// y = Gᵀ f over G's pattern: y_a = Σ_t G_ta f_t.
+void reduce_force(const CouplingLevelState& s, const VecX& f, VecX& y) {
+  y.setZero();
+  for (int t = 0; t < static_cast<int>(f.size()); ++t) {
+    if (f[t] == 0) continue;
+    for (int k = s.g_begin[t]; k < s.g_begin[t + 1]; ++k)
+      y[s.g_col[k]] += s.G(t, s.g_col[k]) * f[t];
+  }
+}
+
+// M^s = Gᵀ M_θ G from the tree's M_θ: M^s_ab = Σ_tu G_ta M_θ,tu G_ub over M_θ's upper triangle
+// and G's pattern, each off-diagonal entry once for (t, u) and once for (u, t).
+void reduce_mass(Workspace& ws, const CouplingLevelState& s) {
+  const MatX& M = ws.tree->Ms;
+  ws.Ms.setZero();
+  for (int u = 0; u < M.cols(); ++u)
+    for (int t = 0; t <= u; ++t) {
+      const double m_tu = M(t, u);
+      if (m_tu == 0) continue;
+      for (int i = s.g_begin[t]; i < s.g_begin[t + 1]; ++i) {
+        const int a = s.g_col[i];
+        const double w = s.G(t, a) * m_tu;
+        for (int j = s.g_begin[u]; j < s.g_begin[u + 1]; ++j) {
+          const int b = s.g_col[j];
+          ws.Ms(a, b) += w * s.G(u, b);
+          if (t != u) ws.Ms(b, a) += w * s.G(u, b);
+        }
+      }
+    }
 }
 
 // h = Gᵀ (h_θ + M_θ γ) from the tree's h_θ and M_θ.
 void reduce_bias(Workspace& ws, CouplingLevelState& s) {
   s.f_theta = ws.tree->h;
   s.f_theta.noalias() += ws.tree->Ms * s.gamma;
-  ws.h.noalias() = s.G.transpose() * s.f_theta;
+  reduce_force(s, s.f_theta, ws.h);
 }
 
 }  // namespace
@@ -50,7 +79,7 @@ void evaluate(const Model& m, Workspace& ws, const VecX& q, const VecX& qd, cons
   femdyn::evaluate(*m.tree, t, s.theta, s.theta_dot, kNoActuation);
   reduce_mass(ws, s);
   reduce_bias(ws, s);
-  ws.Q.noalias() = s.G.transpose() * t.Q;
+  reduce_force(s, t.Q, ws.Q);
   if (tau.size()) ws.Q += tau;
   share_bodies(ws);
 }
@@ -69,21 +98,82 @@ void evaluate_bias(const Model& m, Workspace& ws, const VecX& q, const VecX& qd)
   share_bodies(ws);
 }
 
-Status forward_dynamics(const Model& m, Workspace& ws, const VecX& q, const VecX& qd,
-                        const VecX& tau) {
+// h_θ + M_θ γ is the tree's Newton–Euler at θ̈ = γ without gravity or loads, plus its rotors'
+// I_a γ.
+void evaluate_bias_by_bodies(const Model& m, Workspace& ws, const VecX& q, const VecX& qd) {
+  CouplingLevelState& s = level_at(m, ws, q, qd, qd);
+  const Model& tree = *m.tree;
+  Workspace& t = *ws.tree;
+  newton_euler(tree, t, s.theta, s.theta_dot, &s.gamma, false, s.f_theta);
+  if (tree.has_armature) s.f_theta.noalias() += tree.armature_mass * s.gamma;
+  reduce_force(s, s.f_theta, ws.h);
+  share_bodies(ws);
+}
+
+namespace {
+
+// g, G, θ̇ and γ at (q, q̇), or the failure naming the law.
+Status level_status(const Model& m, Workspace& ws, const VecX& q, const VecX& qd,
+                    CouplingLevelState*& s) {
   try {
-    chain::evaluate(m, ws, q, qd, tau);
+    s = &level_at(m, ws, q, qd, qd);
   } catch (const StateError& e) {
     return {false, e.what()};
   }
+  return {};
+}
+
+// q̈ from M^s = Gᵀ M_θ G and Q − h = τ − Gᵀ τ_θ(θ, θ̇, θ̈ = γ), τ_θ in wt.tau_theta and M_θ in wt.Ms;
+// the Cholesky factor is left in ws.reduced (for the derivatives, core/derivatives_coupling.cpp).
+Status solve_reduced(Workspace& ws, CouplingLevelState& s, const VecX& tau) {
+  reduce_mass(ws, s);
+  reduce_force(s, ws.tree->tau_theta, ws.qdd);
+  ws.qdd = -ws.qdd;
+  if (tau.size()) ws.qdd += tau;
+  share_bodies(ws);
   ws.reduced.compute(ws.Ms);
   if (ws.reduced.info() != Eigen::Success)
     return {false,
             "the mass matrix M^s = Gᵀ M_θ G is not positive definite at this state (the coupling "
             "level loses rank: a law with zero slope in every coordinate it follows?)"};
-  ws.qdd = ws.Q - ws.h;
   ws.reduced.solveInPlace(ws.qdd);
   return {};
+}
+
+}  // namespace
+
+// τ_θ(θ, θ̇, γ) = M_θ γ + h_θ − Q_θ is the tree's inverse dynamics at the bias acceleration,
+// by its own route, and M_θ its mass matrix.
+Status forward_dynamics(const Model& m, Workspace& ws, const VecX& q, const VecX& qd,
+                        const VecX& tau) {
+  CouplingLevelState* s = nullptr;
+  if (Status st = level_status(m, ws, q, qd, s); !st.ok) return st;
+  Workspace& t = *ws.tree;
+  femdyn::inverse_dynamics(*m.tree, t, s->theta, s->theta_dot, s->gamma);
+  t.tau_theta = t.tau;
+  femdyn::mass_matrix(*m.tree, t, s->theta);
+  return solve_reduced(ws, *s, tau);
+}
+
+// On a tree with the body-level routes, τ_θ and M_θ come from one pair of sweeps
+// (joint_force_sweeps, core/coupled_dynamics.hpp) with the spanning elements' forces and masses
+// added on θ (core/span_inertia.hpp): the bodies' poses and inertias are formed once.
+Status forward_dynamics_by_bodies(const Model& m, Workspace& ws, const VecX& q, const VecX& qd,
+                                  const VecX& tau) {
+  CouplingLevelState* s = nullptr;
+  if (Status st = level_status(m, ws, q, qd, s); !st.ok) return st;
+  const Model& tree = *m.tree;
+  Workspace& t = *ws.tree;
+  propagate(tree, t, s->theta, s->theta_dot, {.jacobian = false, .bias = false, .rows = false});
+  t.theta_dot = s->theta_dot;
+  joint_force_sweeps(tree, t, &s->gamma);
+  add_span_forces(tree, t, t.tau_theta);
+  if (t.Ms.rows() != tree.n()) t.Ms.setZero(tree.n(), tree.n());  // first use only
+  if (!tree.spanning_masses.empty()) t.Ms.setZero();              // their entries lie off the paths
+  mass_from_composites(tree, t);
+  mirror_upper(t.Ms);
+  add_span_mass(tree, t);
+  return solve_reduced(ws, *s, tau);
 }
 
 void inverse_dynamics(const Model& m, Workspace& ws, const VecX& q, const VecX& qd,
@@ -92,7 +182,7 @@ void inverse_dynamics(const Model& m, Workspace& ws, const VecX& q, const VecX& 
   s.theta_ddot = s.gamma;
   s.theta_ddot.noalias() += s.G * qdd;  // θ̈ = G q̈ + γ
   femdyn::inverse_dynamics(*m.tree, *ws.tree, s.theta, s.theta_dot, s.theta_ddot);
-  ws.tau.noalias() = s.G.transpose() * ws.tree->tau;
+  reduce_force(s, ws.tree->tau, ws.tau);
   share_bodies(ws);
 }
 

@@ -18,8 +18,15 @@ namespace femdyn::chain {
 void evaluate(const Model& m, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau);
 void mass_matrix(const Model& m, Workspace& ws, const VecX& q);
 void evaluate_bias(const Model& m, Workspace& ws, const VecX& q, const VecX& qd);
+// The same by the tree's Newton–Euler at θ̈ = γ, where the tree has the body-level force route.
+void evaluate_bias_by_bodies(const Model& m, Workspace& ws, const VecX& q, const VecX& qd);
 Status forward_dynamics(const Model& m, Workspace& ws, const VecX& q, const VecX& qd,
                         const VecX& tau);
+// The same in one pair of sweeps over the tree's bodies with θ̈ = γ as their bias acceleration
+// (core/coupled_dynamics.hpp), where the tree has the body-level routes (Model::force_route ==
+// Bodies, Model::mass_route == Composite).
+Status forward_dynamics_by_bodies(const Model& m, Workspace& ws, const VecX& q, const VecX& qd,
+                                  const VecX& tau);
 void inverse_dynamics(const Model& m, Workspace& ws, const VecX& q, const VecX& qd,
                       const VecX& qdd);
 void propagate_bilinear(const Model& m, Workspace& ws, const VecX& q, const VecX& x, const VecX& y,

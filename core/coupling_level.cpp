@@ -1,5 +1,7 @@
 #include "core/coupling_level.hpp"
 
+#include <algorithm>
+
 namespace femdyn {
 
 CouplingLevelState::CouplingLevelState(const CouplingLevel& level)
@@ -13,7 +15,24 @@ CouplingLevelState::CouplingLevelState(const CouplingLevel& level)
       d2f(level.largest_arity * level.largest_arity),
       MG(MatX::Zero(level.n_theta, level.n)),
       f_theta(VecX::Zero(level.n_theta)),
-      theta_ddot(VecX::Zero(level.n_theta)) {}
+      theta_ddot(VecX::Zero(level.n_theta)) {
+  // The pattern of G: a coordinate's own joint follows that coordinate alone; a coupled joint,
+  // in dependency order, the union of its sources' patterns.
+  std::vector<std::vector<int>> rows(level.n_theta);
+  for (int a = 0; a < level.n; ++a) rows[level.coordinate_theta[a]] = {a};
+  for (const CoupledJoint& j : level.coupled) {
+    std::vector<int>& row = rows[j.theta];
+    row.clear();
+    for (int s : j.sources) row.insert(row.end(), rows[s].begin(), rows[s].end());
+    std::sort(row.begin(), row.end());
+    row.erase(std::unique(row.begin(), row.end()), row.end());
+  }
+  g_begin.assign(1, 0);
+  for (const std::vector<int>& row : rows) {
+    g_col.insert(g_col.end(), row.begin(), row.end());
+    g_begin.push_back(static_cast<int>(g_col.size()));
+  }
+}
 
 bool evaluate_level(const CouplingLevel& level, const VecX& q, const VecX& x, const VecX& y,
                     CouplingLevelState& s, bool hessian) {

@@ -37,11 +37,15 @@ struct CouplingLevelState {
   explicit CouplingLevelState(const CouplingLevel& level);
   VecX theta, theta_dot, theta_dot_y, gamma;  // θ (n_θq), G x, G y, g''[x, y] (nθ)
   MatX G;                                     // ∂θ/∂q, nθ × n
-  std::vector<MatX> H;                        // ∂²θ_t/∂q², sized on the first request
-  std::vector<double> x, df, d2f;             // one law's arguments and derivatives
-  MatX MG;                                    // M_θ G (core/coupling_chain.cpp)
-  VecX f_theta, theta_ddot;                   // θ-level force and acceleration buffers
-  int failed = -1;                            // index into coupled[] where a law is undefined
+  // G's structural non-zeros row by row: row t may be non-zero only in the columns
+  // g_col[g_begin[t] .. g_begin[t + 1]), the coordinates its joint follows (directly or through
+  // other laws). The reductions through G (core/coupling_chain.cpp) visit only these.
+  std::vector<int> g_begin, g_col;
+  std::vector<MatX> H;             // ∂²θ_t/∂q², sized on the first request
+  std::vector<double> x, df, d2f;  // one law's arguments and derivatives
+  MatX MG;                         // M_θ G (core/coupling_chain.cpp)
+  VecX f_theta, theta_ddot;        // θ-level force and acceleration buffers
+  int failed = -1;                 // index into coupled[] where a law is undefined
 };
 
 // θ = g(q) (q of n_q entries; laws act on joints of one coordinate), G, θ̇ = G x, θ̇_y = G y, γ =

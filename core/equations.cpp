@@ -287,8 +287,12 @@ EquationRoutes choose_equation_routes(const Model& model) {
   if (model.coupling_level) {  // the law chain: the tree's equations reduced through θ = g(q)
     r.evaluate = chain::evaluate;
     r.mass_matrix = chain::mass_matrix;
-    r.evaluate_bias = chain::evaluate_bias;
-    r.forward_dynamics = chain::forward_dynamics;
+    const Model& tree = *model.tree;
+    const bool tree_by_bodies = tree.force_route == ForceRoute::Bodies;
+    r.evaluate_bias = tree_by_bodies ? chain::evaluate_bias_by_bodies : chain::evaluate_bias;
+    r.forward_dynamics = tree_by_bodies && tree.mass_route == MassRoute::Composite
+                             ? chain::forward_dynamics_by_bodies
+                             : chain::forward_dynamics;
     r.inverse_dynamics = chain::inverse_dynamics;
     r.transform_hessian = chain::transform_hessian;
     r.third_order_tensor = chain::third_order_tensor;

@@ -73,18 +73,26 @@ std::vector<SpanningMass> spanning_masses(const Model& m) {
   return out;
 }
 
+// Σ_lj J_lᵀ M_lj J_j over the pairs l ≤ j (M_jl = M_ljᵀ: the pair (j, l) gives the transposed
+// entries). A column's product with M_lj is a force u at x_j, whose work on rate r is the
+// spatial product S_rᵀ (x_j × u, u): one cross product per column c, six products per entry.
 void add_span_mass(const Model& m, Workspace& ws) {
   for (const SpanningMass& s : m.spanning_masses) {
     const int k = static_cast<int>(s.body.size());
     for (int l = 0; l < k; ++l) {
       const Vec3 xl = node_position(ws, s, l);
-      for (int j = 0; j < k; ++j) {
+      for (int j = l; j < k; ++j) {
         const Vec3 xj = node_position(ws, s, j);
-        const auto M_lj = s.mass.block<3, 3>(3 * l, 3 * j);
+        const Mat3 Mlj_T = s.mass.block<3, 3>(3 * l, 3 * j).transpose();
         for (int c = last_rate(m, s.body[l]); c >= 0; c = m.rate_parent[c]) {
-          const Vec3 u = M_lj.transpose() * column_at(ws.subspace[c], xl);  // M_ljᵀ J_c(x_l)
-          for (int r = last_rate(m, s.body[j]); r >= 0; r = m.rate_parent[r])
-            ws.Ms(c, r) += u.dot(column_at(ws.subspace[r], xj));
+          Vec6 f;  // the force M_ljᵀ J_c(x_l) at x_j, as a spatial force about the origin
+          f.tail<3>().noalias() = Mlj_T * column_at(ws.subspace[c], xl);
+          f.head<3>() = xj.cross(f.tail<3>());
+          for (int r = last_rate(m, s.body[j]); r >= 0; r = m.rate_parent[r]) {
+            const double v = ws.subspace[r].dot(f);
+            ws.Ms(c, r) += v;
+            if (j != l) ws.Ms(r, c) += v;
+          }
         }
       }
     }
