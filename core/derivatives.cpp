@@ -461,8 +461,9 @@ void plan_inverse_sweep(const Model& m, DerivativeWorkspace& d) {
 }  // namespace
 
 std::string derivatives_unsupported(const Model& m) {
+  if (!m.constraints.empty() && (m.coupling_level || !m.identity_coupling))
+    return "derivatives of a model with closed loops need uncoupled joints (C = I)";
   if (m.coupling_level) return law_derivatives_unsupported(m);
-  if (!m.constraints.empty()) return "derivatives of a model with closed loops are not available";
   if (!m.condensable_off_spans || !m.velocity_forces_rigid ||
       m.body_inertia.size() != m.bodies.size())
     return "derivatives need an exact body-level form (no explicit correlation table, rigid "
@@ -494,6 +495,10 @@ DerivativeWorkspace::DerivativeWorkspace(const Model& m) {
   if (!m.springs.empty()) springs.size_for(m);
   if (!m.condensable && !m.coupling_level) spans.size_for(m);  // (a law model: its tree's)
   if (m.coupling_level) law = std::make_unique<LawDerivatives>(m);
+  if (!m.constraints.empty()) {
+    loops = std::make_unique<LoopDerivatives>(m);
+    return;  // the constrained solve applies M⁻¹ by columns
+  }
   plan_inverse_sweep(m, *this);
 }
 
@@ -526,6 +531,9 @@ void inverse_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWorks
 Status forward_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d,
                                     const VecX& q, const VecX& qd, const VecX& tau) {
   if (m.coupling_level) return law_forward_derivatives(m, ws, d, q, qd, tau);
+  if (d.loops)
+    return constrained_forward_dynamics_derivatives(m, ws, d.loops->lws, d, q, qd, tau,
+                                                    d.baumgarte);
   const Status st = forward_dynamics(m, ws, q, qd, tau);
   if (!st.ok) return st;
   d.qdd = ws.qdd;

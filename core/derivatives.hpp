@@ -56,6 +56,7 @@
 #include <vector>
 
 #include "core/derivatives_coupling.hpp"
+#include "core/derivatives_loops.hpp"
 #include "core/derivatives_spans.hpp"
 #include "core/derivatives_springs.hpp"
 #include "core/status.hpp"
@@ -131,6 +132,11 @@ struct DerivativeWorkspace {
   SpringDerivatives springs;  // the two-point springs' buffers (core/derivatives_springs.hpp)
   SpanDerivatives spans;      // the spanning elements' (core/derivatives_spans.hpp)
   std::unique_ptr<LawDerivatives> law;  // a coupling law's chain (core/derivatives_coupling.hpp)
+  // Closed loops (core/derivatives_loops.hpp): forward_dynamics_derivatives solves the
+  // constrained equations at Baumgarte's rate `baumgarte` (1/s; the simulator's default unless
+  // set), with these buffers and their own LoopWorkspace.
+  std::unique_ptr<LoopDerivatives> loops;
+  double baumgarte = kDefaultBaumgarte;
 };
 
 // "" if the derivatives cover `model`, else why not (one line).
