@@ -33,8 +33,8 @@ A model with closed loops (docs/loops.md) is linearised at the state assembled o
 (as femdyn simulate starts; q and qd printed are the assembled ones), through its constrained
 equations with Baumgarte's stabilisation at --baumgarte W (1/s; default 20, the simulator's):
 B's lower block is then the projected inverse M⁻¹ − Y S⁺ Yᵀ (Y = M⁻¹ Φ_qᵀ, S = Φ_q Y: no
-torque moves q̈ off the loops), and A has the pair −W for each direction off the loops (at
-W = 0 a double zero).
+torque moves q̈ off the loops), and at an equilibrium A has the pair −W for each direction off
+the loops (at W = 0 a double zero).
 
 --json prints {"n", "coordinates", "q", "qd", "tau", "A", "B"}, A and B as lists of rows.
 )";

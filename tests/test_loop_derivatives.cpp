@@ -261,6 +261,23 @@ TEST_CASE("loop derivatives: the dispatch, and a dead point is a failed Status",
   // The projected inverse keeps q̈ on the loops: Φ_q ∂q̈/∂τ = 0.
   CHECK((lws.k.J * e.Minv).cwiseAbs().maxCoeff() < 1e-10 * e.Minv.cwiseAbs().maxCoeff());
 
+  // Held still on the loops (τ = τ_ID(q, 0, 0): q̈ = 0, λ = 0), A has −ω twice for each of the
+  // two independent rows (the directions off the loops), and at ω = 0 zeros there.
+  const VecX still = VecX::Zero(m.n());
+  inverse_dynamics(m, wl, q, still, still);
+  const VecX hold = wl.tau;
+  for (const double omega : {20.0, 0.0}) {
+    d.baumgarte = omega;
+    REQUIRE(forward_dynamics_derivatives(m, ws, d, q, still, hold).ok);
+    CHECK(d.qdd.cwiseAbs().maxCoeff() < 1e-10);
+    MatX A, B;
+    linearization(m, d, still, A, B);
+    const Eigen::VectorXcd eig = Eigen::EigenSolver<MatX>(A).eigenvalues();
+    int at_omega = 0;
+    for (const auto& z : eig) at_omega += std::abs(z + omega) < 1e-5 * (1 + omega);
+    CHECK(at_omega == 4);
+  }
+
   // Two 1 m links from the origin, the tip held at (2, 0, 0): the stretched loop is singular.
   const Model dead = load_text(R"({"name": "stretched", "gravity": [0, -9.81, 0], "bodies": [
     {"name": "l1", "parent": "world", "joint": {"name": "a", "type": "revolute", "axis": [0, 0, 1]},
