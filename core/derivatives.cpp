@@ -495,10 +495,7 @@ DerivativeWorkspace::DerivativeWorkspace(const Model& m) {
   if (!m.springs.empty()) springs.size_for(m);
   if (!m.condensable && !m.coupling_level) spans.size_for(m);  // (a law model: its tree's)
   if (m.coupling_level) law = std::make_unique<LawDerivatives>(m);
-  if (!m.constraints.empty()) {
-    loops = std::make_unique<LoopDerivatives>(m);
-    return;  // the constrained solve applies M⁻¹ by columns
-  }
+  if (!m.constraints.empty()) loops = std::make_unique<LoopDerivatives>(m);
   plan_inverse_sweep(m, *this);
 }
 
@@ -559,6 +556,12 @@ Status forward_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWor
   d.Minv.setIdentity();
   solve_columns(m, ws, d, d.Minv, 1.0);
   return st;
+}
+
+void inverse_mass_matrix(const Model& m, Workspace& ws, DerivativeWorkspace& d) {
+  if (d.minv_sweep) return inverse_mass_sweep(m, ws, d);
+  d.Minv.setIdentity();
+  solve_columns(m, ws, d, d.Minv, 1.0);
 }
 
 void linearization(const Model& m, const DerivativeWorkspace& d, const VecX& qd, MatX& A, MatX& B) {

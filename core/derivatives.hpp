@@ -156,6 +156,10 @@ void inverse_dynamics_derivatives(const Model& model, Workspace& ws, DerivativeW
 Status forward_dynamics_derivatives(const Model& model, Workspace& ws, DerivativeWorkspace& d,
                                     const VecX& q, const VecX& qd, const VecX& tau);
 
+// (M^s)⁻¹ into d.Minv by the factorisation the last forward dynamics (or constrained forward
+// dynamics) left in ws: the O(n · bodies) sweep on the articulated route, else n column solves.
+void inverse_mass_matrix(const Model& model, Workspace& ws, DerivativeWorkspace& d);
+
 // A = ∂(ξ̇, v̇)/∂(ξ, v) at ξ = 0 (2n × 2n) and B = ∂(ξ̇, v̇)/∂τ (2n × n) from the forward
 // derivatives in d at (q, v): ξ̇ = v on flat joints; in the chart ξ ↦ q ⊕ ξ a spherical joint has
 // ξ̇ = J_r(ξ)⁻¹ ω, so ∂ξ̇/∂ξ = −½ [ω]×, and a free joint also ξ̇_p = exp(ξ_r) v_p, −[v_p]×.

@@ -1,6 +1,5 @@
 #include "core/derivatives_loops.hpp"
 
-#include "core/articulated.hpp"
 #include "core/derivatives.hpp"
 
 namespace femdyn {
@@ -8,6 +7,7 @@ namespace femdyn {
 LoopDerivatives::LoopDerivatives(const Model& m)
     : lws(m),
       terms(m),
+      R(MatX::Zero(m.n(), m.n())),
       Xq(MatX::Zero(m.n(), m.n())),
       Xv(MatX::Zero(m.n(), m.n())),
       Lq(MatX::Zero(m.constraint_rows, m.n())),
@@ -16,18 +16,6 @@ LoopDerivatives::LoopDerivatives(const Model& m)
       y(VecX::Zero(m.constraint_rows)) {}
 
 namespace {
-
-// X ← M⁻¹ X column by column, by the factorisation the constrained solve left in ws.
-void solve_mass(const Model& m, Workspace& ws, VecX& column, MatX& X) {
-  for (Eigen::Index k = 0; k < X.cols(); ++k) {
-    column = X.col(k);
-    if (m.dynamics_route == DynamicsRoute::Articulated)
-      articulated_solve(m, ws, column);
-    else
-      ws.solver.solve_in_place(column);
-    X.col(k) = column;
-  }
-}
 
 // Λ ← S⁺ Λ column by column: the basic solution of solve_constraint_space on S's kept pivots
 // (P S Pᵀ = L Lᵀ, L₁ rank × rank), the redundant part zero.
@@ -64,12 +52,11 @@ Status constrained_forward_dynamics_derivatives(const Model& m, Workspace& ws, L
   // M kept), and the recursion's V, a, S in d for the constraints' terms
   inverse_dynamics_derivatives(m, ws, d, q, v, d.qdd);
   constraint_derivatives(m, ws, d, lws.lambda, omega, L.terms);
-  L.Xq = L.terms.G - d.dtau_dq;  // r₁ along q: ∂g/∂q − ∂τ_ID/∂q
-  solve_mass(m, ws, d.column, L.Xq);
-  L.Xv = -d.dtau_dv;
-  solve_mass(m, ws, d.column, L.Xv);
-  d.Minv.setIdentity();
-  solve_mass(m, ws, d.column, d.Minv);
+  inverse_mass_matrix(m, ws, d);  // the tree's M⁻¹ into d.Minv
+  L.R = L.terms.G - d.dtau_dq;    // r₁ along q: ∂g/∂q − ∂τ_ID/∂q
+  L.Xq.noalias() = d.Minv * L.R;
+  L.R = -d.dtau_dv;  // r₁ along v
+  L.Xv.noalias() = d.Minv * L.R;
   add_constraint_response(lws, &L.terms.Cq, L.y, L.Lq, L.Xq);
   add_constraint_response(lws, &L.terms.Cv, L.y, L.Lv, L.Xv);
   add_constraint_response(lws, nullptr, L.y, L.Lt, d.Minv);

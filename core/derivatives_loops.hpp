@@ -33,7 +33,7 @@ struct LoopDerivatives {
   explicit LoopDerivatives(const Model& model);
   LoopWorkspace lws;  // forward_dynamics_derivatives' own constrained solve
   ConstraintDerivatives terms;
-  MatX Xq, Xv;      // M⁻¹ r₁ per column (n × n)
+  MatX R, Xq, Xv;   // r₁ per column, and M⁻¹ r₁ along q and along v (n × n)
   MatX Lq, Lv, Lt;  // Λ_q, Λ_v, Λ_τ (m × n)
   VecX y;           // a permuted column of S's system (m)
 };

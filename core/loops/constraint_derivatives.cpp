@@ -11,7 +11,9 @@ ConstraintDerivatives::ConstraintDerivatives(const Model& m)
     : G(MatX::Zero(m.n(), m.n())),
       Cq(MatX::Zero(m.constraint_rows, m.n())),
       Cv(MatX::Zero(m.constraint_rows, m.n())),
+      marked(m.n(), 0),
       arm(m.n(), Vec3::Zero()) {
+  rates.reserve(m.n());
   for (PlaceDerivatives* P : {&A, &B}) {
     for (Mat3X* X : {&P->dx, &P->turn, &P->dx_dot, &P->dw, &P->dx_ddot, &P->dalpha, &P->dx_ddot_v,
                      &P->dalpha_v})
@@ -66,6 +68,15 @@ void place_derivatives(const Model& m, const Workspace& ws, const DerivativeWork
     P.dx_ddot_v.col(r) = point_velocity(da, P.x) + S.head<3>().cross(P.x_dot) + P.w.cross(dx);
     P.dalpha_v.col(r) = da.head<3>();
   }
+}
+
+// The rates on A's or B's path into out.rates: every other column of a row's variations is 0.
+void rates_of_places(ConstraintDerivatives& out) {
+  out.rates.clear();
+  for (const std::vector<int>* path : {&out.A.path, &out.B.path})
+    for (const int r : *path)
+      if (!out.marked[r]) out.marked[r] = 1, out.rates.push_back(r);
+  for (const int r : out.rates) out.marked[r] = 0;
 }
 
 // The two places' relative motion (d = x_A − x_B) and B's rotation.
@@ -149,9 +160,11 @@ RowVariation along_distance(const Ends& s, const Variation& e) {
 template <class Row>
 void fill_row(const PlaceDerivatives& A, const PlaceDerivatives& B, double omega, int row,
               ConstraintDerivatives& out, Row&& vary) {
-  for (Eigen::Index k = 0; k < out.Cq.cols(); ++k) {
-    out.Cq(row, k) = vary(along_q(A, B, static_cast<int>(k))).c(omega);
-    out.Cv(row, k) = vary(along_v(A, B, static_cast<int>(k))).c(omega);
+  out.Cq.row(row).setZero();
+  out.Cv.row(row).setZero();
+  for (const int k : out.rates) {
+    out.Cq(row, k) = vary(along_q(A, B, k)).c(omega);
+    out.Cv(row, k) = vary(along_v(A, B, k)).c(omega);
   }
 }
 
@@ -165,8 +178,10 @@ void add_force_turning(const Model& m, const DerivativeWorkspace& d, const Vec3&
 void ball(const Model& m, const DerivativeWorkspace& d, const Vec3& lambda, double omega, int row,
           ConstraintDerivatives& out) {
   const PlaceDerivatives &A = out.A, &B = out.B;
-  for (Eigen::Index k = 0; k < out.Cq.cols(); ++k) {
-    const Variation q = along_q(A, B, static_cast<int>(k)), v = along_v(A, B, static_cast<int>(k));
+  out.Cq.middleRows<3>(row).setZero();
+  out.Cv.middleRows<3>(row).setZero();
+  for (const int k : out.rates) {
+    const Variation q = along_q(A, B, k), v = along_v(A, B, k);
     out.Cq.block<3, 1>(row, k) = q.d_ddot + 2 * omega * q.d_dot + omega * omega * q.d;
     out.Cv.block<3, 1>(row, k) = v.d_ddot + 2 * omega * v.d_dot;
   }
@@ -177,22 +192,21 @@ void rows_along_axes(const Model& m, const DerivativeWorkspace& d, const LoopCon
                      const VecX& lambda, double omega, int row, ConstraintDerivatives& out) {
   const PlaceDerivatives &A = out.A, &B = out.B;
   const Ends s = ends(A, B);
-  const int n = static_cast<int>(out.G.cols());
-  Vec3 force = Vec3::Zero();
+  Vec3 force = Vec3::Zero();  // f = Σ_i λ_i g_i
   for (std::size_t i = 0; i < c.axes.size(); ++i) {
     const Vec3 g = B.R * c.axes[i];
-    const double l = lambda[row + static_cast<int>(i)];
     fill_row(A, B, omega, row + static_cast<int>(i), out,
              [&](const Variation& e) { return along_axis(s, g, e); });
-    force += l * g;
-    // the turning of the row itself: λ [(δg_k)ᵀ Δ_c + (δg_k × d + g × Δ_k)ᵀ ω_B,c]
-    for (int k = 0; k < n; ++k) {
-      const Vec3 dg = B.turn.col(k).cross(g), delta_k = A.dx.col(k) - B.dx.col(k);
-      const Vec3 dgd = dg.cross(s.d) + g.cross(delta_k);
-      if (dg.isZero(0) && dgd.isZero(0)) continue;
-      for (int col = 0; col < n; ++col)
-        out.G(col, k) += l * (dg.dot(A.dx.col(col) - B.dx.col(col)) + dgd.dot(B.turn.col(col)));
-    }
+    force += lambda[row + static_cast<int>(i)] * g;
+  }
+  // The turning of the rows themselves, Σ_i λ_i [(δg_i,k)ᵀ Δ_c + (δg_i,k × d + g_i × Δ_k)ᵀ ω_B,c]
+  // with δg_i,k = ω_B,k × g_i: that of the force f, δf_k = ω_B,k × f,
+  //   G(c, k) += δf_kᵀ Δ_c + (δf_k × d + f × Δ_k)ᵀ ω_B,c.
+  for (const int k : out.rates) {
+    const Vec3 df = B.turn.col(k).cross(force), delta_k = A.dx.col(k) - B.dx.col(k);
+    const Vec3 dt = df.cross(s.d) + force.cross(delta_k);
+    for (const int col : out.rates)
+      out.G(col, k) += df.dot(A.dx.col(col) - B.dx.col(col)) + dt.dot(B.turn.col(col));
   }
   add_force_turning(m, d, force, out);
   add_axis_turning(m, d, force.cross(s.d), B.path, out.G);  // λ (g × d)ᵀ Jω_B
@@ -204,8 +218,10 @@ void weld_angles(const Model& m, const DerivativeWorkspace& d, const Vec3& lambd
   const PlaceDerivatives &A = out.A, &B = out.B;
   const Eigen::AngleAxisd rel(B.R.transpose() * A.R);
   const Vec3 phi = B.R * (rel.angle() * rel.axis());
-  for (Eigen::Index k = 0; k < out.Cq.cols(); ++k) {
-    const Variation q = along_q(A, B, static_cast<int>(k)), v = along_v(A, B, static_cast<int>(k));
+  out.Cq.middleRows<3>(row).setZero();
+  out.Cv.middleRows<3>(row).setZero();
+  for (const int k : out.rates) {
+    const Variation q = along_q(A, B, k), v = along_v(A, B, k);
     const Vec3 dphi = inverse_right_jacobian_times(-phi, q.turn) - phi.cross(q.turn_B);
     out.Cq.block<3, 1>(row, k) = q.alpha + 2 * omega * q.w + omega * omega * dphi;
     out.Cv.block<3, 1>(row, k) = v.alpha + 2 * omega * v.w;
@@ -227,13 +243,10 @@ void distance(const Model& m, const DerivativeWorkspace& d, double lambda, doubl
   fill_row(A, B, omega, row, out, [&](const Variation& e) { return along_distance(s, e); });
   const Vec3 u = s.d / l;
   add_force_turning(m, d, lambda * u, out);
-  const int n = static_cast<int>(out.G.cols());
-  for (int k = 0; k < n; ++k) {  // λ (δê_k)ᵀ Δ_c
+  for (const int k : out.rates) {  // λ (δê_k)ᵀ Δ_c
     const Vec3 delta_k = A.dx.col(k) - B.dx.col(k);
-    if (delta_k.isZero(0)) continue;
     const Vec3 du = (delta_k - u * u.dot(delta_k)) / l;
-    for (int col = 0; col < n; ++col)
-      out.G(col, k) += lambda * du.dot(A.dx.col(col) - B.dx.col(col));
+    for (const int col : out.rates) out.G(col, k) += lambda * du.dot(A.dx.col(col) - B.dx.col(col));
   }
 }
 
@@ -253,6 +266,7 @@ void constraint_derivatives(const Model& m, const Workspace& ws, const Derivativ
     if (c.type != ConstraintType::Gear) {
       place_derivatives(m, ws, d, c.a, out.A);
       place_derivatives(m, ws, d, c.b, out.B);
+      rates_of_places(out);
     }
     switch (c.type) {
       case ConstraintType::Ball:

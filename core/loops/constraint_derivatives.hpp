@@ -26,7 +26,8 @@
 //   distance   λ êᵀ (J(x_A) − J(x_B)),
 // so G is the turning of the point and angular Jacobians at those forces held fixed
 // (add_point_turning, add_axis_turning) plus the turning of the forces themselves:
-//   along g    G(c, k) += λ [(δg_k)ᵀ Δ_c + (δg_k × d + g × Δ_k)ᵀ ω_B,c],   Δ = J(x_A) − J(x_B)
+//   along g    G(c, k) += δf_kᵀ Δ_c + (δf_k × d + f × Δ_k)ᵀ ω_B,c,   Δ = J(x_A) − J(x_B),
+//              f = Σ_i λ_i g_i the constraint's force, δf_k = ω_B,k × f
 //   distance   G(c, k) += λ (δê_k)ᵀ Δ_c,   δê_k = (Δ_k − ê êᵀ Δ_k) / |d|.
 #pragma once
 #include <vector>
@@ -58,7 +59,9 @@ struct ConstraintDerivatives {
   MatX G;       // ∂(Φ_qᵀ λ)/∂q (n × n)
   MatX Cq, Cv;  // ∂c/∂q, ∂c/∂v (m × n)
   PlaceDerivatives A, B;
-  std::vector<Vec3> arm;  // scratch of add_point_turning (per rate)
+  std::vector<int> rates;             // the rates on A's or B's path: the columns not zero
+  std::vector<unsigned char> marked;  // per rate (scratch of `rates`)
+  std::vector<Vec3> arm;              // scratch of add_point_turning (per rate)
 };
 
 // G, C_q, C_v at the state of the last derivative recursion in d (its V, a at the constrained
