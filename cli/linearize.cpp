@@ -30,7 +30,7 @@ the dynamics (docs/derivatives.md): trees with linear couplings, springs, damper
 rotors, stops and loads, closed loops; other models are refused in one line.
 
 A model with closed loops (docs/loops.md) is linearised at the state assembled onto its loops
-(as femdyn simulate starts; q and qd printed are the assembled ones), through its constrained
+(as femdyn simulate starts; --json gives the assembled q and qd), through its constrained
 equations with Baumgarte's stabilisation at --baumgarte W (1/s; default 20, the simulator's):
 B's lower block is then the projected inverse M⁻¹ − Y S⁺ Yᵀ (Y = M⁻¹ Φ_qᵀ, S = Φ_q Y: no
 torque moves q̈ off the loops), and at an equilibrium A has the pair −W for each direction off
