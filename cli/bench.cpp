@@ -306,6 +306,7 @@ std::vector<Row> time_derivative_rows(const Model& m, Workspace& ws, const State
     return {};
   }
   DerivativeWorkspace d(m);
+  d.baumgarte = 0;  // closed loops: the constrained equations as qdd_c times them (ω = 0)
   std::vector<Row> rows;
   rows.push_back(time_femdyn(
       "dtau",

@@ -9,6 +9,7 @@
 #include "cli/commands.hpp"
 #include "core/derivatives.hpp"
 #include "core/equations.hpp"
+#include "core/loops/assembly.hpp"
 #include "core/names.hpp"
 #include "io/output.hpp"
 
@@ -17,6 +18,7 @@ namespace {
 
 constexpr const char* kHelp =
     R"(usage: femdyn linearize MODEL [--q …] [--qd …] [--tau …] [--json] [--gravity gx,gy,gz]
+                        [--baumgarte W]
 
 The linearisation of the equations of motion at the state (--q: n_q values, default the neutral
 configuration; --qd, --tau: n values each, default 0):
@@ -25,7 +27,14 @@ with v̇ = q̈ and ξ the tangent coordinates around q: q + ξ on a flat joint; 
 spherical joint, whose ξ̇ = J_r(ξ)⁻¹ ω turns A's top-left block (−½ [ω]×); (p + R ξ_p,
 q ⊗ exp(ξ_r)) on a free joint (also −[v]× from ξ̇_p = exp(ξ_r) v). By analytic derivatives of
 the dynamics (docs/derivatives.md): trees with linear couplings, springs, dampers, friction,
-rotors, stops and loads; other models are refused in one line.
+rotors, stops and loads, closed loops; other models are refused in one line.
+
+A model with closed loops (docs/loops.md) is linearised at the state assembled onto its loops
+(as femdyn simulate starts; --json gives the assembled q and qd), through its constrained
+equations with Baumgarte's stabilisation at --baumgarte W (1/s; default 20, the simulator's):
+B's lower block is then the projected inverse M⁻¹ − Y S⁺ Yᵀ (Y = M⁻¹ Φ_qᵀ, S = Φ_q Y: no
+torque moves q̈ off the loops), and at an equilibrium A has the pair −W for each direction off
+the loops (at W = 0 a double zero).
 
 --json prints {"n", "coordinates", "q", "qd", "tau", "A", "B"}, A and B as lists of rows.
 )";
@@ -33,16 +42,28 @@ rotors, stops and loads; other models are refused in one line.
 }  // namespace
 
 int cmd_linearize(int argc, char** argv) {
-  const Args a = parse_args(argc, argv, 2, {"help", "json"}, {"gravity", "q", "qd", "tau"});
+  const Args a =
+      parse_args(argc, argv, 2, {"help", "json"}, {"gravity", "q", "qd", "tau", "baumgarte"});
   if (a.has("help")) {
     std::cout << kHelp;
     return 0;
   }
   const Model m = load(a);
-  const VecX q = configuration_vector(a, "q", m), qd = state_vector(a, "qd", m),
-             tau = state_vector(a, "tau", m);
+  VecX q = configuration_vector(a, "q", m), qd = state_vector(a, "qd", m);
+  const VecX tau = state_vector(a, "tau", m);
   Workspace ws(m);
   DerivativeWorkspace d(m);  // a model it does not cover: one line, exit 1
+  if (a.has("baumgarte")) {
+    if (m.constraints.empty()) throw CliError("--baumgarte: the model has no constraints");
+    d.baumgarte = number_option(a, "baumgarte", 0);
+    if (!(d.baumgarte >= 0) || !std::isfinite(d.baumgarte))
+      throw CliError("--baumgarte expects a rate >= 0 (1/s; 0: off)");
+  }
+  if (!m.constraints.empty()) {  // the state onto the loops, as a run starts
+    const StateAssembly loops = assemble_state(m, q, qd);
+    if (!loops.assembly.status.ok)
+      throw CliError(a.positional[0] + ": the state: " + loops.assembly.status.message);
+  }
   const Status st = forward_dynamics_derivatives(m, ws, d, q, qd, tau);
   if (!st.ok) {
     std::cerr << "femdyn linearize: " << escaped(a.positional[0]) << ": at this state "

@@ -461,8 +461,9 @@ void plan_inverse_sweep(const Model& m, DerivativeWorkspace& d) {
 }  // namespace
 
 std::string derivatives_unsupported(const Model& m) {
+  if (!m.constraints.empty() && (m.coupling_level || !m.identity_coupling))
+    return "derivatives of a model with closed loops need uncoupled joints (C = I)";
   if (m.coupling_level) return law_derivatives_unsupported(m);
-  if (!m.constraints.empty()) return "derivatives of a model with closed loops are not available";
   if (!m.condensable_off_spans || !m.velocity_forces_rigid ||
       m.body_inertia.size() != m.bodies.size())
     return "derivatives need an exact body-level form (no explicit correlation table, rigid "
@@ -494,6 +495,7 @@ DerivativeWorkspace::DerivativeWorkspace(const Model& m) {
   if (!m.springs.empty()) springs.size_for(m);
   if (!m.condensable && !m.coupling_level) spans.size_for(m);  // (a law model: its tree's)
   if (m.coupling_level) law = std::make_unique<LawDerivatives>(m);
+  if (!m.constraints.empty()) loops = std::make_unique<LoopDerivatives>(m);
   plan_inverse_sweep(m, *this);
 }
 
@@ -526,6 +528,9 @@ void inverse_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWorks
 Status forward_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d,
                                     const VecX& q, const VecX& qd, const VecX& tau) {
   if (m.coupling_level) return law_forward_derivatives(m, ws, d, q, qd, tau);
+  if (d.loops)
+    return constrained_forward_dynamics_derivatives(m, ws, d.loops->lws, d, q, qd, tau,
+                                                    d.baumgarte);
   const Status st = forward_dynamics(m, ws, q, qd, tau);
   if (!st.ok) return st;
   d.qdd = ws.qdd;
@@ -551,6 +556,12 @@ Status forward_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWor
   d.Minv.setIdentity();
   solve_columns(m, ws, d, d.Minv, 1.0);
   return st;
+}
+
+void inverse_mass_matrix(const Model& m, Workspace& ws, DerivativeWorkspace& d) {
+  if (d.minv_sweep) return inverse_mass_sweep(m, ws, d);
+  d.Minv.setIdentity();
+  solve_columns(m, ws, d, d.Minv, 1.0);
 }
 
 void linearization(const Model& m, const DerivativeWorkspace& d, const VecX& qd, MatX& A, MatX& B) {

@@ -41,14 +41,16 @@
 // Two-point springs (core/derivatives_springs.hpp) and elements spanning bodies
 // (core/derivatives_spans.hpp) add their terms to ∂τ_θ/∂θ, ∂τ_θ/∂θ̇ as forces at body points;
 // a nonlinear coupling level θ = g(q) chains the tree's derivatives through g
-// (core/derivatives_coupling.hpp).
+// (core/derivatives_coupling.hpp); closed loops differentiate the constrained equations at
+// Baumgarte's rate ω (core/derivatives_loops.hpp), ∂q̈/∂τ then the projected inverse.
 //
 // Covered: trees of every joint type, free bases, joint springs, dampers, Coulomb friction,
 // stops, rotors, gravity, point loads and body torques, linear couplings and coupling laws
 // (linear, polynomial, spline, four-bar), two-point springs, and elements spanning bodies that use
-// only their nodes' translations (the rod). Refused with a one-line ModelError: closed loops, an
-// explicit correlation table, an element whose velocity forces are not rigid, and a spanning
-// element with rotations or a velocity force.
+// only their nodes' translations (the rod), closed loops (every constraint form) over uncoupled
+// joints. Refused with a one-line ModelError: closed loops over coupled joints, an explicit
+// correlation table, an element whose velocity forces are not rigid, and a spanning element
+// with rotations or a velocity force.
 #pragma once
 #include <memory>
 #include <string>
@@ -56,6 +58,7 @@
 #include <vector>
 
 #include "core/derivatives_coupling.hpp"
+#include "core/derivatives_loops.hpp"
 #include "core/derivatives_spans.hpp"
 #include "core/derivatives_springs.hpp"
 #include "core/status.hpp"
@@ -97,8 +100,8 @@ struct VelocityInertia {
 struct DerivativeWorkspace {
   explicit DerivativeWorkspace(const Model& model);  // throws ModelError if not covered
 
-  MatX dtau_dq, dtau_dv;        // ∂τ/∂q, ∂τ/∂v (n × n)
-  MatX dqdd_dq, dqdd_dv, Minv;  // ∂q̈/∂q, ∂q̈/∂v, ∂q̈/∂τ = (M^s)⁻¹ (n × n)
+  MatX dtau_dq, dtau_dv;  // ∂τ/∂q, ∂τ/∂v (n × n)
+  MatX dqdd_dq, dqdd_dv, Minv;  // ∂q̈/∂q, ∂q̈/∂v, ∂q̈/∂τ = (M^s)⁻¹ (n × n; loops: projected)
   VecX qdd;                     // q̈ of the last forward derivatives
 
   // Per body (world axes about the origin).
@@ -131,6 +134,11 @@ struct DerivativeWorkspace {
   SpringDerivatives springs;  // the two-point springs' buffers (core/derivatives_springs.hpp)
   SpanDerivatives spans;      // the spanning elements' (core/derivatives_spans.hpp)
   std::unique_ptr<LawDerivatives> law;  // a coupling law's chain (core/derivatives_coupling.hpp)
+  // Closed loops (core/derivatives_loops.hpp): forward_dynamics_derivatives solves the
+  // constrained equations at Baumgarte's rate `baumgarte` (1/s; the simulator's default unless
+  // set), with these buffers and their own LoopWorkspace.
+  std::unique_ptr<LoopDerivatives> loops;
+  double baumgarte = kDefaultBaumgarte;
 };
 
 // "" if the derivatives cover `model`, else why not (one line).
@@ -142,9 +150,15 @@ void inverse_dynamics_derivatives(const Model& model, Workspace& ws, DerivativeW
                                   const VecX& q, const VecX& qd, const VecX& qdd);
 
 // q̈ (into ws.qdd and d.qdd), then ∂q̈/∂q, ∂q̈/∂v and (M^s)⁻¹ into d. A failed forward dynamics
-// (singular M^s) is returned as is.
+// (singular M^s) is returned as is. A model with closed loops: those of the constrained
+// equations at Baumgarte's rate d.baumgarte (constrained_forward_dynamics_derivatives), d.Minv
+// the projected inverse M⁻¹ − Y S⁺ Yᵀ; a dead point is a failed Status.
 Status forward_dynamics_derivatives(const Model& model, Workspace& ws, DerivativeWorkspace& d,
                                     const VecX& q, const VecX& qd, const VecX& tau);
+
+// (M^s)⁻¹ into d.Minv by the factorisation the last forward dynamics (or constrained forward
+// dynamics) left in ws: the O(n · bodies) sweep on the articulated route, else n column solves.
+void inverse_mass_matrix(const Model& model, Workspace& ws, DerivativeWorkspace& d);
 
 // A = ∂(ξ̇, v̇)/∂(ξ, v) at ξ = 0 (2n × 2n) and B = ∂(ξ̇, v̇)/∂τ (2n × n) from the forward
 // derivatives in d at (q, v): ξ̇ = v on flat joints; in the chart ξ ↦ q ⊕ ξ a spherical joint has

@@ -36,6 +36,17 @@ void rates_on_path(const Model& m, int b, std::vector<int>& path);
 void add_point_turning(const Model& m, const DerivativeWorkspace& d, const Vec3& x, const Vec3& F,
                        const std::vector<int>& path, std::vector<Vec3>& arm, MatX& Kq);
 
+// Kq(c, m) += ∂(ω_cᵀ t)/∂θ_m at a torque t fixed, for c, m on `path`: the turning of the
+// angular columns, ∂ω_c/∂θ_m = ω_m × ω_c where S_c moves with θ_m (else 0).
+void add_axis_turning(const Model& m, const DerivativeWorkspace& d, const Vec3& t,
+                      const std::vector<int>& path, MatX& Kq);
+
+// The body's ∂V/∂θ_r, ∂a/∂θ_r (r on its path; a with the base's −g, which cancels).
+void body_position_derivative(const Model& m, const DerivativeWorkspace& d, int body, int r,
+                              Vec6& dV, Vec6& da);
+// Its ∂a/∂θ̇_r (∂V/∂θ̇_r = S_r).
+Vec6 body_rate_derivative(const Model& m, const DerivativeWorkspace& d, int body, int r);
+
 // A point x on body b and its motion, with the derivatives of ẋ and ẍ along θ_r and θ̇_r.
 struct PointMotion {
   int body = -1;

@@ -3,6 +3,9 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
+#include <optional>
+
 #include "core/derivatives.hpp"
 #include "core/equations.hpp"
 #include "python/derivative_rows.hpp"
@@ -12,6 +15,7 @@ namespace femdyn::python {
 namespace {
 
 using OptArray = std::optional<Array>;
+using OptRate = std::optional<double>;
 
 // The model's derivative buffers, made on first use (a model they do not cover: ModelError).
 DerivativeWorkspace& derivative_workspace(PyModel& self) {
@@ -19,20 +23,27 @@ DerivativeWorkspace& derivative_workspace(PyModel& self) {
   return *self.derivatives;
 }
 
-// q̈ and its derivatives at (q, q̇, τ), after forward dynamics.
+// q̈ and its derivatives at (q, q̇, τ), after forward dynamics; a model with closed loops at
+// Baumgarte's rate `baumgarte` (default the simulator's).
 DerivativeWorkspace& forward_at(PyModel& self, const Array& q, const OptArray& qd,
-                                const OptArray& tau, VecX& v) {
+                                const OptArray& tau, const OptRate& baumgarte, VecX& v) {
   const Model& m = *self.model;
   DerivativeWorkspace& d = derivative_workspace(self);
+  if (baumgarte && m.constraints.empty())
+    throw py::value_error("baumgarte: the model has no constraints");
+  if (baumgarte && (!(*baumgarte >= 0) || !std::isfinite(*baumgarte)))
+    throw py::value_error("baumgarte: expected a rate >= 0 (1/s)");
+  d.baumgarte = baumgarte.value_or(kDefaultBaumgarte);
   v = vector_arg(qd, "qd", m);
   forward_derivatives_at(m, self.ws, d, configuration_arg(q, "q", m), v,
                          vector_arg(tau, "tau", m, Entries::Bounded));
   return d;
 }
 
-py::dict forward(PyModel& self, const Array& q, const OptArray& qd, const OptArray& tau) {
+py::dict forward(PyModel& self, const Array& q, const OptArray& qd, const OptArray& tau,
+                 const OptRate& baumgarte) {
   VecX v;
-  const DerivativeWorkspace& d = forward_at(self, q, qd, tau, v);
+  const DerivativeWorkspace& d = forward_at(self, q, qd, tau, baumgarte, v);
   py::dict out;
   out["qdd"] = d.qdd;
   out["dqdd_dq"] = d.dqdd_dq;
@@ -58,9 +69,9 @@ py::dict inverse(PyModel& self, const Array& q, const OptArray& qd, const OptArr
 }
 
 std::pair<MatX, MatX> linearize(PyModel& self, const Array& q, const OptArray& qd,
-                                const OptArray& tau) {
+                                const OptArray& tau, const OptRate& baumgarte) {
   VecX v;
-  const DerivativeWorkspace& d = forward_at(self, q, qd, tau, v);
+  const DerivativeWorkspace& d = forward_at(self, q, qd, tau, baumgarte, v);
   MatX A, B;
   linearization(*self.model, d, v, A, B);
   return {A, B};
@@ -71,16 +82,18 @@ std::pair<MatX, MatX> linearize(PyModel& self, const Array& q, const OptArray& q
 void bind_derivatives(py::module_& m) {
   auto cls = py::reinterpret_borrow<py::class_<PyModel>>(m.attr("Model"));
   cls.def("derivatives", &forward, py::arg("q"), py::arg("qd") = py::none(),
-          py::arg("tau") = py::none(),
+          py::arg("tau") = py::none(), py::arg("baumgarte") = py::none(),
           "Forward dynamics and its analytic derivatives at (q, q̇, τ) as a dict: qdd (n,), "
           "dqdd_dq, dqdd_dv, Minv = dqdd_dtau (n, n); columns over the rates, q moved along "
-          "its tangent q ⊕ ξ on spherical and free joints (docs/derivatives.md)")
+          "its tangent q ⊕ ξ on spherical and free joints (docs/derivatives.md). Closed loops: "
+          "the constrained equations at Baumgarte's rate `baumgarte` (1/s, default 20, the "
+          "simulator's), Minv the projected inverse M⁻¹ − Y S⁺ Yᵀ")
       .def("inverse_derivatives", &inverse, py::arg("q"), py::arg("qd") = py::none(),
            py::arg("qdd") = py::none(),
            "Inverse dynamics and its analytic derivatives at (q, q̇, q̈) as a dict: tau (n,), "
            "dtau_dq, dtau_dv (n, n)")
       .def("linearize", &linearize, py::arg("q"), py::arg("qd") = py::none(),
-           py::arg("tau") = py::none(),
+           py::arg("tau") = py::none(), py::arg("baumgarte") = py::none(),
            "(A, B): d/dt (ξ, v) = A (ξ, v) + B τ at the state, A (2n, 2n), B (2n, n), as "
            "`femdyn linearize` prints them");
 }

@@ -67,7 +67,7 @@ class Motion {
   bool constrained() const { return static_cast<bool>(loops_); }
   void set_baumgarte(double omega) { baumgarte_ = omega; }
   double baumgarte() const { return baumgarte_; }
-  static constexpr double kDefaultBaumgarte = 20;  // 1/s: a residual decays in about 1/ω = 50 ms
+  static constexpr double kDefaultBaumgarte = femdyn::kDefaultBaumgarte;  // 1/s
   // The state at y moved onto the constraints: q by Newton's least-norm steps, v by the
   // kinetic-energy projection (core/loops/assembly.hpp). Fails when the loops cannot close.
   Status project(double t, double* y);

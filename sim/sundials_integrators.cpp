@@ -267,8 +267,10 @@ Bdf::Bdf(const Model& model, const AdaptiveOptions& options, Actuation tau)
       unit_(VecX::Zero(model.n())),
       rate_plus_(VecX::Zero(model.n())),
       rate_minus_(VecX::Zero(model.n())) {
-  // Once per integrator: whether the derivatives cover the model (not per Jacobian).
-  if (options.analytic_jacobian && derivatives_unsupported(model).empty()) {
+  // Once per integrator: whether the derivatives cover the model (not per Jacobian). Closed
+  // loops keep the differences (the run's Baumgarte rate and its projections are not wired in).
+  if (options.analytic_jacobian && model.constraints.empty() &&
+      derivatives_unsupported(model).empty()) {
     derivatives_ = std::make_unique<DerivativeWorkspace>(model);
     derivative_ws_ = std::make_unique<Workspace>(model);
   }

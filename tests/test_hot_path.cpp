@@ -6,8 +6,11 @@
 #include <cstdlib>
 
 #include "core/derivatives.hpp"
+#include "core/loops/assembly.hpp"
+#include "core/sampling.hpp"
 #include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
+#include "tests/loop_checks.hpp"
 #include "validation/alloc_counter.hpp"
 
 using femdyn::alloc_counter::kAvailable;
@@ -66,6 +69,34 @@ TEST_CASE("no heap allocation in the analytic derivatives after the first call",
     alloc_counter::start();
     const bool ok = forward_dynamics_derivatives(m, ws, d, q, qd, tau).ok;
     inverse_dynamics_derivatives(m, ws, d, q, qd, qdd);
+    const long mallocs = alloc_counter::stop();
+    CHECK(ok);
+    CHECK(mallocs == 0);
+  }
+}
+
+TEST_CASE("no heap allocation in the closed loops' derivatives after the first call",
+          "[hot-path][loop_derivatives]") {
+  if (!kAvailable) {
+    WARN(kSkipped);
+    return;
+  }
+  // Balls (redundant on Bricard's), point on line, distances; a weld, a distance and a gear on a
+  // random tree.
+  const Model random = load_text(closable_tree(2, true));
+  for (const char* name : {"five_bar.json", "delta.json", "iftomm_a04_bricard.json", ""}) {
+    INFO(name);
+    const Model loaded = *name ? load_model(model_path(name)) : Model{};
+    const Model& m = *name ? loaded : random;
+    Workspace ws(m);
+    DerivativeWorkspace d(m);
+    std::mt19937 rng(3);
+    VecX q = neutral_posture(m), qd = random_uniform(m.n(), 1, rng);
+    const VecX tau = random_uniform(m.n(), 1e-3, rng);
+    REQUIRE(assemble_state(m, q, qd).assembly.status.ok);
+    REQUIRE(forward_dynamics_derivatives(m, ws, d, q, qd, tau).ok);  // warm-up
+    alloc_counter::start();
+    const bool ok = forward_dynamics_derivatives(m, ws, d, q, qd, tau).ok;
     const long mallocs = alloc_counter::stop();
     CHECK(ok);
     CHECK(mallocs == 0);

@@ -50,6 +50,8 @@ struct LoopWorkspace {
   int rank = 0;           // of S at the last solve
 };
 
+// Baumgarte's rate the simulator uses unless told (1/s): a residual decays in about 1/ω = 50 ms.
+inline constexpr double kDefaultBaumgarte = 20;
 inline constexpr double kRankTolerance = 1e-10;        // ε_rank, relative to S's largest pivot
 inline constexpr double kConsistencyTolerance = 1e-3;  // |S λ − r| relative to its scale
 

@@ -86,6 +86,28 @@ def test_assembly_and_constrained_dynamics(fourbar):
     assert np.allclose(r["constraint_forces"], k["J"].T @ r["lambda"], rtol=0, atol=1e-14)
 
 
+def test_derivatives_of_the_constrained_dynamics(fourbar):
+    s = fourbar.assemble(fourbar.neutral_configuration(), np.array([3.0, 0, 0]), hold=["a"])
+    q, qd = s["q"], s["qd"]
+    tau = np.array([0.3, -0.1, 0.2])
+    for rate in (0.0, 20.0):
+        d = fourbar.derivatives(q, qd, tau, baumgarte=rate)
+        r = fourbar.constrained_dynamics(q, qd, tau, baumgarte=rate)
+        assert np.allclose(d["qdd"], r["qdd"], rtol=0, atol=1e-12)
+        h = 1e-6  # ∂q̈/∂v against central differences
+        fd = np.column_stack([
+            (fourbar.constrained_dynamics(q, qd + h * e, tau, baumgarte=rate)["qdd"]
+             - fourbar.constrained_dynamics(q, qd - h * e, tau, baumgarte=rate)["qdd"]) / (2 * h)
+            for e in np.eye(fourbar.n)])
+        assert np.abs(d["dqdd_dv"] - fd).max() < 1e-6 * max(1.0, np.abs(fd).max())
+        k = fourbar.constraint_kinematics(q, qd)
+        assert np.abs(k["J"] @ d["Minv"]).max() < 1e-10  # the projected inverse
+    A, B = fourbar.linearize(q, qd, tau)  # the simulator's rate, 20 1/s
+    assert A.shape == (6, 6) and B.shape == (6, 3)
+    with pytest.raises(ValueError, match="no constraints"):
+        femdyn.load(model_path("models/pendulum.json")).derivatives([0], baumgarte=1.0)
+
+
 def test_run_keeps_the_loop_and_the_energy(fourbar):
     run = femdyn.simulate(fourbar, t_end=1.0, integrator="dopri", rtol=1e-10, atol=1e-12,
                           t_eval=np.linspace(0, 1, 21))
