@@ -114,4 +114,22 @@ inline int check_constrained_equations(const Model& m, const VecX& q, const VecX
   return rank;
 }
 
+// Two 1 m links from the origin, the tip held at (LENGTH, 0, 0): at 2 a loop that can only close
+// fully stretched, where its Jacobian loses rank.
+inline const char* kStretched = R"({"name": "stretched", "gravity": [0, -9.81, 0], "bodies": [
+  {"name": "l1", "parent": "world", "joint": {"name": "a", "type": "revolute", "axis": [0, 0, 1]},
+   "elements": [{"type": "rigid_body", "mass": 1, "com": [0.5, 0, 0],
+                 "inertia": {"ixx": 0.01, "iyy": 0.1, "izz": 0.1}}]},
+  {"name": "l2", "parent": "l1", "joint": {"name": "b", "type": "revolute", "axis": [0, 0, 1],
+                                           "origin": {"xyz": [1, 0, 0]}},
+   "elements": [{"type": "rigid_body", "mass": 1, "com": [0.5, 0, 0],
+                 "inertia": {"ixx": 0.01, "iyy": 0.1, "izz": 0.1}}]}],
+  "constraints": [{"name": "tip", "type": "ball", "a": {"body": "l2", "xyz": [1, 0, 0]},
+                   "b": {"body": "world", "xyz": [LENGTH, 0, 0]}, "normal": [0, 0, 1]}]})";
+
+inline std::string stretched(const std::string& length) {
+  std::string s = kStretched;
+  return s.replace(s.find("LENGTH"), 6, length);
+}
+
 }  // namespace femdyn::test

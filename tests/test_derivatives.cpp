@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/derivatives.hpp"
+#include "tests/differences.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;
@@ -17,28 +18,6 @@ using namespace femdyn::test;
 using Json = nlohmann::json;
 
 namespace {
-
-using Function = std::function<VecX(const VecX& q, const VecX& v)>;
-
-// Central difference with step h along q ⊕ ε e_m (wrt_q) or v + ε e_m.
-MatX central(const Model& m, const Function& f, const VecX& q, const VecX& v, bool wrt_q,
-             double h) {
-  const int n = m.n();
-  MatX J(n, n);
-  for (int k = 0; k < n; ++k) {
-    const VecX e = VecX::Unit(n, k);
-    const VecX plus = wrt_q ? f(integrate_posture(m, q, h * e), v) : f(q, v + h * e);
-    const VecX minus = wrt_q ? f(integrate_posture(m, q, -h * e), v) : f(q, v - h * e);
-    J.col(k) = (plus - minus) / (2 * h);
-  }
-  return J;
-}
-
-// Richardson: (4 D(h/2) − D(h)) / 3 cancels the h² term of the central difference.
-MatX richardson(const Model& m, const Function& f, const VecX& q, const VecX& v, bool wrt_q) {
-  const double h = 1e-3;
-  return (4 * central(m, f, q, v, wrt_q, h / 2) - central(m, f, q, v, wrt_q, h)) / 3;
-}
 
 // Every joint of one coordinate gets, by a seeded draw, Coulomb friction, a rotor, a stop.
 std::string with_actuators(const std::string& text, unsigned seed) {

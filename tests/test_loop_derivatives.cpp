@@ -12,6 +12,7 @@
 #include "core/derivatives.hpp"
 #include "core/loops/assembly.hpp"
 #include "core/sampling.hpp"
+#include "tests/differences.hpp"
 #include "tests/helpers.hpp"
 #include "tests/loop_checks.hpp"
 
@@ -19,28 +20,6 @@ using namespace femdyn;
 using namespace femdyn::test;
 
 namespace {
-
-using Function = std::function<VecX(const VecX& q, const VecX& v)>;
-
-// Central difference with step h along q ⊕ ε e_m (wrt_q) or v + ε e_m.
-MatX central(const Model& m, const Function& f, const VecX& q, const VecX& v, bool wrt_q,
-             double h) {
-  const int n = m.n();
-  MatX J(n, n);
-  for (int k = 0; k < n; ++k) {
-    const VecX e = VecX::Unit(n, k);
-    const VecX plus = wrt_q ? f(integrate_posture(m, q, h * e), v) : f(q, v + h * e);
-    const VecX minus = wrt_q ? f(integrate_posture(m, q, -h * e), v) : f(q, v - h * e);
-    J.col(k) = (plus - minus) / (2 * h);
-  }
-  return J;
-}
-
-// (4 D(h/2) − D(h)) / 3 cancels the h² term of the central difference.
-MatX richardson(const Model& m, const Function& f, const VecX& q, const VecX& v, bool wrt_q) {
-  const double h = 1e-3;
-  return (4 * central(m, f, q, v, wrt_q, h / 2) - central(m, f, q, v, wrt_q, h)) / 3;
-}
 
 // The worst relative errors: along q, along v, of ∂q̈/∂τ.
 struct Agreement {
@@ -278,17 +257,8 @@ TEST_CASE("loop derivatives: the dispatch, and a dead point is a failed Status",
     CHECK(at_omega == 4);
   }
 
-  // Two 1 m links from the origin, the tip held at (2, 0, 0): the stretched loop is singular.
-  const Model dead = load_text(R"({"name": "stretched", "gravity": [0, -9.81, 0], "bodies": [
-    {"name": "l1", "parent": "world", "joint": {"name": "a", "type": "revolute", "axis": [0, 0, 1]},
-     "elements": [{"type": "rigid_body", "mass": 1, "com": [0.5, 0, 0],
-                   "inertia": {"ixx": 0.01, "iyy": 0.1, "izz": 0.1}}]},
-    {"name": "l2", "parent": "l1", "joint": {"name": "b", "type": "revolute", "axis": [0, 0, 1],
-                                             "origin": {"xyz": [1, 0, 0]}},
-     "elements": [{"type": "rigid_body", "mass": 1, "com": [0.5, 0, 0],
-                   "inertia": {"ixx": 0.01, "iyy": 0.1, "izz": 0.1}}]}],
-    "constraints": [{"name": "tip", "type": "ball", "a": {"body": "l2", "xyz": [1, 0, 0]},
-                     "b": {"body": "world", "xyz": [2, 0, 0]}, "normal": [0, 0, 1]}]})");
+  // The stretched loop (tests/loop_checks.hpp) is singular where it closes.
+  const Model dead = load_text(stretched("2"));
   Workspace wd(dead);
   DerivativeWorkspace dd(dead);
   dd.baumgarte = 0;

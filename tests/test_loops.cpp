@@ -195,24 +195,6 @@ TEST_CASE("a planar loop closed by 3-D balls is redundant, and moves the same", 
   CHECK(rel_error(lb.k.J.transpose() * lb.lambda, la.k.J.transpose() * la.lambda) < 1e-9);
 }
 
-// Two 1 m links from the origin, the tip held at (2, 0, 0): a loop that can only close fully
-// stretched, where its Jacobian loses rank.
-const char* kStretched = R"({"name": "stretched", "gravity": [0, -9.81, 0], "bodies": [
-  {"name": "l1", "parent": "world", "joint": {"name": "a", "type": "revolute", "axis": [0, 0, 1]},
-   "elements": [{"type": "rigid_body", "mass": 1, "com": [0.5, 0, 0],
-                 "inertia": {"ixx": 0.01, "iyy": 0.1, "izz": 0.1}}]},
-  {"name": "l2", "parent": "l1", "joint": {"name": "b", "type": "revolute", "axis": [0, 0, 1],
-                                           "origin": {"xyz": [1, 0, 0]}},
-   "elements": [{"type": "rigid_body", "mass": 1, "com": [0.5, 0, 0],
-                 "inertia": {"ixx": 0.01, "iyy": 0.1, "izz": 0.1}}]}],
-  "constraints": [{"name": "tip", "type": "ball", "a": {"body": "l2", "xyz": [1, 0, 0]},
-                   "b": {"body": "world", "xyz": [LENGTH, 0, 0]}, "normal": [0, 0, 1]}]})";
-
-std::string stretched(const std::string& length) {
-  std::string s = kStretched;
-  return s.replace(s.find("LENGTH"), 6, length);
-}
-
 TEST_CASE("a dead point is a failure naming the constraint, not a NaN", "[loops]") {
   const Model m = load_text(stretched("2"));
   Workspace ws(m);
