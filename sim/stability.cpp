@@ -163,10 +163,11 @@ void analyse(Linearization& lin) {
 // pass of the derivative recursion instead of 4n evaluations of forward dynamics.
 Linearization linearize(const Model& m, Workspace& ws, const VecX& q, const VecX& qd,
                         const VecX& tau, double baumgarte) {
-  if (!m.constraints.empty() || !derivatives_unsupported(m).empty())
+  if (!derivatives_unsupported(m).empty())
     return difference_linearization(m, ws, q, qd, tau, baumgarte);
   Linearization lin;
   DerivativeWorkspace d(m);
+  d.baumgarte = baumgarte;  // (closed loops: the constrained q̈ at this rate)
   lin.status = forward_dynamics_derivatives(m, ws, d, q, qd, tau);
   if (!lin.status.ok) return lin;
   MatX B;

@@ -268,9 +268,9 @@ Bdf::Bdf(const Model& model, const AdaptiveOptions& options, Actuation tau)
       rate_plus_(VecX::Zero(model.n())),
       rate_minus_(VecX::Zero(model.n())) {
   // Once per integrator: whether the derivatives cover the model (not per Jacobian). Closed
-  // loops keep the differences (the run's Baumgarte rate and its projections are not wired in).
-  if (options.analytic_jacobian && model.constraints.empty() &&
-      derivatives_unsupported(model).empty()) {
+  // loops included: f is the constrained q̈ at the run's Baumgarte rate (the projections act
+  // between steps, outside f).
+  if (options.analytic_jacobian && derivatives_unsupported(model).empty()) {
     derivatives_ = std::make_unique<DerivativeWorkspace>(model);
     derivative_ws_ = std::make_unique<Workspace>(model);
   }
@@ -317,6 +317,7 @@ int Bdf::analytic_jacobian(double t, const double* y, double* J) {
   motion_.configuration(y, q_);
   v_ = Eigen::Map<const VecX>(y + n, n);
   motion_.actuation(t, tau_);  // τ(t), saturated as f applies it (no controller here)
+  derivatives_->baumgarte = motion_.baumgarte();  // (closed loops: the rate f is integrated at)
   const Status st =
       forward_dynamics_derivatives(motion_.model(), *derivative_ws_, *derivatives_, q_, v_, tau_);
   if (!st.ok) {
