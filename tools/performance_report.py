@@ -224,6 +224,25 @@ P("M^s is `mass_matrix()` (M^s alone) against Simbody's `calcM`; h is the veloci
   "Simbody's M, h and τ are those of the uncoupled tree of nθ joints and its q̈ includes its "
   "constraint solve.")
 P("")
+# Issue 27, item 2: a coupling law with rods on the body-level routes, against the linearly
+# coupled hand (hand16) and the uncoupled one.
+law, linear, plain = (t("femdyn", "forward", m) for m in ("hand_fourbar", "hand16", "hand"))
+if law and linear and plain:
+    P("hand_fourbar (the hand with a four-bar law and a 0.5 g coupler rod in every finger and the "
+      "thumb, n = 17 over 22 joints) is on the body-level routes: forward dynamics forms its "
+      "tree's joint forces at θ̈ = γ and the composite M_θ in one pair of sweeps, adds the rods' "
+      "terms on θ, and reduces M^s = Gᵀ M_θ G over G's pattern for a 17 × 17 Cholesky "
+      "(docs/design.md, \"Nonlinear couplings\"). Its q̈ takes " + ns(law) + ", " +
+      ratio(law, linear) + " the linearly coupled hand16's (" + ns(linear) + ") and " +
+      ratio(law, plain) + " the 22-DOF hand's (" + ns(plain) + "), against a target of 1.5× the "
+      "linearly coupled hand. Where the rest goes (`perf record` on femdyn/forward/hand_fourbar, "
+      "sampling): the sweeps over the 22 bodies 16 %, the five rods' mass and force terms 19 % "
+      "(each rod's J_lᵀ M_lj J_j over the rates of both its ends' paths), the poses 10 % (half of "
+      "it `sincos`), the reduction through G 5 %, the laws and their four-bar closures 4 %, the "
+      "dense factorisation and solves 6 %, the body inertias in world axes and the composite "
+      "entries 7 %; hand16 has no rods, no law to evaluate and factorises its 12 × 12 M^s along "
+      "the tree.")
+    P("")
 # The URDF robots against both peers, the floating bases included (issue: "floating-base Atlas
 # and HyQ: q̈, τ and M^s at or below the fastest library measured beside them").
 peered = [m for m in named if any(t("mujoco", op, m) for op, _ in ops)]
