@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "core/equations.hpp"
 #include "core/frames.hpp"
@@ -172,20 +173,22 @@ void require_finite_row(bool finite, Eigen::Index i, const std::string& what) {
                          " is NaN or Inf (the state overflows double precision)");
 }
 
-// A thread's buffers for the derivatives (their workspace; A, B of the linearisation).
+// A thread's buffers for the derivatives (their workspace, at Baumgarte's rate ω for closed loops;
+// A, B of the linearisation).
 struct DerivativeScratch {
   DerivativeWorkspace d;
   MatX A, B;
-  explicit DerivativeScratch(const Model& m) : d(m) {}
+  DerivativeScratch(const Model& m, double omega) : d(m) { d.baumgarte = omega; }
 };
 
 // Every row's derivatives into a thread's s.d (the row's state loaded into r), on `nthreads`
 // threads with the GIL released, then put(i, s, r); a failure names the row.
 template <class Put>
-void for_each_derivative_row(const Model& m, const Batch& b, int nthreads, Put&& put) {
+void for_each_derivative_row(const Model& m, const Batch& b, int nthreads, double omega,
+                             Put&& put) {
   py::gil_scoped_release release;
   for_each_row_with(
-      m, b.k, nthreads, [&] { return DerivativeScratch(m); },
+      m, b.k, nthreads, [&] { return DerivativeScratch(m, omega); },
       [&](Workspace& ws, DerivativeScratch& s, Eigen::Index i) {
         thread_local RowState r;
         r.load(b, i);
@@ -201,8 +204,10 @@ void for_each_derivative_row(const Model& m, const Batch& b, int nthreads, Put&&
 // The analytic derivatives at k states (forward_derivatives_at per row, as Model.derivatives):
 // qdd (k, n), dqdd_dq, dqdd_dv, Minv (k, n, n).
 py::dict derivatives_batch(const PyModel& self, const Array& q, const OptArray& qd,
-                           const OptArray& tau, int threads) {
+                           const OptArray& tau, int threads,
+                           const std::optional<double>& baumgarte) {
   const Model& m = *self.model;
+  const double omega = baumgarte_arg(m, baumgarte);
   const Batch b(m, q, qd, tau, "tau", Entries::Bounded);
   const py::ssize_t k = b.k, n = b.n;
   const int nthreads = batch_threads(k, threads);
@@ -212,12 +217,13 @@ py::dict derivatives_batch(const PyModel& self, const Array& q, const OptArray& 
                       Minv = new_array({k, n, n});
   double *pqdd = qdd.mutable_data(), *pq = dq.mutable_data(), *pv = dv.mutable_data(),
          *pM = Minv.mutable_data();
-  for_each_derivative_row(m, b, nthreads, [&](Eigen::Index i, DerivativeScratch& s, RowState&) {
-    store(pqdd, i, s.d.qdd);
-    store(pq, i, s.d.dqdd_dq);
-    store(pv, i, s.d.dqdd_dv);
-    store(pM, i, s.d.Minv);
-  });
+  for_each_derivative_row(m, b, nthreads, omega,
+                          [&](Eigen::Index i, DerivativeScratch& s, RowState&) {
+                            store(pqdd, i, s.d.qdd);
+                            store(pq, i, s.d.dqdd_dq);
+                            store(pv, i, s.d.dqdd_dv);
+                            store(pM, i, s.d.Minv);
+                          });
   py::dict out;
   out["qdd"] = qdd;
   out["dqdd_dq"] = dq;
@@ -228,8 +234,10 @@ py::dict derivatives_batch(const PyModel& self, const Array& q, const OptArray& 
 
 // (A (k, 2n, 2n), B (k, 2n, n)) at k states, as Model.linearize.
 std::pair<py::array_t<double>, py::array_t<double>> linearize_batch(
-    const PyModel& self, const Array& q, const OptArray& qd, const OptArray& tau, int threads) {
+    const PyModel& self, const Array& q, const OptArray& qd, const OptArray& tau, int threads,
+    const std::optional<double>& baumgarte) {
   const Model& m = *self.model;
+  const double omega = baumgarte_arg(m, baumgarte);
   const Batch b(m, q, qd, tau, "tau", Entries::Bounded);
   const py::ssize_t k = b.k, n = b.n;
   const int nthreads = batch_threads(k, threads);
@@ -237,11 +245,12 @@ std::pair<py::array_t<double>, py::array_t<double>> linearize_batch(
                        evaluation_bytes(m) + dense_bytes(14 * n, n));
   py::array_t<double> A = new_array({k, 2 * n, 2 * n}), B = new_array({k, 2 * n, n});
   double *pA = A.mutable_data(), *pB = B.mutable_data();
-  for_each_derivative_row(m, b, nthreads, [&](Eigen::Index i, DerivativeScratch& s, RowState& r) {
-    linearization(m, s.d, r.qd, s.A, s.B);
-    store(pA, i, s.A);
-    store(pB, i, s.B);
-  });
+  for_each_derivative_row(m, b, nthreads, omega,
+                          [&](Eigen::Index i, DerivativeScratch& s, RowState& r) {
+                            linearization(m, s.d, r.qd, s.A, s.B);
+                            store(pA, i, s.A);
+                            store(pB, i, s.B);
+                          });
   return {A, B};
 }
 
@@ -352,14 +361,15 @@ void bind_batch(py::module_& m) {
            "frame_kinematics at k states: dict of p (k, 3), R (k, 3, 3), J (k, 6, n), velocity "
            "and bias (k, 6)")
       .def("derivatives_batch", &derivatives_batch, py::arg("q"), py::arg("qd") = py::none(),
-           py::arg("tau") = py::none(), py::arg("threads") = 0,
+           py::arg("tau") = py::none(), py::arg("threads") = 0, py::arg("baumgarte") = py::none(),
            "Model.derivatives at k states (q (k, n_q), qd, tau (k, n)) as a dict: qdd (k, n), "
-           "dqdd_dq, dqdd_dv, Minv (k, n, n); each row bit-for-bit the single call; threads 0 "
-           "= all cores; GIL released")
+           "dqdd_dq, dqdd_dv, Minv (k, n, n); each row bit-for-bit the single call (closed "
+           "loops at Baumgarte's rate `baumgarte`, as there); threads 0 = all cores; GIL released")
       .def("linearize_batch", &linearize_batch, py::arg("q"), py::arg("qd") = py::none(),
-           py::arg("tau") = py::none(), py::arg("threads") = 0,
+           py::arg("tau") = py::none(), py::arg("threads") = 0, py::arg("baumgarte") = py::none(),
            "Model.linearize at k states: (A (k, 2n, 2n), B (k, 2n, n)); each row bit-for-bit "
-           "the single call; threads 0 = all cores; GIL released")
+           "the single call (closed loops at Baumgarte's rate `baumgarte`, as there); threads 0 "
+           "= all cores; GIL released")
       .def("centroidal_batch", &centroidal_batch, py::arg("q"), py::arg("qd") = py::none(),
            py::arg("threads") = 0,
            "centroidal at k states: each entry with a leading axis of k (mass (k,), A (k, 6, n), "

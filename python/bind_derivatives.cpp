@@ -29,11 +29,7 @@ DerivativeWorkspace& forward_at(PyModel& self, const Array& q, const OptArray& q
                                 const OptArray& tau, const OptRate& baumgarte, VecX& v) {
   const Model& m = *self.model;
   DerivativeWorkspace& d = derivative_workspace(self);
-  if (baumgarte && m.constraints.empty())
-    throw py::value_error("baumgarte: the model has no constraints");
-  if (baumgarte && (!(*baumgarte >= 0) || !std::isfinite(*baumgarte)))
-    throw py::value_error("baumgarte: expected a rate >= 0 (1/s)");
-  d.baumgarte = baumgarte.value_or(kDefaultBaumgarte);
+  d.baumgarte = baumgarte_arg(m, baumgarte);
   v = vector_arg(qd, "qd", m);
   forward_derivatives_at(m, self.ws, d, configuration_arg(q, "q", m), v,
                          vector_arg(tau, "tau", m, Entries::Bounded));

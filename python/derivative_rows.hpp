@@ -2,6 +2,8 @@
 // (bind_derivatives.cpp) and their batch forms (bind_batch.cpp), so that a batch row is the
 // single call's arithmetic exactly.
 #pragma once
+#include <cmath>
+#include <optional>
 #include <string>
 
 #include "core/derivatives.hpp"
@@ -13,6 +15,16 @@ inline void require_finite(const MatX& x, const char* what) {
   if (!x.allFinite())
     throw NumericalError(std::string("at this state ") + what +
                          " is NaN or Inf (the state overflows double precision)");
+}
+
+// Baumgarte's rate for a closed loop's constrained equations (1/s): the argument, checked, or the
+// simulator's default; a rate given to a model without constraints is refused.
+inline double baumgarte_arg(const Model& m, const std::optional<double>& baumgarte) {
+  if (baumgarte && m.constraints.empty())
+    throw py::value_error("baumgarte: the model has no constraints");
+  if (baumgarte && (!(*baumgarte >= 0) || !std::isfinite(*baumgarte)))
+    throw py::value_error("baumgarte: expected a rate >= 0 (1/s)");
+  return baumgarte.value_or(kDefaultBaumgarte);
 }
 
 // q̈, ∂q̈/∂q, ∂q̈/∂v and (M^s)⁻¹ at (q, v, τ) into d; a failed forward dynamics or a NaN is a

@@ -104,8 +104,26 @@ def test_derivatives_of_the_constrained_dynamics(fourbar):
         assert np.abs(k["J"] @ d["Minv"]).max() < 1e-10  # the projected inverse
     A, B = fourbar.linearize(q, qd, tau)  # the simulator's rate, 20 1/s
     assert A.shape == (6, 6) and B.shape == (6, 3)
+    # The batch forms: each row bit for bit the single call, at the rate given.
+    Q, QD, TAU = np.stack([q, q]), np.stack([qd, 0.5 * qd]), np.stack([tau, -tau])
+    for rate in (None, 0.0, 7.5):
+        kw = {} if rate is None else {"baumgarte": rate}
+        batch = fourbar.derivatives_batch(Q, QD, TAU, **kw)
+        Ab, Bb = fourbar.linearize_batch(Q, QD, TAU, **kw)
+        for i in range(2):
+            one = fourbar.derivatives(Q[i], QD[i], TAU[i], **kw)
+            for key in ("qdd", "dqdd_dq", "dqdd_dv", "Minv"):
+                assert np.array_equal(batch[key][i], one[key])
+            Ai, Bi = fourbar.linearize(Q[i], QD[i], TAU[i], **kw)
+            assert np.array_equal(Ab[i], Ai) and np.array_equal(Bb[i], Bi)
+    assert not np.array_equal(fourbar.derivatives_batch(Q, QD, TAU, baumgarte=0.0)["dqdd_dq"],
+                              fourbar.derivatives_batch(Q, QD, TAU, baumgarte=7.5)["dqdd_dq"])
     with pytest.raises(ValueError, match="no constraints"):
         femdyn.load(model_path("models/pendulum.json")).derivatives([0], baumgarte=1.0)
+    with pytest.raises(ValueError, match="no constraints"):
+        femdyn.load(model_path("models/pendulum.json")).derivatives_batch([[0]], baumgarte=1.0)
+    with pytest.raises(ValueError, match="rate >= 0"):
+        fourbar.linearize_batch(Q, QD, TAU, baumgarte=-1.0)
 
 
 def test_run_keeps_the_loop_and_the_energy(fourbar):
