@@ -4,6 +4,7 @@
 
 #include "core/joints/kernel.hpp"
 #include "core/limits.hpp"
+#include "core/span_inertia.hpp"
 
 namespace femdyn {
 namespace {
@@ -174,7 +175,15 @@ void composite_mass(const Model& m, Workspace& ws) {
     if (const Joint& J = m.bodies[b].joint; moves(J))
       spatial_columns(J, ws.body[b].R, parent_rotation(m, ws.body, b), ws.body[b].p,
                       ws.subspace.data() + J.idx_v);
+  whole_mass_from_composites(m, ws);
+}
+
+void whole_mass_from_composites(const Model& m, Workspace& ws) {
+  if (ws.Ms.rows() != m.n()) ws.Ms.setZero(m.n(), m.n());  // first use only
+  if (!m.spanning_masses.empty()) ws.Ms.setZero();         // their entries lie off the paths
   mass_from_composites(m, ws);
+  mirror_upper(ws.Ms);  // (with the rotor inertia on its diagonal)
+  add_span_mass(m, ws);
 }
 
 namespace {

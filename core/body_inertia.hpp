@@ -45,8 +45,12 @@ std::vector<MassProperties> body_mass_properties(const Model& model);
 void composite_inertias(const Model& model, Workspace& ws);
 
 // ws.Ms from the body poses of the last propagate (no Jacobians needed): composite inertias,
-// motion subspaces, then mass_from_composites.
+// motion subspaces, then whole_mass_from_composites.
 void composite_mass(const Model& model, Workspace& ws);
+
+// The whole symmetric ws.Ms from ws.composite and ws.subspace: mass_from_composites mirrored,
+// plus the spanning elements' terms (core/span_inertia.hpp; sized on first use).
+void whole_mass_from_composites(const Model& model, Workspace& ws);
 
 // ws.Ms from ws.composite and ws.subspace: the upper triangle without couplings (mirror it),
 // the whole of Cᵀ M_θ C with them.

@@ -168,11 +168,7 @@ Status forward_dynamics_by_bodies(const Model& m, Workspace& ws, const VecX& q, 
   t.theta_dot = s->theta_dot;
   joint_force_sweeps(tree, t, &s->gamma);
   add_span_forces(tree, t, t.tau_theta);
-  if (t.Ms.rows() != tree.n()) t.Ms.setZero(tree.n(), tree.n());  // first use only
-  if (!tree.spanning_masses.empty()) t.Ms.setZero();              // their entries lie off the paths
-  mass_from_composites(tree, t);
-  mirror_upper(t.Ms);
-  add_span_mass(tree, t);
+  whole_mass_from_composites(tree, t);
   return solve_reduced(ws, *s, tau);
 }
 

@@ -13,7 +13,6 @@ CouplingLevelState::CouplingLevelState(const CouplingLevel& level)
       x(level.largest_arity),
       df(level.largest_arity),
       d2f(level.largest_arity * level.largest_arity),
-      MG(MatX::Zero(level.n_theta, level.n)),
       f_theta(VecX::Zero(level.n_theta)),
       theta_ddot(VecX::Zero(level.n_theta)) {
   // The pattern of G: a coordinate's own joint follows that coordinate alone; a coupled joint,

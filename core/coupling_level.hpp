@@ -43,7 +43,6 @@ struct CouplingLevelState {
   std::vector<int> g_begin, g_col;
   std::vector<MatX> H;             // ∂²θ_t/∂q², sized on the first request
   std::vector<double> x, df, d2f;  // one law's arguments and derivatives
-  MatX MG;                         // M_θ G (core/coupling_chain.cpp)
   VecX f_theta, theta_ddot;        // θ-level force and acceleration buffers
   int failed = -1;                 // index into coupled[] where a law is undefined
 };

@@ -91,22 +91,18 @@ bool is_zero(const VecX& v) { return v.size() == 0 || v.cwiseAbs().maxCoeff() ==
 // ws.Ms from the body poses (composite route) or from T (transform route), both already
 // propagated; mirrored so that it is symmetric in floating point too.
 void form_mass_matrix(const Model& model, Workspace& ws) {
-  if (ws.Ms.rows() != model.n()) ws.Ms.setZero(model.n(), model.n());  // first use only
   if (model.mass_route == MassRoute::Composite) {
-    if (!model.spanning_masses.empty()) ws.Ms.setZero();  // their entries lie off the paths
     composite_mass(model, ws);  // M^s by composite inertias; T is not formed
-  } else {
-    // M^s = Tᵀ (M T)
-    if (ws.MT.rows() != ws.T.rows() || ws.MT.cols() != ws.T.cols())
-      ws.MT.resize(ws.T.rows(), ws.T.cols());  // first use only
-    ws.MT.noalias() = model.M * ws.T;
-    ws.Ms.noalias() = ws.T.transpose() * ws.MT;
-    mirror_upper(ws.Ms);
-    if (model.has_armature) ws.Ms += model.armature_mass;  // + Cᵀ diag(I_a G²) C
     return;
   }
-  mirror_upper(ws.Ms);  // (the composite route has the rotor inertia on its diagonal)
-  add_span_mass(model, ws);
+  if (ws.Ms.rows() != model.n()) ws.Ms.setZero(model.n(), model.n());  // first use only
+  // M^s = Tᵀ (M T)
+  if (ws.MT.rows() != ws.T.rows() || ws.MT.cols() != ws.T.cols())
+    ws.MT.resize(ws.T.rows(), ws.T.cols());  // first use only
+  ws.MT.noalias() = model.M * ws.T;
+  ws.Ms.noalias() = ws.T.transpose() * ws.MT;
+  mirror_upper(ws.Ms);
+  if (model.has_armature) ws.Ms += model.armature_mass;  // + Cᵀ diag(I_a G²) C
 }
 
 // M^s alone: the body poses (composite) or T (transform), then form_mass_matrix.
