@@ -27,13 +27,20 @@ constexpr int kDenseProductSize = 96;
 //        [ −2 [m v + ω × h]×,                                            0 ]],
 // about 70 operations instead of the 6 × 6 products' 430.
 VelocityInertia velocity_inertia(const RigidInertia& I, const Vec3& w, const Vec3& v) {
+  const Mat3& A = I.I;
+  const Vec3& h = I.h;
+  Mat3 W;  // [ω]× A by columns, so that [ω]× A − A [ω]× = W + Wᵀ (A symmetric)
+  for (int j = 0; j < 3; ++j) W.col(j) = cross3(w, A.col(j));
+  const double vh2 = 2 * v.dot(h);
   VelocityInertia B;
-  const Mat3 wA = skew(w) * I.I;
-  B.top = wA + wA.transpose();  // [ω]× A − A [ω]× with A symmetric
-  B.top.noalias() -= I.h * v.transpose() + v * I.h.transpose();
-  B.top.diagonal().array() += 2 * v.dot(I.h);
-  B.top -= skew(I.I * w + cross3(I.h, v));
-  B.hf = I.m * v + cross3(w, I.h);
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i)
+      B.top(i, j) = W(i, j) + W(j, i) - h[i] * v[j] - v[i] * h[j] + (i == j ? vh2 : 0.0);
+  const Vec3 k = A * w + cross3(h, v);  // − [k]×
+  B.top(0, 1) += k[2], B.top(1, 0) -= k[2];
+  B.top(2, 0) += k[1], B.top(0, 2) -= k[1];
+  B.top(1, 2) += k[0], B.top(2, 1) -= k[0];
+  B.hf = I.m * v + cross3(w, h);
   return B;
 }
 
@@ -59,16 +66,13 @@ void columns_and_inertia(const Model& m, const Workspace& ws, DerivativeWorkspac
   d.Ic[b] = inertia_at_origin(m.body_inertia[b], Bs.R, Bs.p);
 }
 
-// The same, with the columns the articulated forward dynamics just formed at this q.
+// The same, with the columns and the inertia the articulated forward dynamics just formed at
+// this q.
 void articulated_columns_and_inertia(const Model& m, const Workspace& ws, DerivativeWorkspace& d,
                                      int b) {
   const Joint& J = m.bodies[b].joint;
-  const BodyState& Bs = ws.body[b];
-  if (J.nv == 1)
-    d.S[J.idx_v] = ws.articulated[b].S;
-  else
-    for (int k = 0; k < J.nv; ++k) d.S[J.idx_v + k] = ws.subspace[J.idx_v + k];
-  d.Ic[b] = inertia_at_origin(m.body_inertia[b], Bs.R, Bs.p);
+  for (int k = 0; k < J.nv; ++k) d.S[J.idx_v + k] = ws.subspace[J.idx_v + k];
+  d.Ic[b] = ws.articulated[b].I;
 }
 
 // Root to leaves for body b, its S and I_b in place: V̄, ā, V, a, the rates' y, δV, z, and its
@@ -103,6 +107,26 @@ void forward_body(const Model& m, DerivativeWorkspace& d, int b, const Vec6& a_b
   d.Bc[b] = velocity_inertia(d.Ic[b], V.head<3>(), V.tail<3>());
 }
 
+// forward_body for a joint of one rate (its column fixed in B), with V, a, S and I_b that the
+// articulated forward dynamics just formed at (q, v, q̈): V̄ = V_P, ā = a_P, and since
+// V = V_P + S θ̇ and S × S = 0, V × S = V_P × S = δV, so that
+//   z = V × S − S × V_P = 2 δV,   y = −S × a_P − δV × V_P.
+void articulated_one_rate_body(const Model& m, const Workspace& ws, DerivativeWorkspace& d, int b,
+                               const Vec6& a_base) {
+  const int p = m.bodies[b].parent, r = m.bodies[b].joint.idx_v;
+  const ArticulatedBody& A = ws.articulated[b];
+  const Vec6 V_P = p >= 0 ? ws.articulated[p].V : Vec6::Zero();
+  const Vec6 a_P = p >= 0 ? ws.articulated[p].a : a_base;
+  d.S[r] = A.S;
+  d.Ic[b] = A.I;
+  d.dV[r] = cross_motion(V_P, A.S);
+  d.z[r] = 2 * d.dV[r];
+  d.y[r] = cross_motion(a_P, A.S) - cross_motion(d.dV[r], V_P);
+  d.V[b] = A.V, d.a[b] = A.a, d.V_bar[b] = V_P, d.a_bar[b] = a_P;
+  d.F[b] = A.I * A.a + cross_force(A.V, A.I * A.V);  // f_b before its loads, and B_b
+  d.Bc[b] = velocity_inertia(A.I, A.V.head<3>(), A.V.tail<3>());
+}
+
 // The external wrenches subtracted from each body's own force (as Newton–Euler does).
 void subtract_loads(const Model& m, const Workspace& ws, DerivativeWorkspace& d) {
   for (const PointLoad& l : m.point_loads) {
@@ -112,10 +136,38 @@ void subtract_loads(const Model& m, const Workspace& ws, DerivativeWorkspace& d)
   for (const BodyTorque& t : m.torques) d.F[t.body].head<3>() -= t.torque;
 }
 
+// backward_body for a joint of one rate r (its column fixed in B, so that z_r = 2 δV_r and the
+// own pair takes Xq without the rigid part), both pair sets in one walk up the path: for each
+// rate a above r, (a, r) from X and (r, a) from u.
+void backward_one_rate_body(const Model& m, DerivativeWorkspace& d, int b, MatX& Kq, MatX& Kv) {
+  const int r = m.bodies[b].joint.idx_v;
+  const RigidInertia& Ic = d.Ic[b];
+  const VelocityInertia& Bc = d.Bc[b];
+  const Vec6& S = d.S[r];
+  Vec6 Xq = Ic * d.y[r] + Bc * d.dV[r];
+  if (d.loads) Xq += d.Lc[b] * S.head<3>();
+  const Vec6 Xv = 2 * (Ic * d.dV[r]) + Bc * S;
+  const Vec6 XqF = Xq + cross_force(S, d.F[b]);
+  Kq(r, r) = S.dot(Xq);
+  Kv(r, r) = S.dot(Xv);
+  const Vec6 uI = Ic * S;
+  const Vec3 uB = Bc.transpose_times(S);
+  Vec3 uL = Vec3::Zero();
+  if (d.loads) uL.noalias() = d.Lc[b].transpose() * S;
+  for (int a = m.rate_parent[r]; a >= 0; a = m.rate_parent[a]) {
+    const Vec6& Sa = d.S[a];
+    Kq(a, r) = Sa.dot(XqF);
+    Kv(a, r) = Sa.dot(Xv);
+    Kq(r, a) = uI.dot(d.y[a]) + uB.dot(d.dV[a].head<3>()) + uL.dot(Sa.head<3>());
+    Kv(r, a) = uI.dot(d.z[a]) + uB.dot(Sa.head<3>());
+  }
+}
+
 // Leaves to root at body b, its subtree's I^c, B^c, L^c, F complete: the pairs (c, m) with c or
 // m a rate of b and the other on b's path to the root (or b's own).
 void backward_body(const Model& m, DerivativeWorkspace& d, int b, MatX& Kq, MatX& Kv) {
   const Joint& J = m.bodies[b].joint;
+  if (J.nv == 1) return backward_one_rate_body(m, d, b, Kq, Kv);
   const RigidInertia& Ic = d.Ic[b];
   const VelocityInertia& Bc = d.Bc[b];
   for (int k = 0; k < J.nv; ++k) {  // m own: c own or above (b is the deeper)
@@ -191,11 +243,15 @@ void joint_level(const Model& m, Workspace& ws, DerivativeWorkspace& d, const Ve
   coupling_apply(m, qdd, d.theta_ddot);
   const Vec6 a_base = gravity_base_acceleration(m);
   for (int b = 0; b < nb; ++b) {
-    if (articulated_ready)
-      articulated_columns_and_inertia(m, ws, d, b);
-    else
+    if (!articulated_ready) {
       columns_and_inertia(m, ws, d, b);
-    forward_body(m, d, b, a_base);
+      forward_body(m, d, b, a_base);
+    } else if (m.bodies[b].joint.nv == 1) {
+      articulated_one_rate_body(m, ws, d, b, a_base);
+    } else {
+      articulated_columns_and_inertia(m, ws, d, b);
+      forward_body(m, d, b, a_base);
+    }
   }
   subtract_loads(m, ws, d);
   if (d.loads) add_load_turning(m, ws, d);
@@ -366,50 +422,58 @@ void solve_chunks(const Model& m, const Workspace& ws, DerivativeWorkspace& d, M
 // ancestors and of b's subtree (a pair (c, m) couples only along one path to the root), as runs
 // of consecutive rates, merged. Needs the sweep's depth-first numbering (sub_first, sub_count).
 // A two-point spring couples the rates of its two bodies' paths across branches: with springs
-// every column is taken whole.
+// every column is taken whole. Consecutive bodies with the same rows (the bodies of a chain
+// segment below its last branching: each one's ancestors and subtree are the segment's whole
+// path) form one group of columns, so that the product is one matrix product per group and run.
 void plan_row_runs(const Model& m, DerivativeWorkspace& d) {
   const int nb = static_cast<int>(m.bodies.size());
-  d.run_begin.assign(nb + 1, 0);
+  d.groups.clear();
   d.runs.clear();
-  std::vector<std::pair<int, int>> rows;  // (first, count), root first
-  for (int b = 0; b < nb; ++b) {
-    d.run_begin[b] = static_cast<int>(d.runs.size());
-    if (!moves(m.bodies[b].joint)) continue;
-    if (!m.springs.empty()) {
-      d.runs.emplace_back(0, m.n());
-      continue;
-    }
-    rows.clear();
-    rows.emplace_back(d.sub_first[b], d.sub_count[b]);
-    for (int a = m.bodies[b].parent; a >= 0; a = m.bodies[a].parent)
-      if (moves(m.bodies[a].joint))
-        rows.emplace_back(m.bodies[a].joint.idx_v, m.bodies[a].joint.nv);
-    std::sort(rows.begin(), rows.end());
-    for (const auto& [first, count] : rows)
-      if (!d.runs.empty() && static_cast<int>(d.runs.size()) > d.run_begin[b] &&
-          d.runs.back().first + d.runs.back().second == first)
-        d.runs.back().second += count;
-      else
-        d.runs.emplace_back(first, count);
-  }
-  d.run_begin[nb] = static_cast<int>(d.runs.size());
-}
-
-// Y = −(M^s)⁻¹ K over K's non-zero rows only (plan_row_runs): per column a few products.
-void minus_minv_times(const Model& m, DerivativeWorkspace& d, const MatX& K, MatX& Y) {
-  const int nb = static_cast<int>(m.bodies.size());
+  std::vector<std::pair<int, int>> rows, merged;  // (first, count), root first
   for (int b = 0; b < nb; ++b) {
     const Joint& J = m.bodies[b].joint;
     if (!moves(J)) continue;
-    for (int c = J.idx_v; c < J.idx_v + J.nv; ++c) {
+    merged.clear();
+    if (!m.springs.empty()) {
+      merged.emplace_back(0, m.n());
+    } else {
+      rows.clear();
+      rows.emplace_back(d.sub_first[b], d.sub_count[b]);
+      for (int a = m.bodies[b].parent; a >= 0; a = m.bodies[a].parent)
+        if (moves(m.bodies[a].joint))
+          rows.emplace_back(m.bodies[a].joint.idx_v, m.bodies[a].joint.nv);
+      std::sort(rows.begin(), rows.end());
+      for (const auto& [first, count] : rows)
+        if (!merged.empty() && merged.back().first + merged.back().second == first)
+          merged.back().second += count;
+        else
+          merged.emplace_back(first, count);
+    }
+    if (!d.groups.empty()) {
+      ColumnGroup& g = d.groups.back();
+      if (g.first + g.count == J.idx_v &&
+          std::equal(d.runs.begin() + g.run_begin, d.runs.end(), merged.begin(), merged.end())) {
+        g.count += J.nv;
+        continue;
+      }
+    }
+    const int begin = static_cast<int>(d.runs.size());
+    d.runs.insert(d.runs.end(), merged.begin(), merged.end());
+    d.groups.push_back({J.idx_v, J.nv, begin, static_cast<int>(d.runs.size())});
+  }
+}
+
+// Y = −(M^s)⁻¹ K over K's non-zero rows only (plan_row_runs): per column a few products.
+void minus_minv_times(const DerivativeWorkspace& d, const MatX& K, MatX& Y) {
+  for (const ColumnGroup& g : d.groups)
+    for (int c = g.first; c < g.first + g.count; ++c) {
       auto y = Y.col(c);
       y.setZero();
-      for (int r = d.run_begin[b]; r < d.run_begin[b + 1]; ++r) {
+      for (int r = g.run_begin; r < g.run_end; ++r) {
         const auto [first, count] = d.runs[r];
         y.noalias() -= d.Minv.middleCols(first, count) * K.col(c).segment(first, count);
       }
     }
-  }
 }
 
 // Whether the sweep applies (articulated route, every subtree's rates contiguous with the
@@ -539,8 +603,8 @@ Status forward_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWor
   if (d.minv_sweep) {
     inverse_mass_sweep(m, ws, d);
     if (m.n() <= kDenseProductSize) {
-      minus_minv_times(m, d, d.dtau_dq, d.dqdd_dq);
-      minus_minv_times(m, d, d.dtau_dv, d.dqdd_dv);
+      minus_minv_times(d, d.dtau_dq, d.dqdd_dq);
+      minus_minv_times(d, d.dtau_dv, d.dqdd_dv);
     } else {
       d.dqdd_dq = d.dtau_dq;
       solve_chunks(m, ws, d, d.dqdd_dq, -1.0);

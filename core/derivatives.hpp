@@ -95,6 +95,12 @@ struct VelocityInertia {
   }
 };
 
+// Columns [first, first + count) of ∂τ/∂·, whose non-zero rows are the same runs of rates
+// runs[run_begin .. run_end) (DerivativeWorkspace::runs).
+struct ColumnGroup {
+  int first, count, run_begin, run_end;
+};
+
 // The results and buffers of the derivatives, sized once for a model: no allocation per call
 // after the first.
 struct DerivativeWorkspace {
@@ -123,10 +129,11 @@ struct DerivativeWorkspace {
   std::vector<int> sub_first, sub_count, slot;
   Eigen::Matrix<double, 6, Eigen::Dynamic> P, A;  // six rows known at compile time
   MatX rows;  // a joint's rows of (M^s)⁻¹ while they are formed (n × 6)
-  // Per body b, runs[run_begin[b] .. run_begin[b + 1]) = (first, count): the rows where its
-  // rates' columns of ∂τ/∂· can be non-zero (its ancestors' and its subtree's rates).
+  // The rows where a column of ∂τ/∂· can be non-zero (its body's ancestors' and subtree's
+  // rates), as runs (first, count) of consecutive rates; columns with the same runs side by side
+  // are one group (ColumnGroup).
   std::vector<std::pair<int, int>> runs;
-  std::vector<int> run_begin;
+  std::vector<ColumnGroup> groups;
   // Above a size, (M^s)⁻¹ ∂τ/∂· by the articulated factorisation eight columns at a time (per
   // body a 6 × 8 force and acceleration) instead of a dense product.
   std::vector<Eigen::Matrix<double, 6, 8>> chunk_force, chunk_acceleration;

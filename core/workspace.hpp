@@ -40,6 +40,7 @@ struct ArticulatedBody {
   Vec6 a = Vec6::Zero();   // spatial acceleration
   double d = 0, u = 0;     // Sᵀ I^A S, and τ − Sᵀ p^A
   double trace = 0;        // tr(I^c), the composite inertia's trace (a bound for the pivots)
+  RigidInertia I;          // the body's own inertia I_b (world axes about the origin)
 };
 
 // Per rate of a joint of several rates (nv > 1), the articulated route's block quantities
