@@ -326,7 +326,7 @@ void inverse_mass_sweep(const Model& m, const Workspace& ws, DerivativeWorkspace
     if (J.nv == 1) {
       const ArticulatedBody& A = ws.articulated[b];
       auto x = X.col(r0).tail(L);
-      x /= A.d;
+      x *= 1 / A.d;
       const Vec6 K = A.U / A.d;
       if (ps >= 0) x.noalias() -= d.A.middleCols(ps * n + r0, L).transpose() * K;
       if (s < 0) continue;
