@@ -613,12 +613,17 @@ Status forward_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWor
     }
     return st;
   }
+  d.Minv.setIdentity();
+  solve_columns(m, ws, d, d.Minv, 1.0);
+  if (m.n() <= kDenseProductSize) {  // n solves and two dense products instead of 3n solves
+    d.dqdd_dq.noalias() = -d.Minv * d.dtau_dq;
+    d.dqdd_dv.noalias() = -d.Minv * d.dtau_dv;
+    return st;
+  }
   d.dqdd_dq = d.dtau_dq;
   solve_columns(m, ws, d, d.dqdd_dq, -1.0);
   d.dqdd_dv = d.dtau_dv;
   solve_columns(m, ws, d, d.dqdd_dv, -1.0);
-  d.Minv.setIdentity();
-  solve_columns(m, ws, d, d.Minv, 1.0);
   return st;
 }
 

@@ -145,6 +145,20 @@ TEST_CASE("derivatives agree with differences on coupled random trees", "[deriva
   WARN("coupled trees: central " << worst.central << ", Richardson " << worst.richardson);
 }
 
+TEST_CASE("derivatives agree with differences above the dense-product size", "[derivatives]") {
+  // Above n = 96 ∂q̈ is formed by the factorisation instead of dense products with (M^s)⁻¹:
+  // eight columns at a time on the articulated route, column by column on a coupled one.
+  Agreement worst;
+  for (const bool coupled : {false, true}) {
+    INFO((coupled ? "coupled" : "uncoupled"));
+    const Model m = load_text(mixed_tree_json(7, coupled ? 160 : 120, 0.0, coupled, false));
+    REQUIRE(m.n() > 96);
+    REQUIRE(m.identity_coupling != coupled);
+    check_model(m, 7, worst);
+  }
+  WARN("n > 96: central " << worst.central << ", Richardson " << worst.richardson);
+}
+
 TEST_CASE("derivatives agree with differences on the bundled and URDF robots", "[derivatives]") {
   Agreement worst;
   for (const char* name : {"finger.json", "finger_coupled.json", "hand.json", "space_robot.json"}) {
