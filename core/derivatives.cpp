@@ -66,8 +66,8 @@ void columns_and_inertia(const Model& m, const Workspace& ws, DerivativeWorkspac
   d.Ic[b] = inertia_at_origin(m.body_inertia[b], Bs.R, Bs.p);
 }
 
-// The same, with the columns and the inertia the articulated forward dynamics just formed at
-// this q.
+// The same for a joint of several rates (or none), with the columns and the inertia the
+// articulated forward dynamics just formed at this q (one rate: articulated_one_rate_body).
 void articulated_columns_and_inertia(const Model& m, const Workspace& ws, DerivativeWorkspace& d,
                                      int b) {
   const Joint& J = m.bodies[b].joint;
@@ -418,6 +418,17 @@ void solve_chunks(const Model& m, const Workspace& ws, DerivativeWorkspace& d, M
   }
 }
 
+// Y = −(M^s)⁻¹ K by the factorisation forward_dynamics left: the articulated one eight columns at
+// a time (the sweep's route), else column by column.
+void minus_minv_solve(const Model& m, Workspace& ws, DerivativeWorkspace& d, const MatX& K,
+                      MatX& Y) {
+  Y = K;
+  if (d.minv_sweep)
+    solve_chunks(m, ws, d, Y, -1.0);
+  else
+    solve_columns(m, ws, d, Y, -1.0);
+}
+
 // The rows where a column of ∂τ/∂q or ∂τ/∂v of body b's rates can be non-zero: the rates of b's
 // ancestors and of b's subtree (a pair (c, m) couples only along one path to the root), as runs
 // of consecutive rates, merged. Needs the sweep's depth-first numbering (sub_first, sub_count).
@@ -600,30 +611,16 @@ Status forward_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWor
   d.qdd = ws.qdd;
   inverse_derivatives(m, ws, d, q, qd, d.qdd,
                       m.dynamics_route == DynamicsRoute::Articulated);  // poses at q in ws
-  if (d.minv_sweep) {
-    inverse_mass_sweep(m, ws, d);
-    if (m.n() <= kDenseProductSize) {
-      minus_minv_times(d, d.dtau_dq, d.dqdd_dq);
-      minus_minv_times(d, d.dtau_dv, d.dqdd_dv);
-    } else {
-      d.dqdd_dq = d.dtau_dq;
-      solve_chunks(m, ws, d, d.dqdd_dq, -1.0);
-      d.dqdd_dv = d.dtau_dv;
-      solve_chunks(m, ws, d, d.dqdd_dv, -1.0);
-    }
-    return st;
-  }
-  d.Minv.setIdentity();
-  solve_columns(m, ws, d, d.Minv, 1.0);
-  if (m.n() <= kDenseProductSize) {  // n solves and two dense products instead of 3n solves
-    d.dqdd_dq.noalias() = -d.Minv * d.dtau_dq;
-    d.dqdd_dv.noalias() = -d.Minv * d.dtau_dv;
-    return st;
-  }
-  d.dqdd_dq = d.dtau_dq;
-  solve_columns(m, ws, d, d.dqdd_dq, -1.0);
-  d.dqdd_dv = d.dtau_dv;
-  solve_columns(m, ws, d, d.dqdd_dv, -1.0);
+  inverse_mass_matrix(m, ws, d);
+  // ∂q̈/∂· = −(M^s)⁻¹ ∂τ/∂·: up to n = 96 by products with (M^s)⁻¹ (on the sweep's route over
+  // ∂τ's non-zero rows only), above by the factorisation.
+  for (const auto& [K, Y] : {std::pair{&d.dtau_dq, &d.dqdd_dq}, std::pair{&d.dtau_dv, &d.dqdd_dv}})
+    if (m.n() > kDenseProductSize)
+      minus_minv_solve(m, ws, d, *K, *Y);
+    else if (d.minv_sweep)
+      minus_minv_times(d, *K, *Y);
+    else
+      Y->noalias() = -d.Minv * *K;
   return st;
 }
 

@@ -35,8 +35,9 @@
 // sweep over the factorisation forward_dynamics leaves (Carpentier, "Analytical inverse of the
 // joint space inertia matrix", 2018), then ∂q̈/∂· as products with (M^s)⁻¹ over each column's
 // non-zero rows (its body's ancestors' and subtree's rates) up to n = 96 and above that by the
-// factorisation eight columns at a time. Otherwise (M^s)⁻¹ is applied column by column by the
-// factorisation forward_dynamics leaves: articulated_solve's or ws.solver's.
+// factorisation eight columns at a time. Otherwise (M^s)⁻¹ is formed by n column solves on the
+// factorisation forward_dynamics leaves (ws.solver's), and ∂q̈/∂· as dense products with it up to
+// n = 96, above by column solves.
 //
 // Two-point springs (core/derivatives_springs.hpp) and elements spanning bodies
 // (core/derivatives_spans.hpp) add their terms to ∂τ_θ/∂θ, ∂τ_θ/∂θ̇ as forces at body points;
