@@ -285,7 +285,8 @@ void solve_columns(const Model& m, Workspace& ws, DerivativeWorkspace& d, MatX& 
 // matrix P holds every body's (its subtree's columns): u = e − Sᵀ P, P += U D⁻¹ u on them. Root
 // to leaves, rows r of the joint: x = D⁻¹ u − D⁻¹ Uᵀ a_parent, a = a_parent + S x, on the
 // columns from the joint's first rate on (the upper triangle; the rest by symmetry). Row r of
-// (M^s)⁻¹ is formed as column r (M^s is symmetric), so that every access is contiguous.
+// (M^s)⁻¹ is formed as column r (M^s is symmetric), so that every access is contiguous. Only the
+// rates of the body's block of (M^s)⁻¹ (block_first, block_end) are formed: the rest is zero.
 void inverse_mass_sweep(const Model& m, const Workspace& ws, DerivativeWorkspace& d) {
   const int n = m.n(), nb = static_cast<int>(m.bodies.size());
   MatX& X = d.Minv;
@@ -293,14 +294,14 @@ void inverse_mass_sweep(const Model& m, const Workspace& ws, DerivativeWorkspace
   for (int b = nb - 1; b >= 0; --b) {
     const Joint& J = m.bodies[b].joint;
     if (!moves(J)) continue;
-    const int r0 = J.idx_v, cnt = d.sub_count[b];
+    const int r0 = J.idx_v, cnt = d.sub_count[b], after = d.block_end[b] - r0 - cnt;
     auto Pb = d.P.middleCols(r0, cnt);
     for (int k = 0; k < J.nv; ++k) {
       const Vec6 minus_S = -(J.nv == 1 ? ws.articulated[b].S : ws.subspace[r0 + k]);
       auto u = X.col(r0 + k);
       u.segment(r0, cnt).noalias() = Pb.transpose() * minus_S;
       u[r0 + k] += 1.0;
-      u.tail(n - r0 - cnt).setZero();
+      u.segment(r0 + cnt, after).setZero();
     }
     if (m.bodies[b].parent < 0) continue;
     for (int k = 0; k < J.nv; ++k) {
@@ -315,17 +316,17 @@ void inverse_mass_sweep(const Model& m, const Workspace& ws, DerivativeWorkspace
     const int p = body.parent, ps = p >= 0 ? d.slot[p] : -1, s = d.slot[b];
     if (!moves(J)) {  // a fixed joint passes its parent's accelerations on
       if (s < 0 || s == ps) continue;
-      const int c0 = d.sub_first[b], L = n - c0;
+      const int c0 = d.sub_first[b], L = d.block_end[b] - c0;
       if (ps >= 0)
         d.A.middleCols(s * n + c0, L) = d.A.middleCols(ps * n + c0, L);
       else
         d.A.middleCols(s * n + c0, L).setZero();
       continue;
     }
-    const int r0 = J.idx_v, L = n - r0;
+    const int r0 = J.idx_v, L = d.block_end[b] - r0;
     if (J.nv == 1) {
       const ArticulatedBody& A = ws.articulated[b];
-      auto x = X.col(r0).tail(L);
+      auto x = X.col(r0).segment(r0, L);
       x *= 1 / A.d;
       const Vec6 K = A.U / A.d;
       if (ps >= 0) x.noalias() -= d.A.middleCols(ps * n + r0, L).transpose() * K;
@@ -342,7 +343,7 @@ void inverse_mass_sweep(const Model& m, const Workspace& ws, DerivativeWorkspace
     u = X.block(r0, r0, L, J.nv);
     for (int k = 0; k < J.nv; ++k) {
       const ArticulatedRate& R = ws.articulated_rate[r0 + k];
-      auto x = X.col(r0 + k).tail(L);
+      auto x = X.col(r0 + k).segment(r0, L);
       x.noalias() = u * R.Dinv.head(J.nv);
       if (ps >= 0) x.noalias() -= d.A.middleCols(ps * n + r0, L).transpose() * R.K;
     }
@@ -354,10 +355,18 @@ void inverse_mass_sweep(const Model& m, const Workspace& ws, DerivativeWorkspace
       As.setZero();
     }
     for (int k = 0; k < J.nv; ++k)
-      As.noalias() += ws.subspace[r0 + k] * X.col(r0 + k).tail(L).transpose();
+      As.noalias() += ws.subspace[r0 + k] * X.col(r0 + k).segment(r0, L).transpose();
   }
-  for (int c = 1; c < n; ++c)  // the upper triangle from the lower
-    for (int r = 0; r < c; ++r) X(r, c) = X(c, r);
+  for (int b = 0; b < nb; ++b) {  // the upper triangle from the lower; outside the blocks 0
+    const Joint& J = m.bodies[b].joint;
+    if (!moves(J)) continue;
+    const int first = d.block_first[b], end = d.block_end[b];
+    for (int c = J.idx_v; c < J.idx_v + J.nv; ++c) {
+      X.col(c).head(first).setZero();
+      X.col(c).tail(n - end).setZero();
+      for (int r = first; r < c; ++r) X(r, c) = X(c, r);
+    }
+  }
 }
 
 // Y ← sign (M^s)⁻¹ Y by the articulated factorisation (articulated_solve's steps) on eight
@@ -435,12 +444,17 @@ void minus_minv_solve(const Model& m, Workspace& ws, DerivativeWorkspace& d, con
 // A two-point spring couples the rates of its two bodies' paths across branches: with springs
 // every column is taken whole. Consecutive bodies with the same rows (the bodies of a chain
 // segment below its last branching: each one's ancestors and subtree are the segment's whole
-// path) form one group of columns, so that the product is one matrix product per group and run.
+// path) form one group of columns. A run is cut where a block of (M^s)⁻¹ ends (with springs).
 void plan_row_runs(const Model& m, DerivativeWorkspace& d) {
-  const int nb = static_cast<int>(m.bodies.size());
+  const int n = m.n(), nb = static_cast<int>(m.bodies.size());
   d.groups.clear();
   d.runs.clear();
+  std::vector<int> rate_block(n);  // per rate, the body whose block it is in
+  for (int b = 0; b < nb; ++b)
+    for (int k = 0; k < m.bodies[b].joint.nv && moves(m.bodies[b].joint); ++k)
+      rate_block[m.bodies[b].joint.idx_v + k] = b;
   std::vector<std::pair<int, int>> rows, merged;  // (first, count), root first
+  std::vector<RowRun> cut;
   for (int b = 0; b < nb; ++b) {
     const Joint& J = m.bodies[b].joint;
     if (!moves(J)) continue;
@@ -460,29 +474,44 @@ void plan_row_runs(const Model& m, DerivativeWorkspace& d) {
         else
           merged.emplace_back(first, count);
     }
+    cut.clear();
+    for (const auto& [first, count] : merged)
+      for (int r = first; r < first + count;) {
+        const int blk = rate_block[r];
+        const int end = std::min(first + count, d.block_end[blk]);
+        cut.push_back({r, end - r, d.block_first[blk], d.block_end[blk]});
+        r = end;
+      }
+    const auto same = [](const RowRun& x, const RowRun& y) {
+      return x.first == y.first && x.count == y.count;  // (the same rates: the same blocks)
+    };
     if (!d.groups.empty()) {
       ColumnGroup& g = d.groups.back();
       if (g.first + g.count == J.idx_v &&
-          std::equal(d.runs.begin() + g.run_begin, d.runs.end(), merged.begin(), merged.end())) {
+          std::equal(d.runs.begin() + g.run_begin, d.runs.end(), cut.begin(), cut.end(), same)) {
         g.count += J.nv;
         continue;
       }
     }
     const int begin = static_cast<int>(d.runs.size());
-    d.runs.insert(d.runs.end(), merged.begin(), merged.end());
+    d.runs.insert(d.runs.end(), cut.begin(), cut.end());
     d.groups.push_back({J.idx_v, J.nv, begin, static_cast<int>(d.runs.size())});
   }
 }
 
-// Y = −(M^s)⁻¹ K over K's non-zero rows only (plan_row_runs): per column a few products.
+// Y = −(M^s)⁻¹ K over K's non-zero rows only (plan_row_runs), each run times its block of
+// (M^s)⁻¹: per column a few small products.
 void minus_minv_times(const DerivativeWorkspace& d, const MatX& K, MatX& Y) {
   for (const ColumnGroup& g : d.groups)
     for (int c = g.first; c < g.first + g.count; ++c) {
       auto y = Y.col(c);
       y.setZero();
       for (int r = g.run_begin; r < g.run_end; ++r) {
-        const auto [first, count] = d.runs[r];
-        y.noalias() -= d.Minv.middleCols(first, count) * K.col(c).segment(first, count);
+        const RowRun& run = d.runs[r];
+        const int rows = run.block_end - run.block_first;
+        y.segment(run.block_first, rows).noalias() -=
+            d.Minv.block(run.block_first, run.first, rows, run.count) *
+            K.col(c).segment(run.first, run.count);
       }
     }
 }
@@ -511,6 +540,17 @@ void plan_inverse_sweep(const Model& m, DerivativeWorkspace& d) {
     }
   }
   d.sub_first = lo;
+  // Each body's block of (M^s)⁻¹: the subtree of its topmost moving ancestor-or-self, or its
+  // own subtree if none moves (parents come before children here).
+  std::vector<int> top(nb);
+  d.block_first.assign(nb, 0);
+  d.block_end.assign(nb, 0);
+  for (int b = 0; b < nb; ++b) {
+    const int p = m.bodies[b].parent;
+    top[b] = p >= 0 && moves(m.bodies[top[p]].joint) ? top[p] : b;
+    d.block_first[b] = d.sub_first[top[b]];
+    d.block_end[b] = d.sub_first[top[b]] + d.sub_count[top[b]];
+  }
   // The last child of each body with rates below it: it may reuse its parent's slot.
   std::vector<int> last(nb, -1);
   for (int b = 0; b < nb; ++b)

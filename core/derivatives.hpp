@@ -96,6 +96,13 @@ struct VelocityInertia {
   }
 };
 
+// Rates [first, first + count) where a column of ∂τ/∂· can be non-zero, all in one diagonal
+// block of (M^s)⁻¹: their part of the product −(M^s)⁻¹ ∂τ/∂· lands in rows
+// [block_first, block_end) only.
+struct RowRun {
+  int first, count, block_first, block_end;
+};
+
 // Columns [first, first + count) of ∂τ/∂·, whose non-zero rows are the same runs of rates
 // runs[run_begin .. run_end) (DerivativeWorkspace::runs).
 struct ColumnGroup {
@@ -126,14 +133,18 @@ struct DerivativeWorkspace {
   // numbered depth first so that a subtree's rates are contiguous): per body its subtree's
   // first rate and count, the slot of its accelerations' block; the 6 × n forces P and the
   // slots' 6 × n accelerations (a body that is its parent's last child reuses its parent's).
+  // (M^s)⁻¹ is block diagonal: rates c, m couple only if they share a moving ancestor-or-self,
+  // so each block is the subtree of a moving body none of whose ancestors moves. Per body the
+  // rates [block_first, block_end) of its block (a body outside every block: its subtree's);
+  // the sweep forms and the products read only these.
   bool minv_sweep = false;
-  std::vector<int> sub_first, sub_count, slot;
+  std::vector<int> sub_first, sub_count, slot, block_first, block_end;
   Eigen::Matrix<double, 6, Eigen::Dynamic> P, A;  // six rows known at compile time
   MatX rows;  // a joint's rows of (M^s)⁻¹ while they are formed (n × 6)
   // The rows where a column of ∂τ/∂· can be non-zero (its body's ancestors' and subtree's
-  // rates), as runs (first, count) of consecutive rates; columns with the same runs side by side
-  // are one group (ColumnGroup).
-  std::vector<std::pair<int, int>> runs;
+  // rates), as runs of consecutive rates within one block (RowRun); columns with the same runs
+  // side by side are one group (ColumnGroup).
+  std::vector<RowRun> runs;
   std::vector<ColumnGroup> groups;
   // Above a size, (M^s)⁻¹ ∂τ/∂· by the articulated factorisation eight columns at a time (per
   // body a 6 × 8 force and acceleration) instead of a dense product.

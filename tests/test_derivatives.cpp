@@ -61,6 +61,32 @@ std::string with_springs(const std::string& text, unsigned seed, int count) {
   return j.dump();
 }
 
+// The tree with its first body welded to the world and every fifth body hung from the world
+// (seeded): (M^s)⁻¹ then falls into diagonal blocks, one per moving subtree off a fixed root.
+std::string with_fixed_roots(const std::string& text) {
+  Json j = Json::parse(text);
+  Json& bodies = j["bodies"];
+  bodies[0]["joint"] = {{"name", "j0"}, {"type", "fixed"}};
+  for (std::size_t b = 3; b < bodies.size(); b += 5) bodies[b]["parent"] = "world";
+  return j.dump();
+}
+
+// The number of diagonal blocks of `minv`: it must be exactly zero off them (a block is a run
+// of rates whose entries couple none outside it).
+int diagonal_blocks(const MatX& minv) {
+  const Eigen::Index n = minv.rows();
+  int blocks = 0;
+  for (Eigen::Index first = 0; first < n;) {
+    Eigen::Index end = first + 1;
+    for (Eigen::Index r = first; r < end; ++r)  // grow while a rate couples one beyond
+      for (Eigen::Index c = end; c < n; ++c)
+        if (minv(r, c) != 0 || minv(c, r) != 0) end = c + 1;
+    ++blocks;
+    first = end;
+  }
+  return blocks;
+}
+
 // The worst relative error of each derivative against both differences.
 struct Agreement {
   double central = 0, richardson = 0;
@@ -157,6 +183,42 @@ TEST_CASE("derivatives agree with differences above the dense-product size", "[d
     check_model(m, 7, worst);
   }
   WARN("n > 96: central " << worst.central << ", Richardson " << worst.richardson);
+}
+
+TEST_CASE("derivatives agree with differences where (M^s)⁻¹ has diagonal blocks",
+          "[derivatives][springs]") {
+  // Subtrees that share no moving joint do not couple in M^s: the sweep forms and the products
+  // read only the blocks. Checked on trees welded to the world (several blocks), with springs
+  // across blocks (whose ∂τ/∂q couples them), and on the fixed-base Atlas and HyQ.
+  Agreement worst;
+  for (unsigned seed = 1; seed <= 6; ++seed)
+    for (const int bodies : {7, 16}) {
+      INFO("seed " << seed << ", " << bodies << " bodies");
+      std::string text = with_fixed_roots(mixed_tree_json(seed, bodies, 0.4, false, seed % 2));
+      if (seed > 3) text = with_springs(text, seed, 2);
+      const Model m = load_text(text);
+      DerivativeWorkspace d(m);
+      REQUIRE(d.minv_sweep);
+      check_model(m, seed, worst);
+      Workspace ws(m);
+      std::mt19937 rng(seed);
+      const VecX q = random_posture(m, rng), v = random_uniform(m.n(), 1.0, rng);
+      REQUIRE(forward_dynamics_derivatives(m, ws, d, q, v, VecX::Zero(m.n())).ok);
+      CHECK(diagonal_blocks(d.Minv) > 1);
+    }
+  const std::string robots = std::string(FEMDYN_SOURCE_DIR) + "/tests/robots/";
+  for (const char* name : {"atlas.urdf", "hyq.urdf"}) {
+    INFO(name);
+    const Model m = load_model(robots + name);
+    check_model(m, 6, worst);
+    Workspace ws(m);
+    DerivativeWorkspace d(m);
+    REQUIRE(forward_dynamics_derivatives(m, ws, d, VecX::Zero(m.n()), VecX::Ones(m.n()),
+                                         VecX::Zero(m.n()))
+                .ok);
+    CHECK(diagonal_blocks(d.Minv) == (m.n() == 30 ? 3 : 4));  // legs and torso; four legs
+  }
+  WARN("diagonal blocks: central " << worst.central << ", Richardson " << worst.richardson);
 }
 
 TEST_CASE("derivatives agree with differences on the bundled and URDF robots", "[derivatives]") {
