@@ -301,10 +301,12 @@ if derived:
           "128–1024; the output is 3n² numbers, so O(n²) is the least any method that writes it "
           "can take.")
         P("")
-    P("Measured elsewhere, not on this machine: Carpentier and Mansard (RSS 2018) report "
-      "Pinocchio's analytical derivatives of ABA at about 3 µs for a 7-dof arm and 17 µs for a "
-      "36-dof humanoid, on their hardware with the Pinocchio of 2018. Pinocchio has not been run "
-      "beside femdyn here.")
+    P("Pinocchio 3.7's computeABADerivatives, built from source with femdyn's flags and run "
+      "beside femdyn_bench on the same machine (not in this run: Pinocchio is not a Debian "
+      "package; `tools/pinocchio_bench/compare.sh`), is in [derivatives.md, "
+      "\"Speed\"](derivatives.md#speed). Measured elsewhere: Carpentier and Mansard (RSS 2018) "
+      "report it at about 3 µs for a 7-dof arm and 17 µs for a 36-dof humanoid, on their "
+      "hardware with the Pinocchio of 2018.")
     P("")
 
 P("## Random chains and trees")
