@@ -25,10 +25,12 @@ constexpr int kDenseProductSize = 96;
 // its right column vanishes:
 //   B = [[ [ω]× A − A [ω]× − (h vᵀ + v hᵀ − 2 (v·h) 1) − [A ω + h × v]×,  0 ],
 //        [ −2 [m v + ω × h]×,                                            0 ]],
-// about 70 operations instead of the 6 × 6 products' 430.
-VelocityInertia velocity_inertia(const RigidInertia& I, const Vec3& w, const Vec3& v) {
+// about 70 operations instead of the 6 × 6 products' 430. With I V = (A ω + h × v, m v + ω × h)
+// given (the body's force needs it too), as IV.
+VelocityInertia velocity_inertia(const RigidInertia& I, const Vec6& V, const Vec6& IV) {
   const Mat3& A = I.I;
   const Vec3& h = I.h;
+  const Vec3 w = V.head<3>(), v = V.tail<3>();
   Mat3 W;  // [ω]× A by columns, so that [ω]× A − A [ω]× = W + Wᵀ (A symmetric)
   for (int j = 0; j < 3; ++j) W.col(j) = cross3(w, A.col(j));
   const double vh2 = 2 * v.dot(h);
@@ -36,11 +38,11 @@ VelocityInertia velocity_inertia(const RigidInertia& I, const Vec3& w, const Vec
   for (int j = 0; j < 3; ++j)
     for (int i = 0; i < 3; ++i)
       B.top(i, j) = W(i, j) + W(j, i) - h[i] * v[j] - v[i] * h[j] + (i == j ? vh2 : 0.0);
-  const Vec3 k = A * w + cross3(h, v);  // − [k]×
+  const Vec3 k = IV.head<3>();  // − [A ω + h × v]×
   B.top(0, 1) += k[2], B.top(1, 0) -= k[2];
   B.top(2, 0) += k[1], B.top(0, 2) -= k[1];
   B.top(1, 2) += k[0], B.top(2, 1) -= k[0];
-  B.hf = I.m * v + cross3(w, h);
+  B.hf = IV.tail<3>();  // m v + ω × h
   return B;
 }
 
@@ -103,8 +105,9 @@ void forward_body(const Model& m, DerivativeWorkspace& d, int b, const Vec6& a_b
     d.z[r] = cross_motion(in_parent ? V_P : V, d.S[r]) - cross_motion(d.S[r], Vbar);
   }
   d.V[b] = V, d.a[b] = a, d.V_bar[b] = Vbar, d.a_bar[b] = abar;
-  d.F[b] = d.Ic[b] * a + cross_force(V, d.Ic[b] * V);
-  d.Bc[b] = velocity_inertia(d.Ic[b], V.head<3>(), V.tail<3>());
+  const Vec6 IV = d.Ic[b] * V;
+  d.F[b] = d.Ic[b] * a + cross_force(V, IV);
+  d.Bc[b] = velocity_inertia(d.Ic[b], V, IV);
 }
 
 // forward_body for a joint of one rate (its column fixed in B), with V, a, S and I_b that the
@@ -123,8 +126,9 @@ void articulated_one_rate_body(const Model& m, const Workspace& ws, DerivativeWo
   d.z[r] = 2 * d.dV[r];
   d.y[r] = cross_motion(a_P, A.S) - cross_motion(d.dV[r], V_P);
   d.V[b] = A.V, d.a[b] = A.a, d.V_bar[b] = V_P, d.a_bar[b] = a_P;
-  d.F[b] = A.I * A.a + cross_force(A.V, A.I * A.V);  // f_b before its loads, and B_b
-  d.Bc[b] = velocity_inertia(A.I, A.V.head<3>(), A.V.tail<3>());
+  const Vec6 IV = A.I * A.V;
+  d.F[b] = A.I * A.a + cross_force(A.V, IV);  // f_b before its loads, and B_b
+  d.Bc[b] = velocity_inertia(A.I, A.V, IV);
 }
 
 // The external wrenches subtracted from each body's own force (as Newton–Euler does).
