@@ -33,8 +33,9 @@
 //   ∂q̈/∂q = −(M^s)⁻¹ ∂τ/∂q|_{q̈},   ∂q̈/∂v = −(M^s)⁻¹ ∂τ/∂v|_{q̈},   ∂q̈/∂τ = (M^s)⁻¹,
 // On the articulated route (rates numbered depth first) (M^s)⁻¹ is formed in one O(n · bodies)
 // sweep over the factorisation forward_dynamics leaves (Carpentier, "Analytical inverse of the
-// joint space inertia matrix", 2018), then ∂q̈/∂· as products with (M^s)⁻¹ over each column's
-// non-zero rows (its body's ancestors' and subtree's rates) up to n = 96 and above that by the
+// joint space inertia matrix", 2018), only its diagonal blocks (subtrees that share no moving
+// joint do not couple), then ∂q̈/∂· as products with those blocks over each column's non-zero
+// rows (its body's ancestors' and subtree's rates) up to n = 96 and above that by the
 // factorisation eight columns at a time. Otherwise (M^s)⁻¹ is formed by n column solves on the
 // factorisation forward_dynamics leaves (ws.solver's), and ∂q̈/∂· as dense products with it up to
 // n = 96, above by column solves.
