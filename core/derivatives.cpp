@@ -454,9 +454,10 @@ void plan_row_runs(const Model& m, DerivativeWorkspace& d) {
   d.groups.clear();
   d.runs.clear();
   std::vector<int> rate_block(n);  // per rate, the body whose block it is in
-  for (int b = 0; b < nb; ++b)
-    for (int k = 0; k < m.bodies[b].joint.nv && moves(m.bodies[b].joint); ++k)
-      rate_block[m.bodies[b].joint.idx_v + k] = b;
+  for (int b = 0; b < nb; ++b) {
+    const Joint& J = m.bodies[b].joint;
+    if (moves(J)) std::fill_n(rate_block.begin() + J.idx_v, J.nv, b);
+  }
   std::vector<std::pair<int, int>> rows, merged;  // (first, count), root first
   std::vector<RowRun> cut;
   for (int b = 0; b < nb; ++b) {
