@@ -4,7 +4,8 @@
 // with loop constraints the constrained q̈ (docs/loops.md), femdyn and Simbody batch by batch in
 // turn (docs/benchmarks.md). A URDF robot is also timed on MuJoCo's
 // own import of the file (M, q̈, τ) when femdyn is built with MuJoCo (validation/mujoco_peer.hpp).
-// The analytic derivatives (core/derivatives.hpp) are timed on femdyn alone: neither peer has them.
+// The analytic derivatives (core/derivatives/derivatives.hpp) are timed on femdyn alone: neither
+// peer has them.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -20,7 +21,7 @@
 #include <vector>
 
 #include "cli/commands.hpp"
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 #include "core/equations.hpp"
 #include "core/loops/constrained_dynamics.hpp"
 #include "core/math.hpp"

@@ -1,5 +1,5 @@
 // femdyn linearize: the state-space linearisation of the dynamics at a state
-// (core/derivatives.hpp),
+// (core/derivatives/derivatives.hpp),
 //   d/dt (ξ, v) = A (ξ, v) + B τ,   A = ∂(ξ̇, v̇)/∂(ξ, v),   B = ∂(ξ̇, v̇)/∂τ,
 // ξ the tangent coordinates q ⊕ ξ around the state's q (ξ = q − q₀ on flat joints).
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 #include "core/equations.hpp"
 #include "core/loops/assembly.hpp"
 #include "core/names.hpp"

@@ -183,7 +183,7 @@ Status articulated_forward_dynamics(const Model& model, Workspace& ws, const Vec
     A.IA = I.matrix();
     A.trace = I.I.trace() + 3 * I.m;
     A.pA = cross_force(A.V, I * A.V);
-    A.I = I;  // kept for the derivatives (core/derivatives.cpp)
+    A.I = I;  // kept for the derivatives (core/derivatives/derivatives.cpp)
   }
   subtract_body_loads(model, ws);
 

@@ -124,7 +124,7 @@ Status level_status(const Model& m, Workspace& ws, const VecX& q, const VecX& qd
 }
 
 // q̈ from M^s = Gᵀ M_θ G and Q − h = τ − Gᵀ τ_θ(θ, θ̇, θ̈ = γ), τ_θ in wt.tau_theta and M_θ in wt.Ms;
-// the Cholesky factor is left in ws.reduced (for the derivatives, core/derivatives_coupling.cpp).
+// the Cholesky factor is left in ws.reduced (for the derivatives, core/derivatives/coupling.cpp).
 Status solve_reduced(Workspace& ws, CouplingLevelState& s, const VecX& tau) {
   reduce_mass(ws, s);
   reduce_force(s, ws.tree->tau_theta, ws.qdd);

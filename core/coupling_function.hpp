@@ -18,7 +18,7 @@ class CouplingFunction {
   virtual bool evaluate(std::span<const double> x, double& f, std::span<double> df,
                         std::span<double> d2f) const = 0;
   // ∂³f/∂x_k∂x_l∂x_p into d3f[(k * arity + l) * arity + p], where evaluate is true (the analytic
-  // derivatives of the dynamics chain them through the level: core/derivatives_coupling.hpp).
+  // derivatives of the dynamics chain them through the level: core/derivatives/coupling.hpp).
   virtual void third_derivatives(std::span<const double> x, std::span<double> d3f) const = 0;
   // The law's form and parameters for reports, e.g. "four-bar (ground 0.03, …)".
   virtual std::string form() const = 0;

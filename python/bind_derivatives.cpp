@@ -1,12 +1,12 @@
 // Model.derivatives, Model.inverse_derivatives and Model.linearize: the analytic derivatives of
-// the dynamics at one state (core/derivatives.hpp, docs/derivatives.md).
+// the dynamics at one state (core/derivatives/derivatives.hpp, docs/derivatives.md).
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
 #include <cmath>
 #include <optional>
 
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 #include "core/equations.hpp"
 #include "python/derivative_rows.hpp"
 #include "python/py_model.hpp"

@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 #include "python/arrays.hpp"
 
 namespace femdyn::python {

@@ -5,7 +5,7 @@
 #pragma once
 #include <memory>
 
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 #include "core/memory.hpp"
 #include "core/workspace.hpp"
 #include "python/arrays.hpp"

@@ -50,8 +50,9 @@ struct AdaptiveOptions {
   // interpolation error ~10x the step's own on the examples measured (docs/simulation.md).
   // With stop_at_outputs the method lands on each t_out with a shortened step instead.
   bool stop_at_outputs = false;
-  // BDF's Jacobian: analytic (core/derivatives.hpp) where the derivatives cover the model and τ
-  // does not depend on the state; false: forward differences of forward dynamics always.
+  // BDF's Jacobian: analytic (core/derivatives/derivatives.hpp) where the derivatives cover the
+  // model and τ does not depend on the state; false: forward differences of forward dynamics
+  // always.
   bool analytic_jacobian = true;
   std::string check() const;
 };

@@ -8,7 +8,7 @@
 #include <memory>
 #include <numbers>
 
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 #include "core/joints/passive.hpp"
 #include "core/loops/constraint_kinematics.hpp"
 #include "core/sampling.hpp"

@@ -49,8 +49,8 @@ struct Linearization {
 // per independent equation is then among the eigenvalues (the block of the constraint's own
 // dynamics Φ̈ + 2ωΦ̇ + ω²Φ = 0, which the tangent motion does not feed); at 0 those are zeros
 // and the rest are the mechanism's own modes on its loops.
-// A is analytic (core/derivatives.hpp: ∂q̈/∂q, ∂q̈/∂v and the chart block, in the chart
-// ξ ↦ q ⊕ ξ; closed loops by core/derivatives_loops.hpp at this rate) where the derivatives
+// A is analytic (core/derivatives/derivatives.hpp: ∂q̈/∂q, ∂q̈/∂v and the chart block, in the chart
+// ξ ↦ q ⊕ ξ; closed loops by core/derivatives/loops.hpp at this rate) where the derivatives
 // cover the model; otherwise difference_linearization's.
 Linearization linearize(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                         const VecX& tau, double baumgarte = Motion::kDefaultBaumgarte);

@@ -11,7 +11,7 @@
 #include <cstdio>
 #include <limits>
 
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 #include "core/joints/kernel.hpp"
 #include "core/joints/rotation.hpp"
 

@@ -5,8 +5,8 @@
 //                  direct linear solver; the Jacobian of f is
 //                    ∂f/∂y = [[0, I, 0], [∂q̈/∂q, ∂q̈/∂q̇, 0], [∂P/∂q, ∂P/∂q̇, 0]]
 //                  in the state's chart (q is ξ on a manifold joint, Motion): analytic
-//                  where core/derivatives.hpp covers the model and τ does not depend on the
-//                  state (decided per run, at start), with the rows of ∂P omitted; otherwise
+//                  where core/derivatives/derivatives.hpp covers the model and τ does not depend on
+//                  the state (decided per run, at start), with the rows of ∂P omitted; otherwise
 //                  the lower rows by forward differences of forward dynamics (2n evaluations).
 //                  Buffers owned here.
 // The SUNDIALS memory is created by reset() (per run, not per step); SUNDIALS' own messages are

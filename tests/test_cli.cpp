@@ -13,7 +13,7 @@
 #include <regex>
 #include <set>
 
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;

@@ -1,5 +1,5 @@
-// The analytic derivatives of the dynamics (core/derivatives.hpp) against independent numbers:
-// central differences along the tangent q ⊕ ε e_m (step 1e-6: truncation ~1e-12, round-off
+// The analytic derivatives of the dynamics (core/derivatives/derivatives.hpp) against independent
+// numbers: central differences along the tangent q ⊕ ε e_m (step 1e-6: truncation ~1e-12, round-off
 // ~1e-10 of the scale) and a Richardson extrapolation of them (steps 1e-3 and 5e-4: error
 // O(h⁴)); against the tensor D (∂h/∂v = (D + D over its last two indices swapped) q̇); and
 // ∂q̈/∂τ M^s = I. On seeded random trees of every joint type with springs, dampers, Coulomb
@@ -9,7 +9,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 #include "tests/differences.hpp"
 #include "tests/helpers.hpp"
 

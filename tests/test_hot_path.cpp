@@ -5,7 +5,7 @@
 #include <catch2/catch.hpp>
 #include <cstdlib>
 
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 #include "core/loops/assembly.hpp"
 #include "core/sampling.hpp"
 #include "sim/integrator.hpp"

@@ -4,7 +4,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 #include "core/sampling.hpp"
 #include "sim/integrator.hpp"
 #include "sim/sundials_integrators.hpp"

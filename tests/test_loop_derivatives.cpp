@@ -1,4 +1,4 @@
-// The analytic derivatives of the constrained forward dynamics (core/derivatives_loops.hpp)
+// The analytic derivatives of the constrained forward dynamics (core/derivatives/loops.hpp)
 // against central differences of constrained_forward_dynamics along the tangent q ⊕ ε e_m (step
 // 1e-6) and their Richardson extrapolation (steps 1e-3 and 5e-4), at Baumgarte's rate 0 and 20:
 // random trees with every constraint form (ball, ball in a plane, point on line, point on plane,
@@ -9,7 +9,7 @@
 #include <functional>
 #include <random>
 
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 #include "core/loops/assembly.hpp"
 #include "core/sampling.hpp"
 #include "tests/differences.hpp"

@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 #include "core/loops/assembly.hpp"
 #include "core/sampling.hpp"
 #include "sim/stability.hpp"

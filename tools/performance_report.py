@@ -276,7 +276,7 @@ if peered:
       "engines at these states: docs/validation.md, \"MuJoCo\".")
     P("")
 
-# The analytic derivatives (core/derivatives.hpp), femdyn alone: neither peer has them.
+# The analytic derivatives (core/derivatives/derivatives.hpp), femdyn alone: neither peer has them.
 derived = [m for m in named if t("femdyn", "derivatives", m)]
 if derived:
     P("## Derivatives")

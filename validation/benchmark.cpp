@@ -11,7 +11,7 @@
 //   simbody/forward/M   calcAccelerationIgnoringConstraints
 //   femdyn/inverse/M    inverse_dynamics(): τ
 //   femdyn/derivatives/M forward_dynamics_derivatives(): q̈, ∂q̈/∂q, ∂q̈/∂v and M⁻¹ (models the
-//                       analytic derivatives cover, core/derivatives.hpp)
+//                       analytic derivatives cover, core/derivatives/derivatives.hpp)
 //   femdyn/inverse_derivatives/M  inverse_dynamics_derivatives(): ∂τ/∂q and ∂τ/∂v alone
 //   simbody/inverse/M   residual with θ̈
 //   femdyn/rest/M       evaluate() at q̇ = 0 (h not computed)
@@ -59,7 +59,7 @@
 #include <vector>
 
 #include "compile/compile.hpp"
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 #include "core/equations.hpp"
 #include "core/kinematics.hpp"
 #include "core/loops/assembly.hpp"
@@ -98,7 +98,8 @@ struct Case {
   // need" measured, against evaluate() with gravity.
   std::unique_ptr<const Model> weightless;
   std::unique_ptr<Workspace> ws_weightless;
-  std::unique_ptr<DerivativeWorkspace> derivatives;  // where core/derivatives.hpp covers it
+  std::unique_ptr<DerivativeWorkspace>
+      derivatives;  // where core/derivatives/derivatives.hpp covers it
 };
 
 // What makes the run fail (exit 1): engines that disagree, femdyn allocating in its hot path.

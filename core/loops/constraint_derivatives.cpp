@@ -1,8 +1,8 @@
 #include "core/loops/constraint_derivatives.hpp"
 
 #include "core/body_loads.hpp"
-#include "core/derivatives.hpp"
-#include "core/derivatives_points.hpp"
+#include "core/derivatives/derivatives.hpp"
+#include "core/derivatives/points.hpp"
 #include "core/joints/rotation.hpp"
 
 namespace femdyn {

@@ -1,6 +1,6 @@
 // The constraints' terms of the derivatives of the constrained forward dynamics
-// (core/derivatives_loops.hpp), for each constraint form of core/loops/constraint.hpp, along the
-// tangent convention of core/derivatives.hpp (columns over the rates v; C = I):
+// (core/derivatives/loops.hpp), for each constraint form of core/loops/constraint.hpp, along the
+// tangent convention of core/derivatives/derivatives.hpp (columns over the rates v; C = I):
 //
 //   G  = ∂(Φ_qᵀ λ)/∂q at λ fixed                                     (n × n)
 //   C_q = ∂c/∂q,  C_v = ∂c/∂v at q̈ fixed,  c = Φ_q q̈ + Φ̇_q v + 2ω Φ_q v + ω² Φ   (m × n)
@@ -14,7 +14,7 @@
 //   distance   Φ = |d| − L,   Φ̇ = êᵀ ḋ,                    Φ̈ = êᵀ d̈ + (|ḋ|² − (êᵀ ḋ)²) / |d|
 //   gear       Φ, Φ_q constant rows on θ: C_q = ω² Φ_q, C_v = 2ω Φ_q, G = 0.
 // Each is differentiated by the product rule from the variations of the places' motion along
-// q_k (core/derivatives_points.hpp): δx = J_k(x), the axes turn by δθ = ω_k (δg = ω_k × g),
+// q_k (core/derivatives/points.hpp): δx = J_k(x), the axes turn by δθ = ω_k (δg = ω_k × g),
 // δẋ, δẍ, δω, δα from the body's ∂V, ∂a; and along v_k: δx = 0, δg = 0, δẋ = J_k(x), δω = ω_k,
 // δẍ, δα from ∂a/∂θ̇_k. The weld's rotation vector φ = R_B log(R_Bᵀ R_A) in world axes varies as
 //   δφ = J_l⁻¹(φ) (δθ_A − δθ_B) − φ × δθ_B      (J_l⁻¹(φ) = J_r⁻¹(−φ)).

@@ -1,8 +1,8 @@
-#include "core/derivatives_spans.hpp"
+#include "core/derivatives/spans.hpp"
 
 #include <algorithm>
 
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 
 namespace femdyn {
 

@@ -40,11 +40,11 @@
 // factorisation forward_dynamics leaves (ws.solver's), and ∂q̈/∂· as dense products with it up to
 // n = 96, above by column solves.
 //
-// Two-point springs (core/derivatives_springs.hpp) and elements spanning bodies
-// (core/derivatives_spans.hpp) add their terms to ∂τ_θ/∂θ, ∂τ_θ/∂θ̇ as forces at body points;
+// Two-point springs (core/derivatives/springs.hpp) and elements spanning bodies
+// (core/derivatives/spans.hpp) add their terms to ∂τ_θ/∂θ, ∂τ_θ/∂θ̇ as forces at body points;
 // a nonlinear coupling level θ = g(q) chains the tree's derivatives through g
-// (core/derivatives_coupling.hpp); closed loops differentiate the constrained equations at
-// Baumgarte's rate ω (core/derivatives_loops.hpp), ∂q̈/∂τ then the projected inverse.
+// (core/derivatives/coupling.hpp); closed loops differentiate the constrained equations at
+// Baumgarte's rate ω (core/derivatives/loops.hpp), ∂q̈/∂τ then the projected inverse.
 //
 // Covered: trees of every joint type, free bases, joint springs, dampers, Coulomb friction,
 // stops, rotors, gravity, point loads and body torques, linear couplings and coupling laws
@@ -59,10 +59,10 @@
 #include <utility>
 #include <vector>
 
-#include "core/derivatives_coupling.hpp"
-#include "core/derivatives_loops.hpp"
-#include "core/derivatives_spans.hpp"
-#include "core/derivatives_springs.hpp"
+#include "core/derivatives/coupling.hpp"
+#include "core/derivatives/loops.hpp"
+#include "core/derivatives/spans.hpp"
+#include "core/derivatives/springs.hpp"
 #include "core/status.hpp"
 #include "core/workspace.hpp"
 
@@ -151,10 +151,10 @@ struct DerivativeWorkspace {
   // body a 6 × 8 force and acceleration) instead of a dense product.
   std::vector<Eigen::Matrix<double, 6, 8>> chunk_force, chunk_acceleration;
   Eigen::Matrix<double, Eigen::Dynamic, 8, Eigen::RowMajor> chunk;
-  SpringDerivatives springs;  // the two-point springs' buffers (core/derivatives_springs.hpp)
-  SpanDerivatives spans;      // the spanning elements' (core/derivatives_spans.hpp)
-  std::unique_ptr<LawDerivatives> law;  // a coupling law's chain (core/derivatives_coupling.hpp)
-  // Closed loops (core/derivatives_loops.hpp): forward_dynamics_derivatives solves the
+  SpringDerivatives springs;  // the two-point springs' buffers (core/derivatives/springs.hpp)
+  SpanDerivatives spans;      // the spanning elements' (core/derivatives/spans.hpp)
+  std::unique_ptr<LawDerivatives> law;  // a coupling law's chain (core/derivatives/coupling.hpp)
+  // Closed loops (core/derivatives/loops.hpp): forward_dynamics_derivatives solves the
   // constrained equations at Baumgarte's rate `baumgarte` (1/s; the simulator's default unless
   // set), with these buffers and their own LoopWorkspace.
   std::unique_ptr<LoopDerivatives> loops;

@@ -1,7 +1,7 @@
-#include "core/derivatives_springs.hpp"
+#include "core/derivatives/springs.hpp"
 
-#include "core/derivatives.hpp"
-#include "core/derivatives_points.hpp"
+#include "core/derivatives/derivatives.hpp"
+#include "core/derivatives/points.hpp"
 
 namespace femdyn {
 

@@ -1,6 +1,6 @@
-#include "core/derivatives_points.hpp"
+#include "core/derivatives/points.hpp"
 
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 #include "core/joints/kernel.hpp"
 
 namespace femdyn {

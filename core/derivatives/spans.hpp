@@ -1,9 +1,9 @@
-// The terms of the analytic derivatives (core/derivatives.hpp) of the elements that span bodies
-// (ElementEntry::spans: a node on another body, as the rod coupler of a four-bar). Such an element
-// uses only its nodes' translations x_l (world axes) with a constant mass m_e (blocks M_lj), so by
-// Lagrange with T = ½ Σ_lj ẋ_lᵀ M_lj ẋ_j it adds to τ forces at its nodes,
+// The terms of the analytic derivatives (core/derivatives/derivatives.hpp) of the elements that
+// span bodies (ElementEntry::spans: a node on another body, as the rod coupler of a four-bar). Such
+// an element uses only its nodes' translations x_l (world axes) with a constant mass m_e (blocks
+// M_lj), so by Lagrange with T = ½ Σ_lj ẋ_lᵀ M_lj ẋ_j it adds to τ forces at its nodes,
 //   τ_c += Σ_l J_c(x_l)ᵀ F_l,   F_l = Σ_j M_lj (ẍ_j − g)   (its gravity M g, as in F_constant),
-// and so, with the point formulas of core/derivatives_points.hpp,
+// and so, with the point formulas of core/derivatives/points.hpp,
 //   ∂τ_c/∂θ_m = Σ_l [J_c(x_l) turning at F_l fixed] + Σ_l J_c(x_l)ᵀ Σ_j M_lj ∂ẍ_j/∂θ_m,
 //   ∂τ_c/∂θ̇_m = Σ_l J_c(x_l)ᵀ Σ_j M_lj ∂ẍ_j/∂θ̇_m.
 // The body-level recursion covers every other element (Model::condensable_off_spans).
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "core/derivatives_points.hpp"
+#include "core/derivatives/points.hpp"
 
 namespace femdyn {
 

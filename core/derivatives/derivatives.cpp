@@ -1,4 +1,4 @@
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 
 #include <algorithm>
 #include <cmath>

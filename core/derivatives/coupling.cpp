@@ -1,6 +1,6 @@
-#include "core/derivatives_coupling.hpp"
+#include "core/derivatives/coupling.hpp"
 
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 #include "core/equations.hpp"
 
 namespace femdyn {

@@ -2,9 +2,10 @@
 //
 //   M q̈ + h − Q = τ + Φ_qᵀ λ,     Φ_q q̈ + Φ̇_q v + 2ω Φ_q v + ω² Φ = 0,
 //
-// differentiated at the solution (q̈, λ), along the tangent convention of core/derivatives.hpp.
-// With τ_ID(q, v, q̈) the inverse dynamics, g(q) = Φ_qᵀ λ at λ fixed and
-// c(q, v) = Φ_q q̈ + Φ̇_q v + 2ω Φ_q v + ω² Φ at q̈ fixed (core/loops/constraint_derivatives.hpp):
+// differentiated at the solution (q̈, λ), along the tangent convention of
+// core/derivatives/derivatives.hpp. With τ_ID(q, v, q̈) the inverse dynamics, g(q) = Φ_qᵀ λ at λ
+// fixed and c(q, v) = Φ_q q̈ + Φ̇_q v + 2ω Φ_q v + ω² Φ at q̈ fixed
+// (core/loops/constraint_derivatives.hpp):
 //
 //   M dq̈ − Φ_qᵀ dλ = dτ − ∂τ_ID/∂x dx + ∂g/∂x dx,     Φ_q dq̈ = −∂c/∂x dx,
 //

@@ -1,6 +1,6 @@
-#include "core/derivatives_loops.hpp"
+#include "core/derivatives/loops.hpp"
 
-#include "core/derivatives.hpp"
+#include "core/derivatives/derivatives.hpp"
 
 namespace femdyn {
 

@@ -1,5 +1,5 @@
-// What the derivatives of forces at body points share (core/derivatives_springs.hpp, the
-// two-point springs; core/derivatives_spans.hpp, the elements spanning bodies): a point x fixed
+// What the derivatives of forces at body points share (core/derivatives/springs.hpp, the
+// two-point springs; core/derivatives/spans.hpp, the elements spanning bodies): a point x fixed
 // on body b, moved by the rates on b's path. In world axes about the origin (core/spatial.hpp),
 // with S_m = (ω_m, v_m) a rate's column and J_m(x) = v_m + ω_m × x its velocity at x, along the
 // tangent θ ⊕ ε e_m (m on b's path; the subtree of m's body turns rigidly by S_m):

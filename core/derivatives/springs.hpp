@@ -1,5 +1,5 @@
-// The two-point springs' terms of the analytic derivatives (core/derivatives.hpp; the springs are
-// core/springs.hpp). A spring pulls its end A by f = −s ê, s = k (ℓ − ℓ₀) + c ℓ̇, with
+// The two-point springs' terms of the analytic derivatives (core/derivatives/derivatives.hpp; the
+// springs are core/springs.hpp). A spring pulls its end A by f = −s ê, s = k (ℓ − ℓ₀) + c ℓ̇, with
 // d = x_A − x_B, ℓ = |d|, ê = d / ℓ, u = ẋ_A − ẋ_B, ℓ̇ = êᵀ u, and B by −f. On the joint rates
 //   Q_c = Δ_cᵀ f,   Δ_c = J_c(x_A) − J_c(x_B) = ∂d/∂θ_c,
 // J_c(x) the velocity at x of the rate's column (0 off x's path), and τ_θ gains −Q. Along the
@@ -7,7 +7,7 @@
 //   ∂Q_c/∂θ_m = Δ_cᵀ ∂f/∂θ_m + (the turning of J_c(x_A), J_c(x_B) at ±f fixed),
 //   ∂f/∂θ_m  = −(k g_m + c ∂ℓ̇/∂θ_m) ê − (s / ℓ) (Δ_m − ê g_m),
 //   ∂ℓ̇/∂θ_m = (Δ_m − ê g_m)ᵀ u / ℓ + êᵀ ∂u/∂θ_m,
-// with the turning and ∂ẋ/∂θ_m of core/derivatives_points.hpp. Along θ̇_m: ∂ℓ̇/∂θ̇_m = g_m, so
+// with the turning and ∂ẋ/∂θ_m of core/derivatives/points.hpp. Along θ̇_m: ∂ℓ̇/∂θ̇_m = g_m, so
 // ∂Q_c/∂θ̇_m = −c g_c g_m. O(path²) per spring.
 #pragma once
 #include <vector>
