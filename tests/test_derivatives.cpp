@@ -198,7 +198,7 @@ TEST_CASE("derivatives agree with differences where (M^s)⁻¹ has diagonal bloc
       if (seed > 3) text = with_springs(text, seed, 2);
       const Model m = load_text(text);
       DerivativeWorkspace d(m);
-      REQUIRE(d.minv_sweep);
+      REQUIRE(d.sweep.applies);
       check_model(m, seed, worst);
       Workspace ws(m);
       std::mt19937 rng(seed);

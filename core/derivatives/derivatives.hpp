@@ -31,14 +31,9 @@
 //
 // Forward dynamics q̈ = (M^s)⁻¹ (τ − (h − Q|_{τ=0})):
 //   ∂q̈/∂q = −(M^s)⁻¹ ∂τ/∂q|_{q̈},   ∂q̈/∂v = −(M^s)⁻¹ ∂τ/∂v|_{q̈},   ∂q̈/∂τ = (M^s)⁻¹,
-// On the articulated route (rates numbered depth first) (M^s)⁻¹ is formed in one O(n · bodies)
-// sweep over the factorisation forward_dynamics leaves (Carpentier, "Analytical inverse of the
-// joint space inertia matrix", 2018), only its diagonal blocks (subtrees that share no moving
-// joint do not couple), then ∂q̈/∂· as products with those blocks over each column's non-zero
-// rows (its body's ancestors' and subtree's rates) up to n = 96 and above that by the
-// factorisation eight columns at a time. Otherwise (M^s)⁻¹ is formed by n column solves on the
-// factorisation forward_dynamics leaves (ws.solver's), and ∂q̈/∂· as dense products with it up to
-// n = 96, above by column solves.
+// (M^s)⁻¹ and the products are core/derivatives/inverse_mass.hpp: on the articulated route one
+// O(n · bodies) sweep over the factorisation forward_dynamics leaves forms (M^s)⁻¹'s diagonal
+// blocks, and each column of ∂τ/∂· is multiplied over its non-zero rows only.
 //
 // Two-point springs (core/derivatives/springs.hpp) and elements spanning bodies
 // (core/derivatives/spans.hpp) add their terms to ∂τ_θ/∂θ, ∂τ_θ/∂θ̇ as forces at body points;
@@ -60,6 +55,7 @@
 #include <vector>
 
 #include "core/derivatives/coupling.hpp"
+#include "core/derivatives/inverse_mass.hpp"
 #include "core/derivatives/loops.hpp"
 #include "core/derivatives/spans.hpp"
 #include "core/derivatives/springs.hpp"
@@ -97,19 +93,6 @@ struct VelocityInertia {
   }
 };
 
-// Rates [first, first + count) where a column of ∂τ/∂· can be non-zero, all in one diagonal
-// block of (M^s)⁻¹: their part of the product −(M^s)⁻¹ ∂τ/∂· lands in rows
-// [block_first, block_end) only.
-struct RowRun {
-  int first, count, block_first, block_end;
-};
-
-// Columns [first, first + count) of ∂τ/∂·, whose non-zero rows are the same runs of rates
-// runs[run_begin .. run_end) (DerivativeWorkspace::runs).
-struct ColumnGroup {
-  int first, count, run_begin, run_end;
-};
-
 // The results and buffers of the derivatives, sized once for a model: no allocation per call
 // after the first.
 struct DerivativeWorkspace {
@@ -130,27 +113,7 @@ struct DerivativeWorkspace {
   VecX theta_dot, theta_ddot, column;
   MatX Kq, Kv, KC;  // the joint-level ∂τ_θ/∂θ, ∂τ_θ/∂θ̇ and K C (coupled models only)
   bool loads = false;
-  // (M^s)⁻¹ in one O(n²) sweep over the articulated factorisation (articulated route, rates
-  // numbered depth first so that a subtree's rates are contiguous): per body its subtree's
-  // first rate and count, the slot of its accelerations' block; the 6 × n forces P and the
-  // slots' 6 × n accelerations (a body that is its parent's last child reuses its parent's).
-  // (M^s)⁻¹ is block diagonal: rates c, m couple only if they share a moving ancestor-or-self,
-  // so each block is the subtree of a moving body none of whose ancestors moves. Per body the
-  // rates [block_first, block_end) of its block (a body outside every block: its subtree's);
-  // the sweep forms and the products read only these.
-  bool minv_sweep = false;
-  std::vector<int> sub_first, sub_count, slot, block_first, block_end;
-  Eigen::Matrix<double, 6, Eigen::Dynamic> P, A;  // six rows known at compile time
-  MatX rows;  // a joint's rows of (M^s)⁻¹ while they are formed (n × 6)
-  // The rows where a column of ∂τ/∂· can be non-zero (its body's ancestors' and subtree's
-  // rates), as runs of consecutive rates within one block (RowRun); columns with the same runs
-  // side by side are one group (ColumnGroup).
-  std::vector<RowRun> runs;
-  std::vector<ColumnGroup> groups;
-  // Above a size, (M^s)⁻¹ ∂τ/∂· by the articulated factorisation eight columns at a time (per
-  // body a 6 × 8 force and acceleration) instead of a dense product.
-  std::vector<Eigen::Matrix<double, 6, 8>> chunk_force, chunk_acceleration;
-  Eigen::Matrix<double, Eigen::Dynamic, 8, Eigen::RowMajor> chunk;
+  InverseMassSweep sweep;  // (M^s)⁻¹ and −(M^s)⁻¹ ∂τ/∂· (core/derivatives/inverse_mass.hpp)
   SpringDerivatives springs;  // the two-point springs' buffers (core/derivatives/springs.hpp)
   SpanDerivatives spans;      // the spanning elements' (core/derivatives/spans.hpp)
   std::unique_ptr<LawDerivatives> law;  // a coupling law's chain (core/derivatives/coupling.hpp)
@@ -175,10 +138,6 @@ void inverse_dynamics_derivatives(const Model& model, Workspace& ws, DerivativeW
 // the projected inverse M⁻¹ − Y S⁺ Yᵀ; a dead point is a failed Status.
 Status forward_dynamics_derivatives(const Model& model, Workspace& ws, DerivativeWorkspace& d,
                                     const VecX& q, const VecX& qd, const VecX& tau);
-
-// (M^s)⁻¹ into d.Minv by the factorisation the last forward dynamics (or constrained forward
-// dynamics) left in ws: the O(n · bodies) sweep on the articulated route, else n column solves.
-void inverse_mass_matrix(const Model& model, Workspace& ws, DerivativeWorkspace& d);
 
 // A = ∂(ξ̇, v̇)/∂(ξ, v) at ξ = 0 (2n × 2n) and B = ∂(ξ̇, v̇)/∂τ (2n × n) from the forward
 // derivatives in d at (q, v): ξ̇ = v on flat joints; in the chart ξ ↦ q ⊕ ξ a spherical joint has
