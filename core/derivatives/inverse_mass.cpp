@@ -79,19 +79,20 @@ void one_rate_accelerations(const ArticulatedBody& A, Eigen::Index from, Eigen::
 // (M^s)⁻¹ is formed as column r (M^s is symmetric), so that every access is contiguous. Only the
 // rates of the body's block of (M^s)⁻¹ (block_first, block_end) are formed: the rest is zero.
 void inverse_mass_sweep(const Model& m, const Workspace& ws, DerivativeWorkspace& d) {
+  InverseMassSweep& sweep = d.sweep;
   const int n = m.n(), nb = static_cast<int>(m.bodies.size());
   MatX& X = d.Minv;
-  d.sweep.P.setZero();
+  sweep.P.setZero();
   for (int b = nb - 1; b >= 0; --b) {
     const Joint& J = m.bodies[b].joint;
     if (!moves(J)) continue;
-    const int r0 = J.idx_v, cnt = d.sweep.sub_count[b], after = d.sweep.block_end[b] - r0 - cnt;
+    const int r0 = J.idx_v, cnt = sweep.sub_count[b], after = sweep.block_end[b] - r0 - cnt;
     if (J.nv == 1) {
-      one_rate_forces(ws.articulated[b], m.bodies[b].parent >= 0, r0, cnt, d.sweep.P, X.col(r0));
+      one_rate_forces(ws.articulated[b], m.bodies[b].parent >= 0, r0, cnt, sweep.P, X.col(r0));
       X.col(r0).segment(r0 + cnt, after).setZero();
       continue;
     }
-    auto Pb = d.sweep.P.middleCols(r0, cnt);
+    auto Pb = sweep.P.middleCols(r0, cnt);
     for (int k = 0; k < J.nv; ++k) {
       const Vec6 minus_S = -ws.subspace[r0 + k];
       auto u = X.col(r0 + k);
@@ -100,41 +101,40 @@ void inverse_mass_sweep(const Model& m, const Workspace& ws, DerivativeWorkspace
       u.segment(r0 + cnt, after).setZero();
     }
     if (m.bodies[b].parent < 0) continue;
-    for (int k = 0; k < J.nv; ++k) {
+    for (int k = 0; k < J.nv; ++k)
       Pb.noalias() += ws.articulated_rate[r0 + k].K * X.col(r0 + k).segment(r0, cnt).transpose();
-    }
   }
   for (int b = 0; b < nb; ++b) {
     const Body& body = m.bodies[b];
     const Joint& J = body.joint;
-    const int p = body.parent, ps = p >= 0 ? d.sweep.slot[p] : -1, s = d.sweep.slot[b];
+    const int p = body.parent, ps = p >= 0 ? sweep.slot[p] : -1, s = sweep.slot[b];
     if (!moves(J)) {  // a fixed joint passes its parent's accelerations on
       if (s < 0 || s == ps) continue;
-      const int c0 = d.sweep.sub_first[b], L = d.sweep.block_end[b] - c0;
+      const int c0 = sweep.sub_first[b], L = sweep.block_end[b] - c0;
       if (ps >= 0)
-        d.sweep.A.middleCols(s * n + c0, L) = d.sweep.A.middleCols(ps * n + c0, L);
+        sweep.A.middleCols(s * n + c0, L) = sweep.A.middleCols(ps * n + c0, L);
       else
-        d.sweep.A.middleCols(s * n + c0, L).setZero();
+        sweep.A.middleCols(s * n + c0, L).setZero();
       continue;
     }
-    const int r0 = J.idx_v, L = d.sweep.block_end[b] - r0;
+    const int r0 = J.idx_v, L = sweep.block_end[b] - r0;
     if (J.nv == 1) {
       one_rate_accelerations(ws.articulated[b], ps >= 0 ? ps * n : -1, s >= 0 ? s * n : -1, r0, L,
-                             d.sweep.A, X.col(r0));
+                             sweep.A, X.col(r0));
       continue;
     }
-    auto u = d.sweep.rows.topLeftCorner(L, J.nv);
+    auto u = sweep.rows.topLeftCorner(L, J.nv);
     u = X.block(r0, r0, L, J.nv);
     for (int k = 0; k < J.nv; ++k) {
       const ArticulatedRate& R = ws.articulated_rate[r0 + k];
       auto x = X.col(r0 + k).segment(r0, L);
       x.noalias() = u * R.Dinv.head(J.nv);
-      if (ps >= 0) x.noalias() -= d.sweep.A.middleCols(ps * n + r0, L).transpose() * R.K;
+      if (ps >= 0) x.noalias() -= sweep.A.middleCols(ps * n + r0, L).transpose() * R.K;
     }
     if (s < 0) continue;
-    auto As = d.sweep.A.middleCols(s * n + r0, L);
+    auto As = sweep.A.middleCols(s * n + r0, L);
     if (ps >= 0) {
-      if (s != ps) As = d.sweep.A.middleCols(ps * n + r0, L);
+      if (s != ps) As = sweep.A.middleCols(ps * n + r0, L);
     } else {
       As.setZero();
     }
@@ -144,7 +144,7 @@ void inverse_mass_sweep(const Model& m, const Workspace& ws, DerivativeWorkspace
   for (int b = 0; b < nb; ++b) {  // the upper triangle from the lower; outside the blocks 0
     const Joint& J = m.bodies[b].joint;
     if (!moves(J)) continue;
-    const int first = d.sweep.block_first[b], end = d.sweep.block_end[b];
+    const int first = sweep.block_first[b], end = sweep.block_end[b];
     for (int c = J.idx_v; c < J.idx_v + J.nv; ++c) {
       X.col(c).head(first).setZero();
       X.col(c).tail(n - end).setZero();
@@ -157,57 +157,58 @@ void inverse_mass_sweep(const Model& m, const Workspace& ws, DerivativeWorkspace
 // columns at a time: O(bodies) per column, as the column solves, with the per-body work shared.
 void solve_chunks(const Model& m, const Workspace& ws, DerivativeWorkspace& d, MatX& Y,
                   double sign) {
+  InverseMassSweep& sweep = d.sweep;
   using Row8 = Eigen::Matrix<double, 1, 8>;
   const int nb = static_cast<int>(m.bodies.size());
   for (Eigen::Index c0 = 0; c0 < Y.cols(); c0 += 8) {
     const Eigen::Index w = std::min<Eigen::Index>(8, Y.cols() - c0);
-    if (w < 8) d.sweep.chunk.setZero();
-    d.sweep.chunk.leftCols(w) = sign * Y.middleCols(c0, w);
+    if (w < 8) sweep.chunk.setZero();
+    sweep.chunk.leftCols(w) = sign * Y.middleCols(c0, w);
     for (int b = nb - 1; b >= 0; --b) {  // leaves to root: u = f − Sᵀ p, p += U D⁻¹ u
       const Body& body = m.bodies[b];
       const Joint& J = body.joint;
-      auto& p = d.sweep.chunk_force[b];
+      auto& p = sweep.chunk_force[b];
       if (J.nv == 1) {
         const ArticulatedBody& A = ws.articulated[b];
-        auto x = d.sweep.chunk.row(J.idx_v);
+        auto x = sweep.chunk.row(J.idx_v);
         x.noalias() -= A.S.transpose() * p;
         p.noalias() += (A.U / A.d) * x;
       } else if (J.nv > 1) {
         for (int k = 0; k < J.nv; ++k)
-          d.sweep.chunk.row(J.idx_v + k).noalias() -= ws.subspace[J.idx_v + k].transpose() * p;
+          sweep.chunk.row(J.idx_v + k).noalias() -= ws.subspace[J.idx_v + k].transpose() * p;
         for (int k = 0; k < J.nv; ++k)
-          p.noalias() += ws.articulated_rate[J.idx_v + k].K * d.sweep.chunk.row(J.idx_v + k);
+          p.noalias() += ws.articulated_rate[J.idx_v + k].K * sweep.chunk.row(J.idx_v + k);
       }
-      if (body.parent >= 0) d.sweep.chunk_force[body.parent] += p;
+      if (body.parent >= 0) sweep.chunk_force[body.parent] += p;
       p.setZero();  // ready for the next chunk
     }
     for (int b = 0; b < nb; ++b) {  // root to leaves: x = D⁻¹ u − D⁻¹ Uᵀ a, a += S x
       const Body& body = m.bodies[b];
       const Joint& J = body.joint;
-      auto& a = d.sweep.chunk_acceleration[b];
+      auto& a = sweep.chunk_acceleration[b];
       if (body.parent >= 0)
-        a = d.sweep.chunk_acceleration[body.parent];
+        a = sweep.chunk_acceleration[body.parent];
       else
         a.setZero();
       if (J.nv == 1) {
         const ArticulatedBody& A = ws.articulated[b];
-        auto x = d.sweep.chunk.row(J.idx_v);
+        auto x = sweep.chunk.row(J.idx_v);
         x = (x - A.U.transpose() * a) / A.d;
         a.noalias() += A.S * x;
       } else if (J.nv > 1) {
         Eigen::Matrix<double, 6, 8> u;
-        u.topRows(J.nv) = d.sweep.chunk.middleRows(J.idx_v, J.nv);
+        u.topRows(J.nv) = sweep.chunk.middleRows(J.idx_v, J.nv);
         for (int k = 0; k < J.nv; ++k) {
           const ArticulatedRate& R = ws.articulated_rate[J.idx_v + k];
           Row8 x = R.Dinv.head(J.nv).transpose() * u.topRows(J.nv);
           x.noalias() -= R.K.transpose() * a;
-          d.sweep.chunk.row(J.idx_v + k) = x;
+          sweep.chunk.row(J.idx_v + k) = x;
         }
         for (int k = 0; k < J.nv; ++k)
-          a.noalias() += ws.subspace[J.idx_v + k] * d.sweep.chunk.row(J.idx_v + k);
+          a.noalias() += ws.subspace[J.idx_v + k] * sweep.chunk.row(J.idx_v + k);
       }
     }
-    Y.middleCols(c0, w) = d.sweep.chunk.leftCols(w);
+    Y.middleCols(c0, w) = sweep.chunk.leftCols(w);
   }
 }
 
@@ -313,12 +314,13 @@ void subtract_block_times(double* __restrict y, const double* X, Eigen::Index ld
 // Y = −(M^s)⁻¹ K over K's non-zero rows only (plan_row_runs), each run times its block of
 // (M^s)⁻¹: per column a few small products.
 void minus_minv_times(const DerivativeWorkspace& d, const MatX& K, MatX& Y) {
-  for (const ColumnGroup& g : d.sweep.groups)
+  const InverseMassSweep& sweep = d.sweep;
+  for (const ColumnGroup& g : sweep.groups)
     for (int c = g.first; c < g.first + g.count; ++c) {
       auto y = Y.col(c);
       y.setZero();
       for (int r = g.run_begin; r < g.run_end; ++r) {
-        const RowRun& run = d.sweep.runs[r];
+        const RowRun& run = sweep.runs[r];
         const int rows = run.block_end - run.block_first;
         subtract_block_times(y.data() + run.block_first, &d.Minv(run.block_first, run.first),
                              d.Minv.outerStride(), rows, run.count, K.col(c).data() + run.first);
