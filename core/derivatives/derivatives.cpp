@@ -168,7 +168,8 @@ void subtract_loads(const Model& m, const Workspace& ws, DerivativeWorkspace& d)
 }
 
 // Leaves to root at body b, its subtree's I^c, B^c, L^c, F complete: the pairs (c, m) with c or
-// m a rate of b and the other on b's path to the root (or b's own).
+// m a rate of b and the other on b's path to the root (or b's own). For a joint of several rates
+// (or none); one rate is backward_one_rate_body.
 [[gnu::flatten]] void backward_body(const Model& m, DerivativeWorkspace& d, int b, MatX& Kq,
                                     MatX& Kv) {
   const Joint& J = m.bodies[b].joint;
