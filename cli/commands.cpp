@@ -8,6 +8,7 @@
 
 #include "core/equations.hpp"
 #include "core/limits.hpp"
+#include "core/loops/assembly.hpp"
 #include "core/memory.hpp"
 #include "core/names.hpp"
 #include "core/sampling.hpp"
@@ -31,8 +32,13 @@ constexpr const char* kEquationsHelp =
 Prints the system equations M^s(q) q̈ + h(q, q̇) = Q(q, q̇, τ) at the state, and
 q̈ = (M^s)⁻¹(Q − h). Omitted q, q̇, τ are zero; τ is the actuation force on each generalized
 coordinate. --tensor adds D (n x n x n) with h_a = Σ_bc D_abc q̇_b q̇_c.
+With closed loops (docs/loops.md) M^s, h, Q are the spanning tree's and q̈ is the closed
+mechanism's, M^s q̈ + h = Q + Φ_qᵀ λ with Φ_q q̈ = −Φ̇_q q̇, printed with λ and Φ_qᵀ λ; the state
+must close the loops (else exit 1 naming the constraint), and without --q the neutral
+configuration is assembled onto them first (q̇ projected), as simulate starts.
 --json prints one object: {"n", "coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd"[, "D"]}
-(n the number of coordinates, "coordinates" their names).
+(n the number of coordinates, "coordinates" their names; with loops also "lambda" and
+"constraint_forces"; "failure" when qdd is null).
 M^s and its printed form grow as n²: beyond the memory limit (--max-memory GB, default half the
 available memory) the command is refused before any work, with the memory it would need.
 )";
@@ -212,15 +218,24 @@ int cmd_equations(int argc, char** argv) {
     return 0;
   }
   const Model m = load(a);
-  const VecX q = configuration_vector(a, "q", m), qd = state_vector(a, "qd", m),
-             tau = state_vector(a, "tau", m);
+  VecX q = configuration_vector(a, "q", m), qd = state_vector(a, "qd", m);
+  const VecX tau = state_vector(a, "tau", m);
+  // Closed loops and no --q: the neutral configuration assembled onto them (and q̇ projected),
+  // as simulate starts; a --q given is taken as it is, and must close them.
+  if (!m.constraints.empty() && !a.has("q"))
+    if (const StateAssembly s = assemble_state(m, q, qd); !s.assembly.status.ok)
+      throw StateError(a.positional[0] +
+                       ": the neutral configuration: " + s.assembly.status.message);
   require_memory(
       a.positional[0] + ": the equations of n = " + std::to_string(m.n()) + " coordinates",
       equations_bytes(m, a.has("json")), max_memory(a),
       "use " + max_memory_option(equations_bytes(m, a.has("json"))) +
           " if that much memory is free");
   Workspace ws(m);
-  const Status st = forward_dynamics(m, ws, q, qd, tau);
+  // q̈ of the mechanism: with closed loops the constrained one, at a state on the loops.
+  const std::unique_ptr<LoopWorkspace> loops =
+      m.constraints.empty() ? nullptr : std::make_unique<LoopWorkspace>(m);
+  const Status st = mechanism_forward_dynamics(m, ws, loops.get(), q, qd, tau);
   evaluate(m, ws, q, qd, tau);
   // A result that overflowed is a fault, never printed as an answer.
   struct Result {
@@ -255,9 +270,9 @@ int cmd_equations(int argc, char** argv) {
     evaluate(m, ws, q, qd, tau);  // the tensor sweep reuses the workspace
   }
   if (a.has("json"))
-    std::cout << readable_json(equations_json(m, ws, q, qd, tau, st.ok, D));
+    std::cout << readable_json(equations_json(m, ws, q, qd, tau, st, loops.get(), D));
   else
-    std::cout << equations_text(m, ws, q, qd, tau, st.ok, D);
+    std::cout << equations_text(m, ws, q, qd, tau, st, loops.get(), D);
   if (!st.ok) {
     std::cerr << "femdyn equations: " << escaped(a.positional[0]) << ": at this state "
               << safe_message(st.message) << "\n";

@@ -62,7 +62,7 @@ int cmd_linearize(int argc, char** argv) {
   if (!m.constraints.empty()) {  // the state onto the loops, as a run starts
     const StateAssembly loops = assemble_state(m, q, qd);
     if (!loops.assembly.status.ok)
-      throw CliError(a.positional[0] + ": the state: " + loops.assembly.status.message);
+      throw StateError(a.positional[0] + ": the state: " + loops.assembly.status.message);
   }
   const Status st = forward_dynamics_derivatives(m, ws, d, q, qd, tau);
   if (!st.ok) {

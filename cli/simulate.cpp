@@ -192,7 +192,7 @@ int cmd_simulate(int argc, char** argv) {
   if (!m.constraints.empty()) {
     loops = assemble_state(m, q0, qd0);
     if (!loops.assembly.status.ok)
-      throw CliError(a.positional[0] + ": the initial state: " + loops.assembly.status.message);
+      throw StateError(a.positional[0] + ": the initial state: " + loops.assembly.status.message);
   }
   const long every = static_cast<long>(integer_option(a, "every", 1, 1));
   if (a.has("every") && a.has("sample-dt"))

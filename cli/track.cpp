@@ -18,6 +18,7 @@ namespace {
 
 constexpr const char* kHelp =
     R"(usage: femdyn track MODEL --to a,b,… [--from …] [--duration T] [--steps N] [--csv FILE [--force]] [--json]
+                     [--actuated-base]
                      [--kp KP --kd KD [--start q] [--control evaluation|hold]] [--gravity gx,gy,gz]
 
 Plans the quintic (minimum-jerk) motion q_ref(t) from --from (default 0, the identity rotation
@@ -28,7 +29,9 @@ the simulated motion follows q_ref (max |q_sim ⊖ q_ref|: rad or m; a rotation 
 vector between the two quaternions). --csv writes t, q_ref, τ and q_sim per step (atomically; an
 existing FILE is replaced only with --force, and never when it is MODEL). --json prints
 {"model", "n", "coordinates", "duration", "steps", "max_tracking_error", "max_abs_tau",
-"final_tracking_error", "feedback"}.
+"final_tracking_error", "feedback"}. τ acts on every coordinate, so a model with closed loops is
+refused (exit 1), and so is one with a free joint (a floating base) unless --actuated-base says
+that its base is pushed too (by thrusters: the τ on its 6 rates is the wrench they apply).
 
 With --kp and --kd (1/s², 1/s; e.g. ω² and 2ω) the loop is closed: computed torque with PD,
   τ = M^s(q) (q̈_ref + K_d (v_ref − v) + K_p (q_ref ⊖ q)) + h(q, v) − Q(q, v, τ = 0),
@@ -53,11 +56,28 @@ struct ComputedTorque {
   }
 };
 
+// Computed torque puts a τ on every coordinate. A model where that is not the mechanism's own
+// actuation is refused, naming what would be ignored: closed loops (the open tree's τ would be
+// applied, and the loops' forces left out) and a free joint (a floating base nothing pushes),
+// unless --actuated-base says the base is pushed (thrusters: τ on its 6 rates is a wrench).
+void require_fully_actuated(const std::string& file, const Model& m, bool actuated_base) {
+  if (!m.constraints.empty())
+    throw ModelError(file, "the model has closed loops (" + std::to_string(m.constraint_rows) +
+                               " constraint equations); computed torque by the spanning tree's "
+                               "inverse dynamics would ignore them (not supported)");
+  for (const Body& b : m.bodies)
+    if (b.joint.type == JointType::Free && !actuated_base)
+      throw ModelError(file, "body '" + b.name + "' is on a free joint ('" + b.joint.name +
+                                 "'): computed torque would push on a base nothing actuates "
+                                 "(free-floating tracking is not supported; --actuated-base if "
+                                 "thrusters push it)");
+}
+
 }  // namespace
 
 int cmd_track(int argc, char** argv) {
   const Args a = parse_args(
-      argc, argv, 2, {"help", "json", "force"},
+      argc, argv, 2, {"help", "json", "force", "actuated-base"},
       {"to", "from", "duration", "steps", "csv", "gravity", "kp", "kd", "start", "control"});
   if (a.has("help")) {
     std::cout << kHelp;
@@ -72,6 +92,7 @@ int cmd_track(int argc, char** argv) {
       throw CliError("--csv " + out + ": exists (use --force to replace it)");
   }
   const Model m = load(a);
+  require_fully_actuated(a.positional[0], m, a.has("actuated-base"));
   if (!a.has("to")) throw CliError("--to is required (try --help)");
   const VecX q1 = configuration_vector(a, "to", m);
   const VecX q0 = configuration_vector(a, "from", m);      // (the neutral configuration)

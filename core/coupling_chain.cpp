@@ -31,7 +31,10 @@ CouplingLevelState& level_at(const Model& m, Workspace& ws, const VecX& q, const
 }
 
 // The body states of the tree are this model's.
-void share_bodies(Workspace& ws) { ws.body = ws.tree->body; }
+void share_bodies(Workspace& ws) {
+  ws.body = ws.tree->body;
+  ws.origin = ws.tree->origin;
+}
 
 // y = Gᵀ f over G's pattern: y_a = Σ_t G_ta f_t.
 void reduce_force(const CouplingLevelState& s, const VecX& f, VecX& y) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/arguments.hpp"
 #include "core/articulated.hpp"
 #include "core/body_inertia.hpp"
 #include "core/coupled_dynamics.hpp"
@@ -261,13 +262,14 @@ Energy energy_levels(const Model& model, Workspace& ws, const VecX& q, const Vec
     evaluate(model, ws, q, qd, VecX());
     E.kinetic = 0.5 * qd.dot(ws.Ms.lazyProduct(qd));  // (no temporary: looked at mid-run)
   }
-  // Potential of constant nodal forces: −F_i x_i over translation DOFs (positions in world).
+  // Potential of constant nodal forces: −F_i x_i over translation DOFs (x_i = o + the node's
+  // place from the reference point o: the world position).
   for (int i = 0; i < model.n_u(); ++i) {
     const SystemDof& d = model.dofs[i];
     if (d.kind != DofKind::Translation || model.F_constant[i] == 0) continue;
     const SystemNode& node = model.nodes[d.carrier];
     const BodyState& B = ws.body[node.body];
-    E.potential -= model.F_constant[i] * (B.p + B.R * node.r)[d.axis];
+    E.potential -= model.F_constant[i] * (ws.origin + (B.p + B.R * node.r))[d.axis];
   }
   for (int j = 0; j < model.n_theta(); ++j) {
     const Joint& J = model.bodies[model.theta_joint[j]].joint;
@@ -319,12 +321,15 @@ EquationRoutes choose_equation_routes(const Model& model) {
 // Each function of equations.hpp: the model's route (Model::routes), chosen once by compile().
 
 void mass_matrix(const Model& model, Workspace& ws, const VecX& q) {
+  require_state(model, "mass_matrix", q);
   model.routes.mass_matrix(model, ws, q);
 }
 
 // Two-point springs (core/springs.hpp) act on every route as a generalized force Q_s added to τ.
 
 void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau) {
+  require_state(model, "evaluate", q, &qd, "qd");
+  require_size(model, "evaluate", "tau", tau, ArgumentKind::Actuation);
   model.routes.evaluate(model, ws, q, qd, tau);
   if (model.springs.empty()) return;
   spring_forces(model, ws, q, qd);
@@ -332,15 +337,19 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
 }
 
 void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
+  require_state(model, "evaluate_bias", q, &qd, "qd");
   model.routes.evaluate_bias(model, ws, q, qd);
 }
 
 Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                         const VecX& tau) {
+  require_state(model, "forward_dynamics", q, &qd, "qd");
+  require_size(model, "forward_dynamics", "tau", tau, ArgumentKind::Actuation);
   const VecX* applied = &tau;
   if (!model.springs.empty()) {
     spring_forces(model, ws, q, qd);
-    ws.tau_applied = tau + ws.Q_springs;
+    ws.tau_applied = ws.Q_springs;
+    if (tau.size()) ws.tau_applied += tau;  // (none: no actuation)
     applied = &ws.tau_applied;
   }
   const Status st = model.routes.forward_dynamics(model, ws, q, qd, *applied);
@@ -360,6 +369,8 @@ Status finite_accelerations(const Model& model, const VecX& qdd) {
 
 void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                       const VecX& qdd) {
+  require_state(model, "inverse_dynamics", q, &qd, "qd");
+  require_size(model, "inverse_dynamics", "qdd", qdd, ArgumentKind::Rate);
   model.routes.inverse_dynamics(model, ws, q, qd, qdd);
   if (model.springs.empty()) return;
   spring_forces(model, ws, q, qd);
@@ -367,18 +378,22 @@ void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const Ve
 }
 
 std::vector<MatX> transform_hessian(const Model& model, Workspace& ws, const VecX& q) {
+  require_state(model, "transform_hessian", q);
   return model.routes.transform_hessian(model, ws, q);
 }
 
 std::vector<MatX> third_order_tensor(const Model& model, Workspace& ws, const VecX& q) {
+  require_state(model, "third_order_tensor", q);
   return model.routes.third_order_tensor(model, ws, q);
 }
 
 void joint_state(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
+  require_state(model, "joint_state", q, &qd, "qd");
   model.routes.joint_state(model, ws, q, qd);
 }
 
 Energy energy(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
+  require_state(model, "energy", q, &qd, "qd");
   Energy E = model.routes.energy(model, ws, q, qd);
   if (!model.springs.empty()) E.potential += spring_potential(model, ws, q);
   return E;

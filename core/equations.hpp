@@ -14,7 +14,11 @@
 
 namespace femdyn {
 
-// Fills ws.Ms, ws.h, ws.Q for the state (q, q̇, τ). Sizes are checked by the caller (io/cli).
+// Every function below checks the sizes of its arguments (core/arguments.hpp): q has n_q entries,
+// q̇ and q̈ have n, τ has n or none (no actuation); a wrong size throws ArgumentError naming the
+// function and the argument.
+//
+// Fills ws.Ms, ws.h, ws.Q for the state (q, q̇, τ).
 void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau);
 
 // M^s alone into ws.Ms (the body poses, or T, and nothing of h or Q).

@@ -1,5 +1,6 @@
 #include "core/frames.hpp"
 
+#include "core/arguments.hpp"
 #include "core/kinematics.hpp"
 
 namespace femdyn {
@@ -12,6 +13,7 @@ int find_frame(const Model& model, const std::string& name) {
 
 void frame_kinematics(const Model& model, Workspace& ws, const VecX& q, const VecX& v, int frame,
                       FrameAxes axes, FrameKinematics& out) {
+  require_state(model, "frame_kinematics", q, &v);
   propagate(model, ws, q, v, {.jacobian = true, .bias = true, .rows = false});
   frame_kinematics(model, ws, frame, axes, out);
 }
@@ -22,7 +24,7 @@ void frame_kinematics(const Model& model, const Workspace& ws, int frame, FrameA
   const BodyState& B = ws.body[F.body];
   const Vec3 r = B.R * F.p_BF;
   out.R = B.R * F.R_BF;
-  out.p = B.p + r;
+  out.p = ws.origin + (B.p + r);
   const auto Jw = ws.Jw.middleRows<3>(3 * F.body), Jv = ws.Jv.middleRows<3>(3 * F.body);
   out.J.resize(6, model.n());
   out.J.topRows<3>() = Jv;
@@ -61,7 +63,7 @@ void attachment_motion(const Model& model, const Workspace& ws, const Attachment
   }
   if (A.body < 0) {  // the world
     out.R = A.R;
-    out.p = A.p;
+    out.p = A.p - ws.origin;  // (from the reference point, as the bodies' places)
     out.v.setZero(), out.w.setZero(), out.a.setZero(), out.alpha.setZero();
     if (jacobian) out.Jv.setZero(), out.Jw.setZero();
     return;

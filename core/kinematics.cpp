@@ -15,19 +15,38 @@ namespace {
 //   α_B = α_P + ω_B(y) × Δω(x)                                 (d_y of R_B S_ω x)
 //   a_B = a_P + α_P × r + ω_P(x) × (ω_P(y) × r + Δv(y)) + ω_B(y) × Δv(x)
 // (d_y r = ω_P(y) × r + Δv(y); d_y R_B S_v x = ω_B(y) × Δv(x); S_J is constant in B).
+//
+// Places are taken from the reference point o = p_pj,0 + d_0, the first body's origin
+// (Workspace::origin): a root (a body on the world) is at (p_pj − p_pj,0) + (d_J − d_0), the
+// difference of its joint frame's place and the first's (numbers given in the file) plus that of
+// the displacements (numbers of the mechanism's size), so that no place loses digits to the
+// world's own numbers (a robot 1e6 m out); every other body at p_P + R_P (p_pj + d_J).
+struct RootReference {
+  Vec3 p_pj = Vec3::Zero(), d = Vec3::Zero();  // the first body's joint frame place and d_0
+};
+
 template <class J>
 [[gnu::always_inline]] inline void tree_step(const Model& model, Workspace& ws, int b,
-                                             const KinematicsRequest& req, const BodyState& root) {
+                                             const KinematicsRequest& req, const BodyState& root,
+                                             RootReference& reference) {
   const Joint& j = model.bodies[b].joint;
   const int parent = model.bodies[b].parent;
   const BodyState& P = parent < 0 ? root : ws.body[parent];
   BodyState& B = ws.body[b];
 
   Mat3 R_J;
-  Vec3 p_J;
-  J::pose(j, J::nq > 0 ? ws.theta.data() + j.idx_q : nullptr, R_J, p_J);
+  Vec3 d_J;
+  J::pose(j, J::nq > 0 ? ws.theta.data() + j.idx_q : nullptr, R_J, d_J);
   B.R.noalias() = P.R * R_J;
-  B.p.noalias() = P.p + P.R * p_J;
+  if (parent >= 0) {
+    B.p.noalias() = P.p + P.R * (j.p_pj + d_J);
+  } else {
+    if (b == 0) {
+      reference = {j.p_pj, d_J};
+      ws.origin = j.p_pj + d_J;
+    }
+    B.p = (j.p_pj - reference.p_pj) + (d_J - reference.d);
+  }
   const Vec3 r = B.p - P.p;
 
   std::array<Vec3, J::nv + 1> s_w, s_v;  // the columns of S_J in world axes (one spare: nv = 0)
@@ -81,10 +100,12 @@ void propagate_tree(const Model& model, Workspace& ws, KinematicsRequest req) {
     ws.Jw.setZero(3 * nb, model.n());
     ws.Jv.setZero(3 * nb, model.n());
   }
-  const BodyState root;
+  const BodyState root;  // the world (its place is never used: nothing moves it)
+  RootReference reference;
+  ws.origin.setZero();
   for (int b = 0; b < static_cast<int>(nb); ++b)
     visit_joint(model.bodies[b].joint.type,
-                [&]<class J>(J) { tree_step<J>(model, ws, b, req, root); });
+                [&]<class J>(J) { tree_step<J>(model, ws, b, req, root, reference); });
 }
 
 // Node level: rows of T, T'[q̇,q̇] and u̇ for every kept transition coordinate.

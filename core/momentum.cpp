@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 
+#include "core/arguments.hpp"
 #include "core/errors.hpp"
 #include "core/kinematics.hpp"
 
@@ -94,7 +95,8 @@ void momentum_kinematics(const Model& model, const Workspace& ws, MomentumKinema
     out.A.noalias() += out.Ww[b] * ws.Jw.middleRows<3>(bi);
   }
 
-  // The locked mechanism: mass, first moment m c, inertia about the origin.
+  // The locked mechanism: mass, first moment m c, inertia about the origin (the reference point
+  // o of the body places, Workspace::origin, until c is made a world position below).
   out.mass = I_O.topLeftCorner<3, 3>().trace() / 3;
   if (!(out.mass > 0)) throw StateError(model.name + ": the mechanism has no mass");
   const Mat3 mc_cross = I_O.bottomLeftCorner<3, 3>();  // [m c]×
@@ -112,10 +114,12 @@ void momentum_kinematics(const Model& model, const Workspace& ws, MomentumKinema
   out.Jcom = out.A.topRows<3>() / out.mass;
   out.com_velocity = out.momentum.head<3>() / out.mass;
   out.com_bias = out.bias.head<3>() / out.mass;
+  out.com += ws.origin;  // (about the reference point above: Workspace::origin)
 }
 
 void momentum_kinematics(const Model& model, Workspace& ws, const VecX& q, const VecX& v,
                          MomentumKinematics& out) {
+  require_state(model, "momentum_kinematics", q, &v);
   propagate(model, ws, q, v, {.jacobian = true, .bias = true, .rows = false});
   momentum_kinematics(model, ws, out);
 }

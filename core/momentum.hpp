@@ -5,6 +5,8 @@
 // off each element's own mass m_e on its own nodes y_l = (x y z, rx ry rz) — not off the
 // system's M on u, which leaves out what never moves (a node at rest; a rotation rate that stays
 // 0 about a hinge while a full inertia tensor couples it to the others still carries momentum).
+// (The origin below is the reference point of the body places, Workspace::origin; c is handed out
+// as a world position.)
 // A rigid twist ξ = (v₀, ω) of the whole mechanism about the world origin moves node l by
 //   ẏ_l = G_l ξ,   G_l = [[1, −[x_l]×], [0, R_eᵀ]]   (R_e: the element's body's rotation),
 // so the mechanism locked rigid has the inertia I_O = Σ_e Σ_l,j G_lᵀ m_e[l, j] G_j

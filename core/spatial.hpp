@@ -2,6 +2,9 @@
 // Algorithms", ch. 2): a motion vector is (ω, v_O), v_O the velocity of the body-fixed point at
 // the world origin; a force vector is (n_O, f), n_O the moment about the origin. Expressed this
 // way no coordinate transform is needed between bodies (the book's "base coordinates").
+// "The origin" in the recursions is the workspace's reference point o (Workspace::origin), the
+// first body's origin, from which every body place is measured: the sums below then hold
+// entries of the mechanism's own size (m·|p|², |p| its extent) wherever it is in the world.
 #pragma once
 #include <Eigen/Dense>
 

@@ -12,7 +12,8 @@ namespace femdyn {
 
 struct BodyState {
   Mat3 R = Mat3::Identity();  // R_WB, body orientation in world
-  Vec3 p = Vec3::Zero();      // p_WB, body origin in world
+  Vec3 p = Vec3::Zero();      // p_WB − o: body origin in world axes, from the reference point
+                              // o = Workspace::origin (world position p_WB = o + p)
   Vec3 w = Vec3::Zero();      // ω, angular velocity (world), along the rate x
   Vec3 w_y = Vec3::Zero();    // ω along the second rate y of the bilinear bias
   Vec3 v = Vec3::Zero();      // velocity of the body origin (world)
@@ -56,16 +57,23 @@ struct Workspace {
   explicit Workspace(const Model& model);
 
   VecX theta, theta_dot, theta_dot_y;  // θ, θ̇ (= C x), C y
-  std::vector<BodyState> body;         // per body
-  MatX Jw, Jv;                         // body Jacobians in q: rows 3b..3b+2 of body b (3nb x n),
-                                       // sized when first formed
-  MatX T;                              // T = ∂u/∂q (N_u x n), sized when first formed
-  VecX bias;                           // T'[q̇,q̇] (N_u)
-  VecX u_dot;                          // u̇ = T q̇
-  VecX nodal;                          // M T'[q̇,q̇] + g, then nodal forces F (N_u)
-  MatX MT;                             // M T (N_u x n), sized when first formed
-  VecX u_acc;  // T q̈ + T'[q̇,q̇] (inverse dynamics); also the nodal forces
-               // plus the body torques in generalized_force (N_u)
+  // The reference point o (world) of the last propagate: the origin of the first body, so that
+  // every position the algorithms use (BodyState::p, nodes, attachments, spatial inertias and
+  // motions "about the origin") is measured from the mechanism itself. The equations do not
+  // depend on o; their round-off would grow as m·|p|² with positions taken from the world's
+  // origin (a robot 1 km away). Positions handed out (frames, centre of mass, poses, energy)
+  // add o back.
+  Vec3 origin = Vec3::Zero();
+  std::vector<BodyState> body;  // per body
+  MatX Jw, Jv;                  // body Jacobians in q: rows 3b..3b+2 of body b (3nb x n),
+                                // sized when first formed
+  MatX T;                       // T = ∂u/∂q (N_u x n), sized when first formed
+  VecX bias;                    // T'[q̇,q̇] (N_u)
+  VecX u_dot;                   // u̇ = T q̇
+  VecX nodal;                   // M T'[q̇,q̇] + g, then nodal forces F (N_u)
+  MatX MT;                      // M T (N_u x n), sized when first formed
+  VecX u_acc;                   // T q̈ + T'[q̇,q̇] (inverse dynamics); also the nodal forces
+                                // plus the body torques in generalized_force (N_u)
   std::vector<RigidInertia> composite;  // per body: composite inertia I^c_b (world, origin)
   std::vector<Vec6> subspace;  // per rate of θ̇: its column of S (world, origin), at the joint's
                                // idx_v (core/joints/kernel.hpp)

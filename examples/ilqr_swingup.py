@@ -199,7 +199,8 @@ def plot(r, path):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--plot", default="ilqr_swingup.png")
+    parser.add_argument("--plot", default=None,
+                        help="write the figure to this PNG file (none unless asked)")
     args = parser.parse_args()
     r = run()
     xf = np.r_[r["q"][-1], r["qd"][-1]]
@@ -207,8 +208,9 @@ def main():
           f"{r['history'][-1]:.4g}; plan's final error {np.abs(r['plan_x'][-1] - GOAL).max():.2e}")
     print(f"simulated final state {np.array2string(xf, precision=5)}, error "
           f"{np.abs(xf - GOAL).max():.2e} (goal {np.array2string(GOAL, precision=5)})")
-    plot(r, args.plot)
-    print("plot:", args.plot)
+    if args.plot:
+        plot(r, args.plot)
+        print("plot:", args.plot)
 
 
 if __name__ == "__main__":

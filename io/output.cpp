@@ -1,5 +1,6 @@
 #include "io/output.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -70,7 +71,8 @@ std::string json_text(const Json& doc) {
 }
 
 Json equations_json(const Model& model, const Workspace& ws, const VecX& q, const VecX& qd,
-                    const VecX& tau, bool have_qdd, const std::vector<MatX>& D) {
+                    const VecX& tau, const Status& dynamics, const LoopWorkspace* loops,
+                    const std::vector<MatX>& D) {
   Json j;
   j["n"] = model.n();
   j["coordinates"] = model.coordinate_names;
@@ -80,7 +82,12 @@ Json equations_json(const Model& model, const Workspace& ws, const VecX& q, cons
   j["M"] = matrix_json(ws.Ms);
   j["h"] = vector_json(ws.h);
   j["Q"] = vector_json(ws.Q);
-  j["qdd"] = have_qdd ? vector_json(ws.qdd) : Json();
+  j["qdd"] = dynamics.ok ? vector_json(ws.qdd) : Json();
+  if (!dynamics.ok) j["failure"] = dynamics.message;
+  if (loops && dynamics.ok) {
+    j["lambda"] = vector_json(loops->lambda);
+    j["constraint_forces"] = vector_json(loops->k.J.transpose() * loops->lambda);
+  }
   if (!D.empty()) {
     Json d = Json::array();
     for (const MatX& Da : D) d.push_back(matrix_json(Da));
@@ -90,7 +97,8 @@ Json equations_json(const Model& model, const Workspace& ws, const VecX& q, cons
 }
 
 std::string equations_text(const Model& model, const Workspace& ws, const VecX& q, const VecX& qd,
-                           const VecX& tau, bool have_qdd, const std::vector<MatX>& D) {
+                           const VecX& tau, const Status& dynamics, const LoopWorkspace* loops,
+                           const std::vector<MatX>& D) {
   std::ostringstream out;
   out << "model: " << model.name << "\n";
   out << "coordinates:";
@@ -103,10 +111,18 @@ std::string equations_text(const Model& model, const Workspace& ws, const VecX& 
   print_mat(out, ws.Ms);
   print_vec(out, "h  ", ws.h);
   print_vec(out, "Q  ", ws.Q);
-  if (have_qdd)
+  if (loops)
+    out << "closed loops (" << model.constraint_rows
+        << " equations): qdd from M^s qdd + h = Q + Phi_q^T lambda, Phi_q qdd = -Phi_q' qd\n";
+  if (!dynamics.ok) {
+    out << "qdd = (none: " << dynamics.message << ")\n";
+  } else {
     print_vec(out, "qdd", ws.qdd);
-  else
-    out << "qdd = (M^s is singular at this state)\n";
+    if (loops) {
+      print_vec(out, "lambda", loops->lambda);
+      print_vec(out, "Phi_q^T lambda", VecX(loops->k.J.transpose() * loops->lambda));
+    }
+  }
   for (std::size_t a = 0; a < D.size(); ++a) {
     out << "D[" << a << "] (" << model.coordinate_names[a] << "):\n";
     print_mat(out, D[a]);
@@ -199,7 +215,11 @@ std::string info_text(const Model& model) {
     for (const auto& c : model.configuration_names) out << " " << c;
     out << "\n";
   }
-  out << "joints (" << model.n_theta() << " movable):\n";
+  // Joints counted as joints (a ball or free joint is one, of 3 or 6 rates θ̇).
+  const auto movable = std::count_if(model.bodies.begin(), model.bodies.end(),
+                                     [](const Body& b) { return moves(b.joint); });
+  out << "joints (" << model.bodies.size() << ", " << movable << " movable, " << model.n_theta()
+      << " joint rates):\n";
   std::vector<const CoupledJoint*> law_of(model.n_theta(), nullptr);  // θ -> its law, if any
   if (model.coupling_level)
     for (const CoupledJoint& c : model.coupling_level->coupled) law_of[c.theta] = &c;

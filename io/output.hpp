@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "core/loops/constrained_dynamics.hpp"
+#include "core/status.hpp"
 #include "core/workspace.hpp"
 #include "io/params.hpp"
 
@@ -15,12 +17,16 @@ Json matrix_json(const MatX& m);
 
 // {"n", "coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd"} (+ "D" when D is non-empty):
 // n the number of coordinates, "coordinates" their names (as in every JSON output of femdyn).
-// qdd is null when M^s is singular at the state.
+// M, h, Q are the spanning tree's; qdd is the mechanism's (mechanism_forward_dynamics: with
+// closed loops, `loops` holds λ and Φ_q and the JSON adds "lambda" and "constraint_forces"
+// Φ_qᵀ λ), null when `dynamics` failed at the state (then "failure" says why).
 Json equations_json(const Model& model, const Workspace& ws, const VecX& q, const VecX& qd,
-                    const VecX& tau, bool have_qdd, const std::vector<MatX>& D);
+                    const VecX& tau, const Status& dynamics, const LoopWorkspace* loops,
+                    const std::vector<MatX>& D);
 
 std::string equations_text(const Model& model, const Workspace& ws, const VecX& q, const VecX& qd,
-                           const VecX& tau, bool have_qdd, const std::vector<MatX>& D);
+                           const VecX& tau, const Status& dynamics, const LoopWorkspace* loops,
+                           const std::vector<MatX>& D);
 
 std::string info_text(const Model& model);
 Json info_json(const Model& model);

@@ -93,25 +93,27 @@ py::dict equations_batch(const PyModel& self, const Array& q, const OptArray& qd
   const int nthreads = batch_threads(k, threads);
   {
     py::gil_scoped_release release;
-    for_each_row(m, k, nthreads, [&](Workspace& ws, Eigen::Index i) {
-      thread_local RowState s;
-      s.load(b, i);
-      Status st;
-      try {
-        equations_at(m, ws, s.q, s.qd, s.x, st);
-      } catch (const NumericalError& e) {
-        throw NumericalError("row " + std::to_string(i) + ": " + e.what());
-      }
-      Eigen::Map<RowMatX>(pM + i * n * n, n, n) = ws.Ms;
-      Eigen::Map<VecX>(ph + i * n, n) = ws.h;
-      Eigen::Map<VecX>(pQ + i * n, n) = ws.Q;
-      if (st.ok)
-        Eigen::Map<VecX>(pqdd + i * n, n) = ws.qdd;
-      else
-        Eigen::Map<VecX>(pqdd + i * n, n).setConstant(std::numeric_limits<double>::quiet_NaN());
-      pok[i] = st.ok;
-      failures[i] = st.message;
-    });
+    for_each_row_with(
+        m, k, nthreads, [&] { return loops_for(m); },
+        [&](Workspace& ws, std::unique_ptr<LoopWorkspace>& loops, Eigen::Index i) {
+          thread_local RowState s;
+          s.load(b, i);
+          Status st;
+          try {
+            equations_at(m, ws, loops.get(), s.q, s.qd, s.x, st);
+          } catch (const NumericalError& e) {
+            throw NumericalError("row " + std::to_string(i) + ": " + e.what());
+          }
+          Eigen::Map<RowMatX>(pM + i * n * n, n, n) = ws.Ms;
+          Eigen::Map<VecX>(ph + i * n, n) = ws.h;
+          Eigen::Map<VecX>(pQ + i * n, n) = ws.Q;
+          if (st.ok)
+            Eigen::Map<VecX>(pqdd + i * n, n) = ws.qdd;
+          else
+            Eigen::Map<VecX>(pqdd + i * n, n).setConstant(std::numeric_limits<double>::quiet_NaN());
+          pok[i] = st.ok;
+          failures[i] = st.message;
+        });
   }
   py::dict d;
   d["M"] = M;
@@ -128,6 +130,7 @@ template <bool Forward>
 py::array_t<double> dynamics_batch(const PyModel& self, const Array& q, const OptArray& qd,
                                    const OptArray& third, int threads) {
   const Model& m = *self.model;
+  if constexpr (!Forward) require_open_tree(m, "inverse_dynamics_batch");
   const Batch b(m, q, qd, third, Forward ? "tau" : "qdd", Entries::Bounded);
   const py::ssize_t k = b.k, n = b.n;
   require_batch_memory(Forward ? "forward_dynamics_batch" : "inverse_dynamics_batch", m, k,
@@ -138,24 +141,26 @@ py::array_t<double> dynamics_batch(const PyModel& self, const Array& q, const Op
   const int nthreads = batch_threads(k, threads);
   {
     py::gil_scoped_release release;
-    for_each_row(m, k, nthreads, [&](Workspace& ws, Eigen::Index i) {
-      thread_local RowState s;
-      s.load(b, i);
-      const VecX* result = &ws.tau;
-      if constexpr (Forward) {
-        const Status st = forward_dynamics(m, ws, s.q, s.qd, s.x);
-        if (!st.ok)
-          throw NumericalError("row " + std::to_string(i) + ": at this state " + st.message);
-        result = &ws.qdd;
-      } else {
-        inverse_dynamics(m, ws, s.q, s.qd, s.x);
-      }
-      for (Eigen::Index a = 0; a < n; ++a)
-        if (!std::isfinite((*result)[a]))
-          throw NumericalError("row " + std::to_string(i) + ": " + (Forward ? "q̈" : "τ") + " of '" +
-                               m.coordinate_names[a] + "' is NaN or Inf");
-      Eigen::Map<VecX>(po + i * n, n) = *result;
-    });
+    for_each_row_with(
+        m, k, nthreads, [&] { return loops_for(m); },
+        [&](Workspace& ws, std::unique_ptr<LoopWorkspace>& loops, Eigen::Index i) {
+          thread_local RowState s;
+          s.load(b, i);
+          const VecX* result = &ws.tau;
+          if constexpr (Forward) {
+            const Status st = mechanism_forward_dynamics(m, ws, loops.get(), s.q, s.qd, s.x);
+            if (!st.ok)
+              throw NumericalError("row " + std::to_string(i) + ": at this state " + st.message);
+            result = &ws.qdd;
+          } else {
+            inverse_dynamics(m, ws, s.q, s.qd, s.x);
+          }
+          for (Eigen::Index a = 0; a < n; ++a)
+            if (!std::isfinite((*result)[a]))
+              throw NumericalError("row " + std::to_string(i) + ": " + (Forward ? "q̈" : "τ") +
+                                   " of '" + m.coordinate_names[a] + "' is NaN or Inf");
+          Eigen::Map<VecX>(po + i * n, n) = *result;
+        });
   }
   return out;
 }

@@ -50,6 +50,7 @@ py::dict forward(PyModel& self, const Array& q, const OptArray& qd, const OptArr
 
 py::dict inverse(PyModel& self, const Array& q, const OptArray& qd, const OptArray& qdd) {
   const Model& m = *self.model;
+  require_open_tree(m, "inverse_derivatives");
   DerivativeWorkspace& d = derivative_workspace(self);
   const VecX qv = configuration_arg(q, "q", m), v = vector_arg(qd, "qd", m),
              a = vector_arg(qdd, "qdd", m);

@@ -68,7 +68,7 @@ EquationsResult equations(PyModel& self, const Array& q_in, const OptArray& qd_i
   require_memory("equations of n = " + std::to_string(m.n()) + " coordinates", bytes, 0,
                  "use forward_dynamics (no n x n result), or " + set_max_memory_text(bytes));
   Status st;
-  equations_at(m, self.ws, q, qd, tau, st);
+  equations_at(m, self.ws, self.loops.get(), q, qd, tau, st);
   EquationsResult r{self.ws.Ms, self.ws.h, self.ws.Q, std::nullopt, st.message};
   if (st.ok) r.qdd = self.ws.qdd;
   return r;
@@ -76,16 +76,17 @@ EquationsResult equations(PyModel& self, const Array& q_in, const OptArray& qd_i
 
 VecX forward(PyModel& self, const Array& q, const OptArray& qd, const OptArray& tau) {
   const Model& m = *self.model;
-  const Status st =
-      forward_dynamics(m, self.ws, configuration_arg(q, "q", m), vector_arg(qd, "qd", m),
-                       vector_arg(tau, "tau", m, Entries::Bounded));
+  const Status st = mechanism_forward_dynamics(
+      m, self.ws, self.loops.get(), configuration_arg(q, "q", m), vector_arg(qd, "qd", m),
+      vector_arg(tau, "tau", m, Entries::Bounded));
   if (!st.ok) throw NumericalError("at this state " + st.message);
   require_finite(m, self.ws.qdd.data(), m.n(), m.n(), "q̈");
   return self.ws.qdd;
 }
 
-VecX inverse(PyModel& self, const Array& q, const OptArray& qd, const OptArray& qdd) {
+VecX inverse(PyModel& self, const Array& q, const OptArray& qd, const OptArray& qdd, bool tree) {
   const Model& m = *self.model;
+  if (!tree) require_open_tree(m, "inverse_dynamics");
   inverse_dynamics(m, self.ws, configuration_arg(q, "q", m), vector_arg(qd, "qd", m),
                    vector_arg(qdd, "qdd", m));
   require_finite(m, self.ws.tau.data(), m.n(), m.n(), "τ");
@@ -218,9 +219,9 @@ py::object json_to_python(const Json& j) {
 
 }  // namespace
 
-void equations_at(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau,
-                  Status& status) {
-  status = forward_dynamics(model, ws, q, qd, tau);
+void equations_at(const Model& model, Workspace& ws, LoopWorkspace* loops, const VecX& q,
+                  const VecX& qd, const VecX& tau, Status& status) {
+  status = mechanism_forward_dynamics(model, ws, loops, q, qd, tau);
   evaluate(model, ws, q, qd, tau);
   const Eigen::Index n = model.n();
   require_finite(model, ws.Ms.data(), ws.Ms.size(), n, "M^s");
@@ -229,10 +230,22 @@ void equations_at(const Model& model, Workspace& ws, const VecX& q, const VecX& 
   if (status.ok) require_finite(model, ws.qdd.data(), n, n, "q̈");
 }
 
+void require_open_tree(const Model& model, const char* what) {
+  if (!model.constraints.empty())
+    throw ModelError(model.where, std::string(what) + ": the model has closed loops (" +
+                                      std::to_string(model.constraint_rows) +
+                                      " constraint equations): τ is not unique, the loops' forces "
+                                      "Φ_qᵀ λ share the load (constrained_dynamics gives q̈ and λ "
+                                      "from τ; inverse_dynamics(..., tree=True) the spanning "
+                                      "tree's τ)");
+}
+
 void bind_model(py::module_& m) {
   py::class_<EquationsResult>(m, "Equations",
                               "M^s q̈ + h = Q at one state: M (n, n), h, Q, qdd (n,); qdd is "
-                              "None when M^s is singular there (failure says why)")
+                              "None when M^s is singular there or the state does not close the "
+                              "model's loops (failure says why). With closed loops M, h, Q are "
+                              "the spanning tree's and qdd the closed mechanism's")
       .def_readonly("M", &EquationsResult::M)
       .def_readonly("h", &EquationsResult::h)
       .def_readonly("Q", &EquationsResult::Q)
@@ -303,24 +316,30 @@ void bind_model(py::module_& m) {
            "and drift (6,): with no external force the frame moves with J v_m + drift "
            "(femdyn.ModelError on a model that is not one tree on a free joint)")
       .def("forward_dynamics", &forward, py::arg("q"), py::arg("qd") = py::none(),
-           py::arg("tau") = py::none(), "q̈ = (M^s)⁻¹ (Q − h); NumericalError if M^s is singular")
+           py::arg("tau") = py::none(),
+           "q̈ = (M^s)⁻¹ (Q − h); with closed loops the closed mechanism's (M^s q̈ + h = Q + "
+           "Φ_qᵀ λ, Φ_q q̈ = −Φ̇_q q̇) at a state on them; NumericalError if M^s is singular or "
+           "the state does not close the loops")
       .def("inverse_dynamics", &inverse, py::arg("q"), py::arg("qd") = py::none(),
-           py::arg("qdd") = py::none(), "τ such that M^s q̈ + h = Q(τ)")
+           py::arg("qdd") = py::none(), py::kw_only(), py::arg("tree") = false,
+           "τ such that M^s q̈ + h = Q(τ). With closed loops τ is not unique and the call is "
+           "refused (femdyn.ModelError), unless tree=True asks for the spanning tree's τ, the "
+           "loops cut (on the closed mechanism: τ + Φ_qᵀ λ)")
       .def(
           "mass_matrix",
           [](PyModel& s, const Array& q) {
-            mass_matrix(*s.model, s.ws, vector_arg(q, "q", *s.model));
+            mass_matrix(*s.model, s.ws, configuration_arg(q, "q", *s.model));
             return MatX(s.ws.Ms);
           },
-          py::arg("q"), "M^s(q), (n, n)")
+          py::arg("q"), "M^s(q), (n, n), at the configuration q (n_q)")
       .def(
           "bias",
           [](PyModel& s, const Array& q, const Array& qd) {
-            evaluate_bias(*s.model, s.ws, vector_arg(q, "q", *s.model),
+            evaluate_bias(*s.model, s.ws, configuration_arg(q, "q", *s.model),
                           vector_arg(qd, "qd", *s.model));
             return VecX(s.ws.h);
           },
-          py::arg("q"), py::arg("qd"), "h(q, q̇) = D[q̇, q̇], (n,)")
+          py::arg("q"), py::arg("qd"), "h(q, q̇) = D[q̇, q̇], (n,), at the configuration q (n_q)")
       .def("tensor", &tensor, py::arg("q"),
            "D (n, n, n) with h_a = Σ_bc D[a, b, c] q̇_b q̇_c (numpy: einsum('abc,b,c', D, qd, qd))")
       .def("energy", &energy_of, py::arg("q"), py::arg("qd") = py::none(),

@@ -6,16 +6,24 @@
 #include <memory>
 
 #include "core/derivatives/derivatives.hpp"
+#include "core/loops/constrained_dynamics.hpp"
 #include "core/memory.hpp"
 #include "core/workspace.hpp"
 #include "python/arrays.hpp"
 
 namespace femdyn::python {
 
+// A model's loop buffers: a LoopWorkspace with closed loops, else null.
+inline std::unique_ptr<LoopWorkspace> loops_for(const Model& model) {
+  return model.constraints.empty() ? nullptr : std::make_unique<LoopWorkspace>(model);
+}
+
 struct PyModel {
-  explicit PyModel(Model m) : model(std::make_shared<const Model>(std::move(m))), ws(*model) {}
+  explicit PyModel(Model m)
+      : model(std::make_shared<const Model>(std::move(m))), ws(*model), loops(loops_for(*model)) {}
   std::shared_ptr<const Model> model;
   Workspace ws;
+  std::unique_ptr<LoopWorkspace> loops;              // with closed loops: their buffers (else null)
   std::unique_ptr<DerivativeWorkspace> derivatives;  // made by the first derivatives call
   std::string source;  // the file it was loaded from (femdyn.load), else ""
 };
@@ -29,10 +37,16 @@ struct EquationsResult {
   std::string failure;
 };
 
-// The part of `femdyn equations` after parsing: forward dynamics, then evaluate (the same order,
-// so the same numbers). Throws NumericalError if M^s, h, Q or q̈ is not finite.
-void equations_at(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, const VecX& tau,
-                  Status& status);
+// The part of `femdyn equations` after parsing: the mechanism's forward dynamics (with closed
+// loops the constrained q̈, `loops` their buffers), then evaluate (the same order, so the same
+// numbers). Throws NumericalError if M^s, h, Q or q̈ is not finite.
+void equations_at(const Model& model, Workspace& ws, LoopWorkspace* loops, const VecX& q,
+                  const VecX& qd, const VecX& tau, Status& status);
+
+// Inverse dynamics answers for the spanning tree alone: with closed loops τ is not unique (the
+// loops' forces Φ_qᵀ λ share the load), so the doors that give τ refuse such a model (ModelError
+// naming `what`).
+void require_open_tree(const Model& model, const char* what);
 
 // How to raise the memory limit (core/memory.hpp) from Python far enough for `bytes`:
 // "femdyn.set_max_memory(4.9) if that much memory is free".

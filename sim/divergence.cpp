@@ -17,7 +17,7 @@ double potential_reach(const Model& model, const Workspace& ws) {
     if (force[k].isZero(0)) continue;
     const SystemNode& node = model.nodes[k];
     const BodyState& B = ws.body[node.body];
-    reach += force[k].norm() * (B.p + B.R * node.r).norm();
+    reach += force[k].norm() * (ws.origin + (B.p + B.R * node.r)).norm();  // (world, as V's x)
   }
   return reach;
 }

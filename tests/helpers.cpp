@@ -197,7 +197,7 @@ double translation_value(const Model& m, const Workspace& ws, int i) {
   const SystemDof& d = m.dofs[i];
   const SystemNode& n = m.nodes[d.carrier];
   const BodyState& B = ws.body[n.body];
-  return (B.p + B.R * n.r)[d.axis];
+  return (ws.origin + (B.p + B.R * n.r))[d.axis];
 }
 
 std::string with_rods(const std::string& text, unsigned seed, int& rods) {

@@ -65,7 +65,7 @@ inline std::string closable_tree(unsigned seed, bool weld) {
   std::mt19937 rng(seed);
   const int last = static_cast<int>(tree.bodies.size()) - 1;
   const Vec3 r = {0.05, 0.02, -0.03};
-  const Vec3 p = ws.body[last].p + ws.body[last].R * r;
+  const Vec3 p = ws.origin + ws.body[last].p + ws.body[last].R * r;  // (world)
   const Vec3 pa = ws.body[2].p, pb = ws.body[6].p;
   const std::string name_last = tree.bodies[last].name;
   j["constraints"] =

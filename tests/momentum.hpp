@@ -13,9 +13,10 @@ inline Vec6 momentum(const Model& m, Workspace& ws, const VecX& q, const VecX& v
   Vec6 h = Vec6::Zero();
   for (std::size_t b = 0; b < m.bodies.size(); ++b) {
     const BodyState& B = ws.body[b];
+    const Vec3 p = ws.origin + B.p;  // (world: the workspace holds it from its reference point)
     Vec6 V;
-    V << B.w, B.v - B.w.cross(B.p);
-    h += inertia_at_origin(m.body_inertia[b], B.R, B.p) * V;
+    V << B.w, B.v - B.w.cross(p);
+    h += inertia_at_origin(m.body_inertia[b], B.R, p) * V;
   }
   return h;
 }
@@ -26,7 +27,7 @@ inline Vec3 centre_of_mass(const Model& m, const Workspace& ws) {
   double mass = 0;
   for (std::size_t b = 0; b < m.bodies.size(); ++b) {
     const BodyState& B = ws.body[b];
-    mc += m.body_inertia[b].m * B.p + B.R * m.body_inertia[b].h;
+    mc += m.body_inertia[b].m * (ws.origin + B.p) + B.R * m.body_inertia[b].h;
     mass += m.body_inertia[b].m;
   }
   return mc / mass;

@@ -125,7 +125,7 @@ TEST_CASE("track on a floating base: the feed-forward along the geodesic is exac
   for (int k = 0; k < 12; ++k) to << "," << 0.2 + 0.03 * k;
   double previous = 0;
   for (const int steps : {100, 200, 400}) {
-    const Run r = run("track " + hyq + " --floating-base --to " + to.str() +
+    const Run r = run("track " + hyq + " --floating-base --actuated-base --to " + to.str() +
                       " --duration 0.5 --json --steps " + std::to_string(steps));
     INFO(r.out);
     REQUIRE(r.code == 0);
@@ -243,7 +243,7 @@ TEST_CASE("validate: table and exit 0 on a good model, JSON, exit 1 when it cann
 
   // track takes n_q values: a wrong count is named in one line with the configuration's names.
   const Run track = run("track " + std::string(FEMDYN_SOURCE_DIR) +
-                        "/tests/robots/hyq.urdf --floating-base --to 0");
+                        "/tests/robots/hyq.urdf --floating-base --actuated-base --to 0");
   CHECK(track.code != 0);
   CHECK_THAT(track.out,
              Catch::Contains("--to has 1 values, expected 19 (base_link_0.x, base_link_0.y"));

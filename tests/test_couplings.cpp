@@ -314,7 +314,8 @@ TEST_CASE("a rod spanning two bodies: its length is kept and its M^s is (m/6)(2J
   const auto tips = [&](Workspace& ws, double q) {  // the rod's ends in world, from the poses
     mass_matrix(with, ws, VecX::Constant(1, q));
     const BodyState &c = ws.body[0], &r = ws.body[1];
-    return std::pair<Vec3, Vec3>{c.p + c.R * Vec3(0.1, 0, 0), r.p + r.R * Vec3(0.2, 0, 0)};
+    return std::pair<Vec3, Vec3>{ws.origin + c.p + c.R * Vec3(0.1, 0, 0),
+                                 ws.origin + r.p + r.R * Vec3(0.2, 0, 0)};
   };
   for (double q : {-2.5, -1.0, 0.0, 0.7, 2.0}) {
     const auto [a, b] = tips(ww, q);

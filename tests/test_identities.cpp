@@ -208,8 +208,9 @@ TEST_CASE("loads and springs: Q is the virtual work of the applied forces", "[id
       qm[a] -= eps;
       propagate(m, wp, qp, qd, {.jacobian = false, .bias = false});
       propagate(m, wm, qm, qd, {.jacobian = false, .bias = false});
-      const Vec3 dp =
-          ((wp.body[2].p + wp.body[2].R * p_c) - (wm.body[2].p + wm.body[2].R * p_c)) / (2 * eps);
+      const Vec3 dp = ((wp.origin + wp.body[2].p + wp.body[2].R * p_c) -
+                       (wm.origin + wm.body[2].p + wm.body[2].R * p_c)) /
+                      (2 * eps);
       const Mat3 W = (wp.body[1].R - wm.body[1].R) / (2 * eps) * ws.body[1].R.transpose();
       const Vec3 w(W(2, 1), W(0, 2), W(1, 0));
       Q[a] = F.dot(dp) + tau.dot(w);

@@ -159,7 +159,7 @@ TEST_CASE(
   REQUIRE(momentum(m, ws, q0, v0).norm() < 1e-12);
   const Vec3 c0 = centre_of_mass(m, ws);
   propagate(m, ws, q0, v0, {.jacobian = false, .bias = false, .rows = false});
-  const Vec3 p0 = ws.body[0].p;
+  const Vec3 p0 = ws.origin + ws.body[0].p;
   const Mat3 R0 = ws.body[0].R;
 
   auto integrator = dopri(m, joint_torques(m, 5));
@@ -173,7 +173,7 @@ TEST_CASE(
   // The satellite has turned and its centre has moved, by amounts of the arm's mass ratio.
   const BodyState& sat = ws.body[0];
   const double turned = Eigen::AngleAxisd(R0.transpose() * sat.R).angle();
-  const double moved = (sat.p - p0).norm();
+  const double moved = (ws.origin + sat.p - p0).norm();
   INFO("centre of mass drift " << drift << " m; satellite turned " << turned << " rad, moved "
                                << moved << " m in " << integrator->stats().steps << " steps");
   CHECK(turned > 0.01);

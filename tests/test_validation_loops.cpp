@@ -53,7 +53,7 @@ std::string closed_tree(unsigned seed, int bodies, const std::vector<std::string
   const auto vec = [&](double s) { return Vec3(s * u(rng), s * u(rng), s * u(rng)); };
   const auto pose = [&](int b, Mat3& R, Vec3& p) {
     R = b < 0 ? Mat3::Identity() : Mat3(ws.body[b].R);
-    p = b < 0 ? Vec3::Zero() : Vec3(ws.body[b].p);
+    p = b < 0 ? Vec3::Zero() : Vec3(ws.origin + ws.body[b].p);
   };
   const auto name = [&](int b) { return b < 0 ? std::string("world") : tree.bodies[b].name; };
   Json constraints = Json::array();

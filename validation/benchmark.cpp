@@ -461,7 +461,7 @@ void add_loop_chain(int bodies) {
   ConstraintSpec ball{.name = "tip", .type = "ball"};
   ball.a.body = spec.bodies.back().name;
   ball.b.body = "world";
-  ball.b.xyz = wt.body.back().p;
+  ball.b.xyz = wt.origin + wt.body.back().p;
   spec.constraints.push_back(ball);
   auto c = std::make_unique<LoopCase>();
   c->name = "loop_chain" + std::to_string(bodies);

@@ -85,7 +85,7 @@ Json poses_json(const Model& m, Workspace& ws, const VecX& q, double t) {
   for (const BodyState& B : ws.body) {
     if (!B.p.allFinite() || !B.R.allFinite())
       throw StateError("the pose at t = " + std::to_string(t) + " is NaN or Inf");
-    for (const Json& x : vec_json(B.p)) out.push_back(x);
+    for (const Json& x : vec_json(Vec3(ws.origin + B.p))) out.push_back(x);
     for (const Json& x : quaternion_json(B.R)) out.push_back(x);
   }
   return out;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/arguments.hpp"
 #include "core/body_loads.hpp"
 #include "core/coupling.hpp"
 #include "core/equations.hpp"
@@ -333,12 +334,16 @@ void inverse_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d, 
 
 void inverse_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d,
                                   const VecX& q, const VecX& qd, const VecX& qdd) {
+  require_state(m, "inverse_dynamics_derivatives", q, &qd, "qd");
+  require_size(m, "inverse_dynamics_derivatives", "qdd", qdd, ArgumentKind::Rate);
   if (m.coupling_level) return law_inverse_derivatives(m, ws, d, q, qd, qdd);
   inverse_derivatives(m, ws, d, q, qd, qdd, false);
 }
 
 Status forward_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d,
                                     const VecX& q, const VecX& qd, const VecX& tau) {
+  require_state(m, "forward_dynamics_derivatives", q, &qd, "qd");
+  require_size(m, "forward_dynamics_derivatives", "tau", tau, ArgumentKind::Actuation);
   if (m.coupling_level) return law_forward_derivatives(m, ws, d, q, qd, tau);
   if (d.loops)
     return constrained_forward_dynamics_derivatives(m, ws, d.loops->lws, d, q, qd, tau,

@@ -17,7 +17,7 @@ void SpringDerivatives::size_for(const Model& m) {
 namespace {
 
 PointMotion end_of(const Workspace& ws, const DerivativeWorkspace& d, const Attachment& A) {
-  if (A.body < 0) return point_motion(d, -1, A.p);
+  if (A.body < 0) return point_motion(d, -1, A.p - ws.origin);  // (from the reference point)
   const BodyState& B = ws.body[A.body];
   return point_motion(d, A.body, B.p + B.R * A.p);
 }

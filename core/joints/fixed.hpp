@@ -10,9 +10,9 @@ struct FixedJoint : FlatJoint<0> {
   static constexpr int nq = 0, nv = 0;
   static constexpr bool angular = false, linear = false;
 
-  static void pose(const Joint& j, const double*, Mat3& R, Vec3& p) {
+  static void pose(const Joint& j, const double*, Mat3& R, Vec3& d) {
     R = j.R_pj;
-    p = j.p_pj;
+    d.setZero();
   }
   static Vec3 S_angular(const Joint&, int) { return Vec3::Zero(); }
   static Vec3 S_linear(const Joint&, int) { return Vec3::Zero(); }

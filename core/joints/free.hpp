@@ -14,9 +14,9 @@ struct FreeJoint {
   static constexpr int nq = 7, nv = 6;
   static constexpr bool angular = true, linear = true, flat = false;
 
-  static void pose(const Joint& j, const double* q, Mat3& R, Vec3& p) {
+  static void pose(const Joint& j, const double* q, Mat3& R, Vec3& d) {
     R = j.R_pj * quaternion_rotation(q + 3);
-    p = j.p_pj + j.R_pj * Vec3(q[0], q[1], q[2]);
+    d = j.R_pj * Vec3(q[0], q[1], q[2]);
   }
   static Vec3 S_angular(const Joint&, int k) {
     return k < 3 ? Vec3(Vec3::Zero()) : Vec3(Vec3::Unit(k - 3));

@@ -13,11 +13,11 @@ struct HelicalJoint : FlatJoint<1> {
   static constexpr int nq = 1, nv = 1;
   static constexpr bool angular = true, linear = true;
 
-  // R_pj Rot(a, θ) by Rodrigues (as the revolute joint), p_pj + p θ R_pj a.
-  static void pose(const Joint& j, const double* theta, Mat3& R, Vec3& p) {
+  // R_pj Rot(a, θ) by Rodrigues (as the revolute joint), d = p θ R_pj a.
+  static void pose(const Joint& j, const double* theta, Mat3& R, Vec3& d) {
     const double s = std::sin(theta[0]), c = std::cos(theta[0]);
     R = j.R_pj + s * j.R_pj_K + (1 - c) * j.R_pj_K2;
-    p = j.p_pj + (j.pitch * theta[0]) * j.axis_parent;
+    d = (j.pitch * theta[0]) * j.axis_parent;
   }
   static Vec3 S_angular(const Joint& j, int) { return j.axis; }
   static Vec3 S_linear(const Joint& j, int) { return j.pitch * j.axis; }

@@ -4,7 +4,9 @@
 //
 // A joint joins the parent body P to the child B through its joint frame, fixed on P at
 // (R_pj, p_pj). Its nq coordinates θ_J (at Joint::idx_q in θ) place B:
-//   R_B = R_P R_pj R_J(θ_J),   p_B = p_P + R_P (p_pj + R_pj p_J(θ_J))        (J::pose)
+//   R_B = R_P R_pj R_J(θ_J),   p_B = p_P + R_P (p_pj + d_J),   d_J = R_pj p_J(θ_J)
+// (J::pose gives R_pj R_J and d_J, the displacement apart from p_pj, so that the roots' places
+// can be taken from the reference point without the world's large numbers: core/kinematics.cpp)
 // Its nv rates θ̇_J (at Joint::idx_v in θ̇) move B relative to P, about B's origin:
 //   (Δω, Δv) = S_J θ̇_J,   S_J = [S_ω; S_v] (6 × nv)              (J::S_angular, J::S_linear)
 // Each column of S_J is constant in one of two frames: in B (given in B's axes), or in the
@@ -182,8 +184,9 @@ inline void neutral_pose(const Joint& j, Mat3& R, Vec3& p) {
   std::array<double, 7> q{};
   visit_joint(j.type, [&]<class J>(J) {
     J::neutral(q.data());
-    J::pose(j, q.data(), R, p);
+    J::pose(j, q.data(), R, p);  // (its displacement d)
   });
+  p += j.p_pj;
 }
 
 // The joint's neutral configuration into q[0 .. nq): 0, or the identity rotation.

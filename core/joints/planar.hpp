@@ -16,10 +16,10 @@ struct PlanarJoint : FlatJoint<3> {
   static constexpr int nq = 3, nv = 3;
   static constexpr bool angular = true, linear = true;
 
-  static void pose(const Joint& j, const double* q, Mat3& R, Vec3& p) {
+  static void pose(const Joint& j, const double* q, Mat3& R, Vec3& d) {
     const double s = std::sin(q[2]), c = std::cos(q[2]);
     R = j.R_pj + s * j.R_pj_K + (1 - c) * j.R_pj_K2;
-    p = j.p_pj + q[0] * j.axis2_parent + q[1] * j.axis3_parent;
+    d = q[0] * j.axis2_parent + q[1] * j.axis3_parent;
   }
   static Vec3 S_angular(const Joint& j, int k) { return k == 2 ? j.axis : Vec3::Zero(); }
   static Vec3 S_linear(const Joint& j, int k) {

@@ -11,9 +11,9 @@ struct PrismaticJoint : FlatJoint<1> {
   static constexpr int nq = 1, nv = 1;
   static constexpr bool angular = false, linear = true;
 
-  static void pose(const Joint& j, const double* theta, Mat3& R, Vec3& p) {
+  static void pose(const Joint& j, const double* theta, Mat3& R, Vec3& d) {
     R = j.R_pj;
-    p = j.p_pj + j.axis_parent * theta[0];
+    d = j.axis_parent * theta[0];
   }
   static Vec3 S_angular(const Joint&, int) { return Vec3::Zero(); }
   static Vec3 S_linear(const Joint& j, int) { return j.axis; }

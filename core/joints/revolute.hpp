@@ -15,11 +15,12 @@ struct RevoluteJoint : FlatJoint<1> {
   static constexpr int nq = 1, nv = 1;
   static constexpr bool angular = true, linear = false;  // the non-zero halves of S
 
-  // B's orientation and origin in the parent's frame: R_pj R_J(θ), p_pj + R_pj p_J(θ).
-  static void pose(const Joint& j, const double* theta, Mat3& R, Vec3& p) {
+  // B's orientation in the parent's frame, R_pj R_J(θ), and its origin's displacement from the
+  // joint frame's, d = R_pj p_J(θ) (0: B's origin is the joint's).
+  static void pose(const Joint& j, const double* theta, Mat3& R, Vec3& d) {
     const double s = std::sin(theta[0]), c = std::cos(theta[0]);
     R = j.R_pj + s * j.R_pj_K + (1 - c) * j.R_pj_K2;
-    p = j.p_pj;
+    d.setZero();
   }
   static Vec3 S_angular(const Joint& j, int) { return j.axis; }
   static Vec3 S_linear(const Joint&, int) { return Vec3::Zero(); }

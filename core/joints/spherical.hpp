@@ -16,9 +16,9 @@ struct SphericalJoint {
   static constexpr int nq = 4, nv = 3;
   static constexpr bool angular = true, linear = false, flat = false;
 
-  static void pose(const Joint& j, const double* q, Mat3& R, Vec3& p) {
+  static void pose(const Joint& j, const double* q, Mat3& R, Vec3& d) {
     R = j.R_pj * quaternion_rotation(q);
-    p = j.p_pj;
+    d.setZero();
   }
   static Vec3 S_angular(const Joint&, int k) { return Vec3::Unit(k); }
   static Vec3 S_linear(const Joint&, int) { return Vec3::Zero(); }

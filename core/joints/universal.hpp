@@ -14,9 +14,9 @@ struct UniversalJoint : FlatJoint<2> {
   static constexpr int nq = 2, nv = 2;
   static constexpr bool angular = true, linear = false;
 
-  static void pose(const Joint& j, const double* theta, Mat3& R, Vec3& p) {
+  static void pose(const Joint& j, const double* theta, Mat3& R, Vec3& d) {
     R = j.R_pj * axis_rotation(j.axis, theta[0]) * axis_rotation(j.axis2, theta[1]);
-    p = j.p_pj;
+    d.setZero();
   }
   static Vec3 S_angular(const Joint& j, int k) { return k == 0 ? j.axis_parent : j.axis2; }
   static Vec3 S_linear(const Joint&, int) { return Vec3::Zero(); }

@@ -59,10 +59,15 @@ AssemblyReport assemble(const Model& model, Workspace& ws, ConstraintKinematics&
     report.rank = static_cast<int>(cod.rank());
     report.redundant = model.constraint_rows - report.rank;
   }
-  // Converged, or stalled at the round-off of the mechanism's size.
+  // Converged, or stalled at the round-off of the mechanism's size: its places measured from the
+  // reference point (Workspace::origin); a place on the world is known to within the round-off
+  // of its world position (ε |o|, below 1e-10 of the size 1e-4 |o|).
   double size = 1;
+  const auto extent = [&](const Attachment& a) {
+    return a.body < 0 ? std::max((a.p - ws.origin).norm(), 1e-4 * ws.origin.norm()) : a.p.norm();
+  };
   for (const LoopConstraint& c : model.constraints)
-    size = std::max({size, c.a.p.norm(), c.b.p.norm(), c.length});
+    size = std::max({size, extent(c.a), extent(c.b), c.length});
   if (report.residual > std::max(options.tolerance, 1e-10 * size))
     report.status = {false,
                      "the loops cannot close from this configuration: after " +

@@ -1,7 +1,11 @@
 #include "core/loops/constrained_dynamics.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <string>
 
+#include "core/arguments.hpp"
 #include "core/articulated.hpp"
 #include "core/equations.hpp"
 #include "core/kinematics.hpp"
@@ -45,7 +49,8 @@ Status cholesky_constraint_space(const Model& model, Workspace& ws, LoopWorkspac
   lws.tau_id = ws.tau;
   mass_matrix(model, ws, q);
   if (Status st = ws.solver.factorize(ws.Ms); !st.ok) return st;
-  lws.qdd0 = tau - lws.tau_id;
+  lws.qdd0 = -lws.tau_id;
+  if (tau.size()) lws.qdd0 += tau;  // (none: no actuation)
   ws.solver.solve_in_place(lws.qdd0);
   constraint_kinematics(model, ws, q, v, lws.k);
   factorize_constraint_space(model, ws, lws);
@@ -149,8 +154,51 @@ Status solve_constraint_space(const Model& model, LoopWorkspace& lws, double all
   return {};
 }
 
+Status closed_state(const Model& model, Workspace& ws, ConstraintKinematics& k, const VecX& q,
+                    const VecX& v) {
+  constraint_kinematics(model, ws, q, v, k);
+  double size = 1;
+  for (const LoopConstraint& c : model.constraints)
+    for (const Attachment* a : {&c.a, &c.b})
+      size = std::max(size, a->body < 0 ? (a->p - ws.origin).norm() : a->p.norm());
+  const VecX rate = k.J * v;
+  const double v_max = v.size() ? v.cwiseAbs().maxCoeff() : 0.0;
+  const double position_tol = kClosedStateTolerance * size,
+               velocity_tol = kClosedStateTolerance * size * std::max(1.0, v_max);
+  Eigen::Index row = 0;
+  const auto refuse = [&](const char* state, const char* what, double value, double tol) {
+    char value_text[32], tol_text[32];
+    std::snprintf(value_text, sizeof value_text, "%.3g", value);
+    std::snprintf(tol_text, sizeof tol_text, "%.3g", tol);
+    return Status{false,
+                  std::string(state) + ": " + what + " = " + value_text + " at constraint '" +
+                      constraint_row_name(model, static_cast<int>(row)) + "', above " + tol_text +
+                      " (the closed mechanism's equations hold only on them: assemble the state "
+                      "first, as simulate does)",
+                  -1};
+  };
+  if (k.phi.size() && k.phi.cwiseAbs().maxCoeff(&row) > position_tol)
+    return refuse("q does not close the loops", "|Φ(q)|", std::abs(k.phi[row]), position_tol);
+  if (rate.size() && rate.cwiseAbs().maxCoeff(&row) > velocity_tol)
+    return refuse("q̇ does not keep the loops closed", "|Φ_q q̇|", std::abs(rate[row]), velocity_tol);
+  return {};
+}
+
+Status mechanism_forward_dynamics(const Model& model, Workspace& ws, LoopWorkspace* lws,
+                                  const VecX& q, const VecX& v, const VecX& tau) {
+  if (model.constraints.empty()) return forward_dynamics(model, ws, q, v, tau);
+  require_state(model, "mechanism_forward_dynamics", q, &v);
+  if (!lws)
+    throw ArgumentError("mechanism_forward_dynamics: the model '" + model.name +
+                        "' has closed loops and no LoopWorkspace was given");
+  if (Status st = closed_state(model, ws, lws->k, q, v); !st.ok) return st;
+  return constrained_forward_dynamics(model, ws, *lws, q, v, tau, 0);
+}
+
 Status constrained_forward_dynamics(const Model& model, Workspace& ws, LoopWorkspace& lws,
                                     const VecX& q, const VecX& v, const VecX& tau, double omega) {
+  require_state(model, "constrained_forward_dynamics", q, &v);
+  require_size(model, "constrained_forward_dynamics", "tau", tau, ArgumentKind::Actuation);
   if (Status st = lws.constraint_space(model, ws, lws, q, v, tau); !st.ok) return st;
   // r = −(Φ̇_q v + Φ_q q̈₀) − (2ω Φ_q v + ω² Φ), the second part Baumgarte's
   lws.stabilization.noalias() = 2 * omega * lws.k.J * v;

@@ -59,6 +59,22 @@ inline constexpr double kConsistencyTolerance = 1e-3;  // |S λ − r| relative 
 Status constrained_forward_dynamics(const Model& model, Workspace& ws, LoopWorkspace& lws,
                                     const VecX& q, const VecX& v, const VecX& tau, double omega);
 
+// q̈ of the mechanism the model describes, at a state as given — the answer of every door that
+// takes one state (`femdyn equations`, the Python module's equations and forward dynamics, single
+// and batch): the tree's forward_dynamics without loops; with loops, the constrained equations
+// at ω = 0 (Φ̈ = 0, λ into lws->lambda), after closed_state has found the state on them. `lws`
+// may be null only on a model without constraints.
+Status mechanism_forward_dynamics(const Model& model, Workspace& ws, LoopWorkspace* lws,
+                                  const VecX& q, const VecX& v, const VecX& tau);
+
+// Whether (q, v) is a state of the closed mechanism: |Φ(q)|∞ ≤ kClosedStateTolerance L and
+// |Φ_q v|∞ ≤ kClosedStateTolerance L max(1, |v|∞), L ≥ 1 m the size of the constraints' places
+// (assembly's); else a failure naming the constraint row and the residual, and the way onto the
+// loops. Leaves Φ and Φ_q in k.
+inline constexpr double kClosedStateTolerance = 1e-6;
+Status closed_state(const Model& model, Workspace& ws, ConstraintKinematics& k, const VecX& q,
+                    const VecX& v);
+
 // S's pivoted Cholesky factor into lws.F, lws.perm, lws.rank.
 void pivoted_cholesky(LoopWorkspace& lws);
 // After a factorisation of M^s in ws.solver and Φ_q in lws.k.J: Y and S, and S factorised.

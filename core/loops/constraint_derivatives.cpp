@@ -36,7 +36,7 @@ void place_derivatives(const Model& m, const Workspace& ws, const DerivativeWork
   P.body = at.body;
   if (at.body < 0) {  // the world: fixed
     P.R = at.R;
-    P.x = at.p;
+    P.x = at.p - ws.origin;  // from the reference point (Workspace::origin)
     P.x_dot.setZero(), P.x_ddot.setZero(), P.w.setZero(), P.alpha.setZero();
     P.path.clear();
     return;

@@ -81,7 +81,7 @@ def test_assembly_and_constrained_dynamics(fourbar):
     r = fourbar.constrained_dynamics(q, qd, tau)
     # Φ_q q̈ + Φ̇_q v = 0, and M q̈ + h = Q(τ) + Φ_qᵀ λ (inverse dynamics gives τ + Φ_qᵀ λ back).
     assert np.abs(k["J"] @ r["qdd"] + k["bias"]).max() < 1e-9 * np.abs(k["J"] @ r["qdd"]).max()
-    back = fourbar.inverse_dynamics(q, qd, r["qdd"])
+    back = fourbar.inverse_dynamics(q, qd, r["qdd"], tree=True)
     assert np.allclose(back, tau + k["J"].T @ r["lambda"], rtol=0, atol=1e-10)
     assert np.allclose(r["constraint_forces"], k["J"].T @ r["lambda"], rtol=0, atol=1e-14)
 

@@ -1,0 +1,97 @@
+"""One truth (docs/robustness.md#one-truth): the same model and state give the same answer from
+every call, or a clear refusal."""
+import numpy as np
+import pytest
+
+import femdyn
+from conftest import cli_json, model_path, numbers
+
+
+def rel(a, b):
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    return float(np.max(np.abs(a - b)) / max(1e-300, float(np.max(np.abs(b)))))
+
+
+@pytest.mark.parametrize("name", ["models/space_robot.json", "models/urdf/arm7.urdf"])
+def test_mass_matrix_and_bias_take_the_configuration(name):
+    """mass_matrix(q) and bias(q, qd) take q (n_q, quaternions) as every other call does, and give
+    equations()'s M and h."""
+    m = femdyn.load(model_path(name), floating_base=name.endswith(".urdf"))
+    rng = np.random.default_rng(43)
+    q = m.neutral_configuration()
+    q[:3] = rng.uniform(-1, 1, 3)
+    if m.n_q != m.n:  # a quaternion: a random unit one
+        w = rng.normal(size=4)
+        q[3:7] = w / np.linalg.norm(w)
+    q[m.n_q - m.n + 6:] += rng.uniform(-0.5, 0.5, m.n - 6)
+    qd = rng.uniform(-1, 1, m.n)
+    eq = m.equations(q, qd)
+    assert np.array_equal(m.mass_matrix(q), eq.M)
+    assert np.array_equal(m.bias(q, qd), eq.h)
+    with pytest.raises(ValueError, match=rf"q: expected shape \({m.n_q},\)"):
+        m.mass_matrix(q[:m.n])
+    with pytest.raises(ValueError, match=rf"q: expected shape \({m.n_q},\)"):
+        m.bias(q[:m.n], qd)
+
+
+def test_builder_refuses_an_axis_on_a_ball_or_free_joint():
+    for kind in ("spherical", "free"):
+        b = femdyn.Builder("x")
+        with pytest.raises(ValueError, match="takes no axis"):
+            b.body("l", type=kind, axis=[0, 0, 1])
+
+
+def closed_chain():
+    """A planar 2-link chain whose tip is held on the world by a ball (in the plane): a four-bar
+    with the ground as its fourth bar, driven at both joints."""
+    b = femdyn.Builder("held")
+    b.body("l1", type="revolute", axis=[0, 0, 1])
+    b.rigid_body("l1", 1.0, [0.5, 0, 0], np.diag([0.01, 0.1, 0.1]))
+    b.body("l2", "l1", type="revolute", axis=[0, 0, 1], xyz=[1, 0, 0])
+    b.rigid_body("l2", 1.0, [0.5, 0, 0], np.diag([0.01, 0.1, 0.1]))
+    b.body("l3", "l2", type="revolute", axis=[0, 0, 1], xyz=[1, 0, 0])
+    b.rigid_body("l3", 1.0, [0.5, 0, 0], np.diag([0.01, 0.1, 0.1]))
+    b.constraint("ball", name="tip", a={"body": "l3", "xyz": [1, 0, 0]},
+                 b={"body": "world", "xyz": [2.2, 0.9, 0]}, normal=[0, 0, 1])
+    return b.build()
+
+
+def test_every_door_gives_the_closed_mechanism_its_own_qdd():
+    m = closed_chain()
+    s = m.assemble(np.array([0.9, -0.8, -0.6]), np.array([0.7, 0.0, 0.0]))
+    q, qd, tau = s["q"], s["qd"], np.array([0.2, -0.1, 0.3])
+    ref = m.constrained_dynamics(q, qd, tau)
+    assert np.array_equal(m.forward_dynamics(q, qd, tau), ref["qdd"])
+    assert np.array_equal(m.equations(q, qd, tau).qdd, ref["qdd"])
+    batch = m.forward_dynamics_batch(np.stack([q, q]), np.stack([qd, qd]), np.stack([tau, tau]))
+    assert np.array_equal(batch[0], ref["qdd"]) and np.array_equal(batch[1], ref["qdd"])
+    eqb = m.equations_batch(np.stack([q]), np.stack([qd]), np.stack([tau]))
+    assert np.array_equal(eqb["qdd"][0], ref["qdd"])
+    # The tip stays held: Φ_q q̈ + Φ̇_q q̇ = 0.
+    k = m.constraint_kinematics(q, qd)
+    assert np.abs(k["J"] @ ref["qdd"] + k["bias"]).max() < 1e-10
+    # Off the loops: refused, naming the constraint.
+    with pytest.raises(femdyn.NumericalError, match="does not close the loops.*tip"):
+        m.forward_dynamics(q + 0.1, qd, tau)
+    assert m.equations(q + 0.1, qd, tau).qdd is None
+    # Inverse dynamics: τ is not unique on a closed mechanism; the tree's on request.
+    with pytest.raises(femdyn.ModelError, match="closed loops"):
+        m.inverse_dynamics(q, qd, ref["qdd"])
+    with pytest.raises(femdyn.ModelError, match="closed loops"):
+        m.inverse_dynamics_batch(np.stack([q]), np.stack([qd]), np.stack([ref["qdd"]]))
+    back = m.inverse_dynamics(q, qd, ref["qdd"], tree=True)
+    assert rel(back, tau + ref["constraint_forces"]) < 1e-10
+
+
+def test_the_cli_and_the_module_agree_on_a_closed_mechanism(tmp_path):
+    path = model_path("models/five_bar.json")
+    m = femdyn.load(path)
+    cli = cli_json("equations", path, "--json")  # the neutral configuration, assembled
+    q, qd = np.array(cli["q"]), np.array(cli["qd"])
+    assert np.abs(m.constraint_kinematics(q)["phi"]).max() < 1e-10
+    eq = m.equations(q, qd)
+    assert np.array_equal(eq.M, np.array(cli["M"])) and np.array_equal(eq.qdd, cli["qdd"])
+    r = m.constrained_dynamics(q, qd)
+    assert np.array_equal(r["lambda"], cli["lambda"])
+    again = cli_json("equations", path, f"--q={numbers(q)}", f"--qd={numbers(qd)}", "--json")
+    assert np.array_equal(again["qdd"], cli["qdd"])
