@@ -10,6 +10,7 @@
 #include "core/names.hpp"
 #include "io/actuation_table.hpp"
 #include "python/py_model.hpp"
+#include "python/run_stats.hpp"
 #include "sim/integrator.hpp"
 #include "sim/recorded_run.hpp"
 
@@ -186,51 +187,10 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
   stats["wall_time"] = run.wall_time;
   stats["integration_time"] = s.wall_time;
   stats["real_time_factor"] = s.wall_time > 0 ? integ->t() / s.wall_time : 0.0;
-  stats["conservative"] = is_conservative;
-  stats["energy_initial"] = run.initial.total();
-  stats["energy_balance_error"] = run.max_balance;
-  stats["energy_scale"] = run.scale;
-  stats["energy_balance_relative"] = run.relative_balance();
   stats["ok"] = st.ok;
   stats["diverged"] = st.diverged;
-  py::list crossings;
-  for (const LimitCrossing& c : run.limit_crossings) {
-    py::dict x;
-    x["joint"] = c.name;
-    x["t"] = c.t;
-    x["value"] = c.value;
-    x["lower"] = c.lower;
-    x["upper"] = c.upper;
-    crossings.append(x);
-  }
-  stats["limit_crossings"] = crossings;
-  py::list too_fast;
-  for (const VelocityExcess& v : run.velocity_excesses) {
-    py::dict x;
-    x["joint"] = v.name;
-    x["t"] = v.t;
-    x["value"] = v.value;
-    x["limit"] = v.limit;
-    too_fast.append(x);
-  }
-  stats["velocity_excesses"] = too_fast;
-  py::list saturated;
-  for (const EffortSaturation& e : run.saturations) {
-    py::dict x;
-    x["coordinate"] = e.name;
-    x["limit"] = e.limit;
-    x["evaluations"] = e.evaluations;
-    saturated.append(x);
-  }
-  stats["saturations"] = saturated;
-  stats["saturated_evaluations"] = run.saturated_evaluations;
-  stats["saturated_steps"] = run.saturated_steps;
-  stats["unapplied_effort_limits"] = run.unapplied_effort_limits;
   stats["failure"] = st.message;
-  if (!m.constraints.empty()) {  // closed loops: the largest residuals over the rows
-    stats["max_position_residual"] = run.max_position_residual;
-    stats["max_velocity_residual"] = run.max_velocity_residual;
-  }
+  put_run_stats(stats, m, run, is_conservative);
   py::dict d;
   d["t"] = vector_array(rows.t);
   d["q"] = q;

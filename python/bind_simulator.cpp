@@ -9,6 +9,7 @@
 
 #include "core/memory.hpp"
 #include "python/py_model.hpp"
+#include "python/run_stats.hpp"
 #include "sim/control_loop.hpp"
 
 namespace femdyn::python {
@@ -70,7 +71,7 @@ void tau_of(const py::handle& value, const Model& m, double t, VecX& tau) {
 // saturated at the joints' effort limits.
 struct Rows {
   std::vector<double> t, q, qd, tau, work, total;
-  void add(const ControlLoop& loop, Motion& motion, VecX tau_k) {
+  void add(const ControlLoop& loop, Motion& motion, VecX tau_k, const Energy& E) {
     const Integrator& i = loop.integrator();
     if (const Model& m = motion.model(); m.has_effort_limits)
       tau_k = tau_k.cwiseMax(-m.effort_limit).cwiseMin(m.effort_limit);
@@ -80,7 +81,7 @@ struct Rows {
     qd.insert(qd.end(), qd_now.data(), qd_now.data() + qd_now.size());
     tau.insert(tau.end(), tau_k.data(), tau_k.data() + tau_k.size());
     work.push_back(i.work());
-    total.push_back(motion.energy_at(i.y().data()).total());
+    total.push_back(E.total());
   }
 };
 
@@ -171,22 +172,26 @@ class Simulator {
       });
     const auto begin = std::chrono::steady_clock::now();
     const IntegratorStats before = integ.stats();
-    const long saturated_before = integ.motion().saturated_evaluations();
     const long k_before = loop_->period_index();
+    // The run's summary, as femdyn.simulate's (python/run_stats.hpp): a row a period.
+    RunWatch watch(integ);
     Rows rows;
     Status st;
     while (integ.t() < t_end - 1e-9 * T) {
       call(integ.t(), integ.q(), integ.qd(), tau);  // τ_k (in evaluation mode: the row's)
       ++calls;
-      rows.add(*loop_, integ.motion(), tau);
+      rows.add(*loop_, integ.motion(), tau, watch.at_row(integ));
       if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C
       {
         py::gil_scoped_release release;
         st = hold ? loop_->step(tau) : loop_->step();
       }
       if (!st.ok) break;
+      watch.after_step(integ);
     }
-    rows.add(*loop_, integ.motion(), tau);  // the end: τ the last held (ZOH's left limit)
+    // The end: τ the last held (ZOH's left limit).
+    rows.add(*loop_, integ.motion(), tau, watch.at_row(integ));
+    watch.finish(integ);
     if (!st.ok && check) throw NumericalError(st.message);
     const IntegratorStats& s = integ.stats();
     py::dict stats;
@@ -198,7 +203,6 @@ class Simulator {
     stats["steps"] = s.steps - before.steps;
     stats["rejected"] = s.rejected - before.rejected;
     stats["rhs_evals"] = s.rhs_evals - before.rhs_evals;
-    stats["saturated_evaluations"] = integ.motion().saturated_evaluations() - saturated_before;
     stats["integration_time"] = s.wall_time - before.wall_time;
     stats["wall_time"] =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
@@ -206,6 +210,7 @@ class Simulator {
     stats["ok"] = st.ok;
     stats["diverged"] = st.diverged;
     stats["failure"] = st.message;
+    put_run_stats(stats, m, watch.run(), false);  // (a controller acts)
     py::dict d;
     d["t"] = table(rows.t, 0);
     d["q"] = table(rows.q, m.n_q());

@@ -9,8 +9,6 @@
 
 namespace femdyn {
 
-namespace {
-
 // Joints with finite limits, checked after every step; each reported once.
 class LimitWatch {
  public:
@@ -57,44 +55,72 @@ class LimitWatch {
   std::vector<int> limited_, fast_;
 };
 
-}  // namespace
+RunWatch::RunWatch(Integrator& integ)
+    : initial_scale_(integ.divergence().initial_scale()),
+      limits_(std::make_unique<LimitWatch>(integ.motion().model())),
+      saturated_before_(integ.motion().saturated_evaluations()),
+      saturations_before_(integ.motion().saturations()) {
+  run_.initial = integ.divergence().initial();  // E(0), as reset() evaluated it
+  run_.scale = initial_scale_;
+  limits_->look(integ.t(), integ.q(), integ.qd(), run_.limit_crossings, run_.velocity_excesses);
+}
+
+RunWatch::~RunWatch() = default;
+
+void RunWatch::after_step(Integrator& integ) {
+  if (integ.motion().saturated_at(integ.t())) ++run_.saturated_steps;
+  limits_->look(integ.t(), integ.q(), integ.qd(), run_.limit_crossings, run_.velocity_excesses);
+}
+
+Energy RunWatch::at_row(Integrator& integ) {
+  const Energy E = integ.motion().energy_at(integ.y().data());
+  run_.max_balance =
+      std::max(run_.max_balance, std::abs(E.total() - run_.initial.total() - integ.work()));
+  run_.scale = std::max(run_.scale, initial_scale_ + std::abs(integ.work()));
+  if (integ.motion().constrained()) {
+    const Motion::ConstraintResidual c = integ.motion().constraint_residual(integ.y().data());
+    run_.max_position_residual = std::max(run_.max_position_residual, c.position);
+    run_.max_velocity_residual = std::max(run_.max_velocity_residual, c.velocity);
+  }
+  ++run_.rows;
+  return E;
+}
+
+void RunWatch::finish(Integrator& integ) {
+  const Model& model = integ.motion().model();
+  run_.unapplied_effort_limits.clear();
+  for (const Body& b : model.bodies)
+    if (std::isfinite(b.joint.effort_limit) &&
+        std::none_of(model.coordinate_joints.begin(), model.coordinate_joints.end(),
+                     [&](const CoordinateJoint& c) { return &model.bodies[c.body] == &b; }))
+      run_.unapplied_effort_limits.push_back(b.joint.name);
+  const Motion& motion = integ.motion();
+  run_.saturated_evaluations = motion.saturated_evaluations() - saturated_before_;
+  run_.saturations.clear();
+  for (int i = 0; i < model.n(); ++i)
+    if (const long k = motion.saturations()[i] - saturations_before_[i]; k > 0)
+      run_.saturations.push_back({model.coordinate_names[i], model.effort_limit[i], k});
+}
 
 RecordedRun run_recorded(Integrator& integ, double t_end, long every,
                          const std::vector<double>* times,
                          const std::function<void(const Integrator&, const Energy&)>& row,
                          const std::function<bool(double t)>& stop) {
-  RecordedRun r;
-  r.initial = integ.divergence().initial();  // E(0), as reset() evaluated it
-  const double S0 = integ.divergence().initial_scale();
-  r.scale = S0;
+  RunWatch watch(integ);
+  RecordedRun& r = watch.run();
   if (Status plan = integ.plan(times ? (times->empty() ? integ.t() : times->back()) : t_end);
       !plan.ok) {
     r.status = plan;
     r.refused = true;
     return r;
   }
-  const Model& model = integ.motion().model();
-  LimitWatch limits(model);
-  limits.look(integ.t(), integ.q(), integ.qd(), r.limit_crossings, r.velocity_excesses);
-  const auto output = [&] {
-    const Energy E = integ.motion().energy_at(integ.y().data());
-    r.max_balance = std::max(r.max_balance, std::abs(E.total() - r.initial.total() - integ.work()));
-    r.scale = std::max(r.scale, S0 + std::abs(integ.work()));
-    if (integ.motion().constrained()) {
-      const Motion::ConstraintResidual c = integ.motion().constraint_residual(integ.y().data());
-      r.max_position_residual = std::max(r.max_position_residual, c.position);
-      r.max_velocity_residual = std::max(r.max_velocity_residual, c.velocity);
-    }
-    row(integ, E);
-    ++r.rows;
-  };
+  const auto output = [&] { row(integ, watch.at_row(integ)); };
   const auto begin = std::chrono::steady_clock::now();
   if (times) {
     for (double t : *times) {
       if (t > integ.t()) r.status = integ.advance_to(t);
       if (!r.status.ok) break;
-      if (integ.motion().saturated_at(integ.t())) ++r.saturated_steps;
-      limits.look(integ.t(), integ.q(), integ.qd(), r.limit_crossings, r.velocity_excesses);
+      watch.after_step(integ);
       output();
       if ((r.interrupted = stop(integ.t()))) break;
     }
@@ -103,24 +129,13 @@ RecordedRun run_recorded(Integrator& integ, double t_end, long every,
     for (long step = 1; integ.t() < t_end; ++step) {
       r.status = integ.step();
       if (!r.status.ok) break;
-      if (integ.motion().saturated_at(integ.t())) ++r.saturated_steps;
-      limits.look(integ.t(), integ.q(), integ.qd(), r.limit_crossings, r.velocity_excesses);
+      watch.after_step(integ);
       if (step % every == 0 || integ.t() >= t_end) output();
       if ((r.interrupted = stop(integ.t()))) break;
     }
   }
   r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-  for (const Body& b : model.bodies)
-    if (std::isfinite(b.joint.effort_limit) &&
-        std::none_of(model.coordinate_joints.begin(), model.coordinate_joints.end(),
-                     [&](const CoordinateJoint& c) { return &model.bodies[c.body] == &b; }))
-      r.unapplied_effort_limits.push_back(b.joint.name);
-  const Motion& motion = integ.motion();
-  r.saturated_evaluations = motion.saturated_evaluations();
-  for (int i = 0; i < model.n(); ++i)
-    if (motion.saturations()[i] > 0)
-      r.saturations.push_back(
-          {model.coordinate_names[i], model.effort_limit[i], motion.saturations()[i]});
+  watch.finish(integ);
   return r;
 }
 

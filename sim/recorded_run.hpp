@@ -11,6 +11,7 @@
 // that exceed their velocity limit. τ saturated at effort limits is counted (sim/motion.hpp).
 #pragma once
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "core/equations.hpp"
@@ -59,6 +60,33 @@ struct RecordedRun {
   double max_position_residual = 0, max_velocity_residual = 0;
   long rows = 0;
   double wall_time = 0;  // s, the whole loop (rows included)
+};
+
+class LimitWatch;
+
+// What a run watches, whoever drives the integrator (run_recorded below; the Python Simulator's
+// controller loop, python/bind_simulator.cpp): the energy balance and the loops' residuals at each
+// row, limit crossings, velocity excesses and saturated steps after each step, and the effort
+// saturations since the watch began. One summary for every door (the CLI's and the Python
+// module's stats: python/run_stats.hpp).
+class RunWatch {
+ public:
+  explicit RunWatch(Integrator& integ);  // E(0) the integrator's reset; counts from now
+  ~RunWatch();
+  RunWatch(const RunWatch&) = delete;
+  RunWatch& operator=(const RunWatch&) = delete;
+  void after_step(Integrator& integ);
+  Energy at_row(Integrator& integ);  // E at the row, into the balance
+  // The saturations since the start and the effort limits no τ acts on.
+  void finish(Integrator& integ);
+  RecordedRun& run() { return run_; }
+
+ private:
+  RecordedRun run_;
+  double initial_scale_ = 0;
+  std::unique_ptr<LimitWatch> limits_;
+  long saturated_before_ = 0;
+  std::vector<long> saturations_before_;
 };
 
 // `times` null: rows every `every` steps, the last one at t_end exactly; else a row at each of

@@ -95,3 +95,38 @@ def test_the_cli_and_the_module_agree_on_a_closed_mechanism(tmp_path):
     assert np.array_equal(r["lambda"], cli["lambda"])
     again = cli_json("equations", path, f"--q={numbers(q)}", f"--qd={numbers(qd)}", "--json")
     assert np.array_equal(again["qdd"], cli["qdd"])
+
+
+def test_simulator_run_reports_what_simulate_reports():
+    """Simulator.run's stats carry simulate's run summary: the energy balance, limit crossings,
+    velocity excesses and effort saturations (one RecordedRun for both, sim/recorded_run.hpp)."""
+    arm = femdyn.load(model_path("models/urdf/arm7.urdf"))
+    push = np.zeros(arm.n)
+    push[1] = 400.0  # far beyond the joint's effort limit (100 N m): saturated at it
+    sim = femdyn.Simulator(arm, integrator="rk4", dt=1e-3)
+    r = sim.run(lambda t, q, qd: push, 0.5)
+    s = r["stats"]
+    ref = femdyn.simulate(arm, 0.5, integrator="rk4", dt=1e-3, tau=push)["stats"]
+    for key in ("energy_balance_relative", "energy_initial", "limit_crossings",
+                "velocity_excesses", "saturations", "saturated_evaluations", "saturated_steps",
+                "unapplied_effort_limits"):
+        assert key in s, key
+    # The same motion: a held constant τ is simulate's constant τ.
+    assert [e["joint"] for e in s["velocity_excesses"]] == \
+        [e["joint"] for e in ref["velocity_excesses"]]
+    assert s["velocity_excesses"] and s["velocity_excesses"][0]["limit"] == 1.7
+    assert s["saturations"][0]["evaluations"] == ref["saturations"][0]["evaluations"]
+    assert [c["joint"] for c in s["limit_crossings"]] == [c["joint"] for c in ref["limit_crossings"]]
+    # The energy balance over the same rows (a row a period, a step a period): the same figure.
+    assert s["energy_balance_relative"] == pytest.approx(ref["energy_balance_relative"], rel=1e-6)
+    # A second run counts its own saturations only.
+    s2 = sim.run(lambda t, q, qd: np.zeros(arm.n), 0.6)["stats"]
+    assert s2["saturated_evaluations"] == 0 and s2["saturations"] == []
+
+
+def test_simulator_run_on_closed_loops_reports_the_residuals():
+    m = closed_chain()
+    s = m.assemble(np.array([0.9, -0.8, -0.6]))
+    sim = femdyn.Simulator(m, integrator="rk4", dt=1e-3, q0=s["q"])
+    st = sim.run(lambda t, q, qd: np.zeros(m.n), 0.2)["stats"]
+    assert st["ok"] and st["max_position_residual"] < 1e-6 and st["max_velocity_residual"] < 1e-6
