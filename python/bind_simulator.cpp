@@ -155,9 +155,17 @@ class Simulator {
                    bytes, 0,
                    "a shorter run (several run() calls), or " + set_max_memory_text(bytes));
     VecX tau = VecX::Zero(m.n());
+    // The controller's largest output of the run: the suspect a divergence report names.
+    struct Largest {
+      double value = 0, t = 0;
+      Eigen::Index i = -1;
+    } largest;
     // The controller at the current state, into tau (the GIL held).
     const auto call = [&](double t, const VecX& q, const VecX& qd, VecX& out) {
       tau_of(controller(t, copy_array(q), copy_array(qd)), m, t, out);
+      Eigen::Index i = 0;
+      if (out.size() && out.cwiseAbs().maxCoeff(&i) > std::abs(largest.value))
+        largest = {out[i], t, i};
     };
     struct Unset {  // the Python controller leaves the loop with the run, whatever happens
       ControlLoop& loop;
@@ -192,6 +200,10 @@ class Simulator {
     // The end: τ the last held (ZOH's left limit).
     rows.add(*loop_, integ.motion(), tau, watch.at_row(integ));
     watch.finish(integ);
+    if (!st.ok && st.diverged && largest.i >= 0)  // the controller drove it: say how hard
+      st.message += "; the controller's largest output in this run: tau of '" +
+                    m.coordinate_names[largest.i] + "' = " + format_short(largest.value) +
+                    " at t = " + format_short(largest.t) + " s";
     if (!st.ok && check) throw NumericalError(st.message);
     const IntegratorStats& s = integ.stats();
     py::dict stats;

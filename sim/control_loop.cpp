@@ -4,6 +4,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/limits.hpp"
+
 namespace femdyn {
 
 std::string ControlLoopOptions::check() const {
@@ -17,8 +19,11 @@ std::string tau_problem(const Model& model, const VecX& tau) {
   const int n = model.n();
   if (tau.size() != n)
     return "tau has " + std::to_string(tau.size()) + " entries, expected " + std::to_string(n);
-  for (int i = 0; i < n; ++i)
+  for (int i = 0; i < n; ++i) {
     if (!std::isfinite(tau[i])) return "tau is NaN or Inf (" + model.coordinate_names[i] + ")";
+    if (std::abs(tau[i]) > kMaxMagnitude)  // as --tau and every physical input (core/limits.hpp)
+      return "tau of '" + model.coordinate_names[i] + "' " + out_of_range_text(tau[i]);
+  }
   return {};
 }
 

@@ -92,7 +92,8 @@ class ControlLoop {
   bool was_held_ = true;         // the last period held τ (a switch of mode is a jump in τ)
 };
 
-// "tau has 3 entries, expected 4" or "tau is NaN or Inf (mcp)"; "" when τ is usable.
+// "tau has 3 entries, expected 4", "tau is NaN or Inf (mcp)" or "tau of 'mcp' 1e+200 is out of
+// range (…)" (beyond kMaxMagnitude, as --tau); "" when τ is usable.
 std::string tau_problem(const Model& model, const VecX& tau);
 
 }  // namespace femdyn

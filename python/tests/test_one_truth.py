@@ -130,3 +130,19 @@ def test_simulator_run_on_closed_loops_reports_the_residuals():
     sim = femdyn.Simulator(m, integrator="rk4", dt=1e-3, q0=s["q"])
     st = sim.run(lambda t, q, qd: np.zeros(m.n), 0.2)["stats"]
     assert st["ok"] and st["max_position_residual"] < 1e-6 and st["max_velocity_residual"] < 1e-6
+
+
+def test_a_diverging_controller_is_named_and_a_huge_tau_refused():
+    """A run that a controller drives to divergence names the controller's largest output (the
+    suspect); a τ beyond ±1e100, the bound of --tau and of every physical input, is refused."""
+    finger = femdyn.load(model_path("models/finger.json"))
+    q0 = np.array([0.1, 0.4, 0.3, 0.2])
+    sim = femdyn.Simulator(finger, dt=1e-3, q0=q0)
+    with pytest.raises(femdyn.NumericalError,
+                       match=r"diverges.*controller's largest output in this run: tau of '\w+'"):
+        sim.run(lambda t, q, qd: -1e4 * q, 1.0)
+    sim.reset(q0)
+    with pytest.raises(ValueError, match=r"tau of 'abduction' 1e\+200 is out of range"):
+        sim.run(lambda t, q, qd: np.array([1e200, 0, 0, 0]), 0.1)
+    with pytest.raises(ValueError, match=r"tau: entry 2 \('pip'\) 1e\+101 is out of range"):
+        sim.step(np.array([0, 0, 1e101, 0]))
