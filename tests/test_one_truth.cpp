@@ -510,7 +510,7 @@ TEST_CASE("smaller seams: info counts joints as joints; loops that cannot close 
                    "inertia": {"ixx": 0.01, "iyy": 0.1, "izz": 0.1}}]}],
     "constraints": [{"name": "pin", "type": "ball", "a": {"body": "l", "xyz": [1, 0, 0]},
                      "b": {"body": "world", "xyz": [3, 0, 0]}, "normal": [0, 0, 1]}]})";
-  for (const std::string command :
+  for (const std::string& command :
        {"simulate " + file + " --t-end 0.1", "linearize " + file, "equations " + file}) {
     const Run r = run(command);
     INFO(command << ": " << r.out);
