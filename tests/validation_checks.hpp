@@ -13,8 +13,8 @@ inline validation::ValidationOptions quick(int states = 8, double t_end = 0.1) {
   o.t_end = t_end;
 #ifdef FEMDYN_SANITIZED
   // The budget guards a user's wall clock; these checks are about agreement. Under ASan + UBSan
-  // the work runs several times slower (Andrews' trajectory is estimated at 2.1 min there, 8 s
-  // in Release), and with the other test of ctest -j2 beside it crossed the default 120 s.
+  // the work runs several times slower (Andrews' whole validation is estimated at 2.1 min there,
+  // 22 s in Release), and with the other test of ctest -j2 beside it crossed the default 120 s.
   o.budget *= 5;
 #endif
   return o;
