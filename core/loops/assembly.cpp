@@ -1,5 +1,6 @@
 #include "core/loops/assembly.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <limits>
 
@@ -59,15 +60,16 @@ AssemblyReport assemble(const Model& model, Workspace& ws, ConstraintKinematics&
     report.rank = static_cast<int>(cod.rank());
     report.redundant = model.constraint_rows - report.rank;
   }
-  // Converged, or stalled at the round-off of the mechanism's size: its places measured from the
-  // reference point (Workspace::origin); a place on the world is known to within the round-off
-  // of its world position (ε |o|, below 1e-10 of the size 1e-4 |o|).
-  double size = 1;
-  const auto extent = [&](const Attachment& a) {
-    return a.body < 0 ? std::max((a.p - ws.origin).norm(), 1e-4 * ws.origin.norm()) : a.p.norm();
-  };
-  for (const LoopConstraint& c : model.constraints)
-    size = std::max({size, extent(c.a), extent(c.b), c.length});
+  // Converged, or stalled at the round-off of the mechanism's size (loop_size, and the distances'
+  // lengths); a place on the world is known to within the round-off of its world position
+  // (ε |o|, below 1e-10 of the size 1e-4 |o|).
+  double size = loop_size(model, ws.origin);
+  const bool on_world =
+      std::any_of(model.constraints.begin(), model.constraints.end(), [](const LoopConstraint& c) {
+        return c.type != ConstraintType::Gear && (c.a.body < 0 || c.b.body < 0);
+      });
+  if (on_world) size = std::max(size, 1e-4 * ws.origin.norm());
+  for (const LoopConstraint& c : model.constraints) size = std::max(size, c.length);
   if (report.residual > std::max(options.tolerance, 1e-10 * size))
     report.status = {false,
                      "the loops cannot close from this configuration: after " +

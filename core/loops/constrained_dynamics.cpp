@@ -154,13 +154,20 @@ Status solve_constraint_space(const Model& model, LoopWorkspace& lws, double all
   return {};
 }
 
+double loop_size(const Model& model, const Vec3& origin) {
+  double size = 1;
+  for (const LoopConstraint& c : model.constraints) {
+    if (c.type == ConstraintType::Gear) continue;  // (joints, no places)
+    for (const Attachment* a : {&c.a, &c.b})
+      size = std::max(size, a->body < 0 ? (a->p - origin).norm() : a->p.norm());
+  }
+  return size;
+}
+
 Status closed_state(const Model& model, Workspace& ws, ConstraintKinematics& k, const VecX& q,
                     const VecX& v) {
   constraint_kinematics(model, ws, q, v, k);
-  double size = 1;
-  for (const LoopConstraint& c : model.constraints)
-    for (const Attachment* a : {&c.a, &c.b})
-      size = std::max(size, a->body < 0 ? (a->p - ws.origin).norm() : a->p.norm());
+  const double size = loop_size(model, ws.origin);
   const VecX rate = k.J * v;
   const double v_max = v.size() ? v.cwiseAbs().maxCoeff() : 0.0;
   const double position_tol = kClosedStateTolerance * size,

@@ -67,6 +67,11 @@ Status constrained_forward_dynamics(const Model& model, Workspace& ws, LoopWorks
 Status mechanism_forward_dynamics(const Model& model, Workspace& ws, LoopWorkspace* lws,
                                   const VecX& q, const VecX& v, const VecX& tau);
 
+// L, the size of the loops: the largest distance of a constraint's place (gears have none) from
+// its body's origin, or, on the world, from the reference point `origin` (Workspace::origin of
+// the last propagate), and at least 1 m. The scale of Φ's round-off (assemble, closed_state).
+double loop_size(const Model& model, const Vec3& origin);
+
 // Whether (q, v) is a state of the closed mechanism: |Φ(q)|∞ ≤ kClosedStateTolerance L and
 // |Φ_q v|∞ ≤ kClosedStateTolerance L max(1, |v|∞), L ≥ 1 m the size of the constraints' places
 // (assembly's); else a failure naming the constraint row and the residual, and the way onto the
