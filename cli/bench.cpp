@@ -45,7 +45,7 @@ namespace {
 namespace fv = femdyn::validation;
 using Clock = std::chrono::steady_clock;
 
-constexpr const char* kHelp =
+constexpr const char* kBenchHelp =
     R"(usage: femdyn bench MODEL [--json] [--quick] [--states N] [--gravity gx,gy,gz]
 
 Times femdyn's equations of motion against the model's Simbody twin (the one femdyn validate
@@ -450,7 +450,7 @@ nlohmann::ordered_json report_json(const std::string& path, const Model& m,
 int cmd_bench(int argc, char** argv) {
   const Args a = parse_args(argc, argv, 2, {"help", "json", "quick"}, {"states", "gravity"});
   if (a.has("help")) {
-    std::cout << kHelp;
+    std::cout << kBenchHelp;
     return 0;
   }
   refuse_debug_build();

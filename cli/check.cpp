@@ -24,7 +24,7 @@
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kCheckHelp =
     R"(usage: femdyn check MODEL [--states K] [--seed S] [--tol r] [--budget SECONDS] [--json]
                     [--max-memory GB] [--gravity gx,gy,gz]
 
@@ -335,7 +335,7 @@ int cmd_check(int argc, char** argv) {
   const Args a = parse_args(argc, argv, 2, {"help", "json"},
                             {"states", "seed", "tol", "budget", "gravity", "max-memory"});
   if (a.has("help")) {
-    std::cout << kHelp;
+    std::cout << kCheckHelp;
     return 0;
   }
   const Model m = load(a);

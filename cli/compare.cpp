@@ -17,7 +17,7 @@
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kCompareHelp =
     R"(usage: femdyn compare MODEL_A MODEL_B [--states K] [--seed S] [--qd-scale V]
                        [--q a,b,… [--qd …]] [--tau …] [--rtol R] [--json] [--gravity gx,gy,gz]
 
@@ -40,7 +40,7 @@ int cmd_compare(int argc, char** argv) {
   const Args a = parse_args(argc, argv, 2, {"help", "json"},
                             {"states", "seed", "qd-scale", "q", "qd", "tau", "rtol", "gravity"});
   if (a.has("help")) {
-    std::cout << kHelp;
+    std::cout << kCompareHelp;
     return 0;
   }
   if (a.positional.size() != 2) throw CliError("expected two MODEL files (try --help)");

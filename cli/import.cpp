@@ -8,7 +8,7 @@
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kImportHelp =
     R"(usage: femdyn import MODEL -o OUT.json [--force] [--gravity gx,gy,gz]     (-o is --output)
 
 Writes the femdyn JSON document of MODEL: a URDF robot converted (each link with an <inertial>
@@ -26,7 +26,7 @@ replaced only with --force, and never when it is MODEL itself.
 int cmd_import(int argc, char** argv) {
   const Args a = parse_args(argc, argv, 2, {"help", "force"}, {"output", "gravity"});
   if (a.has("help")) {
-    std::cout << kHelp;
+    std::cout << kImportHelp;
     return 0;
   }
   if (a.positional.size() != 1) throw CliError("expected one MODEL file (try --help)");

@@ -16,7 +16,7 @@
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kKinematicsHelp =
     R"(usage: femdyn kinematics MODEL [--q …] [--qd …] [--frame NAME[,NAME…]]
                           [--axes local_world_aligned|local|world] [--json] [--gravity gx,gy,gz]
 
@@ -85,7 +85,7 @@ int cmd_kinematics(int argc, char** argv) {
   const Args a =
       parse_args(argc, argv, 2, {"help", "json"}, {"q", "qd", "frame", "axes", "gravity"});
   if (a.has("help")) {
-    std::cout << kHelp;
+    std::cout << kKinematicsHelp;
     return 0;
   }
   const Model m = load(a);

@@ -16,7 +16,7 @@
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kLinearizeHelp =
     R"(usage: femdyn linearize MODEL [--q …] [--qd …] [--tau …] [--json] [--gravity gx,gy,gz]
                         [--baumgarte W]
 
@@ -45,7 +45,7 @@ int cmd_linearize(int argc, char** argv) {
   const Args a =
       parse_args(argc, argv, 2, {"help", "json"}, {"gravity", "q", "qd", "tau", "baumgarte"});
   if (a.has("help")) {
-    std::cout << kHelp;
+    std::cout << kLinearizeHelp;
     return 0;
   }
   const Model m = load(a);

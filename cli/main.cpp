@@ -78,8 +78,8 @@ int main(int argc, char** argv) {
 #else
     if (cmd == "view")
       throw CliError(
-          "this femdyn was built without the 3-D view (web/node_modules missing: run "
-          "tools/setup.sh)");
+          "this femdyn was built without the 3-D view (three.js missing): run "
+          "tools/setup.sh --all");
 #endif
 #ifdef FEMDYN_WITH_SIMBODY
     if (cmd == "validate") return cmd_validate(argc, argv);
@@ -87,14 +87,9 @@ int main(int argc, char** argv) {
     if (cmd == "stress") return cmd_stress(argc, argv);
     if (cmd == "bench") return cmd_bench(argc, argv);
 #else
-    if (cmd == "bench")
-      throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
-    if (cmd == "stress")
-      throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
-    if (cmd == "study")
-      throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
-    if (cmd == "validate")
-      throw CliError("this femdyn was built without Simbody (FEMDYN_WITH_SIMBODY=OFF)");
+    if (cmd == "validate" || cmd == "study" || cmd == "stress" || cmd == "bench")
+      throw CliError("this femdyn was built without Simbody, which `" + cmd +
+                     "` compares with: run tools/setup.sh --all");
 #endif
     throw CliError("unknown command " + femdyn::quoted_text(cmd) + " (try femdyn --help)");
   } catch (const CliError& e) {

@@ -22,7 +22,7 @@
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kSimulateHelp =
     R"(usage: femdyn simulate MODEL --t-end T [--integrator rk4|euler|dopri|bdf]
                         [--dt h | --rtol r --atol a] [--q0 …] [--qd0 …] [--tau … | --tau-csv FILE]
                         [--out traj.csv] [--every k | --sample-dt s] [--max-steps N] [--force]
@@ -171,7 +171,7 @@ int cmd_simulate(int argc, char** argv) {
       {"gravity", "t-end", "integrator", "dt", "rtol", "atol", "q0", "qd0", "tau", "tau-csv", "out",
        "every", "sample-dt", "max-steps", "max-memory", "baumgarte", "jacobian"});
   if (a.has("help")) {
-    std::cout << kHelp;
+    std::cout << kSimulateHelp;
     return 0;
   }
   const Model m = load(a);

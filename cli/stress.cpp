@@ -26,7 +26,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* kHelp =
+constexpr const char* kStressHelp =
     R"(usage: femdyn stress [--out DIR] [--quick] [--class NAME] [--json] [--force]
 
 Runs the stability suite on generated cases (docs/stability.md): stiff joint springs
@@ -85,7 +85,7 @@ Json loops_json(const validation::StressResult& r) {
 int cmd_stress(int argc, char** argv) {
   const Args a = parse_args(argc, argv, 2, {"help", "quick", "json", "force"}, {"out", "class"});
   if (a.has("help")) {
-    std::cout << kHelp;
+    std::cout << kStressHelp;
     return 0;
   }
   if (!a.positional.empty()) throw CliError("stress takes no MODEL (try --help)");

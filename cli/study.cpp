@@ -35,7 +35,7 @@ namespace fs = std::filesystem;
 using validation::StudyReport;
 using validation::StudyRun;
 
-constexpr const char* kHelp =
+constexpr const char* kStudyHelp =
     R"(usage: femdyn study MODEL [--t-end T] [--out DIR] [--quick] [--json] [--land-on-samples]
                      [--q0 …] [--qd0 …] [--force] [--gravity gx,gy,gz]
 
@@ -79,8 +79,6 @@ unless --force. --quick: fewer sweep points and 0.5 s (seconds; for smoke tests)
 {"cpu", "cores", "build", "compiler", "load_start", "load_end"}, "command", "date"}.
 A Debug build refuses to time anything.
 )";
-
-std::string sci(double x) { return format_number(x, "%.2e"); }
 
 std::string seconds(double t) {
   char buf[32];
@@ -213,8 +211,8 @@ std::string csv_text(const StudyReport& rep, const std::string& command) {
        "larger; "
     << scales_text(rep) << "; position_error in " << position_unit << ", rate_error in "
     << rate_unit << "\n"
-    << "# reference: " << rep.reference_method << "; estimated error " << sci(rep.reference_error)
-    << "; resolution " << sci(rep.resolution) << "\n";
+    << "# reference: " << rep.reference_method << "; estimated error "
+    << format_sci(rep.reference_error) << "; resolution " << format_sci(rep.resolution) << "\n";
   if (!rep.same_formulation) s << "# formulation: " << formulation_text(rep) << "\n";
   s << "# wall_time: median of the timed runs (s), " << timing_text(rep) << "\n"
     << "# machine: " << comment(machine_text(rep)) << "\n"
@@ -328,7 +326,7 @@ std::string markdown_text(const StudyReport& rep, const std::string& command) {
     << "the largest |θ̇ − θ̇_ref| divided by its largest |θ̇|, whichever is larger ("
     << scales_text(rep) << "). The absolute errors (" << position_unit << ", " << rate_unit
     << ") are in study.csv. Reference: " << rep.reference_method << "; its estimated error "
-    << sci(rep.reference_error) << ", so errors below " << sci(rep.resolution)
+    << format_sci(rep.reference_error) << ", so errors below " << format_sci(rep.resolution)
     << " are not resolved and left out.\n"
     << "- **Wall time** (the x axis): the integration alone; " << timing_text(rep) << ".\n";
   if (!rep.same_formulation)
@@ -340,13 +338,13 @@ std::string markdown_text(const StudyReport& rep, const std::string& command) {
   for (const Target& t : targets(rep)) {
     const StudyRun *f = t.femdyn, *b = t.simbody;
     s << "| " << format_number(t.target, "%.0e") << " | "
-      << (f ? label(*f) + " (error " + sci(f->error) + ")" : "none reached it") << " | "
+      << (f ? label(*f) + " (error " + format_sci(f->error) + ")" : "none reached it") << " | "
       << (f ? seconds(f->wall_time) : "—") << " | "
-      << (b ? label(*b) + " (error " + sci(b->error) + ")" : "none reached it") << " | "
+      << (b ? label(*b) + " (error " + format_sci(b->error) + ")" : "none reached it") << " | "
       << (b ? seconds(b->wall_time) : "—") << " | " << ratio_text(rep, t) << " |\n";
   }
   if (rep.resolution > 1e-9)  // the smallest target cannot be resolved
-    s << "\nA target below " << sci(rep.resolution) << " cannot be told apart from the "
+    s << "\nA target below " << format_sci(rep.resolution) << " cannot be told apart from the "
       << "reference's own error here.\n";
   s << "\n![error against wall time](study.png)\n\n";
   for (const std::string& n : rep.notes) s << "Note: " << n << "\n\n";
@@ -363,11 +361,12 @@ std::string markdown_text(const StudyReport& rep, const std::string& command) {
   for (const StudyRun& r : rep.runs) {
     const auto [lo, hi] = std::minmax_element(r.times.begin(), r.times.end());
     s << "| " << r.engine << " | " << r.integrator << " | " << r.setting << " "
-      << std::setprecision(3) << r.value << " | " << (r.ok ? sci(r.error) : "—") << " | "
-      << (r.ok ? sci(r.position_error) : "—") << " | " << (r.ok ? sci(r.rate_error) : "—") << " | "
-      << seconds(r.wall_time) << " | "
+      << std::setprecision(3) << r.value << " | " << (r.ok ? format_sci(r.error) : "—") << " | "
+      << (r.ok ? format_sci(r.position_error) : "—") << " | "
+      << (r.ok ? format_sci(r.rate_error) : "—") << " | " << seconds(r.wall_time) << " | "
       << (r.times.size() > 1 ? seconds(*lo) + " – " + seconds(*hi) : "one run") << " | "
-      << r.rhs_evals << " | " << r.steps << " | " << (r.ok ? sci(r.energy_drift) : "—") << " | "
+      << r.rhs_evals << " | " << r.steps << " | " << (r.ok ? format_sci(r.energy_drift) : "—")
+      << " | "
       << (!r.ok        ? "failed: " + r.failure.substr(0, 90)
           : r.resolved ? ""
                        : "below resolution")
@@ -490,7 +489,7 @@ int cmd_study(int argc, char** argv) {
   const Args a = parse_args(argc, argv, 2, {"help", "quick", "force", "json", "land-on-samples"},
                             {"gravity", "t-end", "out", "q0", "qd0"});
   if (a.has("help")) {
-    std::cout << kHelp;
+    std::cout << kStudyHelp;
     return 0;
   }
 #ifndef NDEBUG
@@ -557,7 +556,7 @@ int cmd_study(int argc, char** argv) {
   std::cout << "model: " << escaped(rep.model) << " (" << rep.n << " coordinates), t = 0…"
             << rep.t_end << " s, " << rep.runs.size()
             << " runs\nreference: " << rep.reference_method << ", estimated error "
-            << sci(rep.reference_error) << "\nsampling: " << sampling_short(rep)
+            << format_sci(rep.reference_error) << "\nsampling: " << sampling_short(rep)
             << "; wall time: " << timing_text(rep) << "\n";
   if (!rep.same_formulation) std::cout << "formulation: " << formulation_text(rep) << "\n";
   std::istringstream lines(md);

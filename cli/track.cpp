@@ -16,7 +16,7 @@
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kTrackHelp =
     R"(usage: femdyn track MODEL --to a,b,… [--from …] [--duration T] [--steps N] [--csv FILE [--force]] [--json]
                      [--actuated-base]
                      [--kp KP --kd KD [--start q] [--control evaluation|hold]] [--gravity gx,gy,gz]
@@ -80,7 +80,7 @@ int cmd_track(int argc, char** argv) {
       argc, argv, 2, {"help", "json", "force", "actuated-base"},
       {"to", "from", "duration", "steps", "csv", "gravity", "kp", "kd", "start", "control"});
   if (a.has("help")) {
-    std::cout << kHelp;
+    std::cout << kTrackHelp;
     return 0;
   }
   if (a.has("csv")) {  // refused before any work if it would clobber a file

@@ -18,7 +18,7 @@
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kValidateHelp =
     R"(usage: femdyn validate MODEL… [--states K] [--seed S] [--t-end T] [--tol X]
                         [--qd-scale V] [--budget SECONDS] [--max-memory GB]
                         [--json | --markdown] [--gravity gx,gy,gz]
@@ -63,8 +63,6 @@ Exit 1 if any check fails. --json: one object per model (an array for several mo
 --markdown: one table row per model (docs/validation.md). The JSON has the whole series: the
 trajectory's sample times "t", "state_error" and the energy of both runs.
 )";
-
-std::string sci(double x) { return format_number(x, "%.2e"); }
 
 constexpr int kNameWidth = 18;  // "frame acceleration"
 
@@ -144,18 +142,20 @@ void print_text(const std::string& path, const validation::ValidationReport& r) 
             << " max abs err   max rel err   tolerance   result\n";
   for (const auto& q : r.quantities)
     std::cout << std::left << std::setw(kNameWidth) << (q.name == "M" ? "M^s" : q.name) << " "
-              << std::setw(13) << sci(q.max_abs) << " " << std::setw(13) << sci(q.max_rel) << " "
-              << std::setw(11) << sci(q.tolerance) << " " << (q.pass() ? "PASS" : "FAIL") << "\n";
+              << std::setw(13) << format_sci(q.max_abs) << " " << std::setw(13)
+              << format_sci(q.max_rel) << " " << std::setw(11) << format_sci(q.tolerance) << " "
+              << (q.pass() ? "PASS" : "FAIL") << "\n";
   const auto& t = r.trajectory;
   if (t.run)
     std::cout << std::setw(kNameWidth) << (t.constrained ? "constrained trajectory" : "trajectory")
-              << " " << std::setw(13) << sci(t.max_state_error) << " " << std::setw(13) << ""
-              << " " << std::setw(11) << sci(t.tolerance) << " " << (t.pass() ? "PASS" : "FAIL")
-              << "   (" << t.t_end << " s; error estimates: femdyn RK4 (step " << sci(t.rk4_step)
-              << " s) " << sci(t.rk4_error_estimate) << ", Simbody "
-              << sci(t.simbody_error_estimate) << "; energy change femdyn "
-              << sci(t.energy_change_femdyn) << " J, Simbody " << sci(t.energy_change_simbody)
-              << " J)\n";
+              << " " << std::setw(13) << format_sci(t.max_state_error) << " " << std::setw(13) << ""
+              << " " << std::setw(11) << format_sci(t.tolerance) << " "
+              << (t.pass() ? "PASS" : "FAIL") << "   (" << t.t_end
+              << " s; error estimates: femdyn RK4 (step " << format_sci(t.rk4_step) << " s) "
+              << format_sci(t.rk4_error_estimate) << ", Simbody "
+              << format_sci(t.simbody_error_estimate) << "; energy change femdyn "
+              << format_sci(t.energy_change_femdyn) << " J, Simbody "
+              << format_sci(t.energy_change_simbody) << " J)\n";
   else if (!t.stopped.empty())
     std::cout << "trajectory   FAIL: not compared within the budget: " << t.stopped
               << " (shorten --t-end, or raise --budget)\n";
@@ -166,7 +166,7 @@ void print_text(const std::string& path, const validation::ValidationReport& r) 
     std::cout << "  state error over time:";
     for (std::size_t k = 0; k < 5; ++k) {
       const std::size_t i = k * (t.t.size() - 1) / 4;
-      std::cout << "  t=" << t.t[i] << " s " << sci(t.error[i]);
+      std::cout << "  t=" << t.t[i] << " s " << format_sci(t.error[i]);
     }
     std::cout << "\n";
   }
@@ -194,13 +194,13 @@ void print_markdown_row(const std::string& path, const validation::ValidationRep
     else if (loop_row(q.name))
       loop = std::max(loop, q.max_rel);
     else if (q.name != "import")
-      std::cout << " | " << sci(q.max_rel);
-  std::cout << " | " << (loop >= 0 ? sci(loop) : "—");
-  std::cout << " | " << (kinematics >= 0 ? sci(kinematics) : "—");
+      std::cout << " | " << format_sci(q.max_rel);
+  std::cout << " | " << (loop >= 0 ? format_sci(loop) : "—");
+  std::cout << " | " << (kinematics >= 0 ? format_sci(kinematics) : "—");
   const auto& t = r.trajectory;
   std::cout << " | "
-            << (t.run ? (t.constrained ? "closed: " : "") + sci(t.max_state_error) + " (tol " +
-                            sci(t.tolerance) + ")"
+            << (t.run ? (t.constrained ? "closed: " : "") + format_sci(t.max_state_error) +
+                            " (tol " + format_sci(t.tolerance) + ")"
                 : t.stopped.empty() ? "—"
                                     : "not within the budget")
             << " | " << (r.pass() ? "PASS" : "FAIL") << " |\n";
@@ -223,7 +223,7 @@ int cmd_validate(int argc, char** argv) {
       parse_args(argc, argv, 2, {"help", "json", "markdown"},
                  {"states", "seed", "t-end", "tol", "qd-scale", "gravity", "budget", "max-memory"});
   if (a.has("help")) {
-    std::cout << kHelp;
+    std::cout << kValidateHelp;
     return 0;
   }
   if (a.positional.empty()) throw CliError("expected a MODEL file (try --help)");

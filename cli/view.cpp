@@ -9,7 +9,7 @@
 namespace femdyn::cli {
 namespace {
 
-constexpr const char* kHelp =
+constexpr const char* kViewHelp =
     R"(usage: femdyn view MODEL [--traj TRAJ.csv | --q …] [--out view.html] [--force]
                     [--gravity gx,gy,gz] [--floating-base]
 
@@ -31,7 +31,7 @@ The file is written atomically, and an existing one is replaced only with --forc
 int cmd_view(int argc, char** argv) {
   const Args a = parse_args(argc, argv, 2, {"help", "force"}, {"traj", "q", "out", "gravity"});
   if (a.has("help")) {
-    std::cout << kHelp;
+    std::cout << kViewHelp;
     return 0;
   }
   if (a.has("traj") && a.has("q")) throw CliError("--traj and --q: give one of them");

@@ -82,6 +82,8 @@ inline std::string format_number(double x, const char* spec = "%.6g") {
 
 // Three significant digits, for reports and diagnoses.
 inline std::string format_short(double x) { return format_number(x, "%.3g"); }
+// Three significant digits with an exponent, for errors and tolerances: "1.23e-09".
+inline std::string format_sci(double x) { return format_number(x, "%.2e"); }
 
 // A duration for a person: "0.4 s", "12 min", "3.1 h", "2.5 days".
 inline std::string format_duration(double seconds) {

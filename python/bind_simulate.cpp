@@ -42,7 +42,7 @@ IntegratorOptions options_of(const std::string& integrator, std::optional<double
 }
 
 // Rows recorded during the run (the GIL released), turned into arrays after it.
-struct Rows {
+struct RunRows {
   std::vector<double> t, y, kinetic, potential, work;
   void add(double time, const VecX& state, const Energy& e, double w) {
     t.push_back(time);
@@ -142,7 +142,7 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
   const bool is_conservative = conservative(m, driven);
 
   std::unique_ptr<Integrator> integ = make_integrator(m, o, tau);
-  Rows rows;
+  RunRows rows;
   RecordedRun run;
   {
     py::gil_scoped_release release;

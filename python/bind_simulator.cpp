@@ -69,7 +69,7 @@ void tau_of(const py::handle& value, const Model& m, double t, VecX& tau) {
 
 // Rows of a run: (t, q, q̇, τ applied from t, W, E) at every period; τ as the dynamics sees it,
 // saturated at the joints' effort limits.
-struct Rows {
+struct ControlRows {
   std::vector<double> t, q, qd, tau, work, total;
   void add(const ControlLoop& loop, Motion& motion, VecX tau_k, const Energy& E) {
     const Integrator& i = loop.integrator();
@@ -183,7 +183,7 @@ class Simulator {
     const long k_before = loop_->period_index();
     // The run's summary, as femdyn.simulate's (python/run_stats.hpp): a row a period.
     RunWatch watch(integ);
-    Rows rows;
+    ControlRows rows;
     Status st;
     while (integ.t() < t_end - 1e-9 * T) {
       call(integ.t(), integ.q(), integ.qd(), tau);  // τ_k (in evaluation mode: the row's)

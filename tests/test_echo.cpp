@@ -38,10 +38,8 @@ std::string urdf_error(const std::string& text) {
   return "(loaded)";
 }
 
-json pendulum() {
-  std::ifstream in(model_path("pendulum.json"));
-  return json::parse(in);
-}
+// models/pendulum.json as JSON, to be mutated.
+json echo_pendulum() { return json::parse(read_file(model_path("pendulum.json"))); }
 
 // A two-link arm whose joints are named `a` and `b`.
 std::string two_joints(const std::string& a, const std::string& b) {
@@ -101,23 +99,23 @@ TEST_CASE("JSON: unknown joint and element types and keys, plugin params: echoed
           "[echo]") {
   for (const auto& [raw, shown] : kControls) {
     INFO(shown);
-    json j = pendulum();
+    json j = echo_pendulum();
     j["bodies"][0]["joint"]["type"] = "hinge" + raw;
     std::string e = text_error(j.dump());
     CHECK(e == "test: /bodies/0/joint/type: unknown joint type 'hinge" + shown +
                    "' (expected revolute, continuous, prismatic, fixed, helical, screw, universal, "
                    "planar, spherical, ball or free)");
-    j = pendulum();
+    j = echo_pendulum();
     j["bodies"][0]["elements"][0]["type"] = "point" + raw;
     e = text_error(j.dump());
     CHECK_THAT(e, Catch::Contains("unknown element type 'point" + shown + "'"));
     CHECK(one_printable_line(e));
     // A key: in the message and in the JSON path (a newline here gave two lines).
-    j = pendulum();
+    j = echo_pendulum();
     j["bodies"][0]["joint"]["sp" + raw] = 1;
     e = text_error(j.dump());
     CHECK(e == "test: /bodies/0/joint/sp" + shown + ": unknown key 'sp" + shown + "'");
-    j = pendulum();
+    j = echo_pendulum();
     j["k" + raw] = 1;
     CHECK(text_error(j.dump()) == "test: /k" + shown + ": unknown key 'k" + shown + "'");
     // A plugin's params.
@@ -134,7 +132,7 @@ TEST_CASE("JSON: unknown joint and element types and keys, plugin params: echoed
 }
 
 TEST_CASE("a 50 MB unknown parent name is echoed cut to 200 bytes with …", "[echo]") {
-  json j = pendulum();
+  json j = echo_pendulum();
   j["bodies"][0]["parent"] = std::string(50'000'000, 'w');
   const std::string e = text_error(j.dump());
   CHECK(e == "test: /bodies/0/parent: unknown parent body '" + std::string(200, 'w') + "…'");

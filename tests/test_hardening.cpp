@@ -40,10 +40,8 @@ std::string load_error(const std::string& path) {
   return "(loaded)";
 }
 
-json pendulum() {
-  std::ifstream in(model_path("pendulum.json"));
-  return json::parse(in);
-}
+// models/pendulum.json as JSON, to be mutated.
+json pendulum_model() { return json::parse(read_file(model_path("pendulum.json"))); }
 
 }  // namespace
 
@@ -80,16 +78,16 @@ TEST_CASE("JSON nested deeper than the limit is refused without recursion", "[ha
 }
 
 TEST_CASE("out-of-range numbers are refused naming the field", "[hardening]") {
-  json g = pendulum();
+  json g = pendulum_model();
   g["gravity"] = {0, 0, -1e308};
   CHECK(text_error(g.dump()) ==
         "test: /gravity: gravity -1e+308 is out of range (|x| ≤ 1e100: "
         "beyond it the equations' products overflow double precision)");
-  json k = pendulum();
+  json k = pendulum_model();
   k["bodies"][0]["joint"]["spring"] = {{"stiffness", 1e308}};
   CHECK_THAT(text_error(k.dump()),
              Catch::StartsWith("test: /bodies/0/joint: stiffness 1e+308 is out of range"));
-  json m = pendulum();
+  json m = pendulum_model();
   m["bodies"][0]["elements"][0]["mass"] = 1e308;
   CHECK_THAT(text_error(m.dump()),
              Catch::StartsWith(
@@ -148,17 +146,17 @@ TEST_CASE("a τ table (--tau-csv) is held to the 1e100 limit like --tau", "[hard
 
 TEST_CASE("names with control characters are refused and user text is echoed escaped",
           "[hardening]") {
-  json j = pendulum();
+  json j = pendulum_model();
   j["bodies"][0]["name"] = "arm\x1b[31m";
   const std::string e = text_error(j.dump());
   CHECK(e ==
         "test: /bodies/0/name: body name 'arm\\x1b[31m' contains a control character "
         "(names must be printable)");
-  json p = pendulum();
+  json p = pendulum_model();
   p["bodies"][0]["parent"] = "w\x1b]0;title\x07";
   CHECK(text_error(p.dump()) ==
         "test: /bodies/0/parent: unknown parent body 'w\\x1b]0;title\\x07'");
-  json c1 = pendulum();  // U+009B, the one-byte CSI of 8-bit terminals
+  json c1 = pendulum_model();  // U+009B, the one-byte CSI of 8-bit terminals
   c1["bodies"][0]["joint"]["name"] =
       "hinge\xc2\x9b"
       "2J";
@@ -217,7 +215,7 @@ TEST_CASE("deep trees and long coupling chains compile on a small stack", "[hard
 }
 
 TEST_CASE("huge joint limits give finite sample postures", "[hardening]") {
-  json j = pendulum();
+  json j = pendulum_model();
   j["bodies"][0]["joint"]["limits"] = {-1e308, 1e308};
   const Model m = load_text(j.dump());
   std::mt19937 rng(1);

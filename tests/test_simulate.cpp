@@ -44,11 +44,6 @@ Csv read_csv(const fs::path& p) {
   return c;
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
-
 }  // namespace
 
 TEST_CASE("simulate: CSV columns name the coordinates, energy balance holds row by row",
@@ -104,7 +99,7 @@ TEST_CASE("simulate: a 1e4 rad/s spring makes RK4 at 1e-3 s diverge cleanly, BDF
   CHECK_THAT(r.out, Catch::Contains("femdyn simulate: ") && Catch::Contains(": at t = ") &&
                         Catch::Contains("the solution diverges") &&
                         Catch::Contains("stability limit") && Catch::Contains("or dopri"));
-  const std::string text = slurp(s / "rk4.csv");
+  const std::string text = read_file(s / "rk4.csv");
   REQUIRE_FALSE(text.empty());
   CHECK(text.find("nan") == std::string::npos);
   CHECK(text.find("inf") == std::string::npos);
@@ -128,7 +123,7 @@ TEST_CASE("simulate: existing files kept without --force, SIGINT leaves the old 
   Run r = run("simulate " + model_path("pendulum.json") + " --t-end 0.1 --out " + out);
   CHECK(r.code == 2);
   CHECK(r.out == "femdyn simulate: --out " + out + ": exists (use --force to replace it)\n");
-  CHECK(slurp(out) == "old content\n");
+  CHECK(read_file(out) == "old content\n");
   // A long run interrupted after 1 s: exit 130, the old file intact, no temporary file left.
   r = run_shell("timeout --preserve-status -s INT 1 " + std::string(FEMDYN_BINARY) + " simulate " +
                 model_path("hand.json") +
@@ -138,12 +133,12 @@ TEST_CASE("simulate: existing files kept without --force, SIGINT leaves the old 
   INFO(r.out);
   CHECK(r.code == 130);
   CHECK_THAT(r.out, Catch::Contains("interrupted at t = ") && Catch::Contains("was not written"));
-  CHECK(slurp(out) == "old content\n");
+  CHECK(read_file(out) == "old content\n");
   CHECK(s.files() == 1);
   // With --force a finished run replaces it.
   r = run("simulate " + model_path("pendulum.json") + " --t-end 0.1 --q0 1 --force --out " + out);
   CHECK(r.code == 0);
-  CHECK(slurp(out).rfind("t,q_theta,qd_theta,kinetic,potential,total,work\n", 0) == 0);
+  CHECK(read_file(out).rfind("t,q_theta,qd_theta,kinetic,potential,total,work\n", 0) == 0);
   CHECK(s.files() == 1);
 }
 

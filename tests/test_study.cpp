@@ -20,11 +20,6 @@ using Json = nlohmann::json;
 
 namespace {
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
-
 // study's stdout alone (stderr dropped): the JSON report with --json.
 Run study(const std::string& args) {
   return run_shell("{ " + std::string(FEMDYN_BINARY) + " study " + args + " 2>/dev/null; }");
@@ -134,7 +129,7 @@ TEST_CASE("study: a quick work-precision run writes the CSV, plot, summary and J
   REQUIRE(t3["simbody"].is_object());
   CHECK(t3["ratio"].get<double>() ==
         Approx(t3["simbody"]["wall_time"].get<double>() / t3["femdyn"]["wall_time"].get<double>()));
-  const std::string md = slurp(fs::path(dir) / "study.md");
+  const std::string md = read_file(fs::path(dir) / "study.md");
   for (const char* target : {"| 1e-03 |", "| 1e-06 |", "| 1e-09 |"})
     CHECK_THAT(md, Catch::Contains(target));
   CHECK_THAT(md, Catch::Contains("both engines step freely and interpolate at the samples") &&
@@ -174,7 +169,7 @@ TEST_CASE("study: a quick work-precision run writes the CSV, plot, summary and J
   CHECK(rows == j["runs"].size());
 
   // The plot: axes with their meaning and units; the key femdyn's curves, then Simbody's.
-  const std::string gp = slurp(fs::path(dir) / "study.gp");
+  const std::string gp = read_file(fs::path(dir) / "study.gp");
   CHECK_THAT(gp, Catch::Contains("set ylabel \"relative state error") &&
                      Catch::Contains("θ in rad, θ̇ in rad/s") &&
                      Catch::Contains("set xlabel \"wall time (s)") &&

@@ -37,11 +37,6 @@ std::vector<Block> blocks(const std::string& markdown) {
   return out;
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 std::pair<int, std::string> sh(const std::string& dir, const std::string& command) {
   const std::string bin = fs::path(FEMDYN_BINARY).parent_path().string();
   std::ofstream(fs::path(dir) / "command.sh") << command << "\n";
@@ -58,7 +53,7 @@ std::pair<int, std::string> sh(const std::string& dir, const std::string& comman
 
 TEST_CASE("every command of docs/tutorial.md runs as the tutorial says", "[docs][tutorial]") {
   const fs::path source = FEMDYN_SOURCE_DIR;
-  const auto all = blocks(slurp(source / "docs/tutorial.md"));
+  const auto all = blocks(read_file(source / "docs/tutorial.md"));
   const fs::path dir = fs::temp_directory_path() / "femdyn_tutorial";
   fs::remove_all(dir);
   fs::create_directories(dir);
@@ -71,7 +66,7 @@ TEST_CASE("every command of docs/tutorial.md runs as the tutorial says", "[docs]
       ++files;
     } else if (b.info.rfind("cpp file=", 0) == 0) {
       INFO(b.info);
-      CHECK(b.text == slurp(source / b.info.substr(9)));
+      CHECK(b.text == read_file(source / b.info.substr(9)));
     } else if (b.info == "sh" || b.info == "sh fails") {
       std::istringstream lines(b.text);
       std::string command;

@@ -27,7 +27,9 @@ export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1${UBSAN_OPTIONS:+:$UBSAN
 export LSAN_OPTIONS="suppressions=$PWD/tools/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 
 t0=$(date +%s)
-if ! { cmake -S . -B "$build" -DFEMDYN_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+generator=()
+[ -f "$build/CMakeCache.txt" ] || generator=(-G Ninja)
+if ! { cmake -S . -B "$build" "${generator[@]}" -DFEMDYN_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
          "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" &&
        cmake --build "$build" -j"$jobs"; } >"$log" 2>&1; then
   tail -n 60 "$log" >&2

@@ -14,7 +14,7 @@
 namespace femdyn::validation {
 namespace {
 
-struct Run {
+struct StressRun {
   std::vector<VecX> x;  // (q, q̇) at the samples
   std::vector<double> balance, scale;
   IntegratorStats stats;
@@ -23,9 +23,9 @@ struct Run {
   std::vector<VecX> q;                  // the configurations at the samples (closed loops)
 };
 
-Run integrate(const Model& m, const IntegratorOptions& o, const StressScenario& s,
-              const std::vector<double>& times, bool energies) {
-  Run r;
+StressRun integrate(const Model& m, const IntegratorOptions& o, const StressScenario& s,
+                    const std::vector<double>& times, bool energies) {
+  StressRun r;
   auto integ = make_integrator(m, o);
   integ->reset(0, s.q0, s.qd0, s.t_end);
   const double E0 = energies ? integ->motion().energy_at(integ->y().data()).total() : 0;
@@ -87,7 +87,7 @@ Status constrained_start(const Model& m, Workspace& ws, const StressScenario& s)
 // Closed loops, whose stiffness changes with the posture (near a dead point most): the
 // linearisation at each of the reference's samples, its largest |λ| and the smallest theory step
 // of each fixed-step integrator (in `steps`, indexed as kIntegrators).
-double linearize_along(const Model& m, const Run& ref, std::vector<double>& steps) {
+double linearize_along(const Model& m, const StressRun& ref, std::vector<double>& steps) {
   Workspace ws(m);
   double stiffest = 0;
   for (std::size_t k = 0; k < ref.q.size(); ++k) {
@@ -146,7 +146,7 @@ StressResult run_stress(const Model& m, const StressScenario& given) {
       .kind = IntegratorKind::Dopri,
       .adaptive = {.rtol = 1e-10, .atol = 1e-12, .max_steps = 200'000, .stop_at_outputs = true}};
   if (s.large) ref_options = {.kind = IntegratorKind::Rk4, .fixed = {.dt = s.dt / 2}};
-  Run ref = integrate(m, ref_options, s, times, true);
+  StressRun ref = integrate(m, ref_options, s, times, true);
   r.reference = s.large ? "rk4 at dt/2" : "dopri rtol 1e-10";
   // A dead point is the motion's, not a stiffness that bdf would cure.
   if (at_dead_point(ref.status)) return dead_point_case(r, ref.status.message);
@@ -206,7 +206,7 @@ StressResult run_stress(const Model& m, const StressScenario& given) {
       o.adaptive = {.rtol = 1e-6, .atol = 1e-8, .max_steps = 200'000, .stop_at_outputs = true};
     else
       o.fixed = {.dt = s.dt};
-    const Run run = integrate(m, o, s, times, false);
+    const StressRun run = integrate(m, o, s, times, false);
     it.steps = run.stats.steps;
     if (run.status.ok) {
       it.error = max_error(run.x, ref.x) / state_scale;
