@@ -12,7 +12,7 @@ page of the trajectory, and in one headless Chromium (driven over the DevTools p
   - takes screenshots of the trajectory's 3-D view at #t=0 and at its last time: not blank,
     and different from each other;
   - moves the mouse over named objects: the tooltip names a body of the model.
-Exit 77 (ctest's SKIP_RETURN_CODE) when Chromium is absent; tools/setup.sh installs it.
+Exit 77 (ctest's SKIP_RETURN_CODE) when Chromium is absent; tools/setup.sh --all installs it.
 """
 import base64
 import json
@@ -264,7 +264,7 @@ def main():
     femdyn, source_dir, work, case = sys.argv[1:]
     exe = chromium()
     if exe is None:
-        print("SKIP: chromium not found (Debian's chromium; tools/setup.sh installs it)")
+        print("SKIP: chromium not found (Debian's chromium; tools/setup.sh --all installs it)")
         return SKIP
     start = time.monotonic()
     work = os.path.join(os.path.abspath(work), case)

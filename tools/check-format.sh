@@ -7,7 +7,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 format=${CLANG_FORMAT:-clang-format}
 if ! command -v "$format" >/dev/null; then
-  echo "check-format: $format not found (tools/setup.sh installs it)" >&2
+  echo "check-format: $format not found (tools/setup.sh --all installs it)" >&2
   exit 1
 fi
 if ! git rev-parse --is-inside-work-tree >/dev/null 2>&1; then

@@ -2,8 +2,8 @@
 # Sanitizers (docs/robustness.md#sanitizers): builds femdyn, its tests and the validation in
 # ./build-asan with -DFEMDYN_SANITIZE=ON (GCC, AddressSanitizer + UndefinedBehaviorSanitizer,
 # -O1 -g1 with asserts on) and runs the whole ctest suite under them. Exits non-zero on a build
-# failure, a sanitizer report or a failed test. Dependencies: those of tools/setup.sh.
-#   tools/sanitize.sh            e.g. CI, after tools/setup.sh
+# failure, a sanitizer report or a failed test. Dependencies: those of tools/setup.sh --all.
+#   tools/sanitize.sh            e.g. CI, after tools/setup.sh --all
 #   JOBS=4 tools/sanitize.sh     parallel build and test jobs (default: nproc)
 # Skipped under sanitizers: the malloc-counting tests ([hot-path], reported as Skipped by ctest)
 # and femdyn_bench with its smoke test (not built).

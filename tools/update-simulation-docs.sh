@@ -5,11 +5,11 @@
 # the text between its markers in docs/simulation.md. Timings are this machine's, medians of
 # timed runs after a warm-up, with the load average at the start and end of each study in its
 # study.md and study.csv: run on an idle machine if you can, with the Release build
-# (tools/setup.sh).
+# (tools/setup.sh --all).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 femdyn=./build/femdyn
-[ -x "$femdyn" ] || { echo "build femdyn first (tools/setup.sh)" >&2; exit 1; }
+[ -x "$femdyn" ] || { echo "build femdyn first (tools/setup.sh --all)" >&2; exit 1; }
 
 study() {  # name, model, extra options
   local name=$1 model=$2

@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 femdyn=./build/femdyn
-[ -x "$femdyn" ] || { echo "build femdyn first (tools/setup.sh)" >&2; exit 1; }
+[ -x "$femdyn" ] || { echo "build femdyn first (tools/setup.sh --all)" >&2; exit 1; }
 "$femdyn" stress --out docs/stability --force >/dev/null
 python3 - <<'PY'
 path = "docs/stability.md"

@@ -5,7 +5,7 @@
 # PINOCCHIO_SRC: a checkout of github.com/stack-of-tasks/pinocchio (measured: tag v3.7.0) with
 # its cmake/ submodule. OUT_DIR (default build-pinocchio) receives pin_bench. Flags as femdyn's
 # Release build: -O3 -DNDEBUG and no -march (set EXTRA_FLAGS=-march=native for a native build).
-# Needs, beyond tools/setup.sh's packages:
+# Needs, beyond tools/setup.sh --all's packages:
 #   apt-get install liburdfdom-dev libboost-filesystem-dev libboost-serialization-dev \
 #                   libboost-system-dev
 set -euo pipefail
