@@ -126,7 +126,9 @@ Drift momentum_drift(const Model& m, double seconds) {
   return {worst_L, worst_p, integrator->stats().steps};
 }
 
-TEST_CASE("in free float dopri conserves the space robot's momentum about its centre of mass") {
+// [long]: not run under the sanitizers (docs/robustness.md#sanitizers).
+TEST_CASE("in free float dopri conserves the space robot's momentum about its centre of mass",
+          "[long]") {
   const Drift d = momentum_drift(held_space_robot(), 10.0);
   INFO("relative drift over 10 s: angular " << d.angular << ", linear " << d.linear << " in "
                                             << d.steps << " steps");
@@ -146,9 +148,11 @@ TEST_CASE("with coupled or four-bar fingers the floating robot still conserves i
   }
 }
 
+// [long]: not run under the sanitizers (docs/robustness.md#sanitizers).
 TEST_CASE(
     "with zero momentum the space robot's arm turns and moves the satellite, and the centre of "
-    "mass stays") {
+    "mass stays",
+    "[long]") {
   const Model m = held_space_robot();
   Workspace ws(m);
   std::mt19937 rng(23);

@@ -133,7 +133,9 @@ nlohmann::json stress_class(const std::string& klass) {
 
 }  // namespace
 
-TEST_CASE("stress springs: 1e1 to 1e5 rad/s, RK4 unstable and BDF stable at 1e5", "[stress]") {
+// [long]: not run under the sanitizers (docs/robustness.md#sanitizers).
+TEST_CASE("stress springs: 1e1 to 1e5 rad/s, RK4 unstable and BDF stable at 1e5",
+          "[stress][long]") {
   const auto springs = stress_class("springs");
   int damped = 0;
   for (const auto& c : springs) {
@@ -156,7 +158,9 @@ TEST_CASE("stress springs: 1e1 to 1e5 rad/s, RK4 unstable and BDF stable at 1e5"
     CHECK(c["integrators"][3]["error"].get<double>() < 1e-2);
   }
 }
-TEST_CASE("stress springs: measured stable steps within 5 % of the closed forms", "[stress]") {
+// [long]: not run under the sanitizers.
+TEST_CASE("stress springs: measured stable steps within 5 % of the closed forms",
+          "[stress][long]") {
   // Undamped: RK4 ω h ≤ 2√2, semi-implicit Euler ω h < 2. Damped (ζ = 100): the fast real mode
   // λ = −ω(ζ + √(ζ² − 1)) limits RK4 to |λ| h ≤ 2.785 and Euler to the spectral radius of its
   // step, which the linear theory column holds (sim/stability.cpp); both within 5 %.
