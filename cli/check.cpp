@@ -61,6 +61,8 @@ constrained equations without Baumgarte's term (a fixed-step run projects onto t
 every step, which removes its pair -20 1/s from the stability limits), and
 the constraint Jacobian's rank (redundant equations) and its nearness to a dead point
 (sigma_min/sigma_max of Phi_q, below 1e-6: near) are reported ("loops" in --json).
+The coordinates no actuator drives (a free joint's, a joint's with "actuated": false;
+docs/control.md#actuation) are listed ("actuated" in --json: the driven ones).
 Exit 0: no fault (notes may be printed); 1: M^s is singular at a sampled state, a body is
 flagged, or the check would exceed its budget; 2: a bad command line.
 )";
@@ -395,6 +397,7 @@ int cmd_check(int argc, char** argv) {
         {"model", m.name},
         {"n", n},
         {"coordinates", m.coordinate_names},
+        {"actuated", actuated_names(m)},
         {"states", K},
         {"stop_states", pressed},
         {"condition", {{"min", finite_or_null(d.cond_lo)}, {"max", finite_or_null(d.cond_hi)}}},
@@ -446,6 +449,15 @@ int cmd_check(int argc, char** argv) {
               << (pressed ? " and " + std::to_string(pressed) + " pressed into their joint stops"
                           : std::string())
               << "\n";
+    if (!m.fully_actuated()) {  // (docs/control.md#actuation)
+      std::cout << "actuation: " << m.n_actuated() << " of " << n << " coordinates driven; not:";
+      for (int i = 0, k = 0; i < n; ++i)
+        if (k < m.n_actuated() && m.actuated[k] == i)
+          ++k;
+        else
+          std::cout << " " << m.coordinate_names[i];
+      std::cout << "\n";
+    }
     if (d.singular_states)
       std::cout << "M^s: singular at " << d.singular_states << " of " << K
                 << " states: " << d.singular_message << "\n";

@@ -22,7 +22,9 @@ constexpr const char* kLinearizeHelp =
 
 The linearisation of the equations of motion at the state (--q: n_q values, default the neutral
 configuration; --qd, --tau: n values each, default 0):
-  d/dt (ξ, v) = A (ξ, v) + B τ,   A = ∂(ξ̇, v̇)/∂(ξ, v) (2n × 2n),   B = ∂(ξ̇, v̇)/∂τ (2n × n),
+  d/dt (ξ, v) = A (ξ, v) + B u,   A = ∂(ξ̇, v̇)/∂(ξ, v) (2n × 2n),   B = ∂(ξ̇, v̇)/∂u (2n × n_a),
+u the τ of the actuated coordinates (all n, but a free joint's and those of a joint with
+"actuated": false: τ = S u, docs/control.md#actuation),
 with v̇ = q̈ and ξ the tangent coordinates around q: q + ξ on a flat joint; q ⊗ exp(ξ) on a
 spherical joint, whose ξ̇ = J_r(ξ)⁻¹ ω turns A's top-left block (−½ [ω]×); (p + R ξ_p,
 q ⊗ exp(ξ_r)) on a free joint (also −[v]× from ξ̇_p = exp(ξ_r) v). By analytic derivatives of
@@ -36,7 +38,8 @@ B's lower block is then the projected inverse M⁻¹ − Y S⁺ Yᵀ (Y = M⁻¹
 torque moves q̈ off the loops), and at an equilibrium A has the pair −W for each direction off
 the loops (at W = 0 a double zero).
 
---json prints {"n", "coordinates", "q", "qd", "tau", "A", "B"}, A and B as lists of rows.
+--json prints {"n", "coordinates", "q", "qd", "tau", "inputs", "A", "B"}, A and B as lists of
+rows, "inputs" the names of u's entries.
 )";
 
 }  // namespace
@@ -83,6 +86,7 @@ int cmd_linearize(int argc, char** argv) {
                                     {"q", vector_json(q)},
                                     {"qd", vector_json(qd)},
                                     {"tau", vector_json(tau)},
+                                    {"inputs", actuated_names(m)},
                                     {"A", matrix_json(A)},
                                     {"B", matrix_json(B)}});
     return 0;
@@ -91,7 +95,12 @@ int cmd_linearize(int argc, char** argv) {
   text.precision(10);
   text << "n = " << m.n() << "; state (xi, v), xi the tangent coordinates around q\n";
   text << "A = d(xi', v')/d(xi, v) (" << 2 * m.n() << " x " << 2 * m.n() << ") =\n" << A << "\n";
-  text << "B = d(xi', v')/d tau (" << 2 * m.n() << " x " << m.n() << ") =\n" << B << "\n";
+  text << "B = d(xi', v')/d u (" << 2 * m.n() << " x " << m.n_actuated() << ") =\n" << B << "\n";
+  if (!m.fully_actuated()) {
+    text << "u = tau of the actuated coordinates:";
+    for (const std::string& c : actuated_names(m)) text << " " << c;
+    text << "\n";
+  }
   std::cout << text.str();
   return 0;
 }

@@ -16,6 +16,7 @@
 #include "io/atomic_file.hpp"
 #include "io/output.hpp"
 #include "io/trajectory_csv.hpp"
+#include "sim/control_loop.hpp"
 #include "sim/integrator.hpp"
 #include "sim/recorded_run.hpp"
 
@@ -226,6 +227,8 @@ int cmd_simulate(int argc, char** argv) {
   bool driven = false;
   if (a.has("tau")) {
     const VecX u = state_vector(a, "tau", m);
+    if (const std::string bad = unactuated_problem(m, u.cwiseAbs()); !bad.empty())
+      throw CliError("--tau: " + bad);
     driven = !u.isZero(0);
     if (driven) tau = [u](double, VecX& out) { out = u; };
   } else if (a.has("tau-csv")) {
@@ -233,6 +236,8 @@ int cmd_simulate(int argc, char** argv) {
     if (table->t_first() > 0 || table->t_last() < t_end)
       throw CliError("--tau-csv " + table->path() + " covers t in [" + num(table->t_first()) +
                      ", " + num(table->t_last()) + "] s; it must cover [0, " + num(t_end) + "] s");
+    if (const std::string bad = unactuated_problem(m, table->largest()); !bad.empty())
+      throw CliError("--tau-csv " + table->path() + ": " + bad);
     tau = [&table](double t, VecX& out) { (*table)(t, out); };
     driven = true;
   }

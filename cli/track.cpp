@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
+#include "compile/actuators.hpp"
 #include "io/csv.hpp"
 #include "io/output.hpp"
 #include "sim/control_loop.hpp"
@@ -30,8 +31,9 @@ vector between the two quaternions). --csv writes t, q_ref, τ and q_sim per ste
 existing FILE is replaced only with --force, and never when it is MODEL). --json prints
 {"model", "n", "coordinates", "duration", "steps", "max_tracking_error", "max_abs_tau",
 "final_tracking_error", "feedback"}. τ acts on every coordinate, so a model with closed loops is
-refused (exit 1), and so is one with a free joint (a floating base) unless --actuated-base says
-that its base is pushed too (by thrusters: the τ on its 6 rates is the wrench they apply).
+refused (exit 1), and so is one with a coordinate no actuator drives (docs/control.md#actuation:
+a free joint, a floating base, unless --actuated-base says that its base is pushed too, by
+thrusters whose wrench is the τ on its 6 rates; a joint with "actuated": false).
 
 With --kp and --kd (1/s², 1/s; e.g. ω² and 2ω) the loop is closed: computed torque with PD,
   τ = M^s(q) (q̈_ref + K_d (v_ref − v) + K_p (q_ref ⊖ q)) + h(q, v) − Q(q, v, τ = 0),
@@ -58,19 +60,25 @@ struct ComputedTorque {
 
 // Computed torque puts a τ on every coordinate. A model where that is not the mechanism's own
 // actuation is refused, naming what would be ignored: closed loops (the open tree's τ would be
-// applied, and the loops' forces left out) and a free joint (a floating base nothing pushes),
-// unless --actuated-base says the base is pushed (thrusters: τ on its 6 rates is a wrench).
-void require_fully_actuated(const std::string& file, const Model& m, bool actuated_base) {
+// applied, and the loops' forces left out) and a coordinate no actuator drives (Model::actuated:
+// a floating base nothing pushes, a passive joint).
+void require_fully_actuated(const std::string& file, const Model& m) {
   if (!m.constraints.empty())
     throw ModelError(file, "the model has closed loops (" + std::to_string(m.constraint_rows) +
                                " constraint equations); computed torque by the spanning tree's "
                                "inverse dynamics would ignore them (not supported)");
-  for (const Body& b : m.bodies)
-    if (b.joint.type == JointType::Free && !actuated_base)
+  for (const Body& b : m.bodies) {
+    if (b.joint.actuated) continue;
+    if (b.joint.type == JointType::Free)
       throw ModelError(file, "body '" + b.name + "' is on a free joint ('" + b.joint.name +
                                  "'): computed torque would push on a base nothing actuates "
                                  "(free-floating tracking is not supported; --actuated-base if "
                                  "thrusters push it)");
+    throw ModelError(file, "joint '" + b.joint.name +
+                               "' is not actuated (\"actuated\": false): "
+                               "computed torque would push on it (underactuated tracking is not "
+                               "supported)");
+  }
 }
 
 }  // namespace
@@ -91,8 +99,9 @@ int cmd_track(int argc, char** argv) {
     if (std::filesystem::exists(out, ec) && !a.has("force"))
       throw CliError("--csv " + out + ": exists (use --force to replace it)");
   }
-  const Model m = load(a);
-  require_fully_actuated(a.positional[0], m, a.has("actuated-base"));
+  Model m = load(a);
+  if (a.has("actuated-base")) actuate_free_joints(m);
+  require_fully_actuated(a.positional[0], m);
   if (!a.has("to")) throw CliError("--to is required (try --help)");
   const VecX q1 = configuration_vector(a, "to", m);
   const VecX q0 = configuration_vector(a, "from", m);      // (the neutral configuration)

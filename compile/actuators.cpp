@@ -76,6 +76,7 @@ void compile_actuator(const JointSpec& js, Joint& j) {
   j.stop = js.stop;
   j.stop_stiffness = js.stop_stiffness;
   j.stop_dissipation = js.stop_dissipation;
+  j.actuated = js.actuated.value_or(j.type != JointType::Free);
 }
 
 void compile_actuators(Model& m) {
@@ -102,6 +103,24 @@ void compile_actuators(Model& m) {
     if (J.nv == 1) m.effort_limit[c.v] = J.effort_limit;
   }
   m.has_effort_limits = (m.effort_limit.array() < INFINITY).any();
+
+  // Actuation: every rate of q but those a joint that is not actuated owns (a coupled
+  // coordinate, owned by no joint, is driven through the joints its coupling moves).
+  std::vector<bool> driven(n, true);
+  for (const CoordinateJoint& c : m.coordinate_joints) {
+    const Joint& J = m.bodies[c.body].joint;
+    if (!J.actuated)
+      for (int k = 0; k < J.nv; ++k) driven[c.v + k] = false;
+  }
+  m.actuated.clear();
+  for (int i = 0; i < n; ++i)
+    if (driven[i]) m.actuated.push_back(i);
+}
+
+void actuate_free_joints(Model& m) {
+  for (Body& b : m.bodies)
+    if (b.joint.type == JointType::Free) b.joint.actuated = true;
+  compile_actuators(m);
 }
 
 }  // namespace femdyn

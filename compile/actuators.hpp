@@ -12,8 +12,13 @@ namespace femdyn {
 // j (its nv known). Each refusal names js.where and the field.
 void compile_actuator(const JointSpec& js, Joint& j);
 
-// After the coordinates are laid out: M_a = Cᵀ diag(I_a G²) C and the effort limit of each rate
-// of q (that of the joint owning it; a coupled joint's limit is not applied).
+// After the coordinates are laid out: M_a = Cᵀ diag(I_a G²) C, the effort limit of each rate
+// of q (that of the joint owning it; a coupled joint's limit is not applied) and the actuated
+// rates of q.
 void compile_actuators(Model& m);
+
+// Every free joint of m taken as actuated (as "actuated": true on it: thrusters push the base),
+// and m's actuated rates derived again (`femdyn track --actuated-base`).
+void actuate_free_joints(Model& m);
 
 }  // namespace femdyn

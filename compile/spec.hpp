@@ -33,6 +33,9 @@ struct JointSpec {
   double velocity_limit = std::numeric_limits<double>::infinity();
   bool stop = false;  // enforce [lower, upper] by a stiff stop (core/joints/passive.hpp)
   double stop_stiffness = 1e4, stop_dissipation = 0.5;
+  // Whether an actuator drives the joint's rates (docs/control.md#actuation); not given: every
+  // joint but a free one (a floating base has no thrusters unless the model says so).
+  std::optional<bool> actuated;
   std::string where;
 };
 

@@ -50,6 +50,7 @@ struct Joint {
   double effort_limit = INFINITY, velocity_limit = INFINITY;
   bool stop = false;
   double stop_stiffness = 1e4, stop_dissipation = 0.5;
+  bool actuated = true;          // an actuator drives its rates (docs/control.md#actuation)
   double reflected_inertia = 0;  // derived: I_a G²
   std::string where;
   // Derived by compile() for the pose (core/joints/): R_pj [a]×, R_pj [a]×², R_pj a.
@@ -236,6 +237,12 @@ struct Model {
   SpMat armature_mass;
   VecX effort_limit;
   bool has_effort_limits = false;
+  // Actuation (docs/control.md#actuation): the rates of q an actuator drives, ascending (n_a of
+  // them). τ = S u with S = I[:, actuated] (n × n_a): a controller's τ is zero on the others (a
+  // free base, passive loop joints), and the linearisation's B has these columns.
+  std::vector<int> actuated;
+  int n_actuated() const { return static_cast<int>(actuated.size()); }
+  bool fully_actuated() const { return n_actuated() == n(); }
 
   // Loops closed by constraints Φ(q) = 0 on the spanning tree (core/loops/), and two-point
   // springs (core/springs.hpp). Empty for a tree without them.

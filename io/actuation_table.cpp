@@ -135,6 +135,11 @@ void ActuationTable::reserve_rows(std::size_t rows, double memory_given) {
   tau_.reserve(rows * static_cast<std::size_t>(n_));
 }
 
+VecX ActuationTable::largest() const {
+  const Eigen::Map<const MatX> rows(tau_.data(), n_, static_cast<Eigen::Index>(t_.size()));
+  return rows.cwiseAbs().rowwise().maxCoeff();
+}
+
 void ActuationTable::operator()(double t, VecX& tau) const {
   // τ(t) = τ_r + (t − t_r)/(t_{r+1} − t_r) (τ_{r+1} − τ_r) for t_r ≤ t < t_{r+1}; held outside.
   const auto column = [this](std::ptrdiff_t r) {

@@ -26,6 +26,7 @@ class ActuationTable {
   ActuationTable(std::vector<double> t, const MatX& tau, std::string path);
 
   void operator()(double t, VecX& tau) const;  // no allocation
+  VecX largest() const;                        // max over the rows of |τ_i|, per coordinate
   double t_first() const { return t_.front(); }
   double t_last() const { return t_.back(); }
   const std::string& path() const { return path_; }

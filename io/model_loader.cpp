@@ -103,6 +103,7 @@ void read_actuator(const Params& p, JointSpec& j) {
   if (p.has("friction_velocity")) j.friction_velocity = p.positive("friction_velocity");
   if (p.has("effort_limit")) j.effort_limit = p.positive("effort_limit");
   if (p.has("velocity_limit")) j.velocity_limit = p.positive("velocity_limit");
+  if (p.has("actuated")) j.actuated = p.boolean_or("actuated", true);
   if (p.has("stop")) {
     const Params s = p.child("stop");
     s.allow_only({"stiffness", "dissipation"});
@@ -116,7 +117,7 @@ void read_actuator(const Params& p, JointSpec& j) {
 JointSpec read_joint(const Params& p) {
   p.allow_only({"name", "type", "origin", "axis", "axis2", "pitch", "limits", "spring", "damping",
                 "armature", "gear", "friction", "friction_velocity", "effort_limit",
-                "velocity_limit", "stop", "initial"});
+                "velocity_limit", "stop", "initial", "actuated"});
   JointSpec j;
   j.where = p.where();
   j.name = p.has("name") ? p.string("name") : "";
@@ -143,7 +144,7 @@ JointSpec read_joint(const Params& p) {
   if (p.has("initial")) j.initial = p.number("initial");  // (compile: joints of one coordinate)
   if (j.type == JointType::Fixed)
     for (const char* key : {"armature", "gear", "friction", "friction_velocity", "effort_limit",
-                            "velocity_limit", "stop"})
+                            "velocity_limit", "stop", "actuated"})
       if (p.has(key)) p.fail(key, "a fixed joint has no motion: no actuator, friction or stop");
   if (p.has("limits")) {
     const Json& l = p.json().at("limits");

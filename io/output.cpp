@@ -159,6 +159,7 @@ Json joint_properties(const Joint& j) {
     p["armature"] = {{"inertia", j.armature}, {"gear", j.gear}, {"reflected", j.reflected_inertia}};
   if (std::isfinite(j.effort_limit)) p["effort_limit"] = j.effort_limit;
   if (std::isfinite(j.velocity_limit)) p["velocity_limit"] = j.velocity_limit;
+  if (!j.actuated) p["actuated"] = false;
   return p;
 }
 
@@ -185,6 +186,7 @@ std::string joint_properties_text(const Joint& j) {
   if (std::isfinite(j.effort_limit)) parts.push_back("effort " + format_number(j.effort_limit));
   if (std::isfinite(j.velocity_limit))
     parts.push_back("velocity " + format_number(j.velocity_limit));
+  if (!j.actuated) parts.push_back("not actuated");
   std::string out;
   for (const std::string& part : parts) out += (out.empty() ? "" : "; ") + part;
   return out;
@@ -203,6 +205,12 @@ std::string place_name(const Model& model, const Attachment& A) {
 }
 }  // namespace
 
+std::vector<std::string> actuated_names(const Model& model) {
+  std::vector<std::string> names;
+  for (int i : model.actuated) names.push_back(model.coordinate_names[i]);
+  return names;
+}
+
 std::string info_text(const Model& model) {
   std::ostringstream out;
   out << "model: " << model.name << "\n";
@@ -213,6 +221,11 @@ std::string info_text(const Model& model) {
   if (model.configuration_names != model.coordinate_names) {  // a spherical or free joint
     out << "configuration q (n_q = " << model.n_q() << "):";
     for (const auto& c : model.configuration_names) out << " " << c;
+    out << "\n";
+  }
+  if (!model.fully_actuated()) {
+    out << "actuated (n_a = " << model.n_actuated() << "):";
+    for (const std::string& c : actuated_names(model)) out << " " << c;
     out << "\n";
   }
   // Joints counted as joints (a ball or free joint is one, of 3 or 6 rates θ̇).
@@ -298,6 +311,7 @@ Json info_json(const Model& model) {
   j["model"] = model.name;
   j["n"] = model.n();
   j["coordinates"] = model.coordinate_names;
+  j["actuated"] = actuated_names(model);
   Json u = Json::array();
   for (int i = 0; i < model.n_u(); ++i) u.push_back(model.dof_name(i));
   j["transition_coordinates"] = u;
@@ -372,8 +386,8 @@ int key_rank(const std::string& k) {
   static const char* order[] = {
       "$schema", "name", "description", "model", "gravity", "params", "type", "parent", "joint",
       "origin", "xyz", "rpy", "axis", "limits", "spring", "damping", "armature", "gear", "friction",
-      "friction_velocity", "effort_limit", "velocity_limit", "stop", "nodes", "elements", "mass",
-      "com", "inertia", "bodies", "couplings", "loads", "correlation_table",
+      "friction_velocity", "effort_limit", "velocity_limit", "stop", "actuated", "nodes",
+      "elements", "mass", "com", "inertia", "bodies", "couplings", "loads", "correlation_table",
       // equations --json
       "n", "coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd", "D"};
   for (std::size_t i = 0; i < std::size(order); ++i)

@@ -30,6 +30,8 @@ std::string equations_text(const Model& model, const Workspace& ws, const VecX& 
 
 std::string info_text(const Model& model);
 Json info_json(const Model& model);
+// The actuated coordinates' names (Model::actuated), in order.
+std::vector<std::string> actuated_names(const Model& model);
 
 // The paper-style correlation table N_m: one row per element, 6 entries per node.
 std::string correlation_table_text(const Model& model);

@@ -237,7 +237,7 @@ py::dict derivatives_batch(const PyModel& self, const Array& q, const OptArray& 
   return out;
 }
 
-// (A (k, 2n, 2n), B (k, 2n, n)) at k states, as Model.linearize.
+// (A (k, 2n, 2n), B (k, 2n, n_a)) at k states, as Model.linearize.
 std::pair<py::array_t<double>, py::array_t<double>> linearize_batch(
     const PyModel& self, const Array& q, const OptArray& qd, const OptArray& tau, int threads,
     const std::optional<double>& baumgarte) {
@@ -246,9 +246,10 @@ std::pair<py::array_t<double>, py::array_t<double>> linearize_batch(
   const Batch b(m, q, qd, tau, "tau", Entries::Bounded);
   const py::ssize_t k = b.k, n = b.n;
   const int nthreads = batch_threads(k, threads);
+  const py::ssize_t n_a = m.n_actuated();
   require_batch_memory("linearize_batch", m, k, nthreads, dense_bytes(6 * n, n),
                        evaluation_bytes(m) + dense_bytes(14 * n, n));
-  py::array_t<double> A = new_array({k, 2 * n, 2 * n}), B = new_array({k, 2 * n, n});
+  py::array_t<double> A = new_array({k, 2 * n, 2 * n}), B = new_array({k, 2 * n, n_a});
   double *pA = A.mutable_data(), *pB = B.mutable_data();
   for_each_derivative_row(m, b, nthreads, omega,
                           [&](Eigen::Index i, DerivativeScratch& s, RowState& r) {

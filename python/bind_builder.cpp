@@ -77,9 +77,10 @@ using OptNumber = std::optional<double>;
 struct ActuatorArgs {
   OptNumber armature, gear, friction, friction_velocity, effort_limit, velocity_limit;
   py::object stop = py::none();
+  std::optional<bool> actuated;
   bool given() const {
     return armature || gear || friction || friction_velocity || effort_limit || velocity_limit ||
-           !stop.is_none();
+           !stop.is_none() || actuated;
   }
 };
 
@@ -92,6 +93,7 @@ void actuator_arg(const ActuatorArgs& a, JointSpec& j) {
   j.friction_velocity = a.friction_velocity.value_or(j.friction_velocity);
   j.effort_limit = a.effort_limit.value_or(j.effort_limit);
   j.velocity_limit = a.velocity_limit.value_or(j.velocity_limit);
+  j.actuated = a.actuated;
   if (a.stop.is_none()) return;
   if (py::isinstance<py::bool_>(a.stop)) {
     j.stop = a.stop.cast<bool>();
@@ -197,9 +199,9 @@ void bind_builder(py::module_& m) {
              OptNumber rest, OptNumber damping, const OptArray& axis2, OptNumber pitch,
              OptNumber armature, OptNumber gear, OptNumber friction, OptNumber friction_velocity,
              OptNumber effort_limit, OptNumber velocity_limit, const py::object& stop,
-             OptNumber initial) {
+             OptNumber initial, std::optional<bool> actuated) {
             const ActuatorArgs act{armature,     gear,           friction, friction_velocity,
-                                   effort_limit, velocity_limit, stop};
+                                   effort_limit, velocity_limit, stop,     actuated};
             if (!type && act.given())
               throw py::value_error(
                   "actuator, friction or stop: given without a joint type; a body without "
@@ -219,7 +221,7 @@ void bind_builder(py::module_& m) {
           py::arg("gear") = py::none(), py::arg("friction") = py::none(),
           py::arg("friction_velocity") = py::none(), py::arg("effort_limit") = py::none(),
           py::arg("velocity_limit") = py::none(), py::arg("stop") = py::none(),
-          py::arg("initial") = py::none(),
+          py::arg("initial") = py::none(), py::arg("actuated") = py::none(),
           "A body on `parent` ('world': the ground) by a joint of `type` (revolute, prismatic, "
           "fixed, helical, universal, planar, spherical, free; docs/notation.md) named `joint` "
           "(default: the body's name), at xyz, rpy (default 0), about axis (default (0, 0, 1)), "
@@ -227,7 +229,8 @@ void bind_builder(py::module_& m) {
           "joint's second axis `axis2`, a helical joint's `pitch` (m/rad); a rotor `armature` "
           "(kg·m²) behind a `gear` ratio, Coulomb `friction` regularised at `friction_velocity`, "
           "`effort_limit`, `velocity_limit`, and `stop` (True or {'stiffness': k, "
-          "'dissipation': d}) enforcing the limits (docs/control.md), and the joint's `initial` "
+          "'dissipation': d}) enforcing the limits (docs/control.md), `actuated` (default: True "
+          "but on a free joint; docs/control.md#actuation), and the joint's `initial` "
           "coordinate (the start of a run). Without type the body "
           "is welded to its parent's origin and no other joint argument may be given (ValueError "
           "naming it); a fixed joint takes no axis, limits, spring or damper.")

@@ -91,8 +91,9 @@ void bind_derivatives(py::module_& m) {
            "dtau_dq, dtau_dv (n, n)")
       .def("linearize", &linearize, py::arg("q"), py::arg("qd") = py::none(),
            py::arg("tau") = py::none(), py::arg("baumgarte") = py::none(),
-           "(A, B): d/dt (ξ, v) = A (ξ, v) + B τ at the state, A (2n, 2n), B (2n, n), as "
-           "`femdyn linearize` prints them");
+           "(A, B): d/dt (ξ, v) = A (ξ, v) + B u at the state, A (2n, 2n), B (2n, n_a): u the "
+           "actuated coordinates' tau (Model.actuated; all n unless a free base or a joint "
+           "with actuated=False is not driven), as `femdyn linearize` prints them");
 }
 
 }  // namespace femdyn::python

@@ -281,6 +281,11 @@ void bind_model(py::module_& m) {
           "coordinates", [](const PyModel& s) { return s.model->coordinate_names; },
           "the names of v's entries (base.vx, …, joint names)")
       .def_property_readonly(
+          "actuated", [](const PyModel& s) { return s.model->actuated; },
+          "the indices into v of the actuated coordinates, ascending (docs/control.md#actuation): "
+          "every rate but a free joint's and those of a joint with actuated=False; "
+          "linearize's B has these columns, and a run's tau is zero off them")
+      .def_property_readonly(
           "configuration", [](const PyModel& s) { return s.model->configuration_names; },
           "the names of q's entries (base.x, …, base.qw, …, joint names)")
       .def(

@@ -11,6 +11,7 @@
 #include "io/actuation_table.hpp"
 #include "python/py_model.hpp"
 #include "python/run_stats.hpp"
+#include "sim/control_loop.hpp"
 #include "sim/integrator.hpp"
 #include "sim/recorded_run.hpp"
 
@@ -76,6 +77,9 @@ Actuation tau_table(const Model& m, const Array& times, const Array& values, dou
                           std::to_string(t.back()) + "] s; it must cover [0, t_end]");
   // Row r is τ at t[r]: finite and bounded, as --tau-csv's rows are.
   MatX tau = batch_arg(values, "tau", m, rows, Entries::Bounded).transpose();  // n x samples
+  if (const std::string bad = unactuated_problem(m, tau.cwiseAbs().rowwise().maxCoeff());
+      !bad.empty())
+    throw py::value_error("tau: " + bad);
   return [table = ActuationTable(std::move(t), std::move(tau), "tau_t")](double time, VecX& out) {
     table(time, out);
   };
@@ -136,6 +140,8 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
     driven = true;
   } else {
     const VecX u = vector_arg(tau_in, "tau", m, Entries::Bounded);
+    if (const std::string bad = unactuated_problem(m, u.cwiseAbs()); !bad.empty())
+      throw py::value_error("tau: " + bad);
     driven = !u.isZero(0);
     if (driven) tau = [u](double, VecX& out) { out = u; };
   }

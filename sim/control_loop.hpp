@@ -92,8 +92,15 @@ class ControlLoop {
   bool was_held_ = true;         // the last period held τ (a switch of mode is a jump in τ)
 };
 
-// "tau has 3 entries, expected 4", "tau is NaN or Inf (mcp)" or "tau of 'mcp' 1e+200 is out of
-// range (…)" (beyond kMaxMagnitude, as --tau); "" when τ is usable.
+// "tau has 3 entries, expected 4", "tau is NaN or Inf (mcp)", "tau of 'mcp' 1e+200 is out of
+// range (…)" (beyond kMaxMagnitude, as --tau) or unactuated_problem's; "" when τ is usable.
 std::string tau_problem(const Model& model, const VecX& tau);
+
+// A τ that acts on a coordinate no actuator drives (Model::actuated: a free base, a joint with
+// "actuated": false), named with its joint: "tau of 'base.x' is 2, but no actuator drives it
+// (…)"; "" when τ is zero off the actuated coordinates. `largest` holds |τ_i| (or its largest
+// over a table's rows), n entries. Every door that runs the mechanism under a τ asks it:
+// simulate, femdyn.simulate, the Simulator's step and controller, track.
+std::string unactuated_problem(const Model& model, const VecX& largest);
 
 }  // namespace femdyn

@@ -362,11 +362,12 @@ Status forward_dynamics_derivatives(const Model& m, Workspace& ws, DerivativeWor
 void linearization(const Model& m, const DerivativeWorkspace& d, const VecX& qd, MatX& A, MatX& B) {
   const int n = m.n();
   A.setZero(2 * n, 2 * n);
-  B.setZero(2 * n, n);
+  B.setZero(2 * n, m.n_actuated());
   A.topRightCorner(n, n).setIdentity();
   A.bottomLeftCorner(n, n) = d.dqdd_dq;
   A.bottomRightCorner(n, n) = d.dqdd_dv;
-  B.bottomRows(n) = d.Minv;
+  for (int k = 0; k < m.n_actuated(); ++k)  // B = [0; M⁻¹ S], S = I[:, actuated]
+    B.col(k).tail(n) = d.Minv.col(m.actuated[k]);
   for (const CoordinateJoint& c : m.coordinate_joints) {
     const Joint& J = m.bodies[c.body].joint;
     if (J.type == JointType::Spherical) {  // ξ̇ = J_r(ξ)⁻¹ ω: −½ [ω]×

@@ -139,8 +139,10 @@ void inverse_dynamics_derivatives(const Model& model, Workspace& ws, DerivativeW
 Status forward_dynamics_derivatives(const Model& model, Workspace& ws, DerivativeWorkspace& d,
                                     const VecX& q, const VecX& qd, const VecX& tau);
 
-// A = ∂(ξ̇, v̇)/∂(ξ, v) at ξ = 0 (2n × 2n) and B = ∂(ξ̇, v̇)/∂τ (2n × n) from the forward
-// derivatives in d at (q, v): ξ̇ = v on flat joints; in the chart ξ ↦ q ⊕ ξ a spherical joint has
+// A = ∂(ξ̇, v̇)/∂(ξ, v) at ξ = 0 (2n × 2n) and B = ∂(ξ̇, v̇)/∂u (2n × n_a) from the forward
+// derivatives in d at (q, v), u the actuated coordinates' τ (τ = S u, S = I[:, model.actuated]:
+// B's columns are those of [0; M⁻¹] at the actuated rates, docs/control.md#actuation).
+// ξ̇ = v on flat joints; in the chart ξ ↦ q ⊕ ξ a spherical joint has
 // ξ̇ = J_r(ξ)⁻¹ ω, so ∂ξ̇/∂ξ = −½ [ω]×, and a free joint also ξ̇_p = exp(ξ_r) v_p, −[v_p]×.
 void linearization(const Model& model, const DerivativeWorkspace& d, const VecX& qd, MatX& A,
                    MatX& B);

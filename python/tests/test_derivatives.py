@@ -82,13 +82,15 @@ def test_batches_equal_single_calls(name, threads):
     d = m.derivatives_batch(q, qd, tau, threads=threads)
     A, B = m.linearize_batch(q, qd, tau, threads=threads)
     assert d["dqdd_dq"].shape == (k, m.n, m.n) and A.shape == (k, 2 * m.n, 2 * m.n)
-    assert B.shape == (k, 2 * m.n, m.n)
+    # B's inputs are the actuated coordinates' tau: all but a free base's (docs/control.md).
+    assert B.shape == (k, 2 * m.n, len(m.actuated))
     for i in range(k):
         one = m.derivatives(q[i], qd[i], tau[i])
         for key in ("qdd", "dqdd_dq", "dqdd_dv", "Minv"):
             assert np.array_equal(d[key][i], one[key]), key
         a, b = m.linearize(q[i], qd[i], tau[i])
         assert np.array_equal(A[i], a) and np.array_equal(B[i], b)
+        assert np.array_equal(b[m.n:], one["Minv"][:, m.actuated]) and not b[:m.n].any()
 
 
 def test_batches_refuse_and_name_the_row():
