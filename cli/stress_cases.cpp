@@ -23,18 +23,20 @@ Json joint(const std::string& name, const std::string& type, Json axis, Json xyz
   return {{"name", name}, {"type", type}, {"axis", axis}, {"origin", {{"xyz", xyz}}}};
 }
 
-Json body(const std::string& name, const std::string& parent, Json j, Json elements) {
-  return {{"name", name}, {"parent", parent}, {"joint", j}, {"elements", elements}};
+// (Lists as std::vector: a braced list of one Json is that Json to clang, an array of it to GCC.)
+Json body(const std::string& name, const std::string& parent, Json j,
+          const std::vector<Json>& elements) {
+  return {{"name", name}, {"parent", parent}, {"joint", j}, {"elements", Json(elements)}};
 }
 
-Json model(const std::string& name, Json bodies, double gravity = 9.81) {
-  return {{"name", name}, {"gravity", {0, 0, -gravity}}, {"bodies", bodies}};
+Json model(const std::string& name, const std::vector<Json>& bodies, double gravity = 9.81) {
+  return {{"name", name}, {"gravity", {0, 0, -gravity}}, {"bodies", Json(bodies)}};
 }
 
 // A chain of links along x with the given masses and lengths; joint axes alternate y, z.
 Json chain(const std::string& name, const std::vector<double>& mass,
            const std::vector<double>& length) {
-  Json bodies = Json::array();
+  std::vector<Json> bodies;
   double offset = 0;
   for (std::size_t i = 0; i < mass.size(); ++i) {
     const std::string self = "link" + std::to_string(i + 1);
@@ -322,7 +324,7 @@ std::vector<StressCase> stress_cases(bool quick) {
                    {"inertia", {{"ixx", 1e-6}, {"iyy", 1e-6}, {"izz", 1e-6}}}};
     Json m = model(
         "slider at zero",
-        {body("table", "world", joint("spin", "revolute", {0, 0, 1}, {0, 0, 0}), Json::array()),
+        {body("table", "world", joint("spin", "revolute", {0, 0, 1}, {0, 0, 0}), {}),
          body("slider", "table", joint("reach", "prismatic", {1, 0, 0}, {0, 0, 0}), {slider})});
     // Started 1 mm off the axis, spinning: the slider is flung out (r grows about as cosh 5t
     // while the spin lasts), so M^s goes from nearly singular (2e-6 kg·m² on the turntable) to

@@ -60,7 +60,7 @@ Levers four_bar_levers(const FingerParams& f, const Vec3& pip) {
                                                   .input = a,
                                                   .coupler = number("coupler", 0),
                                                   .output = c,
-                                                  .branch = static_cast<int>(branch),
+                                                  .branch = branch < 0 ? -1 : 1,
                                                   .input_offset = phi0})
                .value_or(0.0);
   const auto planar = [](double r, double alpha) {

@@ -33,7 +33,10 @@ Json random_tree(const Params& p) {
     // moments a, b, c (the triangle inequality holds), turned by a random rotation.
     const double sa = pos(rng), sb = pos(rng), sc = pos(rng), mass = pos(rng);
     const Vec3 principal(sb + sc, sa + sc, sa + sb);
-    const Mat3 R = rpy_to_rotation(Vec3(u(rng), u(rng), u(rng)) * 3);
+    // (Drawn last to first, the order GCC evaluated Vec3(u(rng), u(rng), u(rng)) in before, so
+    // that a seed keeps its tree; a constructor's arguments are not sequenced.)
+    const double t2 = u(rng), t1 = u(rng), t0 = u(rng);
+    const Mat3 R = rpy_to_rotation(Vec3(t0, t1, t2) * 3);
     const Mat3 I = 0.05 * mass * R * principal.asDiagonal() * R.transpose();
     // (Arguments in separate statements: their order of evaluation is the random sequence.)
     const double a0 = u(rng), a1 = u(rng), a2 = u(rng);

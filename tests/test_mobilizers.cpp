@@ -88,8 +88,13 @@ std::string mixed_tree_json(unsigned seed, int bodies) {
     const std::string parent =
         b == 0 ? "world" : "b" + std::to_string(std::uniform_int_distribution<int>(0, b - 1)(rng));
     const std::string origin = R"("origin": {"xyz": )" + vec(0.3) + R"(, "rpy": )" + vec(1) + "}";
-    const Vec3 a = Vec3(u(rng), u(rng), u(rng)).normalized();
-    const Vec3 a2 = a.cross(Vec3(u(rng), u(rng), u(rng))).normalized();
+    const auto draw = [&] {  // (last to first, as GCC evaluated the constructor's unsequenced
+                             // arguments: the seeds keep their models)
+      const double z = u(rng), y = u(rng), x = u(rng);
+      return Vec3(x, y, z);
+    };
+    const Vec3 a = draw().normalized();
+    const Vec3 a2 = a.cross(draw()).normalized();
     std::ostringstream axes;
     axes.precision(17);
     axes << R"("axis": [)" << a.x() << ", " << a.y() << ", " << a.z() << R"(], "axis2": [)"

@@ -6,6 +6,8 @@
 //     has on the world, its loads and gravity with it — keeps M^s, h, Q, q̈, τ and ∂q̈ (the
 //     coordinates are relative: a free joint's in its joint frame), on every route, at |t| up to
 //     1e6 m;
+//   - splitting: each body split into two welded ones (its mass shared between them, its
+//     children moved to the second) keeps the same answers;
 //   - the entry points: a state of the wrong size is refused by the C++ API in one line;
 //   - the doors: `femdyn equations --json` gives the C++ API's numbers, closed loops included.
 #include <algorithm>
@@ -23,6 +25,8 @@
 #include "core/joints/kernel.hpp"
 #include "core/loops/assembly.hpp"
 #include "io/model_loader.hpp"
+#include "io/params.hpp"
+#include "models/random_tree.hpp"
 #include "tests/helpers.hpp"
 #include "tests/loop_checks.hpp"
 
@@ -368,6 +372,136 @@ TEST_CASE("listing the bodies in another order and renaming them changes no answ
     ++compared;
   }
   CHECK(compared >= 8);
+}
+
+namespace {
+
+using Json = nlohmann::json;
+
+Vec3 vec3_of(const Json& a) { return {a[0].get<double>(), a[1].get<double>(), a[2].get<double>()}; }
+Json json_of(const Vec3& x) { return Json::array({x[0], x[1], x[2]}); }
+Json json_of(const Mat3& I) {
+  return Json::array({json_of(Vec3(I.row(0))), json_of(Vec3(I.row(1))), json_of(Vec3(I.row(2)))});
+}
+Mat3 inertia_of(const Json& e) {  // {"ixx", …} or a 3 × 3 array
+  const Json& i = e["inertia"];
+  if (i.is_array()) {
+    Mat3 I;
+    for (int r = 0; r < 3; ++r) I.row(r) = vec3_of(i[r]).transpose();
+    return I;
+  }
+  const auto at = [&](const char* k) { return i.contains(k) ? i[k].get<double>() : 0.0; };
+  Mat3 I;
+  I << at("ixx"), at("ixy"), at("ixz"), at("ixy"), at("iyy"), at("iyz"), at("ixz"), at("iyz"),
+      at("izz");
+  return I;
+}
+Mat3 parallel_axis(const Vec3& r, double m) {  // m (|r|² 1 − r rᵀ)
+  return m * (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
+}
+
+// The mechanism with each body B split in two welded ones: a new body B_w on a fixed joint at a
+// random (t, R) in B carries B's point masses, rotary nodes and 60 % of its rigid body (the
+// other 40 % stays, the two parts' centres of mass 2 cm apart, their inertias set so that the
+// union is B's), its children hang from B_w (their joint frames carried over), and B keeps its
+// space bars and loads. The same mechanism: the same coordinates, M^s, h, Q, q̈, τ.
+std::string welded_split(const std::string& text, std::mt19937& rng) {
+  Json doc = Json::parse(text);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const auto random3 = [&](double s) {  // (in order: a constructor's arguments are unsequenced)
+    const double x = u(rng), y = u(rng), z = u(rng);
+    return Vec3(s * x, s * y, s * z);
+  };
+  Json out = Json::array();
+  std::map<std::string, std::pair<Vec3, Mat3>> welded;  // body -> (t, R) of its B_w
+  for (const Json& b : doc["bodies"]) {
+    const Vec3 t = random3(0.3);
+    const Mat3 R = rpy_to_rotation(random3(2.0));
+    const auto to_w = [&](const Vec3& x) { return Vec3(R.transpose() * (x - t)); };
+    Json body = b, part = {{"name", b["name"].get<std::string>() + "_w"},
+                           {"parent", b["name"]},
+                           {"joint",
+                            {{"name", b["name"].get<std::string>() + "_weld"},
+                             {"type", "fixed"},
+                             {"origin", {{"xyz", json_of(t)}, {"rpy", rpy_of(R)}}}}},
+                           {"elements", Json::array()}};
+    body["elements"] = Json::array();
+    for (const Json& e : b["elements"]) {
+      const std::string type = e["type"];
+      Json moved = e;
+      if (type == "lumped_point" || type == "rotary_node") {
+        moved["node"] = json_of(to_w(vec3_of(e["node"])));
+        if (type == "rotary_node")
+          moved["inertia"] = json_of(Mat3(R.transpose() * inertia_of(e) * R));
+        part["elements"].push_back(moved);
+      } else if (type == "rigid_body") {  // 40 % at c + 0.6 d, 60 % at c − 0.4 d
+        const double m = e["mass"], alpha = 0.4;
+        const Vec3 c = vec3_of(e["com"]), d = random3(0.02);
+        const Vec3 c1 = c + (1 - alpha) * d, c2 = c - alpha * d;
+        const Mat3 rest = inertia_of(e) - parallel_axis(c1 - c, alpha * m) -
+                          parallel_axis(c2 - c, (1 - alpha) * m);
+        Json kept = e;
+        kept["mass"] = alpha * m, kept["com"] = json_of(c1),
+        kept["inertia"] = json_of(Mat3(alpha * rest));
+        moved["mass"] = (1 - alpha) * m, moved["com"] = json_of(to_w(c2));
+        moved["inertia"] = json_of(Mat3((1 - alpha) * R.transpose() * rest * R));
+        body["elements"].push_back(kept);
+        part["elements"].push_back(moved);
+      } else {
+        body["elements"].push_back(e);
+      }
+    }
+    welded[b["name"]] = {t, R};
+    out.push_back(body);
+    out.push_back(part);
+  }
+  for (Json& b : out) {  // children of B onto B_w: their joint frames seen from B_w
+    const auto it = welded.find(b["parent"].get<std::string>());
+    if (it == welded.end() || b["name"] == it->first + "_w") continue;
+    const auto& [t, R] = it->second;
+    Json& origin = b["joint"]["origin"];
+    const Vec3 xyz = origin.contains("xyz") ? vec3_of(origin["xyz"]) : Vec3::Zero();
+    const Vec3 rpy = origin.contains("rpy") ? vec3_of(origin["rpy"]) : Vec3::Zero();
+    origin["xyz"] = json_of(Vec3(R.transpose() * (xyz - t)));
+    origin["rpy"] = json_of(rpy_of(R.transpose() * rpy_to_rotation(rpy)));
+    b["parent"] = it->first + "_w";
+  }
+  doc["bodies"] = out;
+  return doc.dump();
+}
+
+}  // namespace
+
+TEST_CASE("splitting each body into two welded ones changes no answer", "[one-truth][welded]") {
+  std::mt19937 rng(53);
+  int compared = 0;
+  Change worst;
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    const Json tree_params = {{"seed", seed}, {"bodies", 6}, {"branching", 0.5}};
+    const std::string kinds[] = {mixed_tree_json(seed, 7, 0.4, false, true),
+                                 mixed_tree_json(seed, 7, 0.4, true, false),
+                                 random_tree(Params(tree_params, "random_tree: ")).dump()};
+    for (const std::string& text : kinds) {
+      const Model a = load_text(text), b = load_text(welded_split(text, rng));
+      REQUIRE(b.bodies.size() == 2 * a.bodies.size());
+      REQUIRE(b.configuration_names == a.configuration_names);
+      REQUIRE(b.coordinate_names == a.coordinate_names);
+      VecX q, v, tau;
+      REQUIRE(random_state(a, rng, q, v, tau));
+      const Answers x = answers(a, q, v, tau), y = answers(b, q, v, tau);
+      REQUIRE(x.failure.empty());
+      REQUIRE(y.failure.empty());
+      Answers x_cut = x, y_cut = y;  // (the frame compared is each model's last: not the same)
+      for (Answers* w : {&x_cut, &y_cut}) w->J.resize(0, 0), w->velocity.resize(0);
+      const Change change = worst_change(y_cut, x_cut, v.cwiseAbs().maxCoeff());
+      INFO(a.name << ": " << change << ", cond " << x.condition);
+      CHECK(change.value < std::max(1e-11, 100 * kEpsilon * x.condition));
+      if (change.value > worst.value) worst = change;
+      ++compared;
+    }
+  }
+  CHECK(compared == 18);
+  WARN("welded split: worst change " << worst);
 }
 
 TEST_CASE("a free base flown 1 km and 1000 km away (its own q) changes no answer",

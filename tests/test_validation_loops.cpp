@@ -50,7 +50,11 @@ std::string closed_tree(unsigned seed, int bodies, const std::vector<std::string
   std::mt19937 rng(seed * 7 + 1);
   std::uniform_real_distribution<double> u(-1, 1);
   std::uniform_int_distribution<int> pick(0, bodies - 1);
-  const auto vec = [&](double s) { return Vec3(s * u(rng), s * u(rng), s * u(rng)); };
+  const auto vec = [&](double s) {  // (last to first, as GCC evaluated the constructor's
+                                    // unsequenced arguments: the seeds keep their models)
+    const double z = u(rng), y = u(rng), x = u(rng);
+    return Vec3(s * x, s * y, s * z);
+  };
   const auto pose = [&](int b, Mat3& R, Vec3& p) {
     R = b < 0 ? Mat3::Identity() : Mat3(ws.body[b].R);
     p = b < 0 ? Vec3::Zero() : Vec3(ws.origin + ws.body[b].p);

@@ -18,7 +18,7 @@ namespace femdyn::validation {
 
 namespace {
 
-using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Vec6 = ::Eigen::Matrix<double, 6, 1>;
 
 SimTK::Vec3 to_simtk(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 

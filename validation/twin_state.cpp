@@ -49,7 +49,7 @@ void SimbodyTwin::Impl::finish_state() {
       rotated.push_back({q0, rate, true}), rotated.push_back({q0, rate + 3, false});
   }
   theta_q.resize(m.n_theta_q > 0 ? m.n_theta_q : m.n_theta());
-  rot.assign(rotated.size(), Eigen::Matrix3d::Identity());
+  rot.assign(rotated.size(), ::Eigen::Matrix3d::Identity());
   if (!rotated.empty() && !m.closed_loop()) configuration_coupling();
   const int nu = state.getNU();
   zero_mobility = Vector(nu, 0.0);
@@ -69,7 +69,7 @@ void SimbodyTwin::Impl::configuration_coupling() {
     const TwinBody& tb = m.bodies[m.theta_body[own[k]]];
     return first[m.theta_body[own[k]]] + (own[k] - (tb.rate >= 0 ? tb.rate : tb.theta));
   };
-  std::vector<Eigen::Triplet<double>> entries;
+  std::vector<::Eigen::Triplet<double>> entries;
   theta0_configuration = VecX::Zero(m.n_theta_q);
   for (std::size_t b = 0; b < m.bodies.size(); ++b) {
     const TwinBody& tb = m.bodies[b];
@@ -90,17 +90,17 @@ void SimbodyTwin::Impl::configuration_coupling() {
   C_configuration.setFromTriplets(entries.begin(), entries.end());
 }
 
-std::vector<Eigen::Matrix3d> SimbodyTwin::Impl::rotations(const SimTK::Vector& sq) const {
-  std::vector<Eigen::Matrix3d> out;
+std::vector<::Eigen::Matrix3d> SimbodyTwin::Impl::rotations(const SimTK::Vector& sq) const {
+  std::vector<::Eigen::Matrix3d> out;
   for (const Rotated& r : rotated)
-    out.push_back(Eigen::Quaterniond(sq[r.quat], sq[r.quat + 1], sq[r.quat + 2], sq[r.quat + 3])
+    out.push_back(::Eigen::Quaterniond(sq[r.quat], sq[r.quat + 1], sq[r.quat + 2], sq[r.quat + 3])
                       .normalized()
                       .toRotationMatrix());
   return out;
 }
 
 VecX SimbodyTwin::Impl::gather(const SimTK::Vector& f_u,
-                               const std::vector<Eigen::Matrix3d>& R) const {  // Pᵀ f_u
+                               const std::vector<::Eigen::Matrix3d>& R) const {  // Pᵀ f_u
   VecX f(model.n_theta());
   for (int j = 0; j < model.n_theta(); ++j) f[j] = f_u[theta_u[j]];
   for (std::size_t i = 0; i < rotated.size(); ++i)
@@ -109,7 +109,7 @@ VecX SimbodyTwin::Impl::gather(const SimTK::Vector& f_u,
 }
 
 SimTK::Vector SimbodyTwin::Impl::scatter(const VecX& x,
-                                         const std::vector<Eigen::Matrix3d>& R) const {  // P x
+                                         const std::vector<::Eigen::Matrix3d>& R) const {  // P x
   SimTK::Vector out(state.getNU(), 0.0);
   if (rotated.empty()) {
     for (int j = 0; j < model.n_theta(); ++j) out[theta_u[j]] = x[j];
@@ -160,7 +160,7 @@ void SimbodyTwin::Impl::set_state(const VecX& q, const VecX& qd, SimTK::Stage st
     for (std::size_t i = 0; i < rotated.size(); ++i) {
       if (!rotated[i].free_linear) continue;  // Ṗ θ̇ = R (ω × v) on a free joint's v
       const int r = rotated[i].rate;
-      const Eigen::Vector3d d =
+      const ::Eigen::Vector3d d =
           rot[i] * loop_theta_dot.segment<3>(r + 3).cross(loop_theta_dot.segment<3>(r));
       for (int k = 0; k < 3; ++k) pdot_v[theta_u[r + k]] = d[k];
     }

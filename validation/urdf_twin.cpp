@@ -116,7 +116,7 @@ MobilizedBody mobilize(MobilizedBody& parent, const std::string& type, const Tra
 
 }  // namespace
 
-UrdfTwin::UrdfTwin(const std::string& path, const Eigen::Vector3d& gravity, bool floating)
+UrdfTwin::UrdfTwin(const std::string& path, const ::Eigen::Vector3d& gravity, bool floating)
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   tinyxml2::XMLDocument doc;
@@ -179,7 +179,7 @@ UrdfTwin::~UrdfTwin() = default;
 
 UrdfTwinEquations UrdfTwin::equations(const std::vector<std::string>& rate_names,
                                       const std::vector<std::string>& configuration_names,
-                                      const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+                                      const ::Eigen::VectorXd& q, const ::Eigen::VectorXd& qd) {
   Impl& s = *impl_;
   const int n = static_cast<int>(rate_names.size()), nu = s.state.getNU();
   std::map<std::string, int> rate, entry;  // a name -> its index in v, in q
@@ -195,13 +195,13 @@ UrdfTwinEquations UrdfTwin::equations(const std::vector<std::string>& rate_names
   // joint follows its leader, a planar joint's (x, y, θ) is Simbody's (θ, x, y), and a floating
   // joint's (v, ω) in its child's axes is Simbody's u = (R ω, R v) in the parent's (F) axes, so
   // u̇ = C v̇ + Ċ v with Ċ v = R (ω × v) on the linear part (R ω has no such term).
-  Eigen::MatrixXd C = Eigen::MatrixXd::Zero(nu, n);
-  Eigen::VectorXd Cdot_v = Eigen::VectorXd::Zero(nu);
+  ::Eigen::MatrixXd C = ::Eigen::MatrixXd::Zero(nu, n);
+  ::Eigen::VectorXd Cdot_v = ::Eigen::VectorXd::Zero(nu);
   Vector& sq = s.state.updQ();
-  std::function<void(const std::string&, Eigen::RowVectorXd&, double&)> resolve =
-      [&](const std::string& joint, Eigen::RowVectorXd& row, double& theta) {
+  std::function<void(const std::string&, ::Eigen::RowVectorXd&, double&)> resolve =
+      [&](const std::string& joint, ::Eigen::RowVectorXd& row, double& theta) {
         if (rate.count(joint)) {
-          row = Eigen::RowVectorXd::Unit(n, rate.at(joint));
+          row = ::Eigen::RowVectorXd::Unit(n, rate.at(joint));
           theta = q[at(entry, joint)];
           return;
         }
@@ -217,8 +217,8 @@ UrdfTwinEquations UrdfTwin::equations(const std::vector<std::string>& rate_names
     if (j.type == "floating") {
       const auto rates = [&](const char* first) { return at(rate, j.name + "." + first); };
       const int x = at(entry, j.name + ".x"), w = at(entry, j.name + ".qw");
-      const Eigen::Matrix3d R =
-          Eigen::Quaterniond(q[w], q[w + 1], q[w + 2], q[w + 3]).normalized().toRotationMatrix();
+      const ::Eigen::Matrix3d R =
+          ::Eigen::Quaterniond(q[w], q[w + 1], q[w + 2], q[w + 3]).normalized().toRotationMatrix();
       for (int k = 0; k < 4; ++k) sq[q0 + k] = q[w + k];  // Simbody: (quaternion, p)
       for (int k = 0; k < 3; ++k) sq[q0 + 4 + k] = q[x + k];
       const int v = rates("vx"), om = rates("wx");
@@ -233,7 +233,7 @@ UrdfTwinEquations UrdfTwin::equations(const std::vector<std::string>& rate_names
         sq[q0 + k] = q[at(entry, name)];
       }
     } else {  // Pin, Slider: one q, one u
-      Eigen::RowVectorXd row;
+      ::Eigen::RowVectorXd row;
       double theta = 0;
       resolve(j.name, row, theta);
       C.row(u0) = row;
@@ -241,7 +241,7 @@ UrdfTwinEquations UrdfTwin::equations(const std::vector<std::string>& rate_names
     }
   }
   {
-    const Eigen::VectorXd u = C * qd;
+    const ::Eigen::VectorXd u = C * qd;
     for (int a = 0; a < nu; ++a) s.state.updU()[a] = u[a];
   }
   s.system.realize(s.state, Stage::Dynamics);
@@ -253,8 +253,8 @@ UrdfTwinEquations UrdfTwin::equations(const std::vector<std::string>& rate_names
   s.matter.calcResidualForceIgnoringConstraints(
       s.state, s.system.getMobilityForces(s.state, Stage::Dynamics),
       s.system.getRigidBodyForces(s.state, Stage::Dynamics), zero, with_forces);
-  Eigen::MatrixXd Mt(nu, nu);
-  Eigen::VectorXd ht(nu), Qt(nu);
+  ::Eigen::MatrixXd Mt(nu, nu);
+  ::Eigen::VectorXd ht(nu), Qt(nu);
   for (int a = 0; a < nu; ++a) {
     ht[a] = bias[a];
     Qt[a] = bias[a] - with_forces[a];
