@@ -227,7 +227,7 @@ int cmd_simulate(int argc, char** argv) {
   bool driven = false;
   if (a.has("tau")) {
     const VecX u = state_vector(a, "tau", m);
-    if (const std::string bad = unactuated_problem(m, u.cwiseAbs()); !bad.empty())
+    if (const std::string bad = unactuated_problem(m, u); !bad.empty())
       throw CliError("--tau: " + bad);
     driven = !u.isZero(0);
     if (driven) tau = [u](double, VecX& out) { out = u; };

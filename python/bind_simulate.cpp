@@ -77,12 +77,10 @@ Actuation tau_table(const Model& m, const Array& times, const Array& values, dou
                           std::to_string(t.back()) + "] s; it must cover [0, t_end]");
   // Row r is τ at t[r]: finite and bounded, as --tau-csv's rows are.
   MatX tau = batch_arg(values, "tau", m, rows, Entries::Bounded).transpose();  // n x samples
-  if (const std::string bad = unactuated_problem(m, tau.cwiseAbs().rowwise().maxCoeff());
-      !bad.empty())
+  ActuationTable samples(std::move(t), std::move(tau), "tau_t");
+  if (const std::string bad = unactuated_problem(m, samples.largest()); !bad.empty())
     throw py::value_error("tau: " + bad);
-  return [table = ActuationTable(std::move(t), std::move(tau), "tau_t")](double time, VecX& out) {
-    table(time, out);
-  };
+  return [table = std::move(samples)](double time, VecX& out) { table(time, out); };
 }
 
 py::array_t<double> vector_array(const std::vector<double>& x) {
@@ -140,7 +138,7 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
     driven = true;
   } else {
     const VecX u = vector_arg(tau_in, "tau", m, Entries::Bounded);
-    if (const std::string bad = unactuated_problem(m, u.cwiseAbs()); !bad.empty())
+    if (const std::string bad = unactuated_problem(m, u); !bad.empty())
       throw py::value_error("tau: " + bad);
     driven = !u.isZero(0);
     if (driven) tau = [u](double, VecX& out) { out = u; };

@@ -24,18 +24,18 @@ std::string tau_problem(const Model& model, const VecX& tau) {
     if (std::abs(tau[i]) > kMaxMagnitude)  // as --tau and every physical input (core/limits.hpp)
       return "tau of '" + model.coordinate_names[i] + "' " + out_of_range_text(tau[i]);
   }
-  return unactuated_problem(model, tau.cwiseAbs());
+  return unactuated_problem(model, tau);
 }
 
-std::string unactuated_problem(const Model& model, const VecX& largest) {
+std::string unactuated_problem(const Model& model, const VecX& tau) {
   if (model.fully_actuated()) return {};
   for (const CoordinateJoint& c : model.coordinate_joints) {
     const Joint& J = model.bodies[c.body].joint;
     if (J.actuated) continue;
     for (int k = 0; k < J.nv; ++k) {
       const int i = c.v + k;
-      if (largest[i] == 0) continue;
-      return "tau of '" + model.coordinate_names[i] + "' is " + format_short(largest[i]) +
+      if (tau[i] == 0) continue;
+      return "tau of '" + model.coordinate_names[i] + "' is " + format_short(std::abs(tau[i])) +
              " (in magnitude), but no actuator drives it: joint '" + J.name + "' is " +
              (J.type == JointType::Free ? "a free joint" : "marked \"actuated\": false") +
              " (docs/control.md#actuation; an external force is a load)";

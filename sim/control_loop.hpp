@@ -97,10 +97,11 @@ class ControlLoop {
 std::string tau_problem(const Model& model, const VecX& tau);
 
 // A τ that acts on a coordinate no actuator drives (Model::actuated: a free base, a joint with
-// "actuated": false), named with its joint: "tau of 'base.x' is 2, but no actuator drives it
-// (…)"; "" when τ is zero off the actuated coordinates. `largest` holds |τ_i| (or its largest
-// over a table's rows), n entries. Every door that runs the mechanism under a τ asks it:
-// simulate, femdyn.simulate, the Simulator's step and controller, track.
-std::string unactuated_problem(const Model& model, const VecX& largest);
+// "actuated": false), named with its joint: "tau of 'base.x' is 2 (in magnitude), but no
+// actuator drives it (…)"; "" when τ is zero off the actuated coordinates. `tau`: n entries, τ
+// or, for a table, its largest |τ_i| over the rows (ActuationTable::largest). Every door that runs
+// the mechanism under a τ asks it: simulate, femdyn.simulate, the Simulator's step and
+// controller, ControlLoop. Allocates nothing unless it refuses (a control period's check).
+std::string unactuated_problem(const Model& model, const VecX& tau);
 
 }  // namespace femdyn

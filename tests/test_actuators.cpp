@@ -212,7 +212,7 @@ TEST_CASE("armature: a spring arm oscillates at sqrt(k / (I + I_a G²)), its ene
   CHECK(std::abs(quarter.qd) == Approx(0.1 * std::sqrt(2.0)).epsilon(1e-8));
 }
 
-TEST_CASE("Coulomb friction: a block decelerates at F_c / m and stops; E − E0 = W", "[actuators]") {
+TEST_CASE("Coulomb friction: a block decelerates at F_c / m and stops, E − E0 = W", "[actuators]") {
   // F_c = 2 N on 1 kg from 1 m/s: v = 1 − 2t until t = 0.5, x = t − t²; it stops at 0.25 m.
   const Model m = load_text(block({{"friction", 2.0}, {"friction_velocity", 0.01}}).dump());
   CHECK(m.bodies[0].joint.friction == 2.0);

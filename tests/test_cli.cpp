@@ -451,7 +451,7 @@ TEST_CASE("import writes JSON that loads back, atomically, or nothing at all", "
   CHECK(run("import " + model_path("urdf/arm7.urdf")).code == 2);  // no -o
 }
 
-TEST_CASE("linearize --json equals the library on the space robot; bad input in one line",
+TEST_CASE("linearize --json equals the library on the space robot, bad input in one line",
           "[cli][derivatives]") {
   // A free-floating base: A's chart block, the forward derivatives and M⁻¹, as the library
   // computes them; the text form names its sizes.

@@ -197,7 +197,7 @@ TEST_CASE("a bad controller is named: wrong size, NaN, and its exception", "[con
   CHECK(given.t() == 0);
 }
 
-TEST_CASE("a control period allocates nothing (rk4, dopri, bdf; both modes)",
+TEST_CASE("a control period allocates nothing (rk4, dopri, bdf, both modes)",
           "[control][hot-path]") {
   if (!alloc_counter::kAvailable) {
     WARN("skipped under sanitizers: ASan owns malloc, nothing is counted");
@@ -223,7 +223,7 @@ TEST_CASE("a control period allocates nothing (rk4, dopri, bdf; both modes)",
   }
 }
 
-TEST_CASE("a discontinuous controller in f costs dopri rejected steps; held, far fewer",
+TEST_CASE("a discontinuous controller in f costs dopri rejected steps, held, far fewer",
           "[control]") {
   // Bang-bang on the abduction joint: τ₀ = −τ_max sign(q₀ − q_d), which switches as q₀ crosses
   // q_d. In f the switch lies inside steps, which the error test rejects until they are short;

@@ -283,7 +283,8 @@ TEST_CASE("CLI: simulate --out and track --csv quote a name with a comma", "[ech
 }
 
 TEST_CASE(
-    "the JSON of --json: DEL and C1 as \\u escapes, invalid UTF-8 as U+FFFD, and it parses back",
+    "the JSON of --json: DEL and C1 as u-escapes (backslash u), invalid UTF-8 as U+FFFD, and it "
+    "parses back",
     "[echo]") {
   const nlohmann::json doc{{"path", std::string("a\x7f") + "b\xc2\x9b" + "c\xff" + "d\x1b"},
                            {"n", 3}};

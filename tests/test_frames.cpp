@@ -130,7 +130,7 @@ TEST_CASE("a frame sits where its JSON puts it: xyz, rpy or a node of its body",
              Catch::Contains("give either xyz or node"));
 }
 
-TEST_CASE("info lists the frames; kinematics takes them by name", "[frames][cli]") {
+TEST_CASE("info lists the frames, kinematics takes them by name", "[frames][cli]") {
   Scratch dir("frames_cli");
   std::ofstream(dir / "tip.json")
       << R"({"model": "dexterous_finger", "frames": [{"name": "fingertip", "body": "distal", "node": "b"}]})";

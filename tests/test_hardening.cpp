@@ -371,7 +371,7 @@ TEST_CASE("the nesting limit counts containers, not brackets inside strings", "[
         "test: JSON nested deeper than 64 levels (femdyn's limit)");
 }
 
-TEST_CASE("200,000 bodies with elements load; one more is refused before parsing",
+TEST_CASE("200,000 bodies with elements load, one more is refused before parsing",
           "[hardening][scale]") {
   const Model chain = load_text(scaling::model_json(200'000, false));
   CHECK(chain.n() == 200'000);
@@ -404,7 +404,7 @@ std::string urdf_chain(int links) {
 
 }  // namespace
 
-TEST_CASE("a 10,000-link URDF is read; its links are checked in one walk", "[hardening][scale]") {
+TEST_CASE("a 10,000-link URDF is read, its links are checked in one walk", "[hardening][scale]") {
   const UrdfResult r = urdf_to_model(urdf_chain(10'000), "long.urdf");
   CHECK(r.model["bodies"].size() == 9'999);
   CHECK(parse_model_json(r.model, "long.urdf").bodies.size() == 9'999);

@@ -214,7 +214,7 @@ TEST_CASE("the quintic reference's v and v̇ are its derivatives on every joint'
   }
 }
 
-TEST_CASE("in free float every integrator keeps the quaternions unit; dopri conserves momentum") {
+TEST_CASE("in free float every integrator keeps the quaternions unit, dopri conserves momentum") {
   const Model m = load_text(all_joints_json(0.0));
   Workspace ws(m);
   std::mt19937 rng(5);

@@ -624,7 +624,7 @@ TEST_CASE(
              Catch::Contains("does not close the loops") && Catch::Contains("at constraint '"));
 }
 
-TEST_CASE("smaller seams: info counts joints as joints; loops that cannot close exit 1, not 2",
+TEST_CASE("smaller seams: info counts joints as joints, loops that cannot close exit 1, not 2",
           "[one-truth][cli]") {
   const Model robot = load_model(model_path("space_robot.json"));
   const Run info = run("info " + model_path("space_robot.json"));

@@ -382,7 +382,7 @@ TEST_CASE(
   CHECK(gantry.has_effort_limits);
 }
 
-TEST_CASE("URDF <limit effort=\"0\"> is read as no limit, with a warning; negatives refused",
+TEST_CASE("URDF <limit effort=\"0\"> is read as no limit, with a warning, negatives refused",
           "[urdf][actuators]") {
   const auto robot = [](const std::string& limit, const std::string& dynamics) {
     return R"(<robot name="r"><link name="base"/><link name="l">)" +

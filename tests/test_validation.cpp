@@ -580,7 +580,7 @@ TEST_CASE("a bounded Simbody run takes the unbounded run's steps, and stops when
   }
 }
 
-TEST_CASE("validation beyond a tiny budget or memory limit is refused; validate() throws it",
+TEST_CASE("validation beyond a tiny budget or memory limit is refused, validate() throws it",
           "[validation][bounds]") {
   const Model m = load_model(model_path("finger.json"));
   ValidationOptions o;
