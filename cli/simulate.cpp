@@ -1,5 +1,6 @@
 // femdyn simulate: the motion of a model from an initial state under an actuation, by any of
 // the integrators of sim/integrator.hpp, written as a trajectory CSV with the energy balance.
+#include <algorithm>
 #include <cmath>
 #include <csignal>
 #include <filesystem>
@@ -9,16 +10,14 @@
 
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
-#include "core/loops/assembly.hpp"
 #include "core/memory.hpp"
 #include "core/names.hpp"
 #include "io/actuation_table.hpp"
 #include "io/atomic_file.hpp"
 #include "io/output.hpp"
 #include "io/trajectory_csv.hpp"
-#include "sim/control_loop.hpp"
-#include "sim/integrator.hpp"
-#include "sim/recorded_run.hpp"
+#include "sim/run_report.hpp"
+#include "sim/simulation_request.hpp"
 
 namespace femdyn::cli {
 namespace {
@@ -77,24 +76,14 @@ message names the time, the quantity and the likely cause), 130 when interrupted
 
 std::string num(double x) { return format_number(x, "%.4g"); }
 
-// The row times 0, s, 2s, …, t_end (the last one exactly t_end).
-std::vector<double> output_times(double t_end, double s) {
-  std::vector<double> times;
-  for (long k = 0; static_cast<double>(k) * s < t_end - 1e-9 * s; ++k)
-    times.push_back(static_cast<double>(k) * s);
-  times.push_back(t_end);
-  return times;
-}
-
 // Whether the trajectory file fits on its disk: rows × (2n + 5) numbers of at most 24 bytes
 // (a fixed-step run's rows are known up front; an adaptive run's, without --sample-dt, are not).
-Status output_fits(const AtomicFile& out, const Model& m, const IntegratorOptions& o, double t_end,
-                   long every, const std::optional<std::vector<double>>& times) {
+Status output_fits(const AtomicFile& out, const Model& m, const SimulationRequest& r) {
   double rows = 0;
-  if (times)
-    rows = static_cast<double>(times->size());
-  else if (!is_adaptive(o.kind))
-    rows = std::ceil(t_end / o.fixed.dt) / static_cast<double>(every) + 2;
+  if (r.times)
+    rows = static_cast<double>(r.times->size());
+  else if (!is_adaptive(r.options.kind))
+    rows = std::ceil(r.t_end / r.options.fixed.dt) / static_cast<double>(r.row_every()) + 2;
   else
     return {};
   const double bytes = rows * (2.0 * m.n() + 5) * 24;
@@ -132,39 +121,137 @@ class InterruptGuard {
   }, old_term_{};
 };
 
-}  // namespace
-
-IntegratorOptions integrator_options(const Args& a) {
-  IntegratorOptions o;
-  if (a.has("integrator") && !parse_integrator(a.options.at("integrator"), o.kind))
-    throw CliError("--integrator: " + quoted_text(a.options.at("integrator")) +
-                   " is not one of rk4, euler, dopri, bdf");
-  if (is_adaptive(o.kind)) {
-    if (a.has("dt"))
-      throw CliError(std::string("--dt sets the step of rk4 and euler; ") +
-                     integrator_name(o.kind) + " is adaptive: use --rtol and --atol");
-    o.adaptive.rtol = number_option(a, "rtol", o.adaptive.rtol);
-    o.adaptive.atol = number_option(a, "atol", o.adaptive.atol);
-  } else {
-    if (a.has("rtol") || a.has("atol"))
-      throw CliError(std::string("--rtol/--atol apply to dopri and bdf; ") +
-                     integrator_name(o.kind) + " has a fixed step: use --dt");
-    o.fixed.dt = number_option(a, "dt", o.fixed.dt);
-  }
-  if (a.has("jacobian")) {
-    const std::string& how = a.options.at("jacobian");
-    if (o.kind != IntegratorKind::Bdf)
-      throw CliError("--jacobian applies to bdf, the one integrator that uses a Jacobian");
-    if (how != "analytic" && how != "differences")
-      throw CliError("--jacobian: " + quoted_text(how) + " is not one of analytic, differences");
-    o.adaptive.analytic_jacobian = how == "analytic";
-  }
-  const long max_steps = static_cast<long>(integer_option(a, "max-steps", 1e7, 1, 1e15));
-  o.fixed.max_steps = max_steps;
-  if (a.has("max-steps")) o.adaptive.max_steps = max_steps;
-  if (const std::string why = o.check(); !why.empty()) throw CliError("--" + why);
-  return o;
+// The command line's spelling of the request's options: --t-end, --tau-csv FILE, --max-memory.
+Door command_line(const Args& a) {
+  const std::string tau_csv = a.has("tau-csv") ? " " + a.options.at("tau-csv") : "";
+  return {[tau_csv](std::string_view name) {
+            std::string o = "--" + std::string(name);
+            std::replace(o.begin(), o.end(), '_', '-');
+            return o == "--tau-csv" ? o + tau_csv : o;
+          },
+          [](double bytes) {
+            return "use " + max_memory_option(bytes) + " if that much memory is free";
+          }};
 }
+
+std::optional<double> optional_number(const Args& a, const std::string& name) {
+  if (!a.has(name)) return std::nullopt;
+  return number_option(a, name, 0);
+}
+
+std::optional<std::string> optional_text(const Args& a, const std::string& name) {
+  if (!a.has(name)) return std::nullopt;
+  return a.options.at(name);
+}
+
+// The command line as a request: the options translated, τ read (a table from its file).
+SimulationRequest simulation_request(const Args& a, const Model& m, const Door& door,
+                                     std::optional<ActuationTable>& table) {
+  if (!a.has("t-end")) throw CliError("--t-end is required (try --help)");
+  SimulationRequest r;
+  r.t_end = number_option(a, "t-end", 0);
+  r.options = integrator_options(
+      {optional_text(a, "integrator"), optional_number(a, "dt"), optional_number(a, "rtol"),
+       optional_number(a, "atol"), optional_text(a, "jacobian"), optional_number(a, "max-steps")},
+      door);
+  r.q0 = configuration_vector(a, "q0", m);
+  r.qd0 = state_vector(a, "qd0", m);
+  r.baumgarte = optional_number(a, "baumgarte");
+  r.every = optional_number(a, "every");
+  r.sample_dt = optional_number(a, "sample-dt");
+  r.max_memory = max_memory(a);
+  if (a.has("tau") && a.has("tau-csv")) throw CliError("--tau and --tau-csv exclude each other");
+  if (a.has("tau")) {
+    const VecX u = state_vector(a, "tau", m);
+    r.tau_largest = u.cwiseAbs();
+    if (!u.isZero(0)) r.tau = [u](double, VecX& out) { out = u; };
+  } else if (a.has("tau-csv")) {
+    table.emplace(a.options.at("tau-csv"), m, r.max_memory);
+    r.tau_option = "tau_csv";
+    r.tau_span = {table->t_first(), table->t_last()};
+    r.tau_largest = table->largest();
+    r.tau = [&table](double t, VecX& out) { (*table)(t, out); };
+  }
+  return r;
+}
+
+// --out, refused before any work if it would clobber a file.
+void open_output(const Args& a, std::optional<AtomicFile>& out) {
+  if (!a.has("out")) return;
+  const std::string& path = a.options.at("out");
+  std::error_code ec;
+  if (std::filesystem::equivalent(path, a.positional[0], ec))
+    throw CliError("--out " + path + " is the model file itself");
+  try {
+    out.emplace(path, a.has("force"));
+  } catch (const std::runtime_error& e) {
+    throw CliError(std::string("--out ") + e.what());
+  }
+}
+
+// Limit crossings, velocity excesses and saturations, one warning each on stderr.
+void print_warnings(const Model& m, const SimulationReport& report) {
+  const RecordedRun& run = report.run;
+  for (const LimitCrossing& c : run.limit_crossings)
+    std::cerr << "femdyn simulate: warning: joint '" << c.name << "' left its limits ["
+              << num(c.lower) << ", " << num(c.upper) << "] at t = " << num(c.t) << " s (value "
+              << num(c.value) << ")"
+              << (m.bodies[m.theta_joint[c.joint]].joint.stop
+                      ? "; its stop is compliant (docs/control.md)"
+                      : "; limits are not enforced")
+              << "\n";
+  for (const VelocityExcess& v : run.velocity_excesses)
+    std::cerr << "femdyn simulate: warning: joint '" << v.name << "' exceeded its velocity limit "
+              << num(v.limit) << " at t = " << num(v.t) << " s (rate " << num(v.value) << ")\n";
+  if (!run.unapplied_effort_limits.empty()) {
+    std::cerr << "femdyn simulate: warning: the effort limits of the coupled joints";
+    for (const std::string& name : run.unapplied_effort_limits) std::cerr << " '" << name << "'";
+    std::cerr << " are not applied (tau acts on the coordinates they follow)\n";
+  }
+  if (run.saturated_evaluations > 0) {
+    std::cerr << "femdyn simulate: warning: tau saturated at the effort limits in "
+              << run.saturated_evaluations << " of " << report.stats.rhs_evals
+              << " evaluations and " << run.saturated_steps << " steps (";
+    for (std::size_t k = 0; k < run.saturations.size(); ++k)
+      std::cerr << (k ? ", " : "") << run.saturations[k].name << " at ±"
+                << num(run.saturations[k].limit) << ": " << run.saturations[k].evaluations;
+    std::cerr << ")\n";
+  }
+}
+
+// The summary as text: the integrator, the steps, the time, the energy balance, the loops.
+void print_summary(const Model& m, const SimulationRequest& request,
+                   const SimulationReport& report) {
+  const IntegratorStats& s = report.stats;
+  const RecordedRun& run = report.run;
+  const IntegratorOptions& o = request.options;
+  std::cout << "model: " << m.name << " (" << m.n() << " coordinates)\n"
+            << "integrator: " << report.integrator << " ("
+            << (is_adaptive(o.kind)
+                    ? "rtol " + num(o.adaptive.rtol) + ", atol " + num(o.adaptive.atol)
+                    : "dt " + num(o.fixed.dt) + " s")
+            << ")\n"
+            << "simulated " << num(report.t_reached) << " of " << num(request.t_end)
+            << " s: " << s.steps << " steps (" << s.rejected << " rejected), " << s.rhs_evals
+            << " evaluations of forward dynamics, " << s.jac_evals << " Jacobians\n"
+            << "wall time " << num(run.wall_time) << " s (integration " << num(s.wall_time)
+            << " s), real-time factor " << num(report.real_time_factor()) << "\n"
+            << (report.conservative ? "energy drift" : "energy-balance error")
+            << ": max |E(t) - E(0) - W(t)| = " << num(run.max_balance) << " J ("
+            << num(run.relative_balance()) << " of the " << num(run.scale)
+            << " J the motion started with and was given) over " << run.rows << " rows\n";
+  if (m.constraints.empty()) return;
+  const AssemblyReport& a = report.loops.assembly;
+  std::cout << "loops: " << m.constraint_rows << " constraint equations, rank " << a.rank << " ("
+            << a.redundant << " redundant); start assembled in " << a.iterations
+            << " Newton iterations (|Phi| = " << num(a.residual)
+            << "), velocity projected (|dv| = " << num(report.loops.velocity_change)
+            << "); Baumgarte rate " << num(report.baumgarte) << " 1/s\n"
+            << "constraint residual over the rows: max |Phi| = " << num(run.max_position_residual)
+            << ", max |Phi_q v| = " << num(run.max_velocity_residual) << "\n";
+}
+
+}  // namespace
 
 int cmd_simulate(int argc, char** argv) {
   const Args a = parse_args(
@@ -176,99 +263,35 @@ int cmd_simulate(int argc, char** argv) {
     return 0;
   }
   const Model m = load(a);
-  if (!a.has("t-end")) throw CliError("--t-end is required (try --help)");
-  const double t_end = number_option(a, "t-end", 0);
-  if (!(t_end > 0) || t_end > 1e9) throw CliError("--t-end expects a time in (0, 1e9] s");
-  const IntegratorOptions o = integrator_options(a);
-  VecX q0 = configuration_vector(a, "q0", m), qd0 = state_vector(a, "qd0", m);
-  // Closed loops: the start assembled onto the constraints (docs/loops.md).
-  StateAssembly loops;
-  double baumgarte = Motion::kDefaultBaumgarte;
-  if (a.has("baumgarte")) {
-    if (m.constraints.empty()) throw CliError("--baumgarte: the model has no constraints");
-    baumgarte = number_option(a, "baumgarte", 0);
-    if (!(baumgarte >= 0) || !std::isfinite(baumgarte))
-      throw CliError("--baumgarte expects a rate >= 0 (1/s; 0: off)");
-  }
-  if (!m.constraints.empty()) {
-    loops = assemble_state(m, q0, qd0);
-    if (!loops.assembly.status.ok)
-      throw StateError(a.positional[0] + ": the initial state: " + loops.assembly.status.message);
-  }
-  const long every = static_cast<long>(integer_option(a, "every", 1, 1));
-  if (a.has("every") && a.has("sample-dt"))
-    throw CliError("--every and --sample-dt exclude each other");
-  // Memory: the run's matrices and the sample times, before either is allocated.
-  const double memory_given = max_memory(a);
-  double sample_dt = 0;
-  if (a.has("sample-dt")) {
-    sample_dt = number_option(a, "sample-dt", 0);
-    if (!(sample_dt > 0) || t_end / sample_dt > 1e9)
-      throw CliError("--sample-dt expects a positive interval, at most 1e9 rows over --t-end");
-  }
-  const double run_bytes =
-      integrator_bytes(m, o.kind) + (sample_dt > 0 ? 8 * (std::ceil(t_end / sample_dt) + 1) : 0);
-  require_memory(a.positional[0] + ": simulating n = " + std::to_string(m.n()) +
-                     " coordinates with " + integrator_name(o.kind) +
-                     (sample_dt > 0 ? " and " + format_short(std::ceil(t_end / sample_dt) + 1) +
-                                          " sample times"
-                                    : std::string()),
-                 run_bytes, memory_given,
-                 "use " + max_memory_option(run_bytes) + " if that much memory is free" +
-                     (sample_dt > 0 ? ", or a larger --sample-dt" : "") +
-                     (o.kind == IntegratorKind::Bdf ? ", or dopri (no Jacobian)" : ""));
-  std::optional<std::vector<double>> sample_times;
-  if (sample_dt > 0) sample_times = output_times(t_end, sample_dt);
-
-  // τ: constant, a table, or none (passive).
-  if (a.has("tau") && a.has("tau-csv")) throw CliError("--tau and --tau-csv exclude each other");
-  Actuation tau;
+  const Door door = command_line(a);
   std::optional<ActuationTable> table;
-  bool driven = false;
-  if (a.has("tau")) {
-    const VecX u = state_vector(a, "tau", m);
-    if (const std::string bad = unactuated_problem(m, u); !bad.empty())
-      throw CliError("--tau: " + bad);
-    driven = !u.isZero(0);
-    if (driven) tau = [u](double, VecX& out) { out = u; };
-  } else if (a.has("tau-csv")) {
-    table.emplace(a.options.at("tau-csv"), m, memory_given);
-    if (table->t_first() > 0 || table->t_last() < t_end)
-      throw CliError("--tau-csv " + table->path() + " covers t in [" + num(table->t_first()) +
-                     ", " + num(table->t_last()) + "] s; it must cover [0, " + num(t_end) + "] s");
-    if (const std::string bad = unactuated_problem(m, table->largest()); !bad.empty())
-      throw CliError("--tau-csv " + table->path() + ": " + bad);
-    tau = [&table](double t, VecX& out) { (*table)(t, out); };
-    driven = true;
+  SimulationRequest request;
+  StateAssembly loops;
+  try {
+    request = simulation_request(a, m, door, table);
+  } catch (const RequestError& e) {
+    throw CliError(e.what());
   }
-  const bool is_conservative = conservative(m, driven);
-
-  // Output: refused before any work if it would clobber a file.
+  try {
+    loops = check_request(m, request, door);
+  } catch (const RequestError& e) {
+    throw CliError(e.what());
+  } catch (const StateError& e) {
+    throw StateError(a.positional[0] + ": " + e.what());
+  } catch (const MemoryRefused& e) {
+    throw MemoryRefused(a.positional[0] + ": simulating " + e.what());
+  }
   std::optional<AtomicFile> out;
-  if (a.has("out")) {
-    const std::string& path = a.options.at("out");
-    std::error_code ec;
-    if (std::filesystem::equivalent(path, a.positional[0], ec))
-      throw CliError("--out " + path + " is the model file itself");
-    try {
-      out.emplace(path, a.has("force"));
-    } catch (const std::runtime_error& e) {
-      throw CliError(std::string("--out ") + e.what());
-    }
-  }
-
-  std::unique_ptr<Integrator> integ = make_integrator(m, o, tau);
-  integ->motion().set_baumgarte(baumgarte);
-  integ->reset(0, q0, qd0, t_end);
+  open_output(a, out);
   if (out) {
-    const Status fits = output_fits(*out, m, o, t_end, every, sample_times);
+    const Status fits = output_fits(*out, m, request);
     if (!fits.ok) throw CliError("--out " + out->path() + ": " + fits.message);
     write_trajectory_header(out->stream(), m);
   }
   InterruptGuard guard;
-  Progress progress(t_end, "s");
-  const RecordedRun run = run_recorded(
-      *integ, t_end, every, sample_times ? &*sample_times : nullptr,
+  Progress progress(request.t_end, "s");
+  const SimulationReport report = run_simulation(
+      m, request, loops,
       [&](const Integrator& i, const Energy& E) {
         if (out) write_trajectory_row(out->stream(), i.t(), i.state(), E);
       },
@@ -277,139 +300,28 @@ int cmd_simulate(int argc, char** argv) {
         return g_interrupted != 0;
       });
   progress.finish();
+  const RecordedRun& run = report.run;
   if (run.interrupted) {
-    std::cerr << "femdyn simulate: interrupted at t = " << integ->t() << " s"
+    std::cerr << "femdyn simulate: interrupted at t = " << report.t_reached << " s"
               << (out ? "; " + escaped(out->path()) + " was not written" : std::string()) << "\n";
     return 130;  // `out` discards its temporary file
   }
-  const Status& st = run.status;
   if (run.refused)  // by the plan, before any work
-    throw CliError(std::string(a.positional[0]) + ": " + st.message);
-  const Energy& E0 = run.initial;
-  const double max_balance = run.max_balance, scale = run.scale, wall = run.wall_time;
-  const long rows = run.rows;
+    throw CliError(std::string(a.positional[0]) + ": " + run.status.message);
   if (out) out->commit();
-  if (!a.has("json"))  // (with --json they are the object's "limit_crossings")
-    for (const LimitCrossing& c : run.limit_crossings)
-      std::cerr << "femdyn simulate: warning: joint '" << c.name << "' left its limits ["
-                << num(c.lower) << ", " << num(c.upper) << "] at t = " << num(c.t) << " s (value "
-                << num(c.value) << ")"
-                << (m.bodies[m.theta_joint[c.joint]].joint.stop
-                        ? "; its stop is compliant (docs/control.md)"
-                        : "; limits are not enforced")
-                << "\n";
-  if (!a.has("json")) {
-    for (const VelocityExcess& v : run.velocity_excesses)
-      std::cerr << "femdyn simulate: warning: joint '" << v.name << "' exceeded its velocity limit "
-                << num(v.limit) << " at t = " << num(v.t) << " s (rate " << num(v.value) << ")\n";
-    if (!run.unapplied_effort_limits.empty()) {
-      std::cerr << "femdyn simulate: warning: the effort limits of the coupled joints";
-      for (const std::string& name : run.unapplied_effort_limits) std::cerr << " '" << name << "'";
-      std::cerr << " are not applied (tau acts on the coordinates they follow)\n";
-    }
-    if (run.saturated_evaluations > 0) {
-      std::cerr << "femdyn simulate: warning: tau saturated at the effort limits in "
-                << run.saturated_evaluations << " of " << integ->stats().rhs_evals
-                << " evaluations and " << run.saturated_steps << " steps (";
-      for (std::size_t k = 0; k < run.saturations.size(); ++k)
-        std::cerr << (k ? ", " : "") << run.saturations[k].name << " at ±"
-                  << num(run.saturations[k].limit) << ": " << run.saturations[k].evaluations;
-      std::cerr << ")\n";
-    }
-  }
-
-  const IntegratorStats& s = integ->stats();
-  const double simulated = integ->t();
-  const double rtf = s.wall_time > 0 ? simulated / s.wall_time : 0;
-  const std::string balance_name = is_conservative ? "energy drift" : "energy-balance error";
-  if (a.has("json")) {
-    Json j = {{"model", m.name},
-              {"n", m.n()},
-              {"coordinates", m.coordinate_names},
-              {"integrator", integ->name()},
-              {"t_end", t_end},
-              {"t_reached", simulated},
-              {"steps", s.steps},
-              {"rejected", s.rejected},
-              {"rhs_evals", s.rhs_evals},
-              {"jac_evals", s.jac_evals},
-              {"wall_time", wall},
-              {"integration_time", s.wall_time},
-              {"real_time_factor", rtf},
-              {"conservative", is_conservative},
-              {"energy_initial", E0.total()},
-              {"energy_balance_error", max_balance},
-              {"energy_scale", scale},
-              {"energy_balance_relative", run.relative_balance()},
-              {"rows", rows},
-              {"ok", st.ok},
-              {"diverged", st.diverged}};
-    Json crossings = Json::array();
-    for (const LimitCrossing& c : run.limit_crossings)
-      crossings.push_back({{"joint", c.name},
-                           {"t", c.t},
-                           {"value", c.value},
-                           {"lower", c.lower},
-                           {"upper", c.upper}});
-    j["limit_crossings"] = crossings;
-    Json too_fast = Json::array(), saturated = Json::array();
-    for (const VelocityExcess& v : run.velocity_excesses)
-      too_fast.push_back({{"joint", v.name}, {"t", v.t}, {"value", v.value}, {"limit", v.limit}});
-    for (const EffortSaturation& e : run.saturations)
-      saturated.push_back(
-          {{"coordinate", e.name}, {"limit", e.limit}, {"evaluations", e.evaluations}});
-    j["velocity_excesses"] = too_fast;
-    j["saturations"] = saturated;
-    j["saturated_evaluations"] = run.saturated_evaluations;
-    j["saturated_steps"] = run.saturated_steps;
-    j["unapplied_effort_limits"] = run.unapplied_effort_limits;
-    if (is_adaptive(o.kind))
-      j["options"] = {{"rtol", o.adaptive.rtol}, {"atol", o.adaptive.atol}};
-    else
-      j["options"] = {{"dt", o.fixed.dt}};
-    if (!m.constraints.empty())
-      j["loops"] = {{"equations", m.constraint_rows},
-                    {"rank", loops.assembly.rank},
-                    {"redundant", loops.assembly.redundant},
-                    {"assembly_iterations", loops.assembly.iterations},
-                    {"assembly_residual", loops.assembly.residual},
-                    {"initial_velocity_change", loops.velocity_change},
-                    {"baumgarte", baumgarte},
-                    {"max_position_residual", run.max_position_residual},
-                    {"max_velocity_residual", run.max_velocity_residual}};
+  if (a.has("json")) {  // (the warnings are the object's lists)
+    Json j = simulation_json(m, request, report);
     if (out) j["out"] = out->path();
-    if (!st.ok) j["failure"] = st.message;
     std::cout << json_text(j) << "\n";
   } else {
-    std::cout << "model: " << m.name << " (" << m.n() << " coordinates)\n"
-              << "integrator: " << integ->name() << " ("
-              << (is_adaptive(o.kind)
-                      ? "rtol " + num(o.adaptive.rtol) + ", atol " + num(o.adaptive.atol)
-                      : "dt " + num(o.fixed.dt) + " s")
-              << ")\n"
-              << "simulated " << num(simulated) << " of " << num(t_end) << " s: " << s.steps
-              << " steps (" << s.rejected << " rejected), " << s.rhs_evals
-              << " evaluations of forward dynamics, " << s.jac_evals << " Jacobians\n"
-              << "wall time " << num(wall) << " s (integration " << num(s.wall_time)
-              << " s), real-time factor " << num(rtf) << "\n"
-              << balance_name << ": max |E(t) - E(0) - W(t)| = " << num(max_balance) << " J ("
-              << num(run.relative_balance()) << " of the " << num(scale)
-              << " J the motion started with and was given) over " << rows << " rows\n";
-    if (!m.constraints.empty())
-      std::cout << "loops: " << m.constraint_rows << " constraint equations, rank "
-                << loops.assembly.rank << " (" << loops.assembly.redundant << " redundant); start "
-                << "assembled in " << loops.assembly.iterations
-                << " Newton iterations (|Phi| = " << num(loops.assembly.residual)
-                << "), velocity projected (|dv| = " << num(loops.velocity_change)
-                << "); Baumgarte rate " << num(baumgarte) << " 1/s\n"
-                << "constraint residual over the rows: max |Phi| = "
-                << num(run.max_position_residual)
-                << ", max |Phi_q v| = " << num(run.max_velocity_residual) << "\n";
-    if (out) std::cout << "wrote " << escaped(out->path()) << " (" << rows << " rows)\n";
+    print_warnings(m, report);
+    print_summary(m, request, report);
+    if (out) std::cout << "wrote " << escaped(out->path()) << " (" << run.rows << " rows)\n";
   }
-  if (!st.ok) {
-    std::cerr << "femdyn simulate: " << escaped(a.positional[0]) << ": " << safe_message(st.message)
-              << (out ? "; the rows up to t = " + num(simulated) + " s are in " +
+  if (!run.status.ok) {
+    std::cerr << "femdyn simulate: " << escaped(a.positional[0]) << ": "
+              << safe_message(run.status.message)
+              << (out ? "; the rows up to t = " + num(report.t_reached) + " s are in " +
                             escaped(out->path())
                       : std::string())
               << "\n";

@@ -15,6 +15,7 @@
 #include "io/model_loader.hpp"
 #include "io/output.hpp"
 #include "python/py_model.hpp"
+#include "python/run_stats.hpp"
 
 namespace femdyn::python {
 namespace {
@@ -211,10 +212,6 @@ py::list correlation_table(const PyModel& self) {
     rows.append(d);
   }
   return rows;
-}
-
-py::object json_to_python(const Json& j) {
-  return py::module_::import("json").attr("loads")(j.dump());
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include "python/py_model.hpp"
 #include "python/run_stats.hpp"
 #include "sim/control_loop.hpp"
+#include "sim/run_report.hpp"
 
 namespace femdyn::python {
 namespace {
@@ -206,7 +207,9 @@ class Simulator {
                     " at t = " + format_short(largest.t) + " s";
     if (!st.ok && check) throw NumericalError(st.message);
     const IntegratorStats& s = integ.stats();
-    py::dict stats;
+    // The summary's fields as femdyn.simulate's (sim/run_report.hpp; a controller acts), then the
+    // loop's own.
+    py::dict stats = json_to_python(run_summary_json(m, watch.run(), false));
     stats["integrator"] = std::string(integ.name());
     stats["mode"] = mode;
     stats["dt"] = T;
@@ -222,7 +225,6 @@ class Simulator {
     stats["ok"] = st.ok;
     stats["diverged"] = st.diverged;
     stats["failure"] = st.message;
-    put_run_stats(stats, m, watch.run(), false);  // (a controller acts)
     py::dict d;
     d["t"] = table(rows.t, 0);
     d["q"] = table(rows.q, m.n_q());

@@ -1,14 +1,12 @@
-// A run's summary as the Python module returns it (stats of femdyn.simulate and of
-// Simulator.run), from the one RecordedRun every driver fills (sim/recorded_run.hpp): the energy
-// balance, limit crossings, velocity excesses, effort saturations and, with closed loops, the
-// constraints' residuals — the fields `femdyn simulate --json` prints.
+// A run's report as the Python module returns it: the JSON object `femdyn simulate --json` prints
+// (io/run_report.hpp), as a dict, so that the CLI and Python give the same fields and values.
 #pragma once
+#include "io/params.hpp"
 #include "python/arrays.hpp"
-#include "sim/recorded_run.hpp"
 
 namespace femdyn::python {
 
-// Adds the run's fields to `stats`; `conservative`: nothing but conservative forces acted.
-void put_run_stats(py::dict& stats, const Model& model, const RecordedRun& run, bool conservative);
+// j as Python objects (dict, list, str, float, int, bool), by the json module.
+py::object json_to_python(const Json& j);
 
 }  // namespace femdyn::python

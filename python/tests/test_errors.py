@@ -51,7 +51,7 @@ def test_exception_classes():
      "dt sets the step of rk4 and euler; dopri is adaptive: use rtol and atol"),
     (lambda m: femdyn.simulate(m, 0.1, integrator="rk4", rtol=1e-6),
      "rtol/atol apply to dopri and bdf; rk4 has a fixed step: use dt"),
-    (lambda m: femdyn.simulate(m, -1), "t_end: expected a time in (0, 1e9] s"),
+    (lambda m: femdyn.simulate(m, -1), "t_end expects a time in (0, 1e9] s"),
     (lambda m: femdyn.simulate(m, 1, t_eval=[0.5, 0.2]),
      "t_eval: expected nondecreasing times in [0, t_end]; entry 1 is not"),
     (lambda m: femdyn.load(model_path("models/finger.json"), gravity=[0, 0]),

@@ -133,7 +133,7 @@ def test_run_keeps_the_loop_and_the_energy(fourbar):
     assert stats["ok"]
     for q in run["q"]:
         assert np.abs(fourbar.constraint_kinematics(q)["phi"]).max() < 1e-10
-    assert stats["max_position_residual"] < 1e-10 and stats["max_velocity_residual"] < 1e-9
+    assert stats["loops"]["max_position_residual"] < 1e-10 and stats["loops"]["max_velocity_residual"] < 1e-9
     # Conservative (gravity, a spring): the energy drift stays at the tolerance's level.
     assert stats["energy_balance_relative"] < 1e-8
 

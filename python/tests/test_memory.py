@@ -26,12 +26,12 @@ def test_simulate_t_eval_is_refused_up_front(finger, small_limit):
         femdyn.simulate(finger, 1.0, t_eval=np.linspace(0, 1, 100000))
     text = str(e.value)
     assert text.startswith("simulate: n = 4 coordinates with dopri and 1e+05 rows needs ")
-    assert "beyond the memory limit of 100 kB: fewer t_eval times" in text
+    assert text.endswith("if that much memory is free, or fewer t_eval times")
     assert "femdyn.set_max_memory(" in text and "\n" not in text
 
 
 def test_fixed_step_rows_are_refused_up_front(finger, small_limit):
-    with pytest.raises(ValueError, match=r"^simulate: .* rows needs .*a larger every="):
+    with pytest.raises(ValueError, match=r"^simulate: .* rows needs .*a larger every$"):
         femdyn.simulate(finger, 10.0, integrator="rk4", dt=1e-4)
 
 

@@ -129,7 +129,7 @@ def test_simulator_run_on_closed_loops_reports_the_residuals():
     s = m.assemble(np.array([0.9, -0.8, -0.6]))
     sim = femdyn.Simulator(m, integrator="rk4", dt=1e-3, q0=s["q"])
     st = sim.run(lambda t, q, qd: np.zeros(m.n), 0.2)["stats"]
-    assert st["ok"] and st["max_position_residual"] < 1e-6 and st["max_velocity_residual"] < 1e-6
+    assert st["ok"] and st["loops"]["max_position_residual"] < 1e-6 and st["loops"]["max_velocity_residual"] < 1e-6
 
 
 def test_a_diverging_controller_is_named_and_a_huge_tau_refused():
@@ -146,3 +146,66 @@ def test_a_diverging_controller_is_named_and_a_huge_tau_refused():
         sim.run(lambda t, q, qd: np.array([1e200, 0, 0, 0]), 0.1)
     with pytest.raises(ValueError, match=r"tau: entry 2 \('pip'\) 1e\+101 is out of range"):
         sim.step(np.array([0, 0, 1e101, 0]))
+
+
+# femdyn simulate and femdyn.simulate are one request (sim/simulation_request.hpp): the same
+# runs give the same report, field for field, and break the same rules with the same words.
+SIMULATIONS = [
+    ("models/pendulum.json", ["--q0=0.4"], {"q0": [0.4]}),
+    ("models/finger.json", ["--integrator=rk4", "--dt=2e-3", "--tau=0.1,0,-0.05,0", "--every=7"],
+     {"integrator": "rk4", "dt": 2e-3, "tau": [0.1, 0, -0.05, 0], "every": 7}),
+    ("models/five_bar.json", ["--baumgarte=35", "--q0=2.2,-1.15,1.05,1.2", "--rtol=1e-8"],
+     {"baumgarte": 35, "q0": [2.2, -1.15, 1.05, 1.2], "rtol": 1e-8}),
+    ("models/space_robot.json", ["--integrator=bdf"], {"integrator": "bdf"}),
+]
+TIMES = {"wall_time", "integration_time", "real_time_factor"}
+
+
+@pytest.mark.parametrize("name,args,kwargs", SIMULATIONS)
+def test_simulate_reports_equal_the_cli(name, args, kwargs):
+    model = femdyn.load(model_path(name))
+    cli = cli_json("simulate", model_path(name), "--t-end=0.3", "--json", *args)
+    stats = femdyn.simulate(model, 0.3, **kwargs)["stats"]
+    assert set(stats) == set(cli)
+    for key in set(cli) - TIMES:
+        assert stats[key] == cli[key], key
+    assert stats["ok"] and stats["rows"] > 2
+    if name == "models/five_bar.json":  # the start was off the loops, and assembled
+        assert stats["loops"]["assembly_iterations"] > 0 and stats["loops"]["baumgarte"] == 35
+
+
+def cli_error(*args):
+    from conftest import BINARY, ROOT
+    import subprocess
+    out = subprocess.run([str(BINARY), *map(str, args)], cwd=ROOT, capture_output=True, text=True)
+    assert out.returncode != 0
+    return out.stderr.strip().removeprefix("femdyn simulate: ")
+
+
+# (CLI arguments, Python arguments): each breaks one rule of the request.
+BROKEN = [
+    (["--t-end=-1"], {"t_end": -1}),
+    (["--integrator=rk5"], {"integrator": "rk5"}),
+    (["--dt=1e-3"], {"dt": 1e-3}),
+    (["--integrator=rk4", "--rtol=1e-6"], {"integrator": "rk4", "rtol": 1e-6}),
+    (["--integrator=rk4", "--dt=-1"], {"integrator": "rk4", "dt": -1}),
+    (["--rtol=2"], {"rtol": 2}),
+    (["--baumgarte=3"], {"baumgarte": 3}),
+    (["--max-steps=0.5"], {"max_steps": 0.5}),
+    (["--every=0"], {"every": 0}),
+]
+
+
+@pytest.mark.parametrize("cli_args,kwargs", BROKEN)
+def test_simulate_refuses_as_the_cli(cli_args, kwargs):
+    path = model_path("models/finger.json")
+    model = femdyn.load(path)
+    args = {"t_end": 0.1, **kwargs}
+    with pytest.raises(ValueError) as e:
+        femdyn.simulate(model, **args)
+    cli = cli_error("simulate", path, *(["--t-end=0.1"] if "t_end" not in kwargs else []),
+                    *cli_args)
+    spelled = str(e.value)
+    for name in ("t_end", "max_steps", "integrator", "baumgarte", "every", "rtol", "atol", "dt"):
+        spelled = spelled.replace(name, "--" + name.replace("_", "-"))
+    assert cli.endswith(spelled), (cli, str(e.value))
