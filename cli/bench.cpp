@@ -137,7 +137,7 @@ States random_states(const Model& m, int K) {
 void check_agreement(const std::string& path, const Model& m, Workspace& ws, fv::SimbodyTwin& twin,
                      const States& s) {
   const fv::TwinEquations e = twin.equations(s.q[0], s.qd[0], s.tau[0]);
-  const Status st = forward_dynamics(m, ws, s.q[0], s.qd[0], s.tau[0]);
+  const Status st = tree_forward_dynamics(m, ws, s.q[0], s.qd[0], s.tau[0]);
   const double dqdd = st.ok ? relative_error(ws.qdd, e.qdd, 1e-6) : INFINITY;
   evaluate(m, ws, s.q[0], s.qd[0], s.tau[0]);
   const double dM = relative_error(ws.Ms, e.M, 1e-6), dh = relative_error(ws.h, e.h, 1e-6);
@@ -200,7 +200,7 @@ void check_loop_agreement(const std::string& path, const Model& m, fv::SimbodyTw
 // The same for MuJoCo: M^s, q̈ and τ at the first state.
 void check_mujoco_agreement(const std::string& path, const Model& m, Workspace& ws,
                             fv::MujocoPeer& peer, const States& s) {
-  const Status st = forward_dynamics(m, ws, s.q[0], s.qd[0], s.tau[0]);
+  const Status st = tree_forward_dynamics(m, ws, s.q[0], s.qd[0], s.tau[0]);
   const double dqdd =
       st.ok ? relative_error(peer.forward(s.q[0], s.qd[0], s.tau[0]), ws.qdd, 1e-6) : INFINITY;
   inverse_dynamics(m, ws, s.q[0], s.qd[0], s.qdd[0]);
@@ -532,7 +532,7 @@ int cmd_bench(int argc, char** argv) {
   rows.push_back(time_both(
       "qdd",
       [&](int k) {
-        forward_dynamics(m, ws, s.q[k], s.qd[k], s.tau[k]);
+        tree_forward_dynamics(m, ws, s.q[k], s.qd[k], s.tau[k]);
         keep(ws.qdd.data());
       },
       [&](int k) { twin->time_forward(s.q[k], s.qd[k], s.tau[k]); }, K, method, mj_forward));

@@ -95,7 +95,7 @@ double seconds_per_state(const Model& m) {
   const VecX z = VecX::Zero(m.n());
   auto begin = Clock::now();
   constexpr int kProbe = 4;
-  for (int i = 0; i < kProbe; ++i) (void)forward_dynamics(m, ws, z, z, z);
+  for (int i = 0; i < kProbe; ++i) (void)tree_forward_dynamics(m, ws, z, z, z);
   const double eval = since(begin) / kProbe;
   const double n = m.n(), N0 = std::min(2 * n, 200.0);
   std::mt19937 rng(7);

@@ -25,7 +25,9 @@ Relative error of A against B, ‖A − B‖ / ‖B‖ (max-norm), for M^s, h an
 --tau, default 0), at K seeded
 random states (q uniform within joint limits, or ±π / ±0.5 m without; q̇ uniform in ±V rad/s,
 default V = 2), or at the one state given by --q/--qd. Both models must have the same number of
-generalized coordinates. Prints max and median over the states.
+generalized coordinates. Prints max and median over the states. A model with closed loops is
+compared by its spanning tree (M^s, h and the tree's q̈, loops ignored: random states do not close
+them), and a note on stderr says so; its constrained q̈ is `femdyn equations`'.
 --rtol R (a number > 0) makes it a test: exit 1 if the max relative error of M^s, h or q̈ is
 above R (each one above is named on stderr), exit 0 if none is. Without it the exit is 0.
 --json prints {"a", "b", "n", "coordinates" (A's), "states", "seed", "max_rel_error",
@@ -49,6 +51,11 @@ int cmd_compare(int argc, char** argv) {
   if (A.n() != B.n())
     throw CliError("the models have " + std::to_string(A.n()) + " and " + std::to_string(B.n()) +
                    " coordinates; compare needs the same");
+  for (const Model* m : {&A, &B})
+    if (!m->constraints.empty())
+      std::cerr << "femdyn compare: note: " << escaped(m->name) << " has closed loops ("
+                << m->constraint_rows
+                << " constraint equations): the spanning trees are compared, loops ignored\n";
   const int K = a.has("q") ? 1 : static_cast<int>(integer_option(a, "states", 100, 1, INT_MAX));
   const auto seed = static_cast<unsigned>(integer_option(a, "seed", 1, 0, 4294967295.0));
   const double vscale = number_option(a, "qd-scale", 2.0);
@@ -73,7 +80,8 @@ int cmd_compare(int argc, char** argv) {
       q = random_posture(A, rng);
       qd = random_uniform(A.n(), vscale, rng);
     }
-    const Status sa = forward_dynamics(A, wa, q, qd, tau), sb = forward_dynamics(B, wb, q, qd, tau);
+    const Status sa = tree_forward_dynamics(A, wa, q, qd, tau),
+                 sb = tree_forward_dynamics(B, wb, q, qd, tau);
     evaluate(A, wa, q, qd, tau);
     evaluate(B, wb, q, qd, tau);
     if (!sa.ok || !sb.ok)

@@ -442,7 +442,7 @@ void check_mass_matrix(const Model& m) {
     // Cholesky route factorises M^s.
     Status st;
     if (m.dynamics_route == DynamicsRoute::Articulated) {
-      st = forward_dynamics(m, ws, q, rest, rest);
+      st = tree_forward_dynamics(m, ws, q, rest, rest);
     } else {
       evaluate(m, ws, q, rest, VecX());
       st = ws.solver.factorize(ws.Ms);

@@ -341,10 +341,11 @@ void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX&
   model.routes.evaluate_bias(model, ws, q, qd);
 }
 
-Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
-                        const VecX& tau) {
-  require_state(model, "forward_dynamics", q, &qd, "qd");
-  require_size(model, "forward_dynamics", "tau", tau, ArgumentKind::Actuation);
+namespace {
+
+// The spanning tree's q̈ by the model's route, the arguments checked.
+Status tree_accelerations(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+                          const VecX& tau) {
   const VecX* applied = &tau;
   if (!model.springs.empty()) {
     spring_forces(model, ws, q, qd);
@@ -355,6 +356,28 @@ Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const 
   const Status st = model.routes.forward_dynamics(model, ws, q, qd, *applied);
   if (!st.ok) return st;
   return finite_accelerations(model, ws.qdd);
+}
+
+}  // namespace
+
+Status tree_forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+                             const VecX& tau) {
+  require_state(model, "tree_forward_dynamics", q, &qd, "qd");
+  require_size(model, "tree_forward_dynamics", "tau", tau, ArgumentKind::Actuation);
+  return tree_accelerations(model, ws, q, qd, tau);
+}
+
+Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+                        const VecX& tau) {
+  require_state(model, "forward_dynamics", q, &qd, "qd");
+  require_size(model, "forward_dynamics", "tau", tau, ArgumentKind::Actuation);
+  if (!model.constraints.empty())
+    throw ArgumentError("forward_dynamics: the model '" + model.name + "' has closed loops (" +
+                        std::to_string(model.constraint_rows) +
+                        " constraint equations): its q̈ is mechanism_forward_dynamics' (with a "
+                        "LoopWorkspace, core/loops/constrained_dynamics.hpp); the spanning "
+                        "tree's, loops ignored, is tree_forward_dynamics'");
+  return tree_accelerations(model, ws, q, qd, tau);
 }
 
 Status finite_accelerations(const Model& model, const VecX& qdd) {

@@ -32,8 +32,14 @@ void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX&
 // a Cholesky factorisation of M^s (with Q − h from one Newton–Euler pass where the body level
 // is exact, else from evaluate()). Call evaluate() for M^s, h and Q. Fails on a singular or
 // indefinite M^s and on a q̈ that is not finite (naming the coordinate).
+// The mechanism's q̈: a model with closed loops is refused (ArgumentError, one line), since its
+// q̈ is the constrained one (mechanism_forward_dynamics, core/loops/constrained_dynamics.hpp).
 Status forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                         const VecX& tau);
+// The same for the spanning tree, the model's loops ignored: the unconstrained q̈₀ the
+// constrained equations start from, or a tree-level comparison.
+Status tree_forward_dynamics(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
+                             const VecX& tau);
 
 // A q̈ that overflowed as a failure naming the coordinate (never a NaN handed on), else ok.
 Status finite_accelerations(const Model& model, const VecX& qdd);

@@ -128,7 +128,7 @@ Status Motion::rhs(double t, const double* y, double* ydot) {
             -1};
   if (model_.has_effort_limits) count_saturation(u_);
   Status st = loops_ ? constrained_forward_dynamics(model_, ws_, *loops_, q_, qd_, u_, baumgarte_)
-                     : forward_dynamics(model_, ws_, q_, qd_, u_);
+                     : tree_forward_dynamics(model_, ws_, q_, qd_, u_);
   if (!st.ok) {
     st.message = at_time(t) + st.message;
     return st;

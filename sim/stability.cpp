@@ -201,7 +201,7 @@ Linearization difference_linearization(const Model& m, Workspace& ws, const VecX
       else
         qp = integrate_posture(m, q, VecX::Unit(n, i) * (side * delta));
       lin.status = loops ? constrained_forward_dynamics(m, ws, *loops, qp, qdp, tau, baumgarte)
-                         : forward_dynamics(m, ws, qp, qdp, tau);
+                         : tree_forward_dynamics(m, ws, qp, qdp, tau);
       if (!lin.status.ok) return lin;
       if (side == 1)
         plus = ws.qdd;

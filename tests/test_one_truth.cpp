@@ -580,15 +580,16 @@ TEST_CASE("the C++ entry points refuse a state of the wrong size in one line nam
   DerivativeWorkspace d(m);
   CHECK_THAT(message([&] { (void)forward_dynamics_derivatives(m, ws, d, v, v, VecX()); }),
              Catch::StartsWith("forward_dynamics_derivatives: q has 33"));
-  // No actuation at all is τ = 0, as before, with springs too (core/springs.hpp).
+  // No actuation at all is τ = 0, as before, with springs too (core/springs.hpp; the model has
+  // loops: its spanning tree).
   CHECK(message([&] { (void)forward_dynamics(m, ws, q, v, VecX()); }) == "(accepted)");
   const Model sprung = load_text(every_constraint_tree(5));
   REQUIRE(!sprung.springs.empty());
   Workspace w1(sprung), w2(sprung);
   std::mt19937 rng(5);
   const VecX qs = random_posture(sprung, rng), vs = random_uniform(sprung.n(), 1, rng);
-  REQUIRE(forward_dynamics(sprung, w1, qs, vs, VecX()).ok);
-  REQUIRE(forward_dynamics(sprung, w2, qs, vs, VecX::Zero(sprung.n())).ok);
+  REQUIRE(tree_forward_dynamics(sprung, w1, qs, vs, VecX()).ok);
+  REQUIRE(tree_forward_dynamics(sprung, w2, qs, vs, VecX::Zero(sprung.n())).ok);
   CHECK(w1.qdd == w2.qdd);
 }
 
@@ -612,9 +613,22 @@ TEST_CASE(
   REQUIRE(constrained_forward_dynamics(m, ws, lws, q, VecX::Zero(m.n()), VecX(), 0).ok);
   CHECK(rel_error(qdd, ws.qdd) < 1e-9);  // (the JSON's printed digits)
   CHECK(j["lambda"].size() == static_cast<std::size_t>(m.constraint_rows));
-  // The open tree's q̈ is not the answer: the tip is held.
-  REQUIRE(forward_dynamics(m, ws, q, VecX::Zero(m.n()), VecX()).ok);
+  // The open tree's q̈ is not the answer: the tip is held. The C++ API's forward_dynamics
+  // refuses the model in one line rather than give it; tree_forward_dynamics gives it by name.
+  try {
+    (void)forward_dynamics(m, ws, q, VecX::Zero(m.n()), VecX());
+    FAIL("forward_dynamics accepted a model with closed loops");
+  } catch (const ArgumentError& e) {
+    CHECK_THAT(std::string(e.what()),
+               Catch::StartsWith("forward_dynamics: the model '" + m.name + "' has closed loops (" +
+                                 std::to_string(m.constraint_rows) + " constraint equations)") &&
+                   Catch::Contains("mechanism_forward_dynamics"));
+  }
+  REQUIRE(tree_forward_dynamics(m, ws, q, VecX::Zero(m.n()), VecX()).ok);
   CHECK(rel_error(qdd, ws.qdd) > 1e-3);
+  VecX tree_qdd = ws.qdd;
+  evaluate(m, ws, q, VecX::Zero(m.n()), VecX::Zero(m.n()));
+  CHECK(rel_error(tree_qdd, VecX(ws.Ms.ldlt().solve(ws.Q - ws.h))) < 1e-10);
   // A --q that does not close the loops: exit 1, one line naming the constraint.
   std::string zeros;
   for (int i = 0; i < m.n_q(); ++i) zeros += (i ? "," : "") + std::string("0.3");

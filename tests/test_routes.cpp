@@ -23,8 +23,8 @@ void check_same_equations(const Model& a, const Model& b, unsigned seed, double 
   for (int k = 0; k < 3; ++k) {
     const VecX q = random_posture(a, rng), qd = random_uniform(a.n(), 2, rng),
                tau = random_uniform(a.n(), 3, rng), qdd = random_uniform(a.n(), 3, rng);
-    REQUIRE(forward_dynamics(a, wa, q, qd, tau).ok);
-    REQUIRE(forward_dynamics(b, wb, q, qd, tau).ok);
+    REQUIRE(tree_forward_dynamics(a, wa, q, qd, tau).ok);
+    REQUIRE(tree_forward_dynamics(b, wb, q, qd, tau).ok);
     CHECK(rel_error(wa.qdd, wb.qdd) < tol);
     evaluate(a, wa, q, qd, tau);
     evaluate(b, wb, q, qd, tau);

@@ -123,7 +123,7 @@ StressResult run_stress(const Model& m, const StressScenario& given) {
 
   // The initial state must have a regular M^s.
   Workspace ws(m);
-  if (const Status st = forward_dynamics(m, ws, s.q0, s.qd0, VecX::Zero(m.n())); !st.ok)
+  if (const Status st = tree_forward_dynamics(m, ws, s.q0, s.qd0, VecX::Zero(m.n())); !st.ok)
     return refused_case("at the initial state: " + st.message);
   if (const Status st = constrained_start(m, ws, s); !st.ok)
     return at_dead_point(st) ? dead_point_case(r, "at the initial state: " + st.message)

@@ -493,7 +493,7 @@ struct Validator::Impl {
     std::mt19937 rng(o.seed + 104729);
     const VecX q = random_posture(m, rng), qd = random_uniform(n, o.qd_scale, rng),
                tau = random_uniform(n, o.tau_scale, rng), qdd = random_uniform(n, o.qdd_scale, rng);
-    t_fd = timed([&] { (void)forward_dynamics(m, ws, q, qd, tau); });
+    t_fd = timed([&] { (void)tree_forward_dynamics(m, ws, q, qd, tau); });
     const double t_id = timed([&] { inverse_dynamics(m, ws, q, qd, qdd); });
     double t_eval = 0;
     if (n <= kEvaluateProbeLimit) {
@@ -843,7 +843,7 @@ struct Validator::Impl {
         loop.max_rel =
             std::max({loop.max_rel, s.loop_position_error / length, s.loop_velocity_error / speed});
       }
-      const Status st = forward_dynamics(m, ws, q, qd, tau);
+      const Status st = tree_forward_dynamics(m, ws, q, qd, tau);
       evaluate(m, ws, q, qd, tau);
       if (r.dense_mass)
         accumulate(eM, ws.Ms, s.M);

@@ -33,7 +33,7 @@ void fill_constraint_space(LoopWorkspace& lws, Solve&& solve) {
 Status articulated_constraint_space(const Model& model, Workspace& ws, LoopWorkspace& lws,
                                     const VecX& q, const VecX& v, const VecX& tau) {
   // The model's forward dynamics is the articulated recursion here (two-point springs added).
-  if (Status st = forward_dynamics(model, ws, q, v, tau); !st.ok) return st;
+  if (Status st = tree_forward_dynamics(model, ws, q, v, tau); !st.ok) return st;
   lws.qdd0 = ws.qdd;
   propagate(model, ws, q, v, {.jacobian = false, .bias = true, .rows = false});
   constraint_kinematics_by_paths(model, ws, lws.k);
