@@ -179,6 +179,8 @@ class Simulator {
         ++calls;
         call(t, q, qd, out);
       });
+    const double t_start = integ.t();
+    const VecX q_start = integ.q(), qd_start = integ.qd();  // (a divergence's cause)
     const auto begin = std::chrono::steady_clock::now();
     const IntegratorStats before = integ.stats();
     const long k_before = loop_->period_index();
@@ -186,25 +188,41 @@ class Simulator {
     RunWatch watch(integ);
     ControlRows rows;
     Status st;
-    while (integ.t() < t_end - 1e-9 * T) {
-      call(integ.t(), integ.q(), integ.qd(), tau);  // τ_k (in evaluation mode: the row's)
-      ++calls;
-      rows.add(*loop_, integ.motion(), tau, watch.at_row(integ));
-      if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C
-      {
-        py::gil_scoped_release release;
-        st = hold ? loop_->step(tau) : loop_->step();
+    // Whether the controller's gain at the run's start makes the loop grow: a clause for a
+    // divergence, or for a controller output driven out of range (sim/controller_diagnosis.hpp).
+    const auto controller_clause = [&] {
+      const Control u = [&](double t, const VecX& q, const VecX& qd, VecX& out) {
+        tau_of(controller(t, copy_array(q), copy_array(qd)), m, t, out);
+      };
+      return loop_->controller_clause(u, t_start, q_start, qd_start, hold);
+    };
+    try {
+      while (integ.t() < t_end - 1e-9 * T) {
+        call(integ.t(), integ.q(), integ.qd(), tau);  // τ_k (in evaluation mode: the row's)
+        ++calls;
+        rows.add(*loop_, integ.motion(), tau, watch.at_row(integ));
+        if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C
+        {
+          py::gil_scoped_release release;
+          st = hold ? loop_->step(tau) : loop_->step();
+        }
+        if (!st.ok) break;
+        watch.after_step(integ);
       }
-      if (!st.ok) break;
-      watch.after_step(integ);
+    } catch (const py::value_error& e) {  // the controller's output refused
+      const std::string why = controller_clause();
+      if (why.empty()) throw;
+      throw py::value_error(std::string(e.what()) + "; " + why);
     }
     // The end: τ the last held (ZOH's left limit).
     rows.add(*loop_, integ.motion(), tau, watch.at_row(integ));
     watch.finish(integ);
-    if (!st.ok && st.diverged && largest.i >= 0)  // the controller drove it: say how hard
+    if (!st.ok && st.diverged && largest.i >= 0) {  // the controller drove it: say how hard
       st.message += "; the controller's largest output in this run: tau of '" +
                     m.coordinate_names[largest.i] + "' = " + format_short(largest.value) +
                     " at t = " + format_short(largest.t) + " s";
+      if (const std::string why = controller_clause(); !why.empty()) st.message += "; " + why;
+    }
     if (!st.ok && check) throw NumericalError(st.message);
     const IntegratorStats& s = integ.stats();
     // The summary's fields as femdyn.simulate's (sim/run_report.hpp; a controller acts), then the

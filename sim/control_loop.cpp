@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/limits.hpp"
+#include "sim/controller_diagnosis.hpp"
 
 namespace femdyn {
 
@@ -54,6 +55,7 @@ ControlLoop::ControlLoop(const Model& model, const IntegratorOptions& integrator
       v_(VecX::Zero(model.n())) {
   if (const std::string why = options.check(); !why.empty()) throw std::invalid_argument(why);
   integ_ = make_integrator(model, integrator);
+  fixed_dt_ = is_adaptive(integrator.kind) ? 0 : integrator.fixed.dt;
   // f's τ: the controller inside f (per evaluation), or the held sample (ZOH, and step(tau)).
   integ_->set_control([this](double t, const VecX& q, const VecX& v, VecX& tau) {
     if (per_evaluation_)
@@ -98,18 +100,34 @@ Status ControlLoop::step(const VecX& tau) {
 
 Status ControlLoop::run(double t_end) {
   if (Status plan = integ_->plan(t_end); !plan.ok) return plan;
+  const double t = integ_->t();
+  const VecX q = integ_->q(), v = integ_->qd();  // the run's start, for a divergence's cause
   while (integ_->t() < t_end)
-    if (Status st = step(); !st.ok) return st;
+    if (Status st = step(); !st.ok) {
+      if (u_)  // (a divergence, or the controller's output out of range)
+        if (const std::string why =
+                controller_clause(u_, t, q, v, options_.mode == ControlMode::ZeroOrderHold);
+            !why.empty())
+          st.message += "; " + why;
+      return st;
+    }
   return {};
+}
+
+std::string ControlLoop::controller_clause(const Control& u, double t, const VecX& q, const VecX& v,
+                                           bool held) const {
+  return controller_divergence(model_, u, t, q, v, options_.period, held, integ_->kind(),
+                               fixed_dt_);
 }
 
 Status ControlLoop::advance_period() {
   const double t_next = sample_time(k_ + 1);
   // ZOH: τ jumps at t_k; the method restarts there and stops exactly at t_{k+1}. Per
   // evaluation: one smooth run (restarted once where it follows held periods).
-  if (!per_evaluation_)
+  if (!per_evaluation_) {
+    if (k_ == 0) integ_->hold_start_tau(held_);  // (the start's τ, for a divergence's cause)
     integ_->restart(t_next);
-  else if (was_held_ && k_ > 0)
+  } else if (was_held_ && k_ > 0)
     integ_->restart(std::numeric_limits<double>::infinity());
   was_held_ = !per_evaluation_;
   Status st = integ_->advance_to(t_next);

@@ -63,8 +63,14 @@ class ControlLoop {
   // of the wrong size or not finite is a failed Status naming it.
   Status step(const VecX& tau);
   // Periods until t reaches t_end (whole periods: stops at the first t_k ≥ t_end). A fixed-step
-  // run beyond max_steps is refused first (Integrator::plan).
+  // run beyond max_steps is refused first (Integrator::plan). A failure (a divergence, the
+  // controller's τ out of range) names the controller as its cause where the closed loop at the
+  // run's start implicates it (sim/controller_diagnosis.hpp).
   Status run(double t_end);
+  // That clause for a run that started at (t, q, v) under the controller u, held over each
+  // period (`held`) or called inside f: "" when the loop there does not implicate it.
+  std::string controller_clause(const Control& u, double t, const VecX& q, const VecX& v,
+                                bool held) const;
 
   // The controller from now on (empty: none).
   void set_controller(Control u) { u_ = std::move(u); }
@@ -87,6 +93,7 @@ class ControlLoop {
   std::unique_ptr<Integrator> integ_;
   VecX held_, q_, v_;  // τ_k, and q_k, v_k for the sample
   double t0_ = 0;
+  double fixed_dt_ = 0;  // the integrator's fixed step (0: adaptive)
   long k_ = 0, calls_ = 0;
   bool per_evaluation_ = false;  // u inside f during this period
   bool was_held_ = true;         // the last period held τ (a switch of mode is a jump in τ)

@@ -97,6 +97,7 @@ void Integrator::reset(double t0, const VecX& q0, const VecX& qd0, double t_stop
   if (Status p = motion_.project(t0, y_.data()); !p.ok) throw StateError(p.message);
   y0_ = y_;
   q0_ = q0;
+  tau0_held_ = false;
   t_ = t0_ = t0;
   t_stop_ = t_stop;
   stats_ = {};
@@ -162,8 +163,11 @@ Status Integrator::explain(Status failure) {
 Status Integrator::diverged() {
   const int n = motion_.n();
   VecX tau0 = VecX::Zero(n);
-  try {  // (τ at the start, for the cause: a controller is asked at (q0, q̇0))
-    motion_.tau_at(t0_, q0_, y0_.segment(n, n), tau0);
+  try {  // (τ at the start, for the cause: the first period's, or f's at (t0, q0, q̇0))
+    if (tau0_held_)
+      tau0 = tau0_;
+    else
+      motion_.tau_at(t0_, q0_, y0_.segment(n, n), tau0);
   } catch (...) {
     tau0.setZero(n);
   }

@@ -90,6 +90,13 @@ class Integrator {
   void restart(double t_stop);
   // The controller τ = u(t, q, v) in f from now on (Motion::set_control).
   void set_control(Control u) { motion_.set_control(std::move(u)); }
+  // The τ held over the first period after reset (a sampled controller's first output, or
+  // ControlLoop::step(τ)'s): the start state's τ that a divergence's cause linearises at. Without
+  // it, f's τ at the start is asked (τ(t0), or a controller inside f at (q0, q̇0)).
+  void hold_start_tau(const VecX& tau) {
+    tau0_ = tau;
+    tau0_held_ = true;
+  }
   // One step: dt for a fixed-step method, one internal (error-controlled) step for an adaptive
   // one; never past t_stop.
   Status step();
@@ -135,7 +142,8 @@ class Integrator {
   // The fixed step, or 0 for an adaptive method (for the divergence's cause).
   virtual double fixed_dt() const { return 0; }
   Motion motion_;
-  VecX y_, y0_, q0_;
+  VecX y_, y0_, q0_, tau0_;
+  bool tau0_held_ = false;
   double t_ = 0, t0_ = 0, t_stop_ = 0;
   IntegratorStats stats_;
   DivergenceWatch watch_;

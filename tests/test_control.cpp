@@ -282,3 +282,23 @@ TEST_CASE("on a spherical joint the controller sees q (n_q = 4) and v (n = 3)", 
     }
   }
 }
+
+TEST_CASE("a controller whose sampled loop grows is named as the cause of the failure",
+          "[control][divergence]") {
+  // The pendulum (I = 1, ω₀² = 9.81) under τ = −4e6 θ − 1e3 θ̇ held over 1 ms: ρ(Φ + Γ K) =
+  // √2 (python/tests/test_control.py checks the number against scipy); rk4's 20 substeps follow
+  // the model itself.
+  const Model m = load_model(model_path("pendulum.json"));
+  ControlLoop c(m, fixed(IntegratorKind::Rk4, 5e-5), loop(ControlMode::ZeroOrderHold, 1e-3),
+                pd(VecX::Constant(1, 4e6), VecX::Constant(1, 1e3), VecX::Zero(1)));
+  c.reset(0, VecX::Constant(1, 0.1), VecX::Zero(1));
+  const Status st = c.run(2.0);
+  REQUIRE(!st.ok);
+  CHECK_THAT(st.message, Catch::Contains("the controller is the likely cause") &&
+                             Catch::Contains("grow ×1.41 a period"));
+  // A gentle PD law runs.
+  ControlLoop g(m, fixed(IntegratorKind::Rk4, 1e-3), loop(ControlMode::ZeroOrderHold, 1e-3),
+                pd(VecX::Constant(1, 100), VecX::Constant(1, 20), VecX::Zero(1)));
+  g.reset(0, VecX::Constant(1, 0.1), VecX::Zero(1));
+  CHECK(g.run(1.0).ok);
+}

@@ -200,3 +200,59 @@ def test_a_run_beyond_the_memory_limit_is_refused_before_it_starts(finger):
     finally:
         femdyn.set_max_memory(None)
     assert calls == [] and sim.t == 0
+
+
+def zoh_radius(A, B, K, T):
+    """ρ(Φ + Γ K) of the loop held over T, by scipy's expm of Van Loan's block."""
+    import scipy.linalg
+    n2, n = A.shape[0], B.shape[1]
+    C = np.zeros((n2 + n, n2 + n))
+    C[:n2, :n2], C[:n2, n2:] = A * T, B * T
+    E = scipy.linalg.expm(C)
+    return max(abs(np.linalg.eigvals(E[:n2, :n2] + E[:n2, n2:] @ K)))
+
+
+def test_a_controller_that_destabilises_the_sampled_loop_is_named_with_its_growth():
+    """A pendulum under a PD law held over T = 1 ms: the report's growth per period and the
+    period below which the gains hold are those of the sampled loop's theory (x_{k+1} =
+    (Φ + Γ K) x_k, computed here by scipy), and the model alone is not blamed."""
+    m = femdyn.load(model_path("models/pendulum.json"))
+    kp, kd, T = 4e6, 1e3, 1e-3
+    A, B = m.linearize(np.zeros(1), np.zeros(1))
+    K = np.array([[-kp, -kd]])
+    rho = zoh_radius(A, B, K, T)
+    assert rho > 1.3  # (the case: unstable at T, though rk4's 20 substeps follow the model)
+    sim = femdyn.Simulator(m, integrator="rk4", dt=T, substeps=20, q0=[0.1])
+    with pytest.raises((femdyn.NumericalError, ValueError)) as e:
+        sim.run(lambda t, q, qd: -kp * q - kd * qd, 2.0)
+    text = str(e.value)
+    assert "the controller is the likely cause" in text
+    assert f"grow ×{rho:.3g} a period" in text
+    below = float(text.split("hold below a period of about ")[1].split(" s")[0])
+    assert zoh_radius(A, B, K, 0.97 * below) <= 1 + 1e-6 < zoh_radius(A, B, K, 1.03 * below)
+    # the same gains sampled at 0.9 of that period run
+    sim = femdyn.Simulator(m, integrator="rk4", dt=0.9 * below, substeps=4, q0=[0.1])
+    assert sim.run(lambda t, q, qd: -kp * q - kd * qd, 0.05)["stats"]["ok"]
+
+
+def test_a_controller_too_stiff_for_the_step_is_named_with_rk4s_limit():
+    """Called inside f, a gain of 1e8 makes the loop ω = 1e4 rad/s: rk4 at 1 ms is beyond its
+    limit 2√2/ω (the imaginary-axis bound of its stability region), the model alone far within."""
+    m = femdyn.load(model_path("models/pendulum.json"))
+    sim = femdyn.Simulator(m, integrator="rk4", dt=1e-3, q0=[0.1])
+    with pytest.raises(femdyn.NumericalError) as e:
+        sim.run(lambda t, q, qd: -1e8 * q, 1.0, mode="evaluation")
+    text = str(e.value)
+    limit = float(text.split("beyond the stability limit of the step 0.001 s (")[1].split(" s")[0])
+    assert limit == pytest.approx(2 * np.sqrt(2) / np.sqrt(1e8 + 9.81), rel=2e-3)
+
+
+def test_a_gentle_controller_and_a_plain_step_divergence_do_not_blame_the_controller():
+    m = femdyn.load(model_path("models/pendulum.json"))
+    sim = femdyn.Simulator(m, integrator="rk4", dt=1e-3, q0=[0.1])
+    assert sim.run(lambda t, q, qd: -100 * q - 20 * qd, 1.0)["stats"]["ok"]
+    # rk4 at a step beyond the model's own limit (0.905 s), the controller doing nothing
+    sim = femdyn.Simulator(m, integrator="rk4", dt=2.0, q0=[0.1])
+    with pytest.raises(femdyn.NumericalError) as e:
+        sim.run(lambda t, q, qd: np.zeros(1), 1e4)
+    assert "controller is the likely cause" not in str(e.value)
