@@ -109,7 +109,8 @@ ControlledLoop controlled_loop(const Model& m, const VecX& q, const VecX& v, con
 std::string controller_cause(const ControlledLoop& r, double period, bool held) {
   if (!r.status.ok) return {};
   const std::string modes = "closed-loop stiffest mode " + format_short(r.stiffest) +
-                            " 1/s, the model's with τ held " + format_short(r.plant_stiffest) + " 1/s";
+                            " 1/s, the model's with τ held " + format_short(r.plant_stiffest) +
+                            " 1/s";
   if (held && r.radius > std::max(kGrows, r.plant_radius * kGrows)) {
     std::string text =
         "the controller is the likely cause: at the run's start its gain makes "

@@ -27,7 +27,7 @@ Status sample_run(const Model& m, const IntegratorOptions& o, const VecX& q0, co
 StepTrial try_fixed_step(const Model& m, IntegratorKind kind, double dt, const VecX& q0,
                          const VecX& qd0, const StepTrialOptions& o) {
   StepTrial t;
-  t.horizon = std::min(o.periods * o.period, 10.0);
+  t.horizon = o.horizon > 0 ? o.horizon : std::min(o.periods * o.period, 10.0);
   t.dt = dt;
   std::vector<VecX> ref, x;
   const IntegratorOptions reference{
@@ -47,12 +47,13 @@ StepTrial try_fixed_step(const Model& m, IntegratorKind kind, double dt, const V
     if (spent + steps > o.step_budget) break;
     spent += steps;
     t.dt = step, t.halvings = k;
-    t.error_per_period = NAN;
+    t.error_per_period = t.error = NAN;
     if (!sample_run(m, {.kind = kind, .fixed = {.dt = step}}, q0, qd0, t.horizon, x).ok) continue;
     double e = 0;
     for (std::size_t i = 0; i < ref.size(); ++i)
       e = std::max(e, (x[i] - ref[i]).cwiseAbs().maxCoeff());
-    t.error_per_period = e / scale / (t.horizon / o.period);
+    t.error = e / scale;
+    t.error_per_period = t.error / (t.horizon / o.period);
     if (t.error_per_period <= o.allowed) {
       t.verified = true;
       return t;

@@ -16,6 +16,7 @@ namespace femdyn {
 struct StepTrialOptions {
   double period = 0;           // of the fastest motion (s); the horizon is `periods` of it
   double periods = 3;          // (at most 10 s)
+  double horizon = 0;          // s, the run's own length when given (then `periods` is unused)
   double allowed = 0;          // error per period the step must keep
   long step_budget = 200'000;  // fixed steps over all the tries
   int max_halvings = 10;
@@ -27,6 +28,7 @@ struct StepTrial {
   int halvings = 0;               // times dt was halved from the one asked
   double horizon = 0;             // s
   double error_per_period = 0;    // measured at dt (NaN where the run failed)
+  double error = 0;               // over the whole horizon, relative (NaN where the run failed)
   std::string failure;            // why not verified ("" when verified)
   bool reference_failed = false;  // the motion itself could not be followed (a dead point)
 };
