@@ -775,3 +775,22 @@ TEST_CASE(
     CHECK(a.acceleration.norm() > 1);  // a motion, not rest
   }
 }
+
+TEST_CASE("validate's estimate does not grow with the budget it is given", "[validation][bounds]") {
+  // Andrews' trajectory costs about 15 s (Simbody's runs most of it). A budget of 1 or 2 s once
+  // cut the probe of Simbody's run short, and the estimate echoed the budget ("at least 1.2 s",
+  // then "at least 2.1 s", …); the probe now has at least 1 s, so both give the same estimate.
+  const Model m = load_model(model_path("andrews.json"));
+  std::vector<double> estimates;
+  for (const double budget : {1.0, 2.0}) {
+    ValidationOptions o;
+    o.budget = budget;
+    const std::string why = validation::Validator(m, o).refusal("andrews.json");
+    INFO(why);
+    REQUIRE_THAT(why, Catch::Contains("would take about "));
+    estimates.push_back(std::stod(why.substr(why.find("would take about ") + 17)));
+  }
+  CHECK(estimates[0] >= 3);
+  CHECK(estimates[1] >= 3);
+  CHECK(estimates[0] / estimates[1] == Approx(1).epsilon(0.5));
+}

@@ -256,6 +256,7 @@ constexpr double kSecondsPerFlop = 1e-9;
 //   Simbody's trajectory, timed over 1/kSimbodyProbeParts of it; its run at 100x the accuracy
 //   takes 100^(1/4) = 3.2 times as many steps of its 4th-order method (measured: 3.0 to 3.1);
 constexpr double kSimbodyProbeParts = 20;
+constexpr double kProbeSeconds = 1;  // the least time the probe of Simbody's run is given
 const double kTightRatio = std::pow(100.0, 0.25);
 //   memory per body of the twin (Simbody's system and state) and of femdyn's workspaces.
 constexpr double kBytesPerBody = 20e3;
@@ -551,8 +552,12 @@ struct Validator::Impl {
         if (!m.constraints.empty()) (void)consistent_state(m, q0, qd0, why);
         const double stretch = o.t_end / kSimbodyProbeParts;
         const double scale = (1 + kTightRatio) * kSimbodyProbeParts;
-        TwinRunLimits limits;  // a probe that runs out of time is over the budget already
-        limits.wall_time = o.budget / scale;
+        // The probe gets its share of the budget, and at least kProbeSeconds whatever the budget:
+        // a small budget would otherwise cut it short and the estimate would be the budget
+        // echoed back ("at least 5.1 s" for --budget 5, then 6.0 for 6, …). A probe that runs
+        // out of even that is a lower bound, said so.
+        TwinRunLimits limits;
+        limits.wall_time = std::max(o.budget / scale, kProbeSeconds);
         const TwinRun probe =
             twin->simulate(q0, qd0, {0.0, stretch}, o.simbody_accuracy,
                            SimbodyIntegrator::RungeKuttaMerson, TwinSampling::StepToEach, limits);
