@@ -2,6 +2,7 @@
 
 #include <tinyxml2.h>
 
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -99,18 +100,50 @@ Json inertial_element(const Ctx& c, const XMLElement* link, const std::string& w
   return {{"type", "rigid_body"}, {"mass", m}, {"com", vec3_json(o.xyz)}, {"inertia", rows}};
 }
 
-// The document's <robot>; plain URDF only (xacro is refused).
+// The first place in the document that needs xacro, or "": an element of the xacro namespace
+// (<xacro:macro>, <xacro:include>, whatever prefix an xmlns binds to xacro's URI), or a
+// substitution ${…} or $(…) in an attribute. A declaration alone (xmlns:xacro on <robot>, which
+// exported files keep) and xacro inside comments (not elements) need nothing. Iterative, in
+// document order: no recursion for a hostile file's depth.
+std::string needs_xacro(const XMLElement* robot) {
+  std::vector<std::string> prefixes = {"xacro:"};
+  std::vector<const XMLElement*> order, stack = {robot};
+  while (!stack.empty()) {
+    const XMLElement* e = stack.back();
+    stack.pop_back();
+    order.push_back(e);
+    for (const tinyxml2::XMLAttribute* a = e->FirstAttribute(); a; a = a->Next())
+      if (std::string name = a->Name(); name.rfind("xmlns:", 0) == 0 &&
+                                        std::string(a->Value()).find("xacro") != std::string::npos)
+        prefixes.push_back(name.substr(6) + ":");
+    for (const XMLElement* c = e->LastChildElement(); c; c = c->PreviousSiblingElement())
+      stack.push_back(c);
+  }
+  for (const XMLElement* e : order) {
+    const std::string tag = e->Name();
+    const std::string at = "<" + echo_text(tag) + "> at line " + std::to_string(e->GetLineNum());
+    for (const std::string& p : prefixes)
+      if (tag.rfind(p, 0) == 0) return at + " is a xacro element";
+    for (const tinyxml2::XMLAttribute* a = e->FirstAttribute(); a; a = a->Next())
+      if (const std::string value = a->Value();
+          value.find("${") != std::string::npos || value.find("$(") != std::string::npos)
+        return at + " has a xacro substitution, " + echo_text(a->Name()) + "=" + quoted_text(value);
+  }
+  return {};
+}
+
+// The document's <robot>; plain URDF only (a file that needs xacro is refused, naming where).
 const XMLElement* robot_element(tinyxml2::XMLDocument& doc, const std::string& text,
                                 const std::string& source) {
-  if (text.find("xmlns:xacro") != std::string::npos || text.find("<xacro:") != std::string::npos)
-    throw ModelError(source,
-                     "xacro is not supported: expand it first (xacro robot.urdf.xacro > "
-                     "robot.urdf)");
   if (doc.Parse(text.c_str(), text.size()) != tinyxml2::XML_SUCCESS)
     throw ModelError(source, std::string("malformed XML at line ") +
                                  std::to_string(doc.ErrorLineNum()) + ": " + doc.ErrorName());
   const XMLElement* robot = doc.FirstChildElement("robot");
   if (!robot) throw ModelError(source, "no <robot> element");
+  if (const std::string why = needs_xacro(robot); !why.empty())
+    throw ModelError(source, why +
+                                 ": the file needs xacro, which femdyn does not run; expand it "
+                                 "first (xacro robot.urdf.xacro > robot.urdf)");
   return robot;
 }
 
@@ -181,7 +214,13 @@ std::vector<UrdfVisual> urdf_visuals(const std::string& text, const std::string&
 }
 
 bool is_urdf_path(const std::string& path) {
-  return path.size() >= 5 && path.compare(path.size() - 5, 5, ".urdf") == 0;
+  std::string lower = path;
+  for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  const auto ends = [&](const std::string& ext) {
+    return lower.size() >= ext.size() &&
+           lower.compare(lower.size() - ext.size(), ext.size(), ext) == 0;
+  };
+  return ends(".urdf") || ends(".xacro");  // (a .xacro is read to say it needs expanding)
 }
 
 UrdfResult urdf_to_model(const std::string& text, const std::string& source,

@@ -30,7 +30,8 @@ UrdfResult urdf_to_model(const std::string& xml_text, const std::string& source,
                          const UrdfOptions& options = {});
 UrdfResult read_urdf(const std::string& path, const UrdfOptions& options = {});
 
-bool is_urdf_path(const std::string& path);  // by extension (.urdf)
+// By extension, in any case: .urdf, and .xacro (refused as needing expansion, with where).
+bool is_urdf_path(const std::string& path);
 
 // A link's <visual>, in the link frame: a primitive (box: size x y z; cylinder: radius, length
 // along z; sphere: radius) or a mesh (its filename; size holds its scale). Read for the 3-D

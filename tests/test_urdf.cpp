@@ -448,7 +448,8 @@ TEST_CASE("bad URDF: one line naming the file, the link or joint, and the proble
   CHECK_THAT(
       error_of(
           R"(<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:macro name="m"/></robot>)"),
-      Catch::StartsWith("bad.urdf: xacro is not supported"));
+      Equals("bad.urdf: <xacro:macro> at line 1 is a xacro element: the file needs xacro, which "
+             "femdyn does not run; expand it first (xacro robot.urdf.xacro > robot.urdf)"));
   CHECK_THAT(error_of(one_link(ok_inertial, "<mimic joint=\"ghost\"/>")),
              Equals("bad.urdf: joint 'j': mimics unknown joint 'ghost'"));
   // A movable massless leaf: M^s singular, named by the URDF joint and link, not a JSON path.
@@ -560,4 +561,41 @@ TEST_CASE("URDF with a floating base: a free root, in free fall every joint keep
     CHECK(ws.qdd.segment<3>(3).norm() < 1e-10);
     CHECK(ws.qdd.tail(m.n() - 6).cwiseAbs().maxCoeff() < 1e-9);
   }
+}
+
+TEST_CASE("xacro: only what needs expanding is refused, naming where", "[urdf][xacro]") {
+  // A declaration alone (exported URDFs keep xmlns:xacro on <robot>) and xacro inside comments
+  // need nothing: the file loads. Real cases: bullet3's iiwa (declaration) and Unitree's A1
+  // (declaration, and xacro in comments) load.
+  const std::string link = R"(<link name="base"/><link name="l">)" +
+                           inertial(1, "0.1 0 0", "0 0 0", 0.01, 0.01, 0.01) + "</link>";
+  const std::string joint =
+      R"(<joint name="j" type="revolute"><parent link="base"/><child link="l"/>)"
+      R"(<axis xyz="0 0 1"/></joint>)";
+  const std::string declared = R"(<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">)";
+  CHECK(load_urdf_text(declared + link + joint + "</robot>").n() == 1);
+  CHECK(load_urdf_text(declared + "<!-- <xacro:include filename=\"$(find x)/a.xacro\"/> -->" +
+                       link + joint + "</robot>")
+            .n() == 1);
+  // Any prefix the file binds to xacro's namespace, and substitutions in attributes.
+  CHECK_THAT(error_of(R"(<robot name="r" xmlns:x="http://ros.org/wiki/xacro">)" + link +
+                      "\n<x:property name=\"a\" value=\"1\"/>" + joint + "</robot>"),
+             Catch::StartsWith("bad.urdf: <x:property> at line 2 is a xacro element: the file "
+                               "needs xacro"));
+  CHECK_THAT(error_of(declared + link +
+                      R"(<joint name="j" type="revolute"><origin rpy="0 0 ${pi/2}"/>)"
+                      R"(<parent link="base"/><child link="l"/></joint></robot>)"),
+             Catch::StartsWith("bad.urdf: <origin> at line 1 has a xacro substitution, "
+                               "rpy='0 0 ${pi/2}': the file needs xacro"));
+  // Real files (tests/data/urdf/README.md).
+  const std::string data = std::string(FEMDYN_SOURCE_DIR) + "/tests/data/urdf/";
+  CHECK(load_model(data + "bullet3_kuka_iiwa.urdf").n() == 7);
+  CHECK(load_model(data + "unitree_a1.urdf").n() == 12);
+  // The extension in any case; a .xacro file is read to say what it needs.
+  const std::string upper = write_temp("robot.URDF", declared + link + joint + "</robot>");
+  CHECK(load_model(upper).n() == 1);
+  const std::string macro =
+      write_temp("arm.urdf.xacro", declared + "<xacro:macro name=\"m\"/></robot>");
+  CHECK_THROWS_WITH(load_model(macro), Catch::Contains("<xacro:macro> at line 1 is a xacro "
+                                                       "element: the file needs xacro"));
 }
