@@ -21,6 +21,10 @@ using tinyxml2::XMLElement;
 
 struct Ctx {
   std::string source;
+  // The model's length scale L (m): the largest joint or inertial offset, 1 m without any. An
+  // inertia's round-off is judged against m L² (export noise of −2.4e-35 on a point mass is not
+  // a negative moment).
+  double length = 1;
   [[noreturn]] void fail(const std::string& what_element, const std::string& problem) const {
     throw ModelError(source, what_element + ": " + problem);
   }
@@ -86,7 +90,11 @@ Json inertial_element(const Ctx& c, const XMLElement* link, const std::string& w
                ixz = number_attr(c, ie, "ixz", 0, who), iyz = number_attr(c, ie, "iyz", 0, who);
   Mat3 I;
   I << ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz;
-  if (auto problem = inertia_problem(I)) c.fail(who, *problem);
+  if (auto problem = inertia_problem(I, m * c.length * c.length)) c.fail(who, *problem);
+  // Principal moments negative by round-off only (within 1e-9 m L², as just checked) are zero.
+  if (const Eigen::SelfAdjointEigenSolver<Mat3> eig(I); eig.eigenvalues().minCoeff() < 0)
+    I = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
+        eig.eigenvectors().transpose();
   if (m == 0 && I.cwiseAbs().maxCoeff() == 0) return nullptr;  // massless link
   // The inertia is expressed in the <inertial> origin frame: rotate it into the link frame.
   const Origin o = origin_of(c, in, who);
@@ -223,11 +231,33 @@ bool is_urdf_path(const std::string& path) {
   return ends(".urdf") || ends(".xacro");  // (a .xacro is read to say it needs expanding)
 }
 
+namespace {
+
+// The largest |xyz| of the joints' and the inertials' <origin>s (unparsable ones skipped: they
+// fail where they are read), or 1 m.
+double length_scale(const XMLElement* robot) {
+  double L = 0;
+  const auto take = [&L](const XMLElement* parent) {
+    const XMLElement* o = parent ? parent->FirstChildElement("origin") : nullptr;
+    std::istringstream in(o && o->Attribute("xyz") ? o->Attribute("xyz") : "");
+    Vec3 x;
+    if (in >> x[0] >> x[1] >> x[2] && x.allFinite()) L = std::max(L, x.norm());
+  };
+  for (const XMLElement* j = robot->FirstChildElement("joint"); j;
+       j = j->NextSiblingElement("joint"))
+    take(j);
+  for (const XMLElement* l = robot->FirstChildElement("link"); l; l = l->NextSiblingElement("link"))
+    take(l->FirstChildElement("inertial"));
+  return L > 0 && L < 1e100 ? L : 1.0;
+}
+
+}  // namespace
+
 UrdfResult urdf_to_model(const std::string& text, const std::string& source,
                          const UrdfOptions& options) {
-  const Ctx c{source};
   tinyxml2::XMLDocument doc;
   const XMLElement* robot = robot_element(doc, text, source);
+  const Ctx c{source, length_scale(robot)};
 
   UrdfResult out;
   // Links.

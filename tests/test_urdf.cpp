@@ -599,3 +599,24 @@ TEST_CASE("xacro: only what needs expanding is refused, naming where", "[urdf][x
   CHECK_THROWS_WITH(load_model(macro), Catch::Contains("<xacro:macro> at line 1 is a xacro "
                                                        "element: the file needs xacro"));
 }
+
+TEST_CASE("an inertia's round-off is judged against m L², not against the tensor itself",
+          "[urdf][inertia]") {
+  // iCub's point-mass links carry export noise (−2.4e-35) in a zero tensor: round-off against
+  // m L² (L the model's largest offset, here 0.3 m), so the link is a point mass. A moment
+  // negative beyond 1e-9 m L² is still refused.
+  const auto robot = [](const std::string& ixx) {
+    return R"(<robot name="r"><link name="base"/><link name="l"><inertial><origin xyz="0.3 0 0"/>)"
+           R"(<mass value="0.5"/><inertia ixx=")" +
+           ixx +
+           R"(" iyy="0" izz="0" ixy="0" ixz="0" iyz="0"/></inertial></link>)"
+           R"(<joint name="j" type="revolute"><parent link="base"/><child link="l"/>)"
+           R"(<axis xyz="0 0 1"/></joint></robot>)";
+  };
+  const Model m = load_urdf_text(robot("-2.40741e-35"));
+  Workspace ws(m);
+  mass_matrix(m, ws, VecX::Zero(1));
+  CHECK(ws.Ms(0, 0) == Approx(0.5 * 0.09).epsilon(1e-12));  // m r², the point mass
+  CHECK_THAT(error_of(robot("-1e-9")),
+             Equals("bad.urdf: link 'l': inertia has a negative principal moment (-1e-09)"));
+}
