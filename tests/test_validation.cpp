@@ -787,12 +787,21 @@ TEST_CASE("validate's estimate does not grow with the budget it is given", "[val
     o.budget = budget;
     const std::string why = validation::Validator(m, o).refusal("andrews.json");
     INFO(why);
-    REQUIRE_THAT(why, Catch::Contains("would take about "));
-    estimates.push_back(std::stod(why.substr(why.find("would take about ") + 17)));
+    // ("about" in Release; under the sanitizers the probe may run out of its 1 s: "at least")
+    const std::size_t at = why.find("would take ");
+    REQUIRE(at != std::string::npos);
+    std::string rest = why.substr(at + 11);
+    if (rest.rfind("about ", 0) == 0) rest = rest.substr(6);
+    if (rest.rfind("at least ", 0) == 0) rest = rest.substr(9);
+    std::size_t end = 0;
+    double seconds = std::stod(rest, &end);  // (format_duration: s, min, h)
+    if (rest.compare(end, 4, " min") == 0) seconds *= 60;
+    if (rest.compare(end, 2, " h") == 0) seconds *= 3600;
+    estimates.push_back(seconds);
   }
   CHECK(estimates[0] >= 3);
   CHECK(estimates[1] >= 3);
-  CHECK(estimates[0] / estimates[1] == Approx(1).epsilon(0.5));
+  CHECK(estimates[0] / estimates[1] == Approx(1).epsilon(0.3));
 }
 
 TEST_CASE("q̈'s tolerance is 10 ε cond(M^s) where that exceeds the fixed one",
