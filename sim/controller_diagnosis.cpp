@@ -90,17 +90,21 @@ ControlledLoop controlled_loop(const Model& m, const VecX& q, const VecX& v, con
   if (held) {
     std::tie(r.radius, r.plant_radius) = held_radii(plant.A, B, K, period);
     // A shorter period that holds the loop: halvings to 1e-9 T, then bisection on log T.
+    // (Each ρ is computed once: the one at T is r.radius.)
+    const auto holds = [&](double T) { return held_radii(plant.A, B, K, T).first <= kGrows; };
     double lo = period, hi = period;
-    for (int k = 0; k < 30 && held_radii(plant.A, B, K, lo).first > kGrows; ++k) {
+    bool held_at_lo = r.radius <= kGrows;
+    for (int k = 0; k < 30 && !held_at_lo; ++k) {
       hi = lo;
       lo /= 2;
+      held_at_lo = holds(lo);
     }
-    if (held_radii(plant.A, B, K, lo).first <= kGrows) {
+    if (held_at_lo) {
       for (int i = 0; i < 30 && hi / lo > 1.01; ++i) {
         const double mid = lo * std::sqrt(hi / lo);
-        (held_radii(plant.A, B, K, mid).first <= kGrows ? lo : hi) = mid;
+        (holds(mid) ? lo : hi) = mid;
       }
-      r.stable_period = lo < period ? lo : period;
+      r.stable_period = lo;
     }
   }
   return r;

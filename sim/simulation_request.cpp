@@ -10,7 +10,8 @@
 namespace femdyn {
 namespace {
 
-std::string num(double x) { return format_number(x, "%.4g"); }
+// (named for this file alone: the sim library is built as one unity source)
+std::string request_time_text(double x) { return format_number(x, "%.4g"); }
 
 // An options check's "field: what" with the field in the door's spelling.
 std::string spelled(const std::string& why, const Door& door) {
@@ -51,8 +52,9 @@ void check_rows(SimulationRequest& r, const Door& door) {
 void check_tau(const Model& model, const SimulationRequest& r, const Door& door) {
   const std::string option = door.option(r.tau_option);
   if (r.tau_span && ((*r.tau_span)[0] > 0 || (*r.tau_span)[1] < r.t_end))
-    throw RequestError(option + " covers t in [" + num((*r.tau_span)[0]) + ", " +
-                       num((*r.tau_span)[1]) + "] s; it must cover [0, " + num(r.t_end) + "] s");
+    throw RequestError(option + " covers t in [" + request_time_text((*r.tau_span)[0]) + ", " +
+                       request_time_text((*r.tau_span)[1]) + "] s; it must cover [0, " +
+                       request_time_text(r.t_end) + "] s");
   if (r.tau_largest.size())
     if (const std::string bad = unactuated_problem(model, r.tau_largest); !bad.empty())
       throw RequestError(option + ": " + bad);
