@@ -113,7 +113,8 @@ void bind_validate(py::module_& m) {
         "The model against its Simbody twin (docs/validation.md): M, h, Q, qdd, tau at `states` "
         "seeded random states and a passive trajectory of t_end s (what `femdyn validate` does, "
         "less its URDF import check); tolerance None is the CLI's default, max(1e-10, eps d^2) "
-        "for a tree d bodies deep. Estimated first: beyond `budget` seconds or `max_memory` "
+        "for a tree d bodies deep (q-ddot: at least 10 eps cond(M^s)). Estimated first: beyond "
+        "`budget` seconds or `max_memory` "
         "GB (default: half the available memory) a ValueError with `femdyn validate`'s message. "
         "Returns a dict: quantities {name: {max_abs, max_rel, tolerance, pass}}, trajectory "
         "{...}, notes, work, failure, pass. The GIL is released.");
