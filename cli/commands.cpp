@@ -159,6 +159,7 @@ LoadOptions load_options(const Args& a) {
     opt.gravity_source = "--gravity";
   }
   opt.floating_base = a.has("floating-base");
+  opt.balance_inertia = a.has("balance-inertia");
   return opt;
 }
 
@@ -179,8 +180,9 @@ Args parse_args(int argc, char** argv, int first, const std::vector<std::string>
       value = key.substr(eq + 1);
       key = key.substr(0, eq);
     }
-    // --floating-base: every command that loads a model (load_options).
-    if (key == "floating-base" || std::find(flags.begin(), flags.end(), key) != flags.end()) {
+    // --floating-base, --balance-inertia: every command that loads a model (load_options).
+    if (key == "floating-base" || key == "balance-inertia" ||
+        std::find(flags.begin(), flags.end(), key) != flags.end()) {
       if (inline_value) throw CliError("--" + key + " takes no value");
       a.options[key] = "";
     } else if (std::find(valued.begin(), valued.end(), key) != valued.end()) {

@@ -34,7 +34,8 @@ commands:
 
 every command takes --help, and --gravity gx,gy,gz to override the model's gravity (m/s^2).
 models: JSON files (docs/model-format.md) or URDF files (*.urdf; gravity (0, 0, -9.81) unless
---gravity; the root link welded to the world unless --floating-base; docs/tutorial.md).
+--gravity; the root link welded to the world unless --floating-base; a non-physical body inertia
+refused unless --balance-inertia takes the nearest physical one; docs/tutorial.md).
 )";
 
 // The last line of defence: whatever reaches here is printed as one safe line, though

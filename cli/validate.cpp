@@ -280,8 +280,8 @@ int cmd_validate(int argc, char** argv) {
     if (is_urdf_path(a.positional[i]) && r.failure.empty()) {
       // The import itself, against a Simbody model read straight from the XML.
       std::string failure;
-      r.quantities.push_back(
-          validation::validate_urdf_import(models[i], a.positional[i], o, failure));
+      r.quantities.push_back(validation::validate_urdf_import(models[i], a.positional[i], o,
+                                                              failure, a.has("balance-inertia")));
       if (!failure.empty()) r.failure = failure;
     }
     all_pass = all_pass && r.pass();

@@ -703,8 +703,8 @@ std::string read_text(const std::string& path) { return read_input_file(path); }
 
 namespace {
 
-Json urdf_document(const std::string& urdf, bool floating_base, const LoadOptions& options) {
-  UrdfResult r = read_urdf(urdf, {.floating_base = floating_base});
+Json urdf_document(const std::string& urdf, UrdfOptions urdf_options, const LoadOptions& options) {
+  UrdfResult r = read_urdf(urdf, urdf_options);
   if (options.warn)
     for (const std::string& w : r.warnings) options.warn(w);
   return std::move(r.model);
@@ -719,7 +719,7 @@ std::optional<std::pair<Json, std::string>> urdf_reference(const std::string& pa
     return std::nullopt;
   const Params p = plugin_form(root, path);
   const Params params = p.child("params");
-  params.allow_only({"file", "root_joint"});
+  params.allow_only({"file", "root_joint", "balance_inertia"});
   const std::string root_joint = params.has("root_joint") ? params.string("root_joint") : "fixed";
   if (root_joint != "fixed" && root_joint != "free")
     params.fail("root_joint", "expected \"fixed\" or \"free\", got " + quoted_text(root_joint));
@@ -729,7 +729,11 @@ std::optional<std::pair<Json, std::string>> urdf_reference(const std::string& pa
   if (!is_urdf_path(urdf.string())) params.fail("file", "expected a *.urdf file");
   Json doc;
   try {
-    doc = urdf_document(urdf.string(), root_joint == "free", options);
+    doc = urdf_document(
+        urdf.string(),
+        {.floating_base = root_joint == "free",
+         .balance_inertia = options.balance_inertia || params.boolean_or("balance_inertia", false)},
+        options);
   } catch (const Error& e) {
     params.fail("file", e.what());
   }
@@ -737,12 +741,26 @@ std::optional<std::pair<Json, std::string>> urdf_reference(const std::string& pa
   return std::pair{std::move(doc), urdf.string()};
 }
 
+// --balance-inertia repairs what an exporter wrote; a JSON model's inertias are the author's own,
+// refused with the element named, to be corrected there.
+void refuse_balance_on_json(const std::string& path, const LoadOptions& options) {
+  if (options.balance_inertia)
+    throw ModelError(path,
+                     "--balance-inertia is for URDF models (and URDF references, \"params\": "
+                     "{\"balance_inertia\": true}): a JSON model's inertias are its own, to be "
+                     "corrected where a refusal names them");
+}
+
 }  // namespace
 
 Json model_document(const std::string& path, const LoadOptions& options) {
-  if (is_urdf_path(path)) return urdf_document(path, options.floating_base, options);
+  if (is_urdf_path(path))
+    return urdf_document(
+        path, {.floating_base = options.floating_base, .balance_inertia = options.balance_inertia},
+        options);
   const Json root = parse_json(read_text(path), path);
   if (auto ref = urdf_reference(path, root, options)) return std::move(ref->first);
+  refuse_balance_on_json(path, options);
   const Catalog& catalog = options.catalog ? *options.catalog : default_catalog();
   (void)parse_model_json(root, path, catalog);  // reports every model error by its path
   return root.contains("model") ? expand_plugin(catalog, root, path) : root;
@@ -764,6 +782,7 @@ MechanismSpec read_spec(const std::string& path, const LoadOptions& options) {
         rethrow_for_urdf(e, ref->first, ref->second);
       }
     }
+    refuse_balance_on_json(path, options);
     return parse_model_json(root, path, catalog);
   }
   const Json doc = model_document(path, options);

@@ -19,6 +19,7 @@ struct LoadOptions {
   const Catalog* catalog = nullptr;  // element types and model plugins; null: default_catalog()
   CompileOptions compile;            // e.g. the routes (compile/compile.hpp)
   bool floating_base = false;        // URDF: a free joint under the root link (io/urdf_loader.hpp)
+  bool balance_inertia = false;      // URDF: a non-physical body inertia -> the nearest physical
 };
 
 // A model file: femdyn JSON, or URDF by its extension .urdf (io/urdf_loader.hpp).

@@ -2,6 +2,7 @@
 
 #include <tinyxml2.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <fstream>
@@ -12,6 +13,7 @@
 #include "core/inertia.hpp"
 #include "core/limits.hpp"
 #include "core/names.hpp"
+#include "io/centroidal_mass.hpp"
 #include "io/input_file.hpp"
 
 namespace femdyn {
@@ -75,10 +77,11 @@ Origin origin_of(const Ctx& c, const XMLElement* parent, const std::string& who)
   return {vec_attr(c, o, "xyz", Vec3::Zero(), who), vec_attr(c, o, "rpy", Vec3::Zero(), who)};
 }
 
-// <inertial> -> rigid_body element (inertia about the COM in the link frame), or null.
-Json inertial_element(const Ctx& c, const XMLElement* link, const std::string& who) {
-  const XMLElement* in = link->FirstChildElement("inertial");
-  if (!in) return nullptr;
+// <inertial> -> the link's mass properties in the link frame (the inertia rotated out of the
+// <inertial> origin frame), unchecked: a link is checked as part of its rigid body.
+CentroidalMass link_mass(const Ctx& c, const XMLElement* link, const std::string& who) {
+  const XMLElement* in = link ? link->FirstChildElement("inertial") : nullptr;
+  if (!in) return {};
   const XMLElement* mass = in->FirstChildElement("mass");
   if (!mass) c.fail(who, "<inertial> has no <mass>");
   const double m = number_attr(c, mass, "value", 0, who, true);
@@ -90,22 +93,30 @@ Json inertial_element(const Ctx& c, const XMLElement* link, const std::string& w
                ixz = number_attr(c, ie, "ixz", 0, who), iyz = number_attr(c, ie, "iyz", 0, who);
   Mat3 I;
   I << ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz;
-  if (auto problem = inertia_problem(I, m * c.length * c.length)) c.fail(who, *problem);
-  // Principal moments negative by round-off only (within 1e-9 m L², as just checked) are zero.
-  if (const Eigen::SelfAdjointEigenSolver<Mat3> eig(I); eig.eigenvalues().minCoeff() < 0)
-    I = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
-        eig.eigenvectors().transpose();
-  if (m == 0 && I.cwiseAbs().maxCoeff() == 0) return nullptr;  // massless link
-  // The inertia is expressed in the <inertial> origin frame: rotate it into the link frame.
   const Origin o = origin_of(c, in, who);
-  const Mat3 R = rpy_to_rotation(o.rpy);
-  const Mat3 I_link = R * I * R.transpose();
+  const Mat3 R = rpy_to_rotation(o.rpy);  // the <inertial> frame's axes in the link frame
+  return {m, o.xyz, R * I * R.transpose()};
+}
+
+// What is not physical about a body's inertia, judged against m L² (round-off of a point mass
+// is not a negative moment), or nothing.
+std::optional<std::string> mass_problem(const Ctx& c, const CentroidalMass& mp) {
+  return inertia_problem(mp.inertia, mp.mass * c.length * c.length);
+}
+
+// A physical body's element (rigid_body, or rotary_node when massless with an inertia), or
+// null when it has neither mass nor inertia.
+Json mass_element(const CentroidalMass& mp) {
+  if (mp.empty()) return nullptr;
+  // Not physical by round-off only (within 1e-9 m L², as checked): the nearest physical tensor.
+  const Mat3 I = nearest_physical_inertia(mp.inertia);
   Json rows = Json::array();
-  for (int r = 0; r < 3; ++r) rows.push_back(vec3_json(I_link.row(r).transpose()));
+  for (int r = 0; r < 3; ++r) rows.push_back(vec3_json(I.row(r).transpose()));
   // Zero mass with an inertia (some exporters' placeholder links, or a pure rotor): a rotary
   // inertia alone.
-  if (m == 0) return {{"type", "rotary_node"}, {"node", vec3_json(o.xyz)}, {"inertia", rows}};
-  return {{"type", "rigid_body"}, {"mass", m}, {"com", vec3_json(o.xyz)}, {"inertia", rows}};
+  if (mp.mass == 0)
+    return {{"type", "rotary_node"}, {"node", vec3_json(mp.com)}, {"inertia", rows}};
+  return {{"type", "rigid_body"}, {"mass", mp.mass}, {"com", vec3_json(mp.com)}, {"inertia", rows}};
 }
 
 // The first place in the document that needs xacro, or "": an element of the xacro namespace
@@ -251,38 +262,149 @@ double length_scale(const XMLElement* robot) {
   return L > 0 && L < 1e100 ? L : 1.0;
 }
 
+struct JointInfo {
+  const XMLElement* e;
+  std::string name, parent, child;
+};
+
+// Where each link sits in its rigid body: the body's head (the link on its movable joint, or
+// the root) and the link frame's pose in the head's frame, composed along fixed joints.
+struct WeldedPose {
+  std::string head;
+  Mat3 R = Mat3::Identity();
+  Vec3 p = Vec3::Zero();
+};
+
+std::map<std::string, WeldedPose> welded_poses(const Ctx& c, const std::vector<JointInfo>& joints,
+                                               const std::string& root) {
+  std::map<std::string, std::vector<const JointInfo*>> below;
+  for (const JointInfo& ji : joints) below[ji.parent].push_back(&ji);
+  std::map<std::string, WeldedPose> pose = {{root, {root}}};
+  for (std::vector<std::string> stack = {root}; !stack.empty();) {
+    const std::string link = stack.back();
+    stack.pop_back();
+    const WeldedPose& up = pose.at(link);
+    for (const JointInfo* ji : below[link]) {
+      WeldedPose& mine = pose[ji->child];
+      mine.head = ji->child;
+      if (const char* t = ji->e->Attribute("type"); t && std::string(t) == "fixed") {
+        const Origin o = origin_of(c, ji->e, "joint " + quoted_text(ji->name));
+        mine = {up.head, up.R * rpy_to_rotation(o.rpy), up.R * o.xyz + up.p};
+      }
+      stack.push_back(ji->child);
+    }
+  }
+  return pose;
+}
+
+std::string link_list(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + quoted_text(n);
+  return out;
+}
+
+// Each link's element. The links welded together by fixed joints are one rigid body, and it is
+// the body that must be physical (as Pinocchio merges fixed joints): a link whose own tensor is
+// not (a sensor, a 1e-6 kg dummy root) has the body's merged mass properties put on the head
+// and none of its own, with a note. A body still not physical is refused naming its head, or
+// with balance_inertia takes the nearest physical inertia, reported. The links welded to a
+// fixed base never move: theirs are not checked (a non-physical one is dropped, noted).
+std::map<std::string, Json> link_elements(const Ctx& c,
+                                          const std::map<std::string, const XMLElement*>& links,
+                                          const std::vector<std::string>& link_order,
+                                          const std::vector<JointInfo>& joints,
+                                          const std::string& root, const UrdfOptions& options,
+                                          std::vector<std::string>& notes) {
+  const std::map<std::string, WeldedPose> pose = welded_poses(c, joints, root);
+  std::map<std::string, CentroidalMass> own;
+  std::map<std::string, std::vector<std::string>> bodies;  // head -> its links, in file order
+  for (const std::string& name : link_order) {
+    own[name] = link_mass(c, links.at(name), "link " + quoted_text(name));
+    bodies[pose.at(name).head].push_back(name);
+  }
+  const auto note = [&](const std::string& text) { notes.push_back(c.source + ": " + text); };
+  std::map<std::string, Json> element;
+  for (const auto& [head, members] : bodies) {
+    std::vector<std::string> bad;
+    for (const std::string& name : members)
+      if (const auto problem = mass_problem(c, own[name])) bad.push_back(name);
+    const bool never_moves = head == root && !options.floating_base;
+    if (bad.empty() || never_moves) {
+      for (const std::string& name : members)
+        element[name] = std::find(bad.begin(), bad.end(), name) == bad.end()
+                            ? mass_element(own[name])
+                            : Json(nullptr);
+      if (!bad.empty())
+        note("link " + link_list(bad) + ": inertia not physical, ignored: welded to the fixed " +
+             "base, it never moves");
+      continue;
+    }
+    CentroidalMass body;
+    for (const std::string& name : members)
+      body = welded(body, own[name].expressed_in(pose.at(name).R, pose.at(name).p));
+    std::string who = "link " + quoted_text(head);
+    if (members.size() > 1) {
+      who += " (a rigid body with the links welded to it: " +
+             link_list({members.begin() + 1, members.end()}) + ")";
+      note("link " + link_list(bad) + ": " + *mass_problem(c, own[bad[0]]) +
+           "; checked as part of the rigid body of link " + quoted_text(head) +
+           " (fixed joints), whose merged mass properties it carries");
+    }
+    if (const auto problem = mass_problem(c, body)) {
+      if (!options.balance_inertia)
+        c.fail(who, *problem +
+                        "; the balance_inertia option (--balance-inertia) takes the "
+                        "nearest physical inertia instead");
+      const Mat3 balanced = nearest_physical_inertia(body.inertia);
+      note(who + ": inertia balanced to the nearest physical one, principal moments " +
+           principal_moments_text(body.inertia) + " -> " + principal_moments_text(balanced));
+      body.inertia = balanced;
+    }
+    for (const std::string& name : members) element[name] = nullptr;
+    element[head] = mass_element(body);
+  }
+  return element;
+}
+
 }  // namespace
 
-UrdfResult urdf_to_model(const std::string& text, const std::string& source,
-                         const UrdfOptions& options) {
-  tinyxml2::XMLDocument doc;
-  const XMLElement* robot = robot_element(doc, text, source);
-  const Ctx c{source, length_scale(robot)};
+namespace {
 
-  UrdfResult out;
-  // Links.
-  std::map<std::string, const XMLElement*> links;
-  std::vector<std::string> link_order;
+// The <link>s by name, in file order. A joint's parent "world" that no link defines is the world
+// itself (Drake's convention): it becomes the root, a link without mass.
+struct Links {
+  std::map<std::string, const XMLElement*> by_name;
+  std::vector<std::string> order;
+};
+
+Links read_links(const Ctx& c, const XMLElement* robot) {
+  Links links;
   for (const XMLElement* l = robot->FirstChildElement("link"); l;
        l = l->NextSiblingElement("link")) {
     const char* name = l->Attribute("name");
     if (!name || !*name) c.fail("a <link>", "has no name");
-    if (!links.emplace(name, l).second)
+    if (!links.by_name.emplace(name, l).second)
       c.fail(std::string("link '") + name + "'", "is defined twice");
-    link_order.push_back(name);
+    links.order.push_back(name);
   }
-  if (links.empty()) throw ModelError(source, "no <link> elements");
+  if (links.by_name.empty()) throw ModelError(c.source, "no <link> elements");
+  for (const XMLElement* j = robot->FirstChildElement("joint"); j;
+       j = j->NextSiblingElement("joint"))
+    if (const XMLElement* p = j->FirstChildElement("parent");
+        p && p->Attribute("link", "world") && !links.by_name.count("world")) {
+      links.by_name.emplace("world", nullptr);
+      links.order.insert(links.order.begin(), "world");
+    }
   // Every link but the root becomes a body: refused here when too many, before the joints.
-  if (links.size() - 1 > static_cast<std::size_t>(kMaxBodies))
-    throw ModelError(source,
-                     too_many_bodies_text(links.size() - 1) + " (one per <link> but the root)");
+  if (links.by_name.size() - 1 > static_cast<std::size_t>(kMaxBodies))
+    throw ModelError(c.source, too_many_bodies_text(links.by_name.size() - 1) +
+                                   " (one per <link> but the root)");
+  return links;
+}
 
-  // Joints: the tree.
-  struct JointInfo {
-    const XMLElement* e;
-    std::string name, parent, child;
-  };
-  std::vector<JointInfo> joints;
+// The <joint>s in file order, checked to make one tree over the links; returns the root link.
+std::string read_tree(const Ctx& c, const XMLElement* robot, const Links& links,
+                      std::vector<JointInfo>& joints) {
   std::map<std::string, std::string> parent_joint;  // child link -> joint name
   std::set<std::string> joint_names;
   for (const XMLElement* j = robot->FirstChildElement("joint"); j;
@@ -297,9 +419,10 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source,
     const char* cl = ch ? ch->Attribute("link") : nullptr;
     if (!pl) c.fail(who, "has no <parent link=…>");
     if (!cl) c.fail(who, "has no <child link=…>");
-    if (!links.count(pl)) c.fail(who, "parent link " + quoted_text(pl) + " does not exist");
-    if (!links.count(cl)) c.fail(who, "child link " + quoted_text(cl) + " does not exist");
+    if (!links.by_name.count(pl)) c.fail(who, "parent link " + quoted_text(pl) + " does not exist");
+    if (!links.by_name.count(cl)) c.fail(who, "child link " + quoted_text(cl) + " does not exist");
     if (std::string(pl) == cl) c.fail(who, "connects link '" + std::string(cl) + "' to itself");
+    if (std::string(cl) == "world") c.fail(who, "a link named 'world' can only be the root");
     auto [it, fresh] = parent_joint.emplace(cl, name);
     if (!fresh)
       c.fail(who, "link '" + std::string(cl) + "' is already the child of joint '" + it->second +
@@ -307,108 +430,150 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source,
     joints.push_back({j, name, pl, cl});
   }
   std::vector<std::string> roots;
-  for (const auto& name : link_order)
+  for (const auto& name : links.order)
     if (!parent_joint.count(name)) roots.push_back(name);
   if (roots.size() != 1) {
     std::string list;
     for (const auto& r : roots) list += (list.empty() ? "'" : ", '") + r + "'";
-    throw ModelError(source, roots.empty() ? "no root link (the joints form a loop)"
-                                           : "more than one root link: " + list);
+    throw ModelError(c.source, roots.empty() ? "no root link (the joints form a loop)"
+                                             : "more than one root link: " + list);
   }
-  const std::string root = roots[0];
   // Every link must hang from the root: every other link has one parent joint, so a link the
   // walk down from the root does not reach hangs from a loop of joints. One walk, O(links).
   std::map<std::string, std::vector<std::string>> children;  // link -> child links
   for (const JointInfo& ji : joints) children[ji.parent].push_back(ji.child);
-  std::set<std::string> reached = {root};
-  for (std::vector<std::string> stack = {root}; !stack.empty();) {
+  std::set<std::string> reached = {roots[0]};
+  for (std::vector<std::string> stack = {roots[0]}; !stack.empty();) {
     const auto below = children.find(stack.back());
     stack.pop_back();
     if (below == children.end()) continue;
     for (const std::string& child : below->second)
       if (reached.insert(child).second) stack.push_back(child);
   }
-  for (const auto& name : link_order)
+  for (const auto& name : links.order)
     if (!reached.count(name)) c.fail("link '" + name + "'", "is on a loop of joints");
+  return roots[0];
+}
 
+// What a joint of one coordinate reads: <limit lower upper effort velocity>, <dynamics damping
+// friction>, and <mimic> as a coupling.
+void one_coordinate_joint(const Ctx& c, const JointInfo& ji, const std::string& type,
+                          const std::set<std::string>& joint_names, Json& joint, Json& couplings,
+                          std::vector<std::string>& notes) {
+  const std::string who = "joint " + quoted_text(ji.name);
+  const Vec3 axis = vec_attr(c, ji.e->FirstChildElement("axis"), "xyz", Vec3::UnitX(), who);
+  if (!(axis.norm() > 1e-12)) c.fail(who, "axis is zero");
+  joint["axis"] = vec3_json(axis.normalized());
+  const XMLElement* lim = ji.e->FirstChildElement("limit");
+  if (type != "continuous" && lim && (lim->Attribute("lower") || lim->Attribute("upper"))) {
+    const double lo = number_attr(c, lim, "lower", 0, who),
+                 hi = number_attr(c, lim, "upper", 0, who);
+    if (lo > hi) c.fail(who, "limit lower > upper");
+    if (lo < hi) joint["limits"] = {lo, hi};
+  }
+  // <limit effort velocity>: τ saturated at ±effort, |θ̇| beyond velocity reported. URDF
+  // requires both; 0 (common for "not given") leaves that limit out, with a warning.
+  for (const auto& [attr, key] :
+       {std::pair{"effort", "effort_limit"}, std::pair{"velocity", "velocity_limit"}}) {
+    if (!lim || !lim->Attribute(attr)) continue;
+    const double x = number_attr(c, lim, attr, 0, who);
+    if (x < 0) c.fail(who, std::string("negative limit ") + attr);
+    if (x > 0)
+      joint[key] = x;
+    else
+      notes.push_back(c.source + ": " + who + ": <limit " + attr + "=\"0\"> read as no " + attr +
+                      " limit");
+  }
+  if (const XMLElement* dyn = ji.e->FirstChildElement("dynamics")) {
+    const double damping = number_attr(c, dyn, "damping", 0, who);
+    const double friction = number_attr(c, dyn, "friction", 0, who);
+    if (damping < 0) c.fail(who, "negative damping");
+    if (damping > 0) joint["damping"] = damping;
+    if (friction < 0) c.fail(who, "negative friction");
+    if (friction > 0) joint["friction"] = friction;  // Coulomb, regularised (docs/control.md)
+  }
+  if (const XMLElement* mimic = ji.e->FirstChildElement("mimic")) {
+    const char* leader = mimic->Attribute("joint");
+    if (!leader) c.fail(who, "<mimic> has no joint");
+    if (!joint_names.count(leader)) c.fail(who, "mimics unknown joint " + quoted_text(leader));
+    couplings.push_back({{"joint", ji.name},
+                         {"follows", leader},
+                         {"ratio", number_attr(c, mimic, "multiplier", 1.0, who)},
+                         {"offset", number_attr(c, mimic, "offset", 0.0, who)}});
+  }
+}
+
+// A <joint> as femdyn's joint: revolute, continuous (a revolute), prismatic, fixed, planar,
+// floating (free) and PyBullet's spherical. What a type does not use is reported.
+Json joint_json(const Ctx& c, const JointInfo& ji, const std::set<std::string>& joint_names,
+                Json& couplings, std::vector<std::string>& notes) {
+  const std::string who = "joint " + quoted_text(ji.name);
+  const char* type_c = ji.e->Attribute("type");
+  const std::string type = type_c ? type_c : "";
+  static const std::map<std::string, std::string> femdyn_type = {
+      {"revolute", "revolute"},  {"continuous", "revolute"}, {"prismatic", "prismatic"},
+      {"fixed", "fixed"},        {"floating", "free"},       {"planar", "planar"},
+      {"spherical", "spherical"}};
+  const auto known = femdyn_type.find(type);
+  if (known == femdyn_type.end()) c.fail(who, "unknown type " + quoted_text(type));
+  const Origin o = origin_of(c, ji.e, who);
+  Json joint = {{"name", ji.name},
+                {"type", known->second},
+                {"origin", {{"xyz", vec3_json(o.xyz)}, {"rpy", vec3_json(o.rpy)}}}};
+  const auto ignored = [&](const char* element, const std::string& why) {
+    if (ji.e->FirstChildElement(element))
+      notes.push_back(c.source + ": " + who + ": <" + element + "> ignored on a " + type +
+                      " joint (" + why + ")");
+  };
+  if (type == "revolute" || type == "continuous" || type == "prismatic") {
+    one_coordinate_joint(c, ji, type, joint_names, joint, couplings, notes);
+    return joint;
+  }
+  const std::string why = type == "fixed" ? "it has no coordinate"
+                                          : "femdyn models none on a joint of several coordinates";
+  for (const char* unused : {"limit", "dynamics", "mimic"}) ignored(unused, why);
+  if (type == "planar") {  // the axis is the plane's normal
+    const Vec3 axis = vec_attr(c, ji.e->FirstChildElement("axis"), "xyz", Vec3::UnitZ(), who);
+    if (!(axis.norm() > 1e-12)) c.fail(who, "axis is zero");
+    joint["axis"] = vec3_json(axis.normalized());
+  } else if (type != "fixed") {
+    ignored("axis", "it turns about every axis");
+  }
+  return joint;
+}
+
+}  // namespace
+
+UrdfResult urdf_to_model(const std::string& text, const std::string& source,
+                         const UrdfOptions& options) {
+  tinyxml2::XMLDocument doc;
+  const XMLElement* robot = robot_element(doc, text, source);
+  const Ctx c{source, length_scale(robot)};
+  const Links links = read_links(c, robot);
+  std::vector<JointInfo> joints;
+  const std::string root = read_tree(c, robot, links, joints);
+  if (!options.floating_base && std::all_of(joints.begin(), joints.end(), [](const JointInfo& ji) {
+        return ji.e->Attribute("type", "fixed");
+      }))
+    throw ModelError(source, "root link " + quoted_text(root) +
+                                 " is welded to the world and no joint moves: nothing to "
+                                 "compute (a free-flying robot: --floating-base, or "
+                                 "\"root_joint\": \"free\" in a reference)");
+  UrdfResult out;
+  const std::map<std::string, Json> element =
+      link_elements(c, links.by_name, links.order, joints, root, options, out.warnings);
+  std::set<std::string> joint_names;
+  for (const JointInfo& ji : joints) joint_names.insert(ji.name);
   Json bodies = Json::array(), couplings = Json::array();
   for (const JointInfo& ji : joints) {
-    const std::string who = "joint '" + ji.name + "'";
-    const char* type_c = ji.e->Attribute("type");
-    const std::string type = type_c ? type_c : "";
-    if (type != "revolute" && type != "continuous" && type != "prismatic" && type != "fixed" &&
-        type != "floating" && type != "planar")
-      c.fail(who, "unknown type " + quoted_text(type));
-    if (ji.child == "world") c.fail(who, "a link named 'world' can only be the root");
-    const Origin o = origin_of(c, ji.e, who);
-    Json joint = {{"name", ji.name},
-                  {"type", type == "continuous" ? "revolute"
-                           : type == "floating" ? "free"
-                                                : type},
-                  {"origin", {{"xyz", vec3_json(o.xyz)}, {"rpy", vec3_json(o.rpy)}}}};
-    if (type == "floating" || type == "planar") {  // (no limits, dynamics or mimic: not used)
-      for (const char* unused : {"limit", "dynamics", "mimic"})
-        if (ji.e->FirstChildElement(unused))
-          out.warnings.push_back(source + ": " + who + ": <" + unused + "> ignored on a " + type +
-                                 " joint (femdyn models none on a joint of several coordinates)");
-      if (type == "planar") {  // the axis is the plane's normal
-        const Vec3 axis = vec_attr(c, ji.e->FirstChildElement("axis"), "xyz", Vec3::UnitZ(), who);
-        if (!(axis.norm() > 1e-12)) c.fail(who, "axis is zero");
-        joint["axis"] = vec3_json(axis.normalized());
-      } else if (ji.e->FirstChildElement("axis")) {
-        out.warnings.push_back(source + ": " + who + ": <axis> ignored on a floating joint");
-      }
-    } else if (type != "fixed") {
-      const Vec3 axis = vec_attr(c, ji.e->FirstChildElement("axis"), "xyz", Vec3::UnitX(), who);
-      if (!(axis.norm() > 1e-12)) c.fail(who, "axis is zero");
-      joint["axis"] = vec3_json(axis.normalized());
-      const XMLElement* lim = ji.e->FirstChildElement("limit");
-      if (type != "continuous" && lim && (lim->Attribute("lower") || lim->Attribute("upper"))) {
-        const double lo = number_attr(c, lim, "lower", 0, who),
-                     hi = number_attr(c, lim, "upper", 0, who);
-        if (lo > hi) c.fail(who, "limit lower > upper");
-        if (lo < hi) joint["limits"] = {lo, hi};
-      }
-      // <limit effort velocity>: τ saturated at ±effort, |θ̇| beyond velocity reported. URDF
-      // requires both; 0 (common for "not given") leaves that limit out, with a warning.
-      for (const auto& [attr, key] :
-           {std::pair{"effort", "effort_limit"}, std::pair{"velocity", "velocity_limit"}}) {
-        if (!lim || !lim->Attribute(attr)) continue;
-        const double x = number_attr(c, lim, attr, 0, who);
-        if (x < 0) c.fail(who, std::string("negative limit ") + attr);
-        if (x > 0)
-          joint[key] = x;
-        else
-          out.warnings.push_back(source + ": " + who + ": <limit " + attr + "=\"0\"> read as no " +
-                                 attr + " limit");
-      }
-      if (const XMLElement* dyn = ji.e->FirstChildElement("dynamics")) {
-        const double damping = number_attr(c, dyn, "damping", 0, who);
-        const double friction = number_attr(c, dyn, "friction", 0, who);
-        if (damping < 0) c.fail(who, "negative damping");
-        if (damping > 0) joint["damping"] = damping;
-        if (friction < 0) c.fail(who, "negative friction");
-        if (friction > 0) joint["friction"] = friction;  // Coulomb, regularised (docs/control.md)
-      }
-      if (const XMLElement* mimic = ji.e->FirstChildElement("mimic")) {
-        const char* leader = mimic->Attribute("joint");
-        if (!leader) c.fail(who, "<mimic> has no joint");
-        if (!joint_names.count(leader)) c.fail(who, "mimics unknown joint " + quoted_text(leader));
-        couplings.push_back({{"joint", ji.name},
-                             {"follows", leader},
-                             {"ratio", number_attr(c, mimic, "multiplier", 1.0, who)},
-                             {"offset", number_attr(c, mimic, "offset", 0.0, who)}});
-      }
-    }
     const bool under_world = ji.parent == root && !options.floating_base;
-    Json body = {
-        {"name", ji.child}, {"parent", under_world ? "world" : ji.parent}, {"joint", joint}};
-    const Json element = inertial_element(c, links.at(ji.child), "link '" + ji.child + "'");
-    if (!element.is_null()) body["elements"] = Json::array({element});
+    Json body = {{"name", ji.child},
+                 {"parent", under_world ? "world" : ji.parent},
+                 {"joint", joint_json(c, ji, joint_names, couplings, out.warnings)}};
+    if (const Json& e = element.at(ji.child); !e.is_null()) body["elements"] = Json::array({e});
     bodies.push_back(body);
   }
-  // The root link: welded to the world, its inertia never moves (still checked); or floating.
-  const Json root_element = inertial_element(c, links.at(root), "link '" + root + "'");
+  // The root link: welded to the world (its inertia never moves), or floating.
   if (options.floating_base) {
     if (root == "world")
       c.fail("link 'world'",
@@ -416,7 +581,7 @@ UrdfResult urdf_to_model(const std::string& text, const std::string& source,
              "--floating-base floats a root link that is a part of the robot");
     Json base = {
         {"name", root}, {"parent", "world"}, {"joint", {{"name", root}, {"type", "free"}}}};
-    if (!root_element.is_null()) base["elements"] = Json::array({root_element});
+    if (const Json& e = element.at(root); !e.is_null()) base["elements"] = Json::array({e});
     bodies.insert(bodies.begin(), base);
   }
   const char* name = robot->Attribute("name");

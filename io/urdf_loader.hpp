@@ -1,6 +1,9 @@
 // Reading URDF (plain URDF; xacro is refused) into a femdyn model document — the same JSON a
 // hand-written model would be — so that a robot loads, validates and exports like any model.
-//   links  -> bodies with one rigid_body element (inertia rotated out of the <inertial> frame)
+//   links  -> bodies with one rigid_body element (inertia rotated out of the <inertial> frame);
+//             the links welded by fixed joints are checked as one rigid body (a non-physical
+//             sensor or dummy link is merged into it); `balance_inertia` replaces a body's
+//             non-physical inertia by the nearest physical one, each change reported
 //   joints -> revolute / continuous / prismatic / fixed / planar joints, floating -> free;
 //             <mimic> -> couplings;
 //             <dynamics damping friction> -> joint dampers and Coulomb friction
@@ -24,7 +27,8 @@ struct UrdfResult {
 };
 
 struct UrdfOptions {
-  bool floating_base = false;  // a free joint between the world and the root link
+  bool floating_base = false;    // a free joint between the world and the root link
+  bool balance_inertia = false;  // a body's non-physical inertia -> the nearest physical one
 };
 UrdfResult urdf_to_model(const std::string& xml_text, const std::string& source,
                          const UrdfOptions& options = {});

@@ -32,10 +32,11 @@ void require_finite(const Model& model, const double* x, Eigen::Index size, Eige
                            "' is NaN or Inf (the forces or the state overflow double precision)");
 }
 
-std::unique_ptr<PyModel> load(const std::string& path, const OptArray& gravity,
-                              bool floating_base) {
+std::unique_ptr<PyModel> load(const std::string& path, const OptArray& gravity, bool floating_base,
+                              bool balance_inertia) {
   LoadOptions options;
   options.floating_base = floating_base;
+  options.balance_inertia = balance_inertia;
   std::vector<std::string> warnings;
   options.warn = [&warnings](const std::string& w) { warnings.push_back(w); };
   if (gravity) {
@@ -356,10 +357,12 @@ void bind_model(py::module_& m) {
       });
 
   m.def("load", &load, py::arg("path"), py::arg("gravity") = py::none(),
-        py::arg("floating_base") = false,
+        py::arg("floating_base") = false, py::arg("balance_inertia") = false,
         "A femdyn JSON model or a URDF file (*.urdf) as a Model; gravity (3,) overrides the "
         "model's; floating_base puts a free joint between the world and a URDF's root link (the "
-        "CLI's --floating-base). Raises femdyn.ModelError (a ValueError) naming the file, place "
+        "CLI's --floating-base); balance_inertia replaces a URDF body's non-physical inertia by "
+        "the nearest physical one, each change in the warnings (--balance-inertia). Raises "
+        "femdyn.ModelError (a ValueError) naming the file, place "
         "and problem.");
 }
 

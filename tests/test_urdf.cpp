@@ -434,7 +434,8 @@ TEST_CASE("bad URDF: one line naming the file, the link or joint, and the proble
              Equals("bad.urdf: link 'l': negative mass -1"));
   CHECK_THAT(error_of(one_link(inertial(1, "0 0 0", "0 0 0", 0.01, 0.01, 0.05))),
              Equals("bad.urdf: link 'l': inertia violates the triangle inequality (principal "
-                    "moments 0.01, 0.01, 0.05)"));
+                    "moments 0.01, 0.01, 0.05); the balance_inertia option (--balance-inertia) "
+                    "takes the nearest physical inertia instead"));
   CHECK_THAT(
       error_of(one_link(
           "<inertial><mass value=\"nan\"/><inertia ixx=\"1\" iyy=\"1\" izz=\"1\"/></inertial>")),
@@ -618,5 +619,7 @@ TEST_CASE("an inertia's round-off is judged against m L², not against the tenso
   mass_matrix(m, ws, VecX::Zero(1));
   CHECK(ws.Ms(0, 0) == Approx(0.5 * 0.09).epsilon(1e-12));  // m r², the point mass
   CHECK_THAT(error_of(robot("-1e-9")),
-             Equals("bad.urdf: link 'l': inertia has a negative principal moment (-1e-09)"));
+             Equals("bad.urdf: link 'l': inertia has a negative principal moment (-1e-09); the "
+                    "balance_inertia option (--balance-inertia) takes the nearest physical "
+                    "inertia instead"));
 }

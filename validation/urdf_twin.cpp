@@ -11,9 +11,15 @@
 #include <stdexcept>
 
 #include "core/errors.hpp"
+#include "core/inertia.hpp"
+#include "io/centroidal_mass.hpp"
 #include "validation/twin_friction.hpp"
 
 namespace femdyn::validation {
+
+// Simbody's small vectors here, not femdyn's Eigen ones (core/math.hpp, seen through inertia.hpp).
+using Vec3 = SimTK::Vec3;
+using Mat33 = SimTK::Mat33;
 
 namespace {
 
@@ -41,19 +47,58 @@ Transform origin(const tinyxml2::XMLElement* parent) {
                    xyz);
 }
 
-// <inertial>: mass, centre of mass at the origin's xyz, inertia about the centre of mass in the
-// <inertial> frame; Simbody wants it about the link origin in the link frame.
-MassProperties mass_properties(const tinyxml2::XMLElement* link) {
-  const tinyxml2::XMLElement* in = link->FirstChildElement("inertial");
-  if (!in) return MassProperties(0, Vec3(0), Inertia(0));
-  const double m = number(in->FirstChildElement("mass"), "value", 0);
+// A link's <inertial> in the link frame, as plain matrices: Simbody's Inertia checks each
+// tensor it is given, and a sensor or dummy link welded to a body need not be physical on its
+// own (the body it is welded into must be). Mass m, centre of mass c, inertia about c.
+struct LinkMass {
+  double m = 0;
+  Mat33 Ic{0};
+  Vec3 c{0};
+};
+
+LinkMass link_mass(const tinyxml2::XMLElement* link) {
+  const tinyxml2::XMLElement* in = link ? link->FirstChildElement("inertial") : nullptr;
+  if (!in) return {};
   const tinyxml2::XMLElement* ie = in->FirstChildElement("inertia");
-  const Inertia I_inertial(number(ie, "ixx", 0), number(ie, "iyy", 0), number(ie, "izz", 0),
-                           number(ie, "ixy", 0), number(ie, "ixz", 0), number(ie, "iyz", 0));
+  Mat33 I;
+  I(0, 0) = number(ie, "ixx", 0), I(1, 1) = number(ie, "iyy", 0), I(2, 2) = number(ie, "izz", 0);
+  I(0, 1) = I(1, 0) = number(ie, "ixy", 0);
+  I(0, 2) = I(2, 0) = number(ie, "ixz", 0);
+  I(1, 2) = I(2, 1) = number(ie, "iyz", 0);
   const Transform X_LI = origin(in);
-  if (m == 0) return MassProperties(0, Vec3(0), Inertia(0));
-  const Inertia Ic_L = I_inertial.reexpress(~X_LI.R());  // expressed in the link frame
-  return MassProperties(m, X_LI.p(), Ic_L.shiftFromMassCenter(-X_LI.p(), m));
+  return {number(in->FirstChildElement("mass"), "value", 0), X_LI.R() * I * ~X_LI.R(), X_LI.p()};
+}
+
+// Two parts of one rigid body, both in its head's frame: masses add, the centre of mass is
+// their mean, each inertia moves to it by the parallel-axis theorem.
+LinkMass welded_pair(const LinkMass& a, const LinkMass& b) {
+  LinkMass out;
+  out.m = a.m + b.m;
+  out.c = out.m > 0 ? (a.m * a.c + b.m * b.c) / out.m : a.c;
+  out.Ic = a.Ic + b.Ic;
+  for (const LinkMass* part : {&a, &b}) {
+    const Vec3 d = part->c - out.c;
+    out.Ic += part->m * (Mat33(dot(d, d)) - d * ~d);
+  }
+  return out;
+}
+
+// A rigid body's mass properties for Simbody (about its frame's origin), made physical the way
+// the import is: within round-off (1e-9 m L²) the nearest physical tensor, and with
+// `balance` the nearest physical tensor at any distance (io/centroidal_mass.hpp).
+MassProperties simbody_mass(const std::string& link, const LinkMass& lm, double length,
+                            bool balance) {
+  ::Eigen::Matrix3d I;
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) I(r, k) = lm.Ic(r, k);
+  if (const auto problem = femdyn::inertia_problem(I, lm.m * length * length); problem && !balance)
+    throw femdyn::Error("link '" + link + "': " + *problem);
+  I = femdyn::nearest_physical_inertia(I);
+  Mat33 Ic;
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) Ic(r, k) = I(r, k);
+  if (lm.m == 0) return MassProperties(0, Vec3(0), Inertia(0));  // (as a massless link)
+  return MassProperties(lm.m, lm.c, Inertia(Ic).shiftFromMassCenter(-lm.c, lm.m));
 }
 
 }  // namespace
@@ -99,6 +144,7 @@ MobilizedBody mobilize(MobilizedBody& parent, const std::string& type, const Tra
                        const Vec3& axis, const Body::Rigid& body) {
   if (type == "fixed") return MobilizedBody::Weld(parent, X_PJ, body, Transform());
   if (type == "floating") return MobilizedBody::Free(parent, X_PJ, body, Transform());
+  if (type == "spherical") return MobilizedBody::Ball(parent, X_PJ, body, Transform());
   if (type == "planar") {
     const Rotation R_a = planar_frame(axis);
     return MobilizedBody::Planar(parent, Transform(X_PJ.R() * R_a, X_PJ.p()), body,
@@ -116,7 +162,60 @@ MobilizedBody mobilize(MobilizedBody& parent, const std::string& type, const Tra
 
 }  // namespace
 
-UrdfTwin::UrdfTwin(const std::string& path, const ::Eigen::Vector3d& gravity, bool floating)
+namespace {
+
+// The rigid bodies of a URDF tree: each link's head (the link on the movable joint above it, or
+// the root) and its frame in the head's, composed along fixed joints; each head's merged mass.
+struct RigidBodies {
+  std::map<std::string, std::string> head;
+  std::map<std::string, LinkMass> mass;  // by head
+};
+
+RigidBodies rigid_bodies(
+    const std::string& root, const std::map<std::string, const tinyxml2::XMLElement*>& links,
+    const std::map<std::string, std::vector<const tinyxml2::XMLElement*>>& children) {
+  RigidBodies out;
+  std::map<std::string, Transform> X_H;  // link frame in its head's
+  std::vector<std::string> todo{root};
+  out.head[root] = root;
+  X_H[root] = Transform();
+  while (!todo.empty()) {
+    const std::string link = todo.back();
+    todo.pop_back();
+    const auto below = children.find(link);
+    if (below == children.end()) continue;
+    for (const tinyxml2::XMLElement* j : below->second) {
+      const std::string child = j->FirstChildElement("child")->Attribute("link");
+      const bool welded = std::string(j->Attribute("type")) == "fixed";
+      out.head[child] = welded ? out.head[link] : child;
+      X_H[child] = welded ? X_H[link] * origin(j) : Transform();
+      todo.push_back(child);
+    }
+  }
+  for (const auto& [link, head] : out.head) {
+    const auto l = links.find(link);
+    LinkMass lm = link_mass(l == links.end() ? nullptr : l->second);
+    const Transform& X = X_H.at(link);
+    lm = {lm.m, X.R() * lm.Ic * ~X.R(), X * lm.c};
+    out.mass[head] = welded_pair(out.mass[head], lm);
+  }
+  return out;
+}
+
+// The model's length scale for round-off: the largest joint or inertial offset, else 1 m.
+double length_scale(const tinyxml2::XMLElement* robot) {
+  double L = 0;
+  for (auto* j = robot->FirstChildElement("joint"); j; j = j->NextSiblingElement("joint"))
+    L = std::max(L, origin(j).p().norm());
+  for (auto* l = robot->FirstChildElement("link"); l; l = l->NextSiblingElement("link"))
+    if (const auto* in = l->FirstChildElement("inertial")) L = std::max(L, origin(in).p().norm());
+  return L > 0 ? L : 1.0;
+}
+
+}  // namespace
+
+UrdfTwin::UrdfTwin(const std::string& path, const ::Eigen::Vector3d& gravity, bool floating,
+                   bool balance_inertia)
     : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   tinyxml2::XMLDocument doc;
@@ -132,16 +231,24 @@ UrdfTwin::UrdfTwin(const std::string& path, const ::Eigen::Vector3d& gravity, bo
     children[j->FirstChildElement("parent")->Attribute("link")].push_back(j);
     joint_to_child[j->FirstChildElement("child")->Attribute("link")] = j;
   }
-  std::string root;
+  // The root: the link no joint has as child, or a parent "world" no link defines (the ground).
+  std::string root = children.count("world") && !links.count("world") ? "world" : "";
   for (const auto& [name, l] : links)
-    if (!joint_to_child.count(name)) root = name;
+    if (root.empty() && !joint_to_child.count(name)) root = name;
+  const RigidBodies rigid = rigid_bodies(root, links, children);
+  const double length = length_scale(robot);
+  // A link's body: its rigid body's merged mass on the head, none on the links welded to it.
+  const auto body_of = [&](const std::string& link) {
+    if (rigid.head.at(link) != link) return Body::Rigid(MassProperties(0, Vec3(0), Inertia(0)));
+    return Body::Rigid(simbody_mass(link, rigid.mass.at(link), length, balance_inertia));
+  };
   // Build from the root outwards; a floating root carries its own <inertial>.
   MobilizedBody root_body = s.matter.updGround();
   if (floating) {
-    root_body = MobilizedBody::Free(s.matter.updGround(), Transform(),
-                                    Body::Rigid(mass_properties(links.at(root))), Transform());
+    root_body = MobilizedBody::Free(s.matter.updGround(), Transform(), body_of(root), Transform());
     s.joints.push_back({root, "floating", root_body});
   }
+  const bool root_moves = floating;
   std::vector<std::pair<std::string, MobilizedBody>> todo{{root, root_body}};
   while (!todo.empty()) {
     auto [link, parent] = todo.back();
@@ -151,10 +258,13 @@ UrdfTwin::UrdfTwin(const std::string& path, const ::Eigen::Vector3d& gravity, bo
       const std::string child = j->FirstChildElement("child")->Attribute("link");
       const Vec3 axis = triple(j->FirstChildElement("axis"), "xyz",
                                type == "planar" ? Vec3(0, 0, 1) : Vec3(1, 0, 0));
-      const MobilizedBody mb =
-          mobilize(parent, type, origin(j), axis, Body::Rigid(mass_properties(links.at(child))));
+      // The links welded to a fixed base never move: their mass is not checked, nor needed.
+      const bool never_moves = !root_moves && rigid.head.at(child) == root;
+      const MobilizedBody mb = mobilize(
+          parent, type, origin(j), axis,
+          never_moves ? Body::Rigid(MassProperties(0, Vec3(0), Inertia(0))) : body_of(child));
       if (type != "fixed") s.joints.push_back({name, type, mb});
-      if (type != "fixed" && type != "planar" && type != "floating") {
+      if (type == "revolute" || type == "continuous" || type == "prismatic") {
         const double c = number(j->FirstChildElement("dynamics"), "damping", 0);
         if (c != 0) Force::MobilityLinearDamper(s.forces, mb, MobilizerUIndex(0), c);
         // Coulomb friction, regularised at femdyn's default v_s = 0.01 (URDF gives none).
@@ -225,6 +335,14 @@ UrdfTwinEquations UrdfTwin::equations(const std::vector<std::string>& rate_names
       C.block<3, 3>(u0, om) = R;
       C.block<3, 3>(u0 + 3, v) = R;
       Cdot_v.segment<3>(u0 + 3) = R * qd.segment<3>(om).cross(qd.segment<3>(v));
+    } else if (j.type == "spherical") {
+      // PyBullet's spherical joint: femdyn's ω in the child's axes is Simbody's Ball u = R ω in
+      // the joint frame's; u̇ = R ω̇ + R (ω × ω) has no Ċ v term.
+      const int w = at(entry, j.name + ".qw"), om = at(rate, j.name + ".wx");
+      const ::Eigen::Matrix3d R =
+          ::Eigen::Quaterniond(q[w], q[w + 1], q[w + 2], q[w + 3]).normalized().toRotationMatrix();
+      for (int k = 0; k < 4; ++k) sq[q0 + k] = q[w + k];
+      C.block<3, 3>(u0, om) = R;
     } else if (j.type == "planar") {
       const char* kOrder[] = {"theta", "x", "y"};  // Simbody's Planar: (θ, x, y)
       for (int k = 0; k < 3; ++k) {

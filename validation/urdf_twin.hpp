@@ -2,9 +2,9 @@
 // import (io/urdf_loader) — so that comparing it with femdyn's equations of the same file checks
 // the import itself: the rpy convention (Simbody's own space-fixed X-Y-Z sequence), the rotation
 // of the inertia out of the <inertial> frame (Inertia::reexpress) and its shift to the link
-// origin, the tree, fixed, planar and floating joints, axes, mimic couplings and damping. Gravity
-// is given (URDF has none; femdyn's default for URDF is (0, 0, −9.81)). Like twin.hpp, this header
-// uses only Eigen; urdf_twin.cpp is C++17 without NDEBUG.
+// origin, the tree, fixed, planar, spherical and floating joints, axes, mimic couplings and
+// damping. Gravity is given (URDF has none; femdyn's default for URDF is (0, 0, −9.81)). Like
+// twin.hpp, this header uses only Eigen; urdf_twin.cpp is C++17 without NDEBUG.
 #pragma once
 #include <Eigen/Dense>
 #include <memory>
@@ -22,7 +22,11 @@ class UrdfTwin {
  public:
   // With `floating`, the root link moves on a Free mobilizer (femdyn's --floating-base);
   // otherwise it is welded to the ground. Throws on bad XML.
-  UrdfTwin(const std::string& urdf_path, const Eigen::Vector3d& gravity, bool floating = false);
+  // The links welded by fixed joints are one body with their merged mass (a sensor link need not
+  // be physical alone); with `balance_inertia` a body's non-physical inertia is replaced by the
+  // nearest physical one, as femdyn's --balance-inertia does.
+  UrdfTwin(const std::string& urdf_path, const Eigen::Vector3d& gravity, bool floating = false,
+           bool balance_inertia = false);
   ~UrdfTwin();
   UrdfTwin(const UrdfTwin&) = delete;
   UrdfTwin& operator=(const UrdfTwin&) = delete;

@@ -990,7 +990,8 @@ ValidationReport validate(const Model& m, const ValidationOptions& o) {
 }
 
 QuantityError validate_urdf_import(const Model& m, const std::string& path,
-                                   const ValidationOptions& o, std::string& failure) {
+                                   const ValidationOptions& o, std::string& failure,
+                                   bool balance_inertia) {
   QuantityError e{"import", 0, 0, o.tolerance > 0 ? o.tolerance : pointwise_tolerance(m)};
   // --floating-base puts the root link first, on a free joint to the world named after it
   // (io/urdf_loader.cpp); the twin then floats the root of the XML's tree.
@@ -999,7 +1000,7 @@ QuantityError validate_urdf_import(const Model& m, const std::string& path,
                         m.bodies[0].joint.name == m.bodies[0].name;
   std::unique_ptr<UrdfTwin> twin;
   try {
-    twin = std::make_unique<UrdfTwin>(path, m.gravity, floating);
+    twin = std::make_unique<UrdfTwin>(path, m.gravity, floating, balance_inertia);
   } catch (const std::exception& ex) {
     failure = std::string("the independent URDF twin could not be built: ") + ex.what();
     return e;

@@ -166,9 +166,10 @@ ValidationReport validate(const Model& model, const ValidationOptions& options =
 // For a model read from a URDF file: femdyn's M^s, h, Q against an independent Simbody model
 // built straight from the XML (urdf_twin.hpp), at the same seeded states. Returns the quantity
 // "import" (the largest of the three relative errors); `failure` is set if the twin cannot be
-// built.
+// built. `balance_inertia`: the model was loaded with it (the twin balances the same bodies).
 QuantityError validate_urdf_import(const Model& model, const std::string& urdf_path,
-                                   const ValidationOptions& options, std::string& failure);
+                                   const ValidationOptions& options, std::string& failure,
+                                   bool balance_inertia = false);
 
 // What the Simbody twin reads of a model; each body's mass properties are the sum of its
 // elements'. Used by validate() and femdyn_bench.

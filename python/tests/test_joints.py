@@ -143,6 +143,26 @@ def test_load_urdf_with_a_floating_base():
     assert np.allclose(qdd[:3], floating.gravity, atol=1e-9)
 
 
+def test_load_urdf_balance_inertia_equals_the_cli(tmp_path):
+    # A link drawn too flat (0.001 + 0.001 < 0.01) is refused; balance_inertia loads it with the
+    # nearest physical tensor (0.005, 0.005, 0.01) and warns, as --balance-inertia does.
+    path = tmp_path / "flat.urdf"
+    path.write_text(
+        '<robot name="r"><link name="base"/><link name="disc"><inertial>'
+        '<origin xyz="0.1 0 0"/><mass value="1"/>'
+        '<inertia ixx="0.001" iyy="0.001" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+        '<joint name="j" type="revolute"><parent link="base"/><child link="disc"/>'
+        '<axis xyz="0 0 1"/></joint></robot>')
+    with pytest.raises(femdyn.ModelError, match="link 'disc': inertia violates the triangle"):
+        femdyn.load(str(path))
+    with pytest.warns(UserWarning, match="0.001, 0.001, 0.01 -> 0.005, 0.005, 0.01"):
+        model = femdyn.load(str(path), balance_inertia=True)
+    M = model.mass_matrix(np.zeros(1))
+    assert M[0, 0] == pytest.approx(0.01 + 0.1**2, rel=1e-14)
+    cli = cli_json("equations", str(path), "--balance-inertia", "--q", "0", "--qd", "0", "--json")
+    assert np.array(cli["M"]) == pytest.approx(M, rel=1e-15)
+
+
 def test_frame_kinematics_from_python_equal_the_cli(tmp_path):
     # A named frame on the floating coupled chain: J (6, n), velocity = J v, and the CLI's
     # `femdyn kinematics --json` gives the same numbers in every set of axes.
