@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <iostream>
 
+#include "compile/correlation.hpp"
 #include "core/equations.hpp"
 #include "core/limits.hpp"
 #include "core/loops/assembly.hpp"
@@ -23,6 +24,9 @@ constexpr const char* kInfoHelp = R"(usage: femdyn info MODEL [--json] [--gravit
 Prints the generalized coordinates, joints (with the coupling level θ = C q + θ0), bodies and
 their elements, the transition coordinates u kept and those left out, and the correlation
 table N_m (one row per element; per node x y z rx ry rz; 0 = left out).
+A model whose M^s is singular (a massless chain end) is described all the same, with a note
+naming the coordinates that move no inertia (--json: "mass_matrix_singular"); import and view
+load it too, and the commands that compute motion refuse it.
 )";
 
 constexpr const char* kEquationsHelp =
@@ -140,6 +144,21 @@ Model load(const Args& a, std::size_t count) {
   return load_model(a.positional[0], load_options(a));
 }
 
+Model load_description(const Args& a, std::string& singular) {
+  if (a.positional.size() != 1) throw CliError("expected one MODEL file (try --help)");
+  LoadOptions opt = load_options(a);
+  opt.compile.check_mass = false;
+  Model m = load_model(a.positional[0], opt);
+  singular.clear();
+  if (const auto p = mass_matrix_problem(m, true)) {
+    std::string inert;
+    for (const std::string& c : p->inert) inert += (inert.empty() ? "'" : ", '") + c + "'";
+    singular = p->message + (inert.empty() ? "" : "; moving no inertia at all: " + inert) +
+               ": equations, simulate and the other dynamics commands refuse this model";
+  }
+  return m;
+}
+
 double max_memory(const Args& a) {
   if (!a.has("max-memory")) return 0;
   const double gb = number_option(a, "max-memory", 0);
@@ -204,11 +223,15 @@ int cmd_info(int argc, char** argv) {
     std::cout << kInfoHelp;
     return 0;
   }
-  const Model m = load(a);
-  if (a.has("json"))
-    std::cout << json_text(info_json(m)) << "\n";
-  else
-    std::cout << info_text(m);
+  std::string singular;
+  const Model m = load_description(a, singular);
+  if (a.has("json")) {
+    Json j = info_json(m);
+    if (!singular.empty()) j["mass_matrix_singular"] = singular;
+    std::cout << json_text(j) << "\n";
+  } else {
+    std::cout << info_text(m) << (singular.empty() ? "" : "note: " + singular + "\n");
+  }
   return 0;
 }
 

@@ -37,6 +37,10 @@ double number_option(const Args& a, const std::string& opt, double fallback);  /
 double integer_option(const Args& a, const std::string& opt, double fallback, double min,
                       double max = 1e15);
 Model load(const Args& a, std::size_t count = 1);  // the first positional; expects `count`
+// For the commands that describe a model without its dynamics (info, import, view): a model
+// whose M^s is singular loads, and `singular` says why, naming the coordinates that move no
+// inertia, in one line ("" when M^s is regular).
+Model load_description(const Args& a, std::string& singular);
 // --max-memory GB (a number > 0, below 1e9) as bytes, or 0 when absent: the memory limit's
 // default, half the available memory (core/memory.hpp).
 double max_memory(const Args& a);

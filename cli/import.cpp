@@ -40,7 +40,9 @@ int cmd_import(int argc, char** argv) {
   const LoadOptions opt = load_options(a);
   Json doc = model_document(a.positional[0], opt);
   if (opt.gravity) doc["gravity"] = {opt.gravity->x(), opt.gravity->y(), opt.gravity->z()};
-  (void)load_model(a.positional[0], opt);  // the model must compile before anything is written
+  std::string singular;  // the model must compile before anything is written
+  (void)load_description(a, singular);
+  if (!singular.empty()) std::cerr << "femdyn import: note: " << safe_message(singular) << "\n";
   try {
     write_file_atomic(out, readable_json(doc), a.has("force"));
   } catch (const std::runtime_error& e) {

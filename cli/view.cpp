@@ -35,7 +35,9 @@ int cmd_view(int argc, char** argv) {
     return 0;
   }
   if (a.has("traj") && a.has("q")) throw CliError("--traj and --q: give one of them");
-  const Model m = load(a);
+  std::string singular;  // the page draws poses: M^s need not be regular
+  const Model m = load_description(a, singular);
+  if (!singular.empty()) std::cerr << "femdyn view: note: " << safe_message(singular) << "\n";
   const std::string out = a.has("out") ? a.options.at("out") : "view.html";
   std::error_code ec;
   for (const std::string& input : {a.positional[0], a.has("traj") ? a.options.at("traj") : ""})

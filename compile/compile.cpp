@@ -375,7 +375,7 @@ Model compile_tree(MechanismSpec spec, const CompileOptions& options) {
   condense_body_inertia(m);
   choose_routes(m, options.routes);
   analyse_mass_pattern(m);
-  check_mass_matrix(m);
+  if (options.check_mass) check_mass_matrix(m);
   return m;
 }
 

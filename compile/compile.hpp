@@ -10,6 +10,9 @@ namespace femdyn {
 // the one compile() chooses is asked for here (tests and benchmarks compare routes).
 struct CompileOptions {
   RouteChoice routes;  // for the model and, with a nonlinear coupling law, its tree
+  // M^s regular at sampled states (compile/correlation.hpp), else ModelError. Off for what
+  // describes a model without its dynamics (info, import, view), which report the problem.
+  bool check_mass = true;
 };
 
 // Compiles a spec; throws ModelError naming spec `where` labels on bad input.

@@ -431,8 +431,8 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
   m.has_nodal_forces = !m.torques.empty() || (N > 0 && m.F_constant.cwiseAbs().maxCoeff() > 0);
 }
 
-void check_mass_matrix(const Model& m) {
-  if (m.n() == 0) return;
+std::optional<MassMatrixProblem> mass_matrix_problem(const Model& m, bool list_inert) {
+  if (m.n() == 0) return std::nullopt;
   Workspace ws(m);
   std::vector<VecX> states = sample_states(m, 2);
   states.insert(states.begin(), neutral_posture(m));
@@ -448,12 +448,22 @@ void check_mass_matrix(const Model& m) {
       st = ws.solver.factorize(ws.Ms);
     }
     if (st.ok) continue;
-    std::string where = m.where;
+    MassMatrixProblem p{m.where, st.message, {}};
     if (st.coordinate >= 0)
       for (const Body& b : m.bodies)
-        if (b.joint.name == m.coordinate_names[st.coordinate]) where = b.joint.where;
-    throw ModelError(where, st.message);
+        if (b.joint.name == m.coordinate_names[st.coordinate]) p.where = b.joint.where;
+    if (!list_inert || m.n() > 4000) return p;
+    evaluate(m, ws, q, rest, VecX());  // (the articulated route formed no M^s)
+    const double scale = ws.Ms.diagonal().cwiseAbs().maxCoeff();
+    for (int a = 0; a < m.n(); ++a)
+      if (!(ws.Ms(a, a) > 1e-13 * scale)) p.inert.push_back(m.coordinate_names[a]);
+    return p;
   }
+  return std::nullopt;
+}
+
+void check_mass_matrix(const Model& m) {
+  if (const auto p = mass_matrix_problem(m)) throw ModelError(p->where, p->message);
 }
 
 std::string Model::dof_name_of(const SystemDof& d) const {

@@ -289,3 +289,41 @@ TEST_CASE("what a URDF says that femdyn does not use is reported", "[urdf]") {
                         Contains("--floating-base"));
   CHECK(run("info " + still + " --floating-base").code == 0);
 }
+
+TEST_CASE("a massless chain end: info, import and view describe it, the dynamics refuse",
+          "[urdf][cli]") {
+  // ABB's and WidowX's files: a joint whose links carry no mass. M^s is singular; describing
+  // the model needs no M^s, computing its motion does.
+  const std::string heavy = inertial_xml(1, {0.1, 0, 0}, Vec3(0.01, 0.01, 0.01).asDiagonal());
+  const std::string path = write_body_urdf(
+      "massless_end.urdf", R"(<robot name="r"><link name="base"/><link name="arm">)" + heavy +
+                               R"(</link><link name="finger"/>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/></joint>
+  <joint name="grip" type="revolute"><parent link="arm"/><child link="finger"/><axis xyz="1 0 0"/></joint></robot>)");
+  const std::string note =
+      "moving no inertia at all: 'grip': equations, simulate and the other "
+      "dynamics commands refuse this model";
+  const Run info = run("info " + path);
+  CHECK(info.code == 0);
+  CHECK_THAT(info.out, Contains("note: the mass matrix M^s is singular: coordinate 'grip' "
+                                "moves no inertia") &&
+                           Contains(note));
+  const Run json = run("info " + path + " --json");
+  CHECK(json.code == 0);
+  CHECK_THAT(json.out, Contains("\"mass_matrix_singular\""));
+  const Scratch scratch("massless_end");
+  const std::string out = (scratch.dir / "end.json").string();
+  const Run import = run("import " + path + " -o " + out);
+  CHECK(import.code == 0);
+  CHECK_THAT(import.out, Contains(note));
+  CHECK(std::filesystem::exists(out));
+  const Run view = run("view " + path + " --out " + (scratch.dir / "end.html").string());
+  CHECK(view.code == 0);
+  CHECK_THAT(view.out, Contains(note));
+  for (const char* command : {"equations ", "simulate ", "validate "}) {
+    const Run r = run(command + path);
+    CHECK(r.code == 1);
+    CHECK_THAT(r.out, Contains("massless_end.urdf: joint 'grip' (link 'finger'): the mass "
+                               "matrix M^s is singular"));
+  }
+}
