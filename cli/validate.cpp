@@ -59,7 +59,8 @@ or --max-memory GB (default: half the available memory, MemAvailable in /proc/me
 command refuses with one line on stderr (the estimate and how to proceed) and exits 1. During
 the trajectory, femdyn's step halving and Simbody's runs stop where the budget ends. On a
 terminal a progress line shows the work done against the estimate.
-Exit 1 if any check fails. --json: one object per model (an array for several models);
+Exit 1 if any check fails; 3 if none fails but a model could not be compared, one line saying
+why (a body Simbody cannot hold: a rotary inertia without mass), with NOT COMPARED. --json: one object per model (an array for several models);
 --markdown: one table row per model (docs/validation.md). The JSON has the whole series: the
 trajectory's sample times "t", "state_error" and the energy of both runs.
 )";
@@ -126,6 +127,7 @@ Json report_json(const std::string& path, const Model& m, const validation::Vali
           {"notes", r.notes},
           {"work", work},
           {"failure", r.failure},
+          {"compared", !r.not_comparable},
           {"pass", r.pass()}};
 }
 
@@ -133,7 +135,7 @@ void print_text(const std::string& path, const validation::ValidationReport& r) 
   if (!r.failure.empty()) {
     std::cout << escaped(path) << ": no comparison possible: " << safe_message(r.failure) << "\n";
     for (const auto& n : r.notes) std::cout << "note: " << n << "\n";
-    std::cout << "FAIL\n";
+    std::cout << (r.not_comparable ? "NOT COMPARED\n" : "FAIL\n");
     return;
   }
   std::cout << escaped(path) << " (" << r.n << " coordinates) against Simbody, " << r.states
@@ -181,8 +183,8 @@ void print_text(const std::string& path, const validation::ValidationReport& r) 
 
 void print_markdown_row(const std::string& path, const validation::ValidationReport& r) {
   if (!r.failure.empty()) {
-    std::cout << "| `" << path << "` | " << r.n
-              << " | — | — | — | — | — | — | — | — | FAIL: " << r.failure << " |\n";
+    std::cout << "| `" << path << "` | " << r.n << " | — | — | — | — | — | — | — | — | "
+              << (r.not_comparable ? "NOT COMPARED: " : "FAIL: ") << r.failure << " |\n";
     return;
   }
   std::cout << "| `" << path << "` | " << r.n;
@@ -262,7 +264,7 @@ int cmd_validate(int argc, char** argv) {
   }
   if (refused) return 1;
 
-  bool all_pass = true;
+  bool any_failed = false, any_not_compared = false;
   Json reports = Json::array();
   if (a.has("markdown"))
     std::cout << "| model | n | M^s | h | Q | q̈ | τ | loop | frames, COM, momentum | trajectory "
@@ -284,7 +286,8 @@ int cmd_validate(int argc, char** argv) {
                                                               failure, a.has("balance-inertia")));
       if (!failure.empty()) r.failure = failure;
     }
-    all_pass = all_pass && r.pass();
+    any_failed = any_failed || (!r.pass() && !r.not_comparable);
+    any_not_compared = any_not_compared || r.not_comparable;
     if (a.has("json"))
       reports.push_back(report_json(a.positional[i], models[i], r));
     else if (a.has("markdown"))
@@ -293,7 +296,7 @@ int cmd_validate(int argc, char** argv) {
       print_text(a.positional[i], r);
   }
   if (a.has("json")) std::cout << json_text((reports.size() == 1 ? reports[0] : reports)) << "\n";
-  return all_pass ? 0 : 1;
+  return any_failed ? 1 : any_not_compared ? 3 : 0;
 }
 
 }  // namespace femdyn::cli

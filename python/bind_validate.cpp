@@ -98,6 +98,7 @@ py::dict validate(const PyModel& self, int states, unsigned seed, std::optional<
   d["notes"] = r.notes;
   d["work"] = work;
   d["failure"] = r.failure;
+  d["compared"] = !r.not_comparable;
   d["pass"] = r.pass();
   return d;
 }

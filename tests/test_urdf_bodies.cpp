@@ -327,3 +327,27 @@ TEST_CASE("a massless chain end: info, import and view describe it, the dynamics
                                "matrix M^s is singular"));
   }
 }
+
+#ifdef FEMDYN_WITH_SIMBODY
+TEST_CASE("validate: a body Simbody cannot hold is not compared, exit 3, never FAIL or PASS",
+          "[urdf][validation]") {
+  // A massless link with a rotary inertia (Bolt's feet, PyBullet's panda_link8): femdyn reads a
+  // rotary node; a Simbody body with no mass has no inertia.
+  const std::string path = write_body_urdf(
+      "rotor.urdf", R"(<robot name="r"><link name="base"/><link name="arm">)" +
+                        inertial_xml(1, {0.1, 0, 0}, Vec3(0.01, 0.01, 0.01).asDiagonal()) +
+                        R"(</link><link name="rotor">)" +
+                        inertial_xml(0, Vec3::Zero(), Vec3(1e-4, 1e-4, 2e-4).asDiagonal()) +
+                        R"(</link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/></joint>
+  <joint name="spin" type="revolute"><parent link="arm"/><child link="rotor"/><origin xyz="0.2 0 0"/><axis xyz="0 0 1"/></joint></robot>)");
+  const Run r = run("validate " + path + " --states 2 --t-end 0");
+  CHECK(r.code == 3);
+  CHECK_THAT(r.out, Contains("body 'rotor' has a rotary inertia but no mass, which a Simbody "
+                             "body cannot have") &&
+                        Contains("NOT COMPARED"));
+  const Run json = run("validate " + path + " --states 2 --t-end 0 --json");
+  CHECK(json.code == 3);
+  CHECK_THAT(json.out, Contains("\"compared\": false"));
+}
+#endif

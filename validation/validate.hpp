@@ -130,7 +130,10 @@ struct ValidationReport {
   TrajectoryReport trajectory;
   std::vector<std::string> notes;  // e.g. approximations the model makes on purpose
   std::string failure;             // why no comparison could be made (then it fails)
-  bool dense_mass = true;          // "M" entry by entry; else ‖ΔM^s V‖∞ / ‖M^s V‖∞
+  // The failure is only what Simbody cannot represent (a massless body with a rotary inertia):
+  // the model is not compared, neither passed nor failed (`femdyn validate` exits 3).
+  bool not_comparable = false;
+  bool dense_mass = true;  // "M" entry by entry; else ‖ΔM^s V‖∞ / ‖M^s V‖∞
   WorkEstimate estimate;
   double wall_time = 0;  // s: the whole validation, the twin and the probes included
   bool pass() const;
