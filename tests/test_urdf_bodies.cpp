@@ -351,3 +351,30 @@ TEST_CASE("validate: a body Simbody cannot hold is not compared, exit 3, never F
   CHECK_THAT(json.out, Contains("\"compared\": false"));
 }
 #endif
+
+TEST_CASE("the format is read from the content: a URDF named .xml, MJCF refused in one line",
+          "[urdf]") {
+  const std::string body = inertial_xml(1, {0.1, 0, 0}, Vec3(0.01, 0.01, 0.01).asDiagonal());
+  const std::string urdf = R"(<?xml version="1.0"?>
+<!-- exported --><!-- twice -->
+<robot name="r"><link name="base"/><link name="a">)" +
+                           body + R"(</link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/></joint></robot>)";
+  const Model by_content = load_model(write_body_urdf("robot.xml", urdf));
+  const Model by_name = load_model(write_body_urdf("robot.urdf", urdf));
+  CHECK(by_content.coordinate_names == by_name.coordinate_names);
+  Workspace wa(by_content), wb(by_name);
+  mass_matrix(by_content, wa, VecX::Constant(1, 0.3));
+  mass_matrix(by_name, wb, VecX::Constant(1, 0.3));
+  CHECK(wa.Ms == wb.Ms);
+  const std::string mjcf = write_body_urdf("arm.xml", "<!-- a -->\n<mujoco model=\"m\"/>");
+  const Run r = run("info " + mjcf);
+  CHECK(r.code == 1);
+  CHECK_THAT(r.out, Contains("arm.xml: <mujoco>: an MJCF model, which femdyn does not read yet"));
+  // JSON under any name is still JSON.
+  const std::string json = write_body_urdf(
+      "pendulum.xml", R"({"name": "p", "bodies": [{"name": "b", "parent": "world", "joint": )"
+                      R"({"type": "revolute", "axis": [0, 0, 1]}, "elements": [{"type": )"
+                      R"("lumped_point", "node": [0.1, 0, 0], "mass": 1}]}]})");
+  CHECK(load_model(json).n() == 1);
+}
