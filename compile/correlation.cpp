@@ -317,6 +317,10 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
   std::vector<int> number(nc, 0);  // candidate -> 1-based system DOF, 0 left out
   std::vector<SystemDof> dofs;
   if (!spec.correlation) {
+    // A DOF that moves above round-off (1e-13 L) but below the cut-off is left out too: an
+    // approximation (an axis tilted by 3.5e-10 rad by rpy="3.141592654"), listed as one.
+    std::vector<std::string> barely;
+    double barely_max = 0;
     for (int c = 0; c < nc; ++c) {
       if (!cand.needed[c]) continue;
       if (moves(Ts, c, tol)) {
@@ -324,7 +328,20 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
         number[c] = static_cast<int>(dofs.size());
       } else {
         m.left_out.push_back(m.dof_name_of(cand.list[c]) + " (never moves)");
+        if (moves(Ts, c, 1e-3 * tol)) {
+          barely.push_back(m.dof_name_of(cand.list[c]));
+          barely_max = std::max(barely_max, Ts.row_max[c]);
+        }
       }
+    }
+    if (!barely.empty()) {
+      std::string list;
+      for (std::size_t k = 0; k < barely.size() && k < 5; ++k) list += (k ? ", " : "") + barely[k];
+      if (barely.size() > 5) list += ", … (" + std::to_string(barely.size()) + " in all)";
+      m.approximations.push_back(list + ": moves by at most " + format_sci(barely_max) +
+                                 " per unit rate, below the cut-off " + format_sci(tol) +
+                                 ", and is treated as never moving (its terms, gravity's "
+                                 "included, are dropped)");
     }
     for (std::size_t e = 0; e < m.elements.size(); ++e)
       for (int c : local_cand[e]) m.elements[e].table_row.push_back(c >= 0 ? number[c] : 0);

@@ -378,3 +378,22 @@ TEST_CASE("the format is read from the content: a URDF named .xml, MJCF refused 
                       R"("lumped_point", "node": [0.1, 0, 0], "mass": 1}]}]})");
   CHECK(load_model(json).n() == 1);
 }
+
+TEST_CASE("a DOF that barely moves is left out as a listed approximation, never silently",
+          "[urdf]") {
+  // rpy="3.141592654" is π + 3.5e-10: the axis tilts, the centre of mass rises and falls by
+  // 6e-11 m per radian, below the 1e-10 L cut-off. femdyn leaves z out and says so.
+  const auto robot = [](const std::string& roll) {
+    return R"(<robot name="r"><link name="base"/><link name="a">)" +
+           inertial_xml(1, {0.3, 0, 0}, Vec3(0.01, 0.01, 0.01).asDiagonal()) +
+           R"(</link><joint name="j" type="revolute"><parent link="base"/><child link="a"/>)"
+           R"(<origin rpy=")" +
+           roll + R"( 0 0"/><axis xyz="0 0 1"/></joint></robot>)";
+  };
+  const Model tilted = load_model(write_body_urdf("tilted.urdf", robot("3.141592654")));
+  REQUIRE(tilted.approximations.size() == 1);
+  CHECK_THAT(tilted.approximations[0],
+             Contains("a/com.z: moves by at most 6.") && Contains("treated as never moving"));
+  const Model exact = load_model(write_body_urdf("exact.urdf", robot("3.141592653589793")));
+  CHECK(exact.approximations.empty());
+}
