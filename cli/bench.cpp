@@ -23,6 +23,7 @@
 #include "cli/commands.hpp"
 #include "core/derivatives/derivatives.hpp"
 #include "core/equations.hpp"
+#include "core/joints/passive.hpp"
 #include "core/loops/constrained_dynamics.hpp"
 #include "core/math.hpp"
 #include "core/sampling.hpp"
@@ -90,8 +91,10 @@ MuJoCo: a URDF robot (with --floating-base too) is also timed on MuJoCo's own im
 file, when femdyn was built with MuJoCo: M (mj_crb, mj_fullM), qdd (mj_forward with the
 constraint solver off: its smooth part qacc_smooth) and tau (mj_inverse), in a third column
 MuJoCo and the ratio MuJoCo / femdyn; its batches alternate with the other two. Checked first
-against femdyn at the first state like Simbody; a file MuJoCo cannot map (a <mimic> joint) is
-a warning, and MuJoCo is left out.
+against femdyn at the first state like Simbody (URDF <dynamics friction>, femdyn's regularised
+Coulomb force, is handed to MuJoCo as an applied force there: MuJoCo's frictionloss is a
+constraint, off in its smooth dynamics; its timed calls run without it); a file MuJoCo cannot
+map (a <mimic> joint) is a warning, and MuJoCo is left out.
 --json: {"model", "n", "coordinates", "build", "results": [{"engine": "femdyn" | "simbody" |
 "mujoco", "quantity", "median_ns", "min_ns", "max_ns"}]} (n the number of coordinates,
 "coordinates" their names; quantity "M", "h", "g", "Q", "qdd", "qdd_c", "tau", "dtau", "dqdd"
@@ -197,14 +200,28 @@ void check_loop_agreement(const std::string& path, const Model& m, fv::SimbodyTw
 }
 
 #ifdef FEMDYN_WITH_MUJOCO
+// femdyn's regularised Coulomb friction on each coordinate at q̇ (core/joints/passive.hpp).
+// MuJoCo has none in its smooth dynamics (its frictionloss is a constraint, off in the peer):
+// the agreement check hands it to MuJoCo as an applied force, like with like.
+VecX coulomb_forces(const Model& m, const VecX& qd) {
+  VecX f = VecX::Zero(m.n());
+  for (const Body& b : m.bodies)
+    if (b.joint.friction != 0 && b.joint.nv == 1 && b.joint.idx_v >= 0)
+      f[b.joint.idx_v] += coulomb_force(b.joint, qd[b.joint.idx_v]);
+  return f;
+}
+
 // The same for MuJoCo: M^s, q̈ and τ at the first state.
 void check_mujoco_agreement(const std::string& path, const Model& m, Workspace& ws,
                             fv::MujocoPeer& peer, const States& s) {
+  const VecX friction = coulomb_forces(m, s.qd[0]);
   const Status st = tree_forward_dynamics(m, ws, s.q[0], s.qd[0], s.tau[0]);
   const double dqdd =
-      st.ok ? relative_error(peer.forward(s.q[0], s.qd[0], s.tau[0]), ws.qdd, 1e-6) : INFINITY;
+      st.ok ? relative_error(peer.forward(s.q[0], s.qd[0], s.tau[0] + friction), ws.qdd, 1e-6)
+            : INFINITY;
   inverse_dynamics(m, ws, s.q[0], s.qd[0], s.qdd[0]);
-  const double dtau = relative_error(peer.inverse(s.q[0], s.qd[0], s.qdd[0]), ws.tau, 1e-6);
+  const double dtau =
+      relative_error(peer.inverse(s.q[0], s.qd[0], s.qdd[0]) - friction, ws.tau, 1e-6);
   mass_matrix(m, ws, s.q[0]);
   const double dM = relative_error(peer.mass(s.q[0]), ws.Ms, 1e-6);
   if (dM < 1e-8 && dtau < 1e-8 && dqdd < 1e-8) return;
