@@ -88,14 +88,14 @@ std::string link_list(const std::vector<std::string>& names) {
   return out;
 }
 
+}  // namespace
+
 // Each link's element. The links welded together by fixed joints are one rigid body, and it is
 // the body that must be physical (as Pinocchio merges fixed joints): a link whose own tensor is
 // not (a sensor, a 1e-6 kg dummy root) has the body's merged mass properties put on the head
 // and none of its own, with a note. A body still not physical is refused naming its head, or
 // with balance_inertia takes the nearest physical inertia, reported. The links welded to a
 // fixed base never move: theirs are not checked (a non-physical one is dropped, noted).
-}  // namespace
-
 std::map<std::string, Json> link_elements(const Ctx& c,
                                           const std::map<std::string, const XMLElement*>& links,
                                           const std::vector<std::string>& link_order,
@@ -131,8 +131,10 @@ std::map<std::string, Json> link_elements(const Ctx& c,
       body = welded(body, own[name].expressed_in(pose.at(name).R, pose.at(name).p));
     std::string who = "link " + quoted_text(head);
     if (members.size() > 1) {
-      who += " (a rigid body with the links welded to it: " +
-             link_list({members.begin() + 1, members.end()}) + ")";
+      std::vector<std::string> welded_to_head;
+      for (const std::string& name : members)
+        if (name != head) welded_to_head.push_back(name);
+      who += " (a rigid body with the links welded to it: " + link_list(welded_to_head) + ")";
       note("link " + link_list(bad) + ": " + *mass_problem(c, own[bad[0]]) +
            "; checked as part of the rigid body of link " + quoted_text(head) +
            " (fixed joints), whose merged mass properties it carries");
