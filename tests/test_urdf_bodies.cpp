@@ -397,3 +397,27 @@ TEST_CASE("a DOF that barely moves is left out as a listed approximation, never 
   const Model exact = load_model(write_body_urdf("exact.urdf", robot("3.141592653589793")));
   CHECK(exact.approximations.empty());
 }
+
+TEST_CASE("ANYmal B as published: a dummy root merged with its welded inertia, against Simbody",
+          "[urdf][inertia]") {
+  const std::string path =
+      std::string(FEMDYN_SOURCE_DIR) + "/tests/data/urdf/example_robot_data_anymal_b.urdf";
+  const std::vector<std::string> welded = warnings_of(path);
+  CHECK_THAT(welded.front(), Contains("link 'base': inertia not physical, ignored: welded to the "
+                                      "fixed base"));
+  const Model floating = load_model(path, {.floating_base = true});
+  CHECK(floating.n() == 18);
+#ifdef FEMDYN_WITH_SIMBODY
+  validation::UrdfTwin twin(path, floating.gravity, true);
+  Workspace ws(floating);
+  std::mt19937 rng(9);
+  for (int k = 0; k < 3; ++k) {
+    const VecX q = random_posture(floating, rng), qd = random_uniform(18, 2.0, rng);
+    evaluate(floating, ws, q, qd, VecX());
+    const auto s = twin.equations(floating.coordinate_names, floating.configuration_names, q, qd);
+    CHECK(rel_error(ws.Ms, s.M) < 1e-12);
+    CHECK(rel_error(ws.h, s.h) < 1e-12);
+    CHECK(rel_error(ws.Q, s.Q) < 1e-12);
+  }
+#endif
+}
