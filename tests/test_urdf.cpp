@@ -16,6 +16,7 @@
 #include "io/model_loader.hpp"
 #include "io/urdf_loader.hpp"
 #include "tests/helpers.hpp"
+#include "tests/urdf_twin_checks.hpp"
 #ifdef FEMDYN_WITH_SIMBODY
 #include "validation/urdf_twin.hpp"
 #include "validation/validate.hpp"
@@ -75,25 +76,6 @@ std::vector<std::string> urdf_files() {
   std::sort(out.begin(), out.end());
   return out;
 }
-
-#ifdef FEMDYN_WITH_SIMBODY
-// femdyn's M^s, h and Q of `m` equal the independent URDF twin's at 4 states: q = draw_q(), q̇
-// uniform in ±2.
-template <class DrawQ>
-void check_equal_to_twin(const Model& m, validation::UrdfTwin& twin, std::mt19937& rng,
-                         DrawQ draw_q) {
-  Workspace ws(m);
-  for (int k = 0; k < 4; ++k) {
-    const VecX q = draw_q(), qd = random_uniform(m.n(), 2.0, rng);
-    evaluate(m, ws, q, qd, VecX());
-    const validation::UrdfTwinEquations s =
-        twin.equations(m.coordinate_names, m.configuration_names, q, qd);
-    CHECK(rel_error(ws.Ms, s.M) < 1e-10);
-    CHECK(rel_error(ws.h, s.h) < 1e-10);
-    CHECK(rel_error(ws.Q, s.Q) < 1e-10);
-  }
-}
-#endif
 
 }  // namespace
 

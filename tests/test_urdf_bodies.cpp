@@ -15,9 +15,7 @@
 #include "io/centroidal_mass.hpp"
 #include "io/model_loader.hpp"
 #include "tests/helpers.hpp"
-#ifdef FEMDYN_WITH_SIMBODY
-#include "validation/urdf_twin.hpp"
-#endif
+#include "tests/urdf_twin_checks.hpp"
 
 using namespace femdyn;
 using namespace femdyn::test;
@@ -115,11 +113,8 @@ TEST_CASE("a non-physical link welded to a body: the body is checked, with the m
   }
 #ifdef FEMDYN_WITH_SIMBODY
   validation::UrdfTwin twin(split, a.gravity);  // Simbody, with the merge of its own
-  const VecX q = random_uniform(2, 3.0, rng), qd = random_uniform(2, 2.0, rng);
-  evaluate(a, wa, q, qd, VecX());
-  const auto s = twin.equations(a.coordinate_names, a.configuration_names, q, qd);
-  CHECK(rel_error(wa.Ms, s.M) < 1e-12);
-  CHECK(rel_error(wa.h, s.h) < 1e-12);
+  check_equal_to_twin(
+      a, twin, rng, [&] { return random_uniform(2, 3.0, rng); }, 1e-12);
 #endif
 }
 
@@ -256,16 +251,9 @@ TEST_CASE("PyBullet's spherical joint and Drake's implied world parent", "[urdf]
   CHECK(m.configuration_names.front() == "neck.qw");
 #ifdef FEMDYN_WITH_SIMBODY
   validation::UrdfTwin twin(path, m.gravity);  // Simbody's Ball mobilizer
-  Workspace ws(m);
   std::mt19937 rng(3);
-  for (int k = 0; k < 4; ++k) {
-    const VecX q = random_posture(m, rng), qd = random_uniform(3, 2.0, rng);
-    evaluate(m, ws, q, qd, VecX());
-    const auto s = twin.equations(m.coordinate_names, m.configuration_names, q, qd);
-    CHECK(rel_error(ws.Ms, s.M) < 1e-12);
-    CHECK(rel_error(ws.h, s.h) < 1e-12);
-    CHECK(rel_error(ws.Q, s.Q) < 1e-12);
-  }
+  check_equal_to_twin(
+      m, twin, rng, [&] { return random_posture(m, rng); }, 1e-12);
 #endif
 }
 
@@ -409,15 +397,8 @@ TEST_CASE("ANYmal B as published: a dummy root merged with its welded inertia, a
   CHECK(floating.n() == 18);
 #ifdef FEMDYN_WITH_SIMBODY
   validation::UrdfTwin twin(path, floating.gravity, true);
-  Workspace ws(floating);
   std::mt19937 rng(9);
-  for (int k = 0; k < 3; ++k) {
-    const VecX q = random_posture(floating, rng), qd = random_uniform(18, 2.0, rng);
-    evaluate(floating, ws, q, qd, VecX());
-    const auto s = twin.equations(floating.coordinate_names, floating.configuration_names, q, qd);
-    CHECK(rel_error(ws.Ms, s.M) < 1e-12);
-    CHECK(rel_error(ws.h, s.h) < 1e-12);
-    CHECK(rel_error(ws.Q, s.Q) < 1e-12);
-  }
+  check_equal_to_twin(
+      floating, twin, rng, [&] { return random_posture(floating, rng); }, 1e-12, 3);
 #endif
 }

@@ -396,7 +396,7 @@ struct Validator::Impl {
       r.notes.push_back("closed loop: " + std::to_string(tm.laws.size()) + " coupled joint(s), " +
                         std::to_string(tm.rods.size()) +
                         " rod(s); Simbody's equations from its constrained forward dynamics");
-    bool representable = true;
+    bool sums_to_rigid_bodies = true;  // else a failure of the model, not of Simbody
     for (std::size_t b = 0; b < tm.bodies.size(); ++b) {
       const TwinBody& tb = tm.bodies[b];
       const Mat3 I_com = tb.inertia_origin - point_inertia(tb.mass, tb.com);  // parallel axis
@@ -407,13 +407,13 @@ struct Validator::Impl {
         continue;
       }
       if (const auto problem = inertia_problem(I_com, tb.inertia_origin.cwiseAbs().maxCoeff())) {
-        representable = false;
+        sums_to_rigid_bodies = false;
         r.failure += (r.failure.empty() ? "" : "; ") +
                      ("body '" + m.bodies[b].name + "': its elements sum to no rigid body (" +
                       *problem + ")");
       }
     }
-    r.not_comparable = !r.failure.empty() && representable;
+    r.not_comparable = !r.failure.empty() && sums_to_rigid_bodies;
     if (!r.failure.empty()) return false;
     try {
       twin = std::make_unique<SimbodyTwin>(tm);

@@ -95,6 +95,33 @@ def test_validate_equals_cli(name):
 
 
 @pytest.mark.skipif(not femdyn.with_simbody, reason="built without Simbody")
+def test_validate_not_compared_equals_cli(tmp_path):
+    # A massless link with a rotary inertia: Simbody cannot hold it, so neither door compares,
+    # both say why in the same words, and neither calls it a pass (the CLI exits 3).
+    import json
+    import subprocess
+    from conftest import BINARY
+    path = tmp_path / "rotor.urdf"
+    inertial = ('<inertial><origin xyz="{c}"/><mass value="{m}"/><inertia ixx="{i}" iyy="{i}" '
+                'izz="{i}" ixy="0" ixz="0" iyz="0"/></inertial>')
+    path.write_text(
+        '<robot name="r"><link name="base"/><link name="arm">'
+        + inertial.format(c="0.1 0 0", m=1, i=0.01) + '</link><link name="rotor">'
+        + inertial.format(c="0 0 0", m=0, i=1e-4) + '</link>'
+        '<joint name="j" type="revolute"><parent link="base"/><child link="arm"/>'
+        '<axis xyz="0 0 1"/></joint><joint name="spin" type="revolute"><parent link="arm"/>'
+        '<child link="rotor"/><origin xyz="0.2 0 0"/><axis xyz="0 0 1"/></joint></robot>')
+    r = femdyn.validate(femdyn.load(str(path)), states=2, t_end=0)
+    out = subprocess.run([str(BINARY), "validate", str(path), "--states=2", "--t-end=0", "--json"],
+                         capture_output=True, text=True)
+    cli = json.loads(out.stdout)
+    assert out.returncode == 3
+    assert r["compared"] is False and cli["compared"] is False
+    assert r["pass"] is False and cli["pass"] is False
+    assert r["failure"] == cli["failure"] and "rotary inertia but no mass" in r["failure"]
+
+
+@pytest.mark.skipif(not femdyn.with_simbody, reason="built without Simbody")
 def test_sundials_does_not_shadow_simbody_cpodes():
     """femdyn's SUNDIALS is linked into the extension statically with its symbols hidden: in the
     interpreter too, Simbody's CPodes (its own SUNDIALS copy) stays usable, beside femdyn's
