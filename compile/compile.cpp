@@ -13,6 +13,7 @@
 #include "core/body_inertia.hpp"
 #include "core/errors.hpp"
 #include "core/joints/kernel.hpp"
+#include "core/joints/rotation.hpp"
 #include "core/limits.hpp"
 #include "core/mass_solver.hpp"
 #include "core/model.hpp"
@@ -88,6 +89,14 @@ void check_joint_parameters(const JointSpec& js, Joint& j) {
   j.pitch = js.pitch;
 }
 
+// An origin given as a quaternion (w, x, y, z): finite, not zero, normalised.
+Mat3 quaternion_origin(const Eigen::Vector4d& w, const std::string& where) {
+  for (int k = 0; k < 4; ++k) check_magnitude(w[k], where, "origin quat");
+  if (!(w.norm() > 1e-12)) throw ModelError(where, "origin quat is zero");
+  const Eigen::Vector4d u = w.normalized();
+  return quaternion_rotation(u.data());
+}
+
 Joint compile_joint(const JointSpec& js, const std::string& body_name) {
   Joint j;
   j.name = js.name.empty() ? body_name : js.name;
@@ -96,7 +105,8 @@ Joint compile_joint(const JointSpec& js, const std::string& body_name) {
   check_magnitude(js.xyz, js.where + "/origin/xyz", "origin xyz");
   check_magnitude(js.rpy, js.where + "/origin/rpy", "origin rpy");
   j.p_pj = js.xyz;
-  j.R_pj = rpy_to_rotation(js.rpy);
+  j.R_pj =
+      js.quat ? quaternion_origin(*js.quat, js.where + "/origin/quat") : rpy_to_rotation(js.rpy);
   if (js.type != JointType::Fixed) {
     check_magnitude(js.axis, js.where + "/axis", "axis");
     const double norm = js.axis.norm();

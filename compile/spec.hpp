@@ -18,11 +18,12 @@ namespace femdyn {
 struct JointSpec {
   std::string name;
   JointType type = JointType::Fixed;
-  Vec3 xyz = Vec3::Zero();    // joint frame origin in the parent body frame
-  Vec3 rpy = Vec3::Zero();    // joint frame orientation, R = Rz(y) Ry(p) Rx(r)
-  Vec3 axis = Vec3::UnitZ();  // in the joint frame (normalised on compile)
-  std::optional<Vec3> axis2;  // universal: the second axis, normal to `axis` (required)
-  double pitch = 0;           // helical: m/rad
+  Vec3 xyz = Vec3::Zero();              // joint frame origin in the parent body frame
+  Vec3 rpy = Vec3::Zero();              // joint frame orientation, R = Rz(y) Ry(p) Rx(r)
+  std::optional<Eigen::Vector4d> quat;  // or as a quaternion (w, x, y, z), normalised on compile
+  Vec3 axis = Vec3::UnitZ();            // in the joint frame (normalised on compile)
+  std::optional<Vec3> axis2;            // universal: the second axis, normal to `axis` (required)
+  double pitch = 0;                     // helical: m/rad
   double lower = -std::numeric_limits<double>::infinity();
   double upper = std::numeric_limits<double>::infinity();
   double stiffness = 0, rest = 0, damping = 0;    // linear spring / damper on θ

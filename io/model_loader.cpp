@@ -12,6 +12,7 @@
 #include "core/names.hpp"
 #include "io/catalog.hpp"
 #include "io/input_file.hpp"
+#include "io/mjcf_loader.hpp"
 #include "io/params.hpp"
 #include "io/urdf_loader.hpp"
 
@@ -124,9 +125,17 @@ JointSpec read_joint(const Params& p) {
   j.type = joint_type(p);
   if (p.has("origin")) {
     const Params o = p.child("origin");
-    o.allow_only({"xyz", "rpy"});
+    o.allow_only({"xyz", "rpy", "quat"});
     j.xyz = o.vec3_or("xyz", Vec3::Zero());
     j.rpy = o.vec3_or("rpy", Vec3::Zero());
+    if (o.has("quat")) {
+      if (o.has("rpy")) o.fail("quat", "give the orientation as rpy or as quat, not both");
+      const Json& w = o.json()["quat"];
+      if (!w.is_array() || w.size() != 4) o.fail("quat", "expected 4 numbers [w, x, y, z]");
+      j.quat.emplace();
+      for (int k = 0; k < 4; ++k)
+        (*j.quat)[k] = json_number(w[k], o.path("quat") + "/" + std::to_string(k));
+    }
   }
   const bool any_axis = j.type == JointType::Spherical || j.type == JointType::Free;
   if (any_axis && p.has("axis"))
@@ -474,8 +483,10 @@ LoadSpec read_load(const Params& p, const BodiesByName& bodies) {
 MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std::string& source);
 
 // {"model": "urdf", "params": {"file": F, "root_joint": "fixed" | "free"}, …}: a URDF by
-// reference (F relative to the JSON file), read from a file only (read_spec, model_document).
+// reference (F relative to the JSON file), read from a file only (read_spec, model_document);
+// {"model": "mjcf", "params": {"file": F}} an MJCF file the same way.
 constexpr const char* kUrdfReference = "urdf";
+constexpr const char* kMjcfReference = "mjcf";
 
 // The file's own name, description, gravity and loads on top of the document it expands to.
 void apply_overrides(const Json& root, const Params& p, Json& doc) {
@@ -500,13 +511,13 @@ Params plugin_form(const Json& root, const std::string& source) {
 Json expand_plugin(const Catalog& catalog, const Json& root, const std::string& source) {
   const Params p = plugin_form(root, source);
   const std::string name = p.string("model");
-  if (name == kUrdfReference)
-    p.fail("model", "\"urdf\" names a file relative to this one: load it from a file");
+  if (name == kUrdfReference || name == kMjcfReference)
+    p.fail("model", "\"" + name + "\" names a file relative to this one: load it from a file");
   const ModelPlugin* plugin = catalog.plugins.find(name);
   if (!plugin) {
     const std::string known = catalog.plugins.names();
     p.fail("model", "unknown model plugin " + quoted_text(name) + " (known: " + known +
-                        (known.empty() ? "" : ", ") + kUrdfReference + ")");
+                        (known.empty() ? "" : ", ") + kUrdfReference + ", " + kMjcfReference + ")");
   }
   static const Json empty = Json::object();
   Json doc = plugin->expand(p.has("params") ? p.child("params") : Params(empty, p.path("params")));
@@ -677,9 +688,12 @@ namespace {
 
 std::string read_text(const std::string& path) { return read_input_file(path); }
 
-// Errors found after conversion name the URDF's link and joint, not the generated JSON path:
-// "robot.urdf: /bodies/3/joint: …" becomes "robot.urdf: joint 'elbow' (link 'forearm'): …".
+// Errors found after conversion name the robot file's link (MJCF: body) and joint, not the
+// generated JSON path: "robot.urdf: /bodies/3/joint: …" becomes "robot.urdf: joint 'elbow'
+// (link 'forearm'): …".
 [[noreturn]] void rethrow_for_urdf(const ModelError& e, const Json& doc, const std::string& path) {
+  const std::string link = is_mjcf_path(path) ? "body" : "link";
+  const std::string mimic = is_mjcf_path(path) ? "' <equality>" : "' <mimic>";
   std::string msg = e.what();
   // "/bodies/N…" names a joint and its child link; "/couplings/N…" a joint's <mimic>.
   for (const std::string section : {"bodies", "couplings"}) {
@@ -691,9 +705,9 @@ std::string read_text(const std::string& path) { return read_input_file(path); }
     if (end == i || rest == std::string::npos) break;
     const Json& item = doc[section][std::stoul(msg.substr(i, end - i))];
     const std::string who = section == "bodies"
-                                ? "joint '" + item["joint"]["name"].get<std::string>() +
-                                      "' (link '" + item["name"].get<std::string>() + "')"
-                                : "joint '" + item["joint"].get<std::string>() + "' <mimic>";
+                                ? "joint '" + item["joint"]["name"].get<std::string>() + "' (" +
+                                      link + " '" + item["name"].get<std::string>() + "')"
+                                : "joint '" + item["joint"].get<std::string>() + mimic;
     msg = path + ": " + who + msg.substr(rest);
   }
   throw ModelError("", msg);
@@ -710,15 +724,60 @@ Json urdf_document(const std::string& urdf, UrdfOptions urdf_options, const Load
   return std::move(r.model);
 }
 
+Json mjcf_document(const std::string& mjcf, MjcfOptions mjcf_options, const LoadOptions& options) {
+  MjcfResult r = read_mjcf(mjcf, mjcf_options);
+  if (options.warn)
+    for (const std::string& w : r.warnings) options.warn(w);
+  return std::move(r.model);
+}
+
+// A URDF or MJCF file as femdyn JSON. --floating-base is for URDF: MJCF floats a body by its own
+// free joint.
+Json robot_document(const std::string& path, const LoadOptions& options) {
+  if (is_urdf_path(path))
+    return urdf_document(
+        path, {.floating_base = options.floating_base, .balance_inertia = options.balance_inertia},
+        options);
+  if (options.floating_base)
+    throw ModelError(path,
+                     "--floating-base is for URDF models: an MJCF model floats a body by its "
+                     "own <freejoint/>");
+  return mjcf_document(path, {.balance_inertia = options.balance_inertia}, options);
+}
+
+// {"model": "mjcf", "params": {"file", "balance_inertia"}}: the MJCF file it names, with the
+// reference's own name, description, gravity and loads.
+std::pair<Json, std::string> mjcf_reference(const std::string& path, const Json& root,
+                                            const Params& p, const Params& params,
+                                            const LoadOptions& options) {
+  params.allow_only({"file", "balance_inertia"});
+  std::filesystem::path file(params.string("file"));
+  if (file.is_relative()) file = std::filesystem::path(path).parent_path() / file;
+  if (!is_mjcf_path(file.string())) params.fail("file", "expected an MJCF file (<mujoco>)");
+  Json doc;
+  try {
+    doc = mjcf_document(
+        file.string(),
+        {.balance_inertia = options.balance_inertia || params.boolean_or("balance_inertia", false)},
+        options);
+  } catch (const Error& e) {
+    params.fail("file", e.what());
+  }
+  apply_overrides(root, p, doc);
+  return {std::move(doc), file.string()};
+}
+
 // A JSON file {"model": "urdf", …}: the URDF it names as femdyn JSON (with the file's own name,
 // description, gravity and loads), and that URDF's path for messages; nullopt for any other file.
 std::optional<std::pair<Json, std::string>> urdf_reference(const std::string& path,
                                                            const Json& root,
                                                            const LoadOptions& options) {
-  if (!root.is_object() || !root.contains("model") || root["model"] != kUrdfReference)
+  if (!root.is_object() || !root.contains("model") ||
+      (root["model"] != kUrdfReference && root["model"] != kMjcfReference))
     return std::nullopt;
   const Params p = plugin_form(root, path);
   const Params params = p.child("params");
+  if (root["model"] == kMjcfReference) return mjcf_reference(path, root, p, params, options);
   params.allow_only({"file", "root_joint", "balance_inertia"});
   const std::string root_joint = params.has("root_joint") ? params.string("root_joint") : "fixed";
   if (root_joint != "fixed" && root_joint != "free")
@@ -754,10 +813,7 @@ void refuse_balance_on_json(const std::string& path, const LoadOptions& options)
 }  // namespace
 
 Json model_document(const std::string& path, const LoadOptions& options) {
-  if (is_urdf_path(path))
-    return urdf_document(
-        path, {.floating_base = options.floating_base, .balance_inertia = options.balance_inertia},
-        options);
+  if (is_robot_file(path)) return robot_document(path, options);
   const Json root = parse_json(read_text(path), path);
   if (auto ref = urdf_reference(path, root, options)) return std::move(ref->first);
   refuse_balance_on_json(path, options);
@@ -768,12 +824,12 @@ Json model_document(const std::string& path, const LoadOptions& options) {
 
 MechanismSpec read_spec(const std::string& path, const LoadOptions& options) {
   const Catalog& catalog = options.catalog ? *options.catalog : default_catalog();
-  if (!is_urdf_path(path) && options.floating_base)
+  if (!is_robot_file(path) && options.floating_base)
     throw ModelError(path,
                      "--floating-base is for URDF models: a JSON model gives its root body a "
                      "free joint itself (\"joint\": {\"type\": \"free\"}), a URDF "
                      "reference by \"root_joint\": \"free\"");
-  if (!is_urdf_path(path)) {
+  if (!is_robot_file(path)) {
     const Json root = parse_json(read_text(path), path);
     if (auto ref = urdf_reference(path, root, options)) {
       try {
@@ -799,7 +855,7 @@ Model load_model(const std::string& path, const LoadOptions& options) {
     spec.gravity = *options.gravity;
     spec.gravity_where = spec.where + options.gravity_source;  // (where ends in ": ")
   }
-  if (!is_urdf_path(path)) return compile(std::move(spec), options.compile);
+  if (!is_robot_file(path)) return compile(std::move(spec), options.compile);
   try {
     return compile(std::move(spec), options.compile);
   } catch (const ModelError& e) {

@@ -135,49 +135,6 @@ std::vector<UrdfVisual> urdf_visuals(const std::string& text, const std::string&
   return out;
 }
 
-bool is_urdf_path(const std::string& path) {
-  std::string lower = path;
-  for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  const auto ends = [&](const std::string& ext) {
-    return lower.size() >= ext.size() &&
-           lower.compare(lower.size() - ext.size(), ext.size(), ext) == 0;
-  };
-  if (ends(".urdf") || ends(".xacro")) return true;  // (a .xacro is read to say it needs expanding)
-  if (ends(".json")) return false;
-  // By content: the first element's name, past <?xml …?>, <!-- … --> and blanks.
-  std::ifstream in(path, std::ios::binary);
-  if (!in || !std::filesystem::is_regular_file(path)) return false;
-  std::string head(4096, '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(in.gcount()));
-  std::size_t at = 0;
-  while (at < head.size()) {
-    at = head.find_first_not_of(" \t\r\n", at);
-    if (at == std::string::npos || head[at] != '<') return false;
-    std::string end;  // of a declaration or comment skipped
-    if (head.compare(at, 5, "<?xml") == 0) {
-      end = "?>";
-    } else if (head.compare(at, 4, "<!--") == 0) {
-      end = "-->";
-    } else {
-      const auto opens = [&](const char* tag) {
-        const std::size_t n = std::strlen(tag);
-        return head.compare(at, n, tag) == 0 &&
-               (at + n == head.size() || !std::isalnum(static_cast<unsigned char>(head[at + n])));
-      };
-      if (opens("<mujoco"))
-        throw ModelError(path,
-                         "<mujoco>: an MJCF model, which femdyn does not read yet (URDF and "
-                         "femdyn JSON are read)");
-      return opens("<robot");
-    }
-    at = head.find(end, at);
-    if (at == std::string::npos) return false;
-    at += end.size();
-  }
-  return false;
-}
-
 namespace {
 
 // The largest |xyz| of the joints' and the inertials' <origin>s (unparsable ones skipped: they

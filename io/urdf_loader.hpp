@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/math.hpp"
+#include "io/model_format.hpp"
 #include "io/params.hpp"
 
 namespace femdyn {
@@ -33,11 +34,6 @@ struct UrdfOptions {
 UrdfResult urdf_to_model(const std::string& xml_text, const std::string& source,
                          const UrdfOptions& options = {});
 UrdfResult read_urdf(const std::string& path, const UrdfOptions& options = {});
-
-// By extension, in any case: .urdf, and .xacro (refused as needing expansion, with where); any
-// other file whose text opens (after an XML declaration, comments and blanks) with <robot>.
-// A file whose text opens with <mujoco> is refused as MJCF, which femdyn does not read yet.
-bool is_urdf_path(const std::string& path);
 
 // A link's <visual>, in the link frame: a primitive (box: size x y z; cylinder: radius, length
 // along z; sphere: radius) or a mesh (its filename; size holds its scale). Read for the 3-D

@@ -224,5 +224,5 @@ TEST_CASE("the loader builds elements and plugins from the catalog it is given",
   // Nor does the custom one know femdyn's plugins if it is not given them.
   const Catalog no_plugins{Registry<ElementType>(types), Registry<ModelPlugin>({})};
   CHECK_THROWS_WITH(parse_spec(R"({"model": "random_tree"})", "tree.json", no_plugins),
-                    Catch::Contains("unknown model plugin 'random_tree' (known: urdf)"));
+                    Catch::Contains("unknown model plugin 'random_tree' (known: urdf, mjcf)"));
 }

@@ -340,7 +340,7 @@ TEST_CASE("validate: a body Simbody cannot hold is not compared, exit 3, never F
 }
 #endif
 
-TEST_CASE("the format is read from the content: a URDF named .xml, MJCF refused in one line",
+TEST_CASE("the format is read from the content: a URDF named .xml, an MJCF file read as MJCF",
           "[urdf]") {
   const std::string body = inertial_xml(1, {0.1, 0, 0}, Vec3(0.01, 0.01, 0.01).asDiagonal());
   const std::string urdf = R"(<?xml version="1.0"?>
@@ -358,7 +358,7 @@ TEST_CASE("the format is read from the content: a URDF named .xml, MJCF refused 
   const std::string mjcf = write_body_urdf("arm.xml", "<!-- a -->\n<mujoco model=\"m\"/>");
   const Run r = run("info " + mjcf);
   CHECK(r.code == 1);
-  CHECK_THAT(r.out, Contains("arm.xml: <mujoco>: an MJCF model, which femdyn does not read yet"));
+  CHECK_THAT(r.out, Contains("arm.xml: <worldbody> holds no body: nothing to compute"));
   // JSON under any name is still JSON.
   const std::string json = write_body_urdf(
       "pendulum.xml", R"({"name": "p", "bodies": [{"name": "b", "parent": "world", "joint": )"

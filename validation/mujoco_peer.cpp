@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -196,39 +197,49 @@ std::string prepared_urdf(const std::string& path, bool floating) {
 struct MujocoPeer::Impl {
   std::unique_ptr<mjModel, ModelDeleter> m;
   std::unique_ptr<mjData, DataDeleter> d;
-  bool floating = false;
-  int n = 0, nq = 0;
-  int free_q = 0, free_v = 0;         // the free joint's qpos and dof addresses
-  std::vector<int> coord_q, coord_v;  // femdyn's joint coordinate k -> MuJoCo qpos, dof
-  Eigen::MatrixXd M;                  // mj_fullM's output (nv × nv, symmetric)
+  int n = 0, nq = 0;  // femdyn's rates and coordinates
+  // Each femdyn joint that moves: its rates (1, 3 for a ball, 6 for a free joint), its MuJoCo
+  // qpos and dof addresses, and its femdyn q and v offsets.
+  struct Map {
+    int rates, q, v, fq, fv;
+  };
+  std::vector<Map> joints;
+  Eigen::MatrixXd M;  // mj_fullM's output (nv × nv, symmetric)
 
   // qvel = P v (mujoco_peer.hpp).
   Eigen::MatrixXd P(const Eigen::VectorXd& q) const {
     Eigen::MatrixXd p = Eigen::MatrixXd::Zero(n, n);
-    const int base = floating ? 6 : 0;
-    if (floating) {
-      p.block<3, 3>(free_v, 0) = rotation(q);
-      p.block<3, 3>(free_v + 3, 3).setIdentity();
+    for (const Map& j : joints) {
+      if (j.rates == 1) p(j.v, j.fv) = 1;
+      if (j.rates == 3) p.block<3, 3>(j.v, j.fv).setIdentity();
+      if (j.rates == 6) {
+        p.block<3, 3>(j.v, j.fv) = rotation(q, j.fq + 3);
+        p.block<3, 3>(j.v + 3, j.fv + 3).setIdentity();
+      }
     }
-    for (size_t k = 0; k < coord_v.size(); ++k) p(coord_v[k], base + k) = 1;
     return p;
   }
-  static Eigen::Matrix3d rotation(const Eigen::VectorXd& q) {
-    return Eigen::Quaterniond(q[3], q[4], q[5], q[6]).normalized().toRotationMatrix();
+  static Eigen::Matrix3d rotation(const Eigen::VectorXd& q, int at) {
+    return Eigen::Quaterniond(q[at], q[at + 1], q[at + 2], q[at + 3])
+        .normalized()
+        .toRotationMatrix();
   }
-  // Ṗ v (nonzero on the free joint's linear triple only).
+  // Ṗ v (nonzero on a free joint's linear triple only).
   Eigen::VectorXd Pdot_v(const Eigen::VectorXd& q, const Eigen::VectorXd& v) const {
     Eigen::VectorXd c = Eigen::VectorXd::Zero(n);
-    if (floating)
-      c.segment<3>(free_v) =
-          rotation(q) * Eigen::Vector3d(v.segment<3>(3)).cross(Eigen::Vector3d(v.head<3>()));
+    for (const Map& j : joints)
+      if (j.rates == 6)
+        c.segment<3>(j.v) =
+            rotation(q, j.fq + 3) *
+            Eigen::Vector3d(v.segment<3>(j.fv + 3)).cross(Eigen::Vector3d(v.segment<3>(j.fv)));
     return c;
   }
   Eigen::VectorXd to_qpos(const Eigen::VectorXd& q) const {
     Eigen::VectorXd out = Eigen::VectorXd::Zero(m->nq);
-    const int base = floating ? 7 : 0;
-    if (floating) out.segment<7>(free_q) = q.head<7>();
-    for (size_t k = 0; k < coord_q.size(); ++k) out[coord_q[k]] = q[base + k];
+    for (const Map& j : joints) {
+      const int width = j.rates == 1 ? 1 : j.rates == 3 ? 4 : 7;
+      out.segment(j.q, width) = q.segment(j.fq, width);
+    }
     return out;
   }
   void check_sizes(const Eigen::VectorXd& q, const Eigen::VectorXd& v) const {
@@ -243,22 +254,122 @@ struct MujocoPeer::Impl {
   }
 };
 
-MujocoPeer::MujocoPeer(const std::string& urdf_path, const Eigen::Vector3d& gravity, bool floating,
-                       const std::vector<std::string>& coordinates, const Eigen::VectorXd& armature)
-    : impl_(std::make_unique<Impl>()) {
-  Impl& s = *impl_;
-  const std::string text = prepared_urdf(urdf_path, floating);
-  const std::string file = "mujoco_peer.urdf";
+namespace {
+
+// MuJoCo's compile of `text` (as the file `file`, from a virtual file system).
+mjModel* compiled(const std::string& text, const std::string& file, const std::string& source) {
   const auto vfs = std::make_unique<mjVFS>();  // (about 2 MB: not on the stack)
   mj_defaultVFS(vfs.get());
   const VfsFiles files{vfs.get()};
   if (mj_makeEmptyFileVFS(vfs.get(), file.c_str(), static_cast<int>(text.size())) != 0)
-    throw std::runtime_error(urdf_path + ": MuJoCo peer: the virtual file system refused it");
+    throw std::runtime_error(source + ": MuJoCo peer: the virtual file system refused it");
   std::copy(text.begin(), text.end(),
             static_cast<char*>(vfs->filedata[mj_findFileVFS(vfs.get(), file.c_str())]));
   char error[1000] = "";
-  s.m.reset(mj_loadXML(file.c_str(), vfs.get(), error, sizeof error));
-  if (!s.m) throw std::runtime_error(urdf_path + ": MuJoCo: " + one_line(error));
+  mjModel* m = mj_loadXML(file.c_str(), vfs.get(), error, sizeof error);
+  if (!m) throw std::runtime_error(source + ": MuJoCo: " + one_line(error));
+  return m;
+}
+
+// The MJCF text MuJoCo is given (see the header): <include>s expanded (relative to the main
+// file's folder), then mesh and height-field geoms, <asset>, <contact> and every reference to an
+// asset removed.
+std::string prepared_mjcf(const std::string& path) {
+  tinyxml2::XMLDocument doc;
+  const auto refuse = [&](const std::string& why) {
+    throw std::runtime_error(path + ": MuJoCo peer: " + why);
+  };
+  if (doc.LoadFile(path.c_str()) != tinyxml2::XML_SUCCESS) refuse("cannot read it as XML");
+  tinyxml2::XMLElement* root = doc.FirstChildElement("mujoco");
+  if (!root) refuse("no <mujoco> element");
+  const std::string folder = std::filesystem::path(path).parent_path().string();
+  for (int round = 0;; ++round) {
+    std::vector<tinyxml2::XMLElement*> includes, stack = {root};
+    while (!stack.empty()) {
+      tinyxml2::XMLElement* e = stack.back();
+      stack.pop_back();
+      for (tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement())
+        (std::string(c->Name()) == "include" ? includes : stack).push_back(c);
+    }
+    if (includes.empty()) break;
+    if (round > 64) refuse("<include>s nested too deep");
+    for (tinyxml2::XMLElement* inc : includes) {
+      tinyxml2::XMLDocument part;
+      const char* file = inc->Attribute("file");
+      const std::string target = file ? folder + "/" + file : "";
+      if (!file || part.LoadFile(target.c_str()) != tinyxml2::XML_SUCCESS ||
+          !part.FirstChildElement("mujoco"))
+        refuse("cannot include " + target);
+      tinyxml2::XMLNode* after = inc;  // the included children in file order, in its place
+      for (const tinyxml2::XMLElement* c = part.FirstChildElement("mujoco")->FirstChildElement(); c;
+           c = c->NextSiblingElement())
+        after = inc->Parent()->InsertAfterChild(after, c->DeepClone(&doc));
+      inc->Parent()->DeleteChild(inc);
+    }
+  }
+  std::vector<tinyxml2::XMLElement*> stack = {root}, doomed;
+  while (!stack.empty()) {
+    tinyxml2::XMLElement* e = stack.back();
+    stack.pop_back();
+    for (const char* a : {"material", "texture", "hfield", "meshdir", "assetdir", "texturedir"})
+      e->DeleteAttribute(a);
+    for (tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+      const std::string tag = c->Name();
+      const char* type = c->Attribute("type");
+      const bool mesh_geom =
+          tag == "geom" && (c->Attribute("mesh") || (type && (std::string(type) == "mesh" ||
+                                                              std::string(type) == "hfield")));
+      (tag == "asset" || tag == "contact" || tag == "skin" || mesh_geom ? doomed : stack)
+          .push_back(c);
+    }
+  }
+  for (tinyxml2::XMLElement* e : doomed) e->Parent()->DeleteChild(e);
+  tinyxml2::XMLPrinter printer;
+  doc.Print(&printer);
+  return printer.CStr();
+}
+
+}  // namespace
+
+MujocoPeer::MujocoPeer(const std::string& mjcf_path, const Eigen::Vector3d& gravity,
+                       const std::vector<MjcfJoint>& joints)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& s = *impl_;
+  s.m.reset(compiled(prepared_mjcf(mjcf_path), "mujoco_peer.xml", mjcf_path));
+  mjModel& m = *s.m;
+  for (int k = 0; k < 3; ++k) m.opt.gravity[k] = gravity[k];
+  m.opt.disableflags |= mjDSBL_CONSTRAINT | mjDSBL_CONTACT;
+  const auto refuse = [&](const std::string& why) {
+    throw std::runtime_error(mjcf_path + ": MuJoCo peer: " + why);
+  };
+  for (const MjcfJoint& j : joints) {
+    int id = mj_name2id(&m, mjOBJ_JOINT, j.name.c_str());
+    if (id < 0 && j.name.rfind("joint", 0) == 0 &&
+        j.name.find_first_not_of("0123456789", 5) == std::string::npos && j.name.size() > 5) {
+      id = std::stoi(j.name.substr(5));
+      if (id >= m.njnt || mj_id2name(&m, mjOBJ_JOINT, id)) id = -1;
+    }
+    const int want = j.rates == 1 ? -1 : j.rates == 3 ? mjJNT_BALL : mjJNT_FREE;
+    if (id < 0 || (want < 0 ? m.jnt_type[id] != mjJNT_HINGE && m.jnt_type[id] != mjJNT_SLIDE
+                            : m.jnt_type[id] != want))
+      refuse("no joint '" + j.name + "' of " + std::to_string(j.rates) + " rates");
+    s.joints.push_back({j.rates, m.jnt_qposadr[id], m.jnt_dofadr[id], s.nq, s.n});
+    s.nq += j.rates == 1 ? 1 : j.rates + 1;
+    s.n += j.rates;
+  }
+  if (m.nv != s.n)
+    refuse("MuJoCo has " + std::to_string(m.nv) + " dofs, femdyn " + std::to_string(s.n) +
+           " rates (an equality femdyn holds as a coupling?)");
+  s.d.reset(mj_makeData(&m));
+  if (!s.d) refuse("mj_makeData failed");
+  s.M.resize(m.nv, m.nv);
+}
+
+MujocoPeer::MujocoPeer(const std::string& urdf_path, const Eigen::Vector3d& gravity, bool floating,
+                       const std::vector<std::string>& coordinates, const Eigen::VectorXd& armature)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& s = *impl_;
+  s.m.reset(compiled(prepared_urdf(urdf_path, floating), "mujoco_peer.urdf", urdf_path));
   mjModel& m = *s.m;
   m.opt.gravity[0] = gravity[0];
   m.opt.gravity[1] = gravity[1];
@@ -266,7 +377,6 @@ MujocoPeer::MujocoPeer(const std::string& urdf_path, const Eigen::Vector3d& grav
   m.opt.disableflags |= mjDSBL_CONSTRAINT | mjDSBL_CONTACT;
   std::fill(m.dof_armature, m.dof_armature + m.nv, 0.0);
 
-  s.floating = floating;
   s.n = static_cast<int>(coordinates.size());
   s.nq = s.n + (floating ? 1 : 0);
   const auto refuse = [&](const std::string& why) {
@@ -280,8 +390,7 @@ MujocoPeer::MujocoPeer(const std::string& urdf_path, const Eigen::Vector3d& grav
   for (int j = 0; j < m.njnt; ++j) {
     if (m.jnt_type[j] == mjJNT_FREE && floating && !found_free) {
       found_free = true;
-      s.free_q = m.jnt_qposadr[j];
-      s.free_v = m.jnt_dofadr[j];
+      s.joints.push_back({6, m.jnt_qposadr[j], m.jnt_dofadr[j], 0, 0});
       continue;
     }
     if (m.jnt_type[j] != mjJNT_HINGE && m.jnt_type[j] != mjJNT_SLIDE)
@@ -293,8 +402,7 @@ MujocoPeer::MujocoPeer(const std::string& urdf_path, const Eigen::Vector3d& grav
     const int j = mj_name2id(&m, mjOBJ_JOINT, coordinates[k].c_str());
     if (j < 0 || (m.jnt_type[j] != mjJNT_HINGE && m.jnt_type[j] != mjJNT_SLIDE))
       refuse("no hinge or slide joint named '" + coordinates[k] + "'");
-    s.coord_q.push_back(m.jnt_qposadr[j]);
-    s.coord_v.push_back(m.jnt_dofadr[j]);
+    s.joints.push_back({1, m.jnt_qposadr[j], m.jnt_dofadr[j], k + (floating ? 1 : 0), k});
     if (armature.size() == s.n) m.dof_armature[m.jnt_dofadr[j]] = armature[k];  // I_a G²
   }
   s.d.reset(mj_makeData(&m));

@@ -41,6 +41,18 @@ class MujocoPeer {
   MujocoPeer(const std::string& urdf_path, const Eigen::Vector3d& gravity, bool floating,
              const std::vector<std::string>& coordinates,
              const Eigen::VectorXd& armature = Eigen::VectorXd());
+  // An MJCF file compiled by MuJoCo itself (docs/validation.md, "MJCF"): `joints` are femdyn's
+  // moving joints in its coordinate order, each by name with its rates (1; 3 for a ball; 6 for a
+  // free joint, whose q is MuJoCo's qpos and whose v is in the body's axes, as above). An
+  // unnamed MuJoCo joint is "joint<i>", i its index. Mesh geoms (whose mass the MJCF reader
+  // refuses), assets and contact pairs are removed first, so that a model loads without its
+  // mesh files; constraints and contacts are off.
+  struct MjcfJoint {
+    std::string name;
+    int rates;
+  };
+  MujocoPeer(const std::string& mjcf_path, const Eigen::Vector3d& gravity,
+             const std::vector<MjcfJoint>& joints);
   ~MujocoPeer();
   MujocoPeer(const MujocoPeer&) = delete;
   MujocoPeer& operator=(const MujocoPeer&) = delete;
