@@ -200,20 +200,11 @@ void check_loop_agreement(const std::string& path, const Model& m, fv::SimbodyTw
 }
 
 #ifdef FEMDYN_WITH_MUJOCO
-// femdyn's regularised Coulomb friction on each coordinate at q̇ (core/joints/passive.hpp).
-// MuJoCo has none in its smooth dynamics (its frictionloss is a constraint, off in the peer):
-// the agreement check hands it to MuJoCo as an applied force, like with like.
-VecX coulomb_forces(const Model& m, const VecX& qd) {
-  VecX f = VecX::Zero(m.n());
-  for (const Body& b : m.bodies)
-    if (b.joint.friction != 0 && b.joint.nv == 1 && b.joint.idx_v >= 0)
-      f[b.joint.idx_v] += coulomb_force(b.joint, qd[b.joint.idx_v]);
-  return f;
-}
-
 // The same for MuJoCo: M^s, q̈ and τ at the first state.
 void check_mujoco_agreement(const std::string& path, const Model& m, Workspace& ws,
                             fv::MujocoPeer& peer, const States& s) {
+  // MuJoCo has no Coulomb friction in its smooth dynamics (its frictionloss is a constraint, off
+  // in the peer): femdyn's is handed to it as an applied force, like with like.
   const VecX friction = coulomb_forces(m, s.qd[0]);
   const Status st = tree_forward_dynamics(m, ws, s.q[0], s.qd[0], s.tau[0]);
   const double dqdd =

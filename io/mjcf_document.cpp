@@ -20,7 +20,7 @@ Document::Document(const std::string& path) : path_(path) {
   for (const XMLElement* c : sections("compiler")) read_compiler(*c);
   const std::vector<const XMLElement*> defaults = sections("default");
   for (const XMLElement* d : defaults) read_defaults(*d, "", 0);
-  if (!classes_.count("main")) classes_["main"] = {nullptr, ""};
+  if (!classes_.count("main")) classes_["main"] = {{}, ""};
   if (compiler_.meshdir.empty() || fs::path(compiler_.meshdir).is_relative())
     compiler_.meshdir = (fs::path(path).parent_path() / compiler_.meshdir).string();
 }
@@ -90,13 +90,11 @@ void Document::read_defaults(const XMLElement& d, const std::string& parent, int
   const char* own = d.Attribute("class");
   const std::string name = own ? own : (parent.empty() ? "main" : "");
   if (name.empty()) fail(d, "a nested <default> needs a class name");
-  if (parent.empty() && classes_.count("main") && name == "main") {
-    // A second top-level <default> (an included file's): its classes join main's.
-    for (const XMLElement* c : children(d, "default")) read_defaults(*c, "main", depth + 1);
-    return;
-  }
-  if (!classes_.emplace(name, std::pair{&d, parent}).second)
+  if (parent.empty() && name == "main" && classes_.count("main")) {
+    classes_["main"].first.push_back(&d);  // a second top-level <default> (an included file's)
+  } else if (!classes_.emplace(name, std::pair{std::vector{&d}, parent}).second) {
     fail(d, "default class " + quoted_text(name) + " is defined twice");
+  }
   for (const XMLElement* c : children(d, "default")) read_defaults(*c, name, depth + 1);
 }
 
@@ -156,9 +154,11 @@ const char* Document::attr(const XMLElement& e, const char* name, const std::str
   if (const char* own = e.Attribute(name)) return own;
   for (std::string c = cls; !c.empty();) {
     const auto it = classes_.find(c);
-    if (it == classes_.end() || !it->second.first) break;
-    for (const XMLElement* d : children(*it->second.first, e.Name()))
-      if (const char* v = d->Attribute(name)) return v;
+    if (it == classes_.end()) break;
+    const std::vector<const XMLElement*>& sections = it->second.first;
+    for (auto d = sections.rbegin(); d != sections.rend(); ++d)
+      for (const XMLElement* x : children(**d, e.Name()))
+        if (const char* v = x->Attribute(name)) return v;
     c = it->second.second;
   }
   return nullptr;

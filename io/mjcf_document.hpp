@@ -77,8 +77,9 @@ class Document {
   std::map<const tinyxml2::XMLDocument*, std::string> file_;
   std::map<std::string, const tinyxml2::XMLDocument*> included_;  // file -> its document
   const XMLElement* root_ = nullptr;
-  // class -> (its <default> element, its parent class); "main" has no parent.
-  std::map<std::string, std::pair<const XMLElement*, std::string>> classes_;
+  // class -> (its <default> elements, its parent class); "main" has no parent and may have
+  // several (each file's top-level <default>; a later one's attributes win).
+  std::map<std::string, std::pair<std::vector<const XMLElement*>, std::string>> classes_;
   Compiler compiler_;
 };
 

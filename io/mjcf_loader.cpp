@@ -160,6 +160,7 @@ Placed read_body(Walk& w, const Visit& v, const std::string& childclass) {
   const std::string name = own ? own : "body" + std::to_string(index);
   if (w.tree.bodies.count(name)) doc.fail(body, "a second body of this name");
   const Pose B = v.in_parent * pose_of(doc, body, "");  // the body frame, femdyn parent's frame
+  if (doc.number(body, "gravcomp", "", 0) != 0) ++w.unused["bodies' gravity compensation"];
   std::vector<std::pair<const XMLElement*, std::string>> joints;  // element, type
   for (const XMLElement* c : doc.children(body)) {
     if (!std::strcmp(c->Name(), "freejoint")) joints.push_back({c, "free"});
@@ -274,9 +275,16 @@ void set_total_mass(Walk& w) {
   }
 }
 
-Vec3 gravity(const Document& doc) {
+// <option gravity>; fluid forces (density, viscosity, wind) are counted as not modelled.
+Vec3 gravity(Walk& w) {
   Vec3 g(0, 0, -9.81);
-  for (const XMLElement* option : doc.sections("option")) g = doc.vec3(*option, "gravity", "", g);
+  for (const XMLElement* option : w.doc.sections("option")) {
+    g = w.doc.vec3(*option, "gravity", "", g);
+    if (w.doc.number(*option, "density", "", 0) != 0 ||
+        w.doc.number(*option, "viscosity", "", 0) != 0 ||
+        w.doc.vec3(*option, "wind", "", Vec3::Zero()) != Vec3::Zero())
+      ++w.unused["<option> with fluid forces (density, viscosity, wind)"];
+  }
   return g;
 }
 
@@ -309,7 +317,7 @@ MjcfResult read_mjcf(const std::string& path, const MjcfOptions& options) {
   MjcfResult out;
   out.model = {{"name", name ? name : std::filesystem::path(path).stem().string()},
                {"description", "imported from " + path + " (MJCF)"},
-               {"gravity", vec3_json(gravity(doc))},
+               {"gravity", vec3_json(gravity(w))},
                {"bodies", w.bodies}};
   read_equalities(doc, w.tree, out.model, w.notes);
   out.warnings = std::move(w.notes);

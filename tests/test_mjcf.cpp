@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "core/equations.hpp"
+#include "core/joints/passive.hpp"
 #include "core/sampling.hpp"
 #include "io/model_loader.hpp"
 #include "tests/helpers.hpp"
@@ -51,18 +52,22 @@ Errors against_mujoco(const std::string& path) {
     mass_matrix(m, ws, q);
     e.mass = std::max(e.mass, rel_error(ws.Ms, peer.mass(q)));
     inverse_dynamics(m, ws, q, qd, qdd);
-    e.inverse = std::max(e.inverse, rel_error(ws.tau, peer.inverse(q, qd, qdd)));
+    // femdyn's Coulomb friction (MJCF frictionloss) handed to MuJoCo as an applied force.
+    const VecX friction = coulomb_forces(m, qd);
+    e.inverse = std::max(e.inverse, rel_error(ws.tau, peer.inverse(q, qd, qdd) - friction));
     REQUIRE(forward_dynamics(m, ws, q, qd, tau).ok);
-    e.forward = std::max(e.forward, rel_error(ws.qdd, peer.forward(q, qd, tau)));
+    e.forward = std::max(e.forward, rel_error(ws.qdd, peer.forward(q, qd, tau + friction)));
   }
   return e;
 }
 
 }  // namespace
 
-TEST_CASE("MJCF: every feature the reader reads equals MuJoCo's compile of the same file",
+TEST_CASE("MJCF: femdyn's feature files and public models equal MuJoCo's compile of the same file",
           "[mjcf][mujoco][validation]") {
-  for (const char* file : {"features.xml", "floating.xml"}) {
+  for (const char* file :
+       {"features.xml", "floating.xml", "dm_control/humanoid.xml", "dm_control/cheetah.xml",
+        "dm_control/swimmer.xml", "menagerie/anymal_c.xml"}) {
     INFO(file);
     const Errors e = against_mujoco(mjcf_path(file));
     CHECK(e.mass < 1e-10);
@@ -71,33 +76,14 @@ TEST_CASE("MJCF: every feature the reader reads equals MuJoCo's compile of the s
   }
 }
 
-// MuJoCo's compiler finds a full tensor's principal axes by an iteration that stops early (M^s
-// off by 1.5e-10 on features.xml's forearm given as fullinertia), so fullinertia is checked by a
-// relation instead: R diag(d) Rᵀ written as fullinertia is the same body as diag(d) turned by R.
-TEST_CASE("MJCF: fullinertia is the same body as diaginertia turned by quat", "[mjcf]") {
-  Scratch scratch("mjcf_fullinertia");
-  const Eigen::Quaterniond turn = Eigen::Quaterniond(0.7, 0.1, 0.2, 0.3).normalized();
-  const Mat3 I = turn.toRotationMatrix() * Vec3(0.011, 0.012, 0.004).asDiagonal() *
-                 turn.toRotationMatrix().transpose();
-  const auto write = [&](const std::string& name, const std::string& inertial) {
-    const std::string path = (scratch.dir / name).string();
-    std::ofstream(path) << "<mujoco><worldbody><body name=\"a\" pos=\"0 0 1\">"
-                           "<joint name=\"j1\" axis=\"1 0 0\"/><joint name=\"j2\" axis=\"0 1 1\"/>"
-                           "<inertial pos=\"0.1 0.2 0.3\" mass=\"0.7\" "
-                        << inertial << "/></body></worldbody></mujoco>";
-    return path;
-  };
-  char full[300];
-  std::snprintf(full, sizeof full, "fullinertia=\"%.17g %.17g %.17g %.17g %.17g %.17g\"", I(0, 0),
-                I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2));
-  const Model a = load_model(write("full.xml", full));
-  const Model b =
-      load_model(write("turned.xml", "quat=\"0.7 0.1 0.2 0.3\" diaginertia=\"0.011 0.012 0.004\""));
-  Workspace wa(a), wb(b);
-  std::mt19937 rng(3);
-  const VecX q = random_posture(a, rng);
-  mass_matrix(a, wa, q);
-  mass_matrix(b, wb, q);
-  CHECK(rel_error(wa.Ms, wb.Ms) < 1e-14);
-  CHECK(wa.Ms.norm() > 0.01);
+TEST_CASE("MJCF: femdyn validate compares with MuJoCo's compile of the file, or says why not",
+          "[mjcf][cli]") {
+  const Run ok = run("validate " + mjcf_path("dm_control/cheetah.xml") + " --json --budget 60");
+  CHECK(ok.code == 0);
+  CHECK_THAT(ok.out, Catch::Contains("\"mujoco\"") &&
+                         Catch::Contains("compared with MuJoCo only") &&
+                         Catch::Contains("rotor inertia"));
+  const Run coupled = run("validate " + mjcf_path("loops.xml") + " --budget 60");
+  CHECK_THAT(coupled.out, Catch::Contains("not compared with MuJoCo's compile of the file: femdyn "
+                                          "holds an <equality joint> as a coupling"));
 }

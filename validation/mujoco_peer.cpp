@@ -273,7 +273,9 @@ mjModel* compiled(const std::string& text, const std::string& file, const std::s
 
 // The MJCF text MuJoCo is given (see the header): <include>s expanded (relative to the main
 // file's folder), then mesh and height-field geoms, <asset>, <contact> and every reference to an
-// asset removed.
+// asset removed, and what M, τ and q̈ do not depend on and MuJoCo 2.2 may not know: actuators,
+// sensors, tendons, keyframes, <option>'s integrator and flags, joints' actuator force ranges.
+// (Gravity compensation, which does change τ, is reported by the reader.)
 std::string prepared_mjcf(const std::string& path) {
   tinyxml2::XMLDocument doc;
   const auto refuse = [&](const std::string& why) {
@@ -311,7 +313,9 @@ std::string prepared_mjcf(const std::string& path) {
   while (!stack.empty()) {
     tinyxml2::XMLElement* e = stack.back();
     stack.pop_back();
-    for (const char* a : {"material", "texture", "hfield", "meshdir", "assetdir", "texturedir"})
+    for (const char* a :
+         {"material", "texture", "hfield", "meshdir", "assetdir", "texturedir", "integrator",
+          "actuatorfrcrange", "actuatorfrclimited", "actuatorgravcomp", "gravcomp"})
       e->DeleteAttribute(a);
     for (tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
       const std::string tag = c->Name();
@@ -319,8 +323,10 @@ std::string prepared_mjcf(const std::string& path) {
       const bool mesh_geom =
           tag == "geom" && (c->Attribute("mesh") || (type && (std::string(type) == "mesh" ||
                                                               std::string(type) == "hfield")));
-      (tag == "asset" || tag == "contact" || tag == "skin" || mesh_geom ? doomed : stack)
-          .push_back(c);
+      const bool unused = tag == "asset" || tag == "contact" || tag == "skin" || tag == "flag" ||
+                          tag == "actuator" || tag == "sensor" || tag == "keyframe" ||
+                          tag == "tendon";
+      (unused || mesh_geom ? doomed : stack).push_back(c);
     }
   }
   for (tinyxml2::XMLElement* e : doomed) e->Parent()->DeleteChild(e);
@@ -337,7 +343,8 @@ MujocoPeer::MujocoPeer(const std::string& mjcf_path, const Eigen::Vector3d& grav
   Impl& s = *impl_;
   s.m.reset(compiled(prepared_mjcf(mjcf_path), "mujoco_peer.xml", mjcf_path));
   mjModel& m = *s.m;
-  for (int k = 0; k < 3; ++k) m.opt.gravity[k] = gravity[k];
+  for (int k = 0; k < 3; ++k) m.opt.gravity[k] = gravity[k], m.opt.wind[k] = 0;
+  m.opt.density = m.opt.viscosity = 0;  // fluid forces: reported by the reader, not modelled
   m.opt.disableflags |= mjDSBL_CONSTRAINT | mjDSBL_CONTACT;
   const auto refuse = [&](const std::string& why) {
     throw std::runtime_error(mjcf_path + ": MuJoCo peer: " + why);

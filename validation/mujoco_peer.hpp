@@ -46,7 +46,9 @@ class MujocoPeer {
   // free joint, whose q is MuJoCo's qpos and whose v is in the body's axes, as above). An
   // unnamed MuJoCo joint is "joint<i>", i its index. Mesh geoms (whose mass the MJCF reader
   // refuses), assets and contact pairs are removed first, so that a model loads without its
-  // mesh files; constraints and contacts are off.
+  // mesh files, and actuators, sensors, tendons, keyframes and the integrator, which the
+  // quantities compared do not depend on (and MuJoCo 2.2 may not read); constraints, contacts
+  // and fluid forces (which the reader reports as not modelled) are off.
   struct MjcfJoint {
     std::string name;
     int rates;

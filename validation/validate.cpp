@@ -272,24 +272,6 @@ const double kTightRatio = std::pow(100.0, 0.25);
 //   memory per body of the twin (Simbody's system and state) and of femdyn's workspaces.
 constexpr double kBytesPerBody = 20e3;
 
-// ‖x_femdyn − x_simbody‖∞ / max(‖x_simbody‖∞, floor) (the absolute error when both are 0). The
-// floor is the size of what the quantity is made of, where it may vanish by cancellation (a
-// centre of mass at the origin): the error is then measured against its parts.
-void accumulate(QuantityError& e, const MatX& femdyn, const MatX& simbody, double floor = 0) {
-  const double d = max_abs(femdyn - simbody);
-  const double scale = std::max(max_abs(simbody), floor);
-  e.max_abs = std::max(e.max_abs, d);
-  e.max_rel = std::max(e.max_rel, scale > 0 ? d / scale : d);
-}
-
-// The size of the parts h is summed from, h_a = Σ_bc D_abc q̇_b q̇_c with D of the size of M^s
-// per unit displacement: ‖M^s‖∞ ‖q̇‖∞². h of a mechanism whose bodies turn about their own
-// principal axes cancels to ~1e-20 (PyBullet's minitaur), where a relative error means nothing.
-double bias_floor(const MatX& Ms, const VecX& qd) {
-  const double v = qd.size() ? qd.cwiseAbs().maxCoeff() : 0.0;
-  return max_abs(Ms) * v * v;
-}
-
 // q and −q are one rotation: each quaternion of x (a joint state θ, θ̇) takes the sign nearer
 // ref's (Simbody keeps the sign it starts with, femdyn's integrators keep w ≥ 0).
 void align_quaternions(const Model& m, const VecX& ref, VecX& x) {
@@ -927,6 +909,24 @@ struct Validator::Impl {
     return r;
   }
 };
+
+// ‖x_femdyn − x_simbody‖∞ / max(‖x_simbody‖∞, floor) (the absolute error when both are 0). The
+// floor is the size of what the quantity is made of, where it may vanish by cancellation (a
+// centre of mass at the origin): the error is then measured against its parts.
+void accumulate(QuantityError& e, const MatX& femdyn, const MatX& simbody, double floor) {
+  const double d = max_abs(femdyn - simbody);
+  const double scale = std::max(max_abs(simbody), floor);
+  e.max_abs = std::max(e.max_abs, d);
+  e.max_rel = std::max(e.max_rel, scale > 0 ? d / scale : d);
+}
+
+// The size of the parts h is summed from, h_a = Σ_bc D_abc q̇_b q̇_c with D of the size of M^s
+// per unit displacement: ‖M^s‖∞ ‖q̇‖∞². h of a mechanism whose bodies turn about their own
+// principal axes cancels to ~1e-20 (PyBullet's minitaur), where a relative error means nothing.
+double bias_floor(const MatX& Ms, const VecX& qd) {
+  const double v = qd.size() ? qd.cwiseAbs().maxCoeff() : 0.0;
+  return max_abs(Ms) * v * v;
+}
 
 double pointwise_tolerance(const Model& m) {
   std::vector<int> depth(m.bodies.size(), 1);  // bodies on the path from the world

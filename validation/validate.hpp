@@ -3,6 +3,7 @@
 #pragma once
 #include <functional>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -173,6 +174,22 @@ ValidationReport validate(const Model& model, const ValidationOptions& options =
 QuantityError validate_urdf_import(const Model& model, const std::string& urdf_path,
                                    const ValidationOptions& options, std::string& failure,
                                    bool balance_inertia = false);
+
+// For a model read from an MJCF file, with the MuJoCo peer built (FEMDYN_WITH_MUJOCO): femdyn's
+// M^s, τ and q̈ against MuJoCo's own compile of the file (validation/mujoco_peer.hpp) at the
+// same seeded states, femdyn's Coulomb friction handed to MuJoCo as an applied force (its
+// frictionloss is a constraint, off in the peer). Returns the quantity "mujoco"; or nullopt with
+// `why` when it cannot be compared: MuJoCo cannot read the file (Debian's 2.2 knows no MuJoCo 3
+// element), or femdyn holds an <equality joint> as a coupling (fewer coordinates than dofs).
+std::optional<QuantityError> validate_mjcf_import(const Model& model, const std::string& path,
+                                                  const ValidationOptions& options,
+                                                  std::string& why);
+
+// ‖x_femdyn − x_reference‖∞ / max(‖x_reference‖∞, floor) into e's largest errors (the absolute
+// error when both are 0). The floor is the size of what the quantity is made of.
+void accumulate(QuantityError& e, const MatX& femdyn, const MatX& reference, double floor = 0);
+// h's floor: ‖M^s‖∞ ‖q̇‖∞² (h cancels to round-off on some mechanisms).
+double bias_floor(const MatX& Ms, const VecX& qd);
 
 // What the Simbody twin reads of a model; each body's mass properties are the sum of its
 // elements'. Used by validate() and femdyn_bench.

@@ -29,6 +29,16 @@ inline double coulomb_force(const Joint& j, double theta_dot) {
 struct StopForce {
   double force = 0, elastic = 0;
 };
+// The Coulomb forces on every coordinate at q̇, for a model without couplings (q̇ = θ̇): what the
+// MuJoCo peer is handed as an applied force (its frictionloss is a constraint, off there).
+inline VecX coulomb_forces(const Model& m, const VecX& qd) {
+  VecX f = VecX::Zero(m.n());
+  for (const Body& b : m.bodies)
+    if (b.joint.friction != 0 && b.joint.nv == 1 && b.joint.idx_v >= 0)
+      f[b.joint.idx_v] += coulomb_force(b.joint, qd[b.joint.idx_v]);
+  return f;
+}
+
 inline StopForce stop_force(const Joint& j, double theta, double theta_dot) {
   if (theta > j.upper) {
     const double x = theta - j.upper;
