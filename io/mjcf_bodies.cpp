@@ -27,21 +27,10 @@ CentroidalMass inertial_mass(const Document& doc, const XMLElement& in) {
   return {m, pose.p, pose.R * I * pose.R.transpose()};
 }
 
-// The mesh a mesh geom names: "'name' (file 'x.stl')".
-std::string mesh_text(const Document& doc, const XMLElement& geom, const std::string& cls) {
-  const char* name = doc.attr(geom, "mesh", cls);
-  std::string out = quoted_text(name ? name : "");
-  for (const XMLElement* asset : doc.sections("asset"))
-    for (const XMLElement* mesh : doc.children(*asset, "mesh"))
-      if (name && mesh->Attribute("name", name) && mesh->Attribute("file"))
-        out += " (file " + quoted_text(mesh->Attribute("file")) + ")";
-  return out;
-}
-
-// The geoms in inertiagrouprange, welded: a plane or height field adds nothing, a mesh with mass
-// is refused (femdyn does not read meshes yet).
-CentroidalMass geoms_mass(const Document& doc, const XMLElement& body,
-                          const std::string& inherited) {
+// The geoms in inertiagrouprange, welded: a plane or height field adds nothing, a mesh the solid
+// it bounds (io/mjcf_mesh.cpp).
+CentroidalMass geoms_mass(const Document& doc, const XMLElement& body, const std::string& inherited,
+                          MeshReport& meshes) {
   CentroidalMass sum;
   for (const XMLElement* geom : doc.children(body, "geom")) {
     const std::string cls = doc.class_of(*geom, inherited);
@@ -53,9 +42,8 @@ CentroidalMass geoms_mass(const Document& doc, const XMLElement& body,
       if (doc.number(*geom, "mass", cls, -1) == 0 ||
           (!doc.attr(*geom, "mass", cls) && doc.number(*geom, "density", cls, 1000) == 0))
         continue;
-      doc.fail(*geom, "the body's mass comes from mesh " + mesh_text(doc, *geom, cls) +
-                          ", whose volume femdyn does not compute yet: give the body an "
-                          "<inertial>, or the geom mass=\"0\"");
+      sum = welded(sum, mesh_geom_mass(doc, *geom, cls, meshes));
+      continue;
     }
     const GeomMass g = primitive_geom_mass(doc, *geom, cls);
     sum = welded(sum, {g.mass, g.pose.p, g.pose.R * g.I * g.pose.R.transpose()});
@@ -73,15 +61,15 @@ void principal_rebuild(CentroidalMass& mp, const auto& change) {
 
 }  // namespace
 
-CentroidalMass body_mass(const Document& doc, const XMLElement& body,
-                         const std::string& childclass) {
+CentroidalMass body_mass(const Document& doc, const XMLElement& body, const std::string& childclass,
+                         MeshReport& meshes) {
   const Compiler& c = doc.compiler();
   const std::vector<const XMLElement*> inertial = doc.children(body, "inertial");
   if (inertial.size() > 1) doc.fail(body, "more than one <inertial>");
   CentroidalMass mp;
   if (c.inertia_from_geom == Compiler::FromGeom::always ||
       (c.inertia_from_geom == Compiler::FromGeom::automatic && inertial.empty()))
-    mp = geoms_mass(doc, body, childclass);
+    mp = geoms_mass(doc, body, childclass, meshes);
   else if (!inertial.empty())
     mp = inertial_mass(doc, *inertial[0]);
   if (c.boundmass > 0 && mp.mass < c.boundmass) mp.mass = c.boundmass;

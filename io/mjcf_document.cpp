@@ -9,6 +9,7 @@
 #include "core/limits.hpp"
 #include "core/names.hpp"
 #include "io/input_file.hpp"
+#include "io/xml_error.hpp"
 
 namespace femdyn::mjcf {
 
@@ -31,8 +32,7 @@ void Document::load(const std::string& file, int depth) {
   const std::string text = read_input_file(file);
   auto doc = std::make_unique<tinyxml2::XMLDocument>();
   if (doc->Parse(text.c_str(), text.size()) != tinyxml2::XML_SUCCESS)
-    throw ModelError(file, std::string("malformed XML at line ") +
-                               std::to_string(doc->ErrorLineNum()) + ": " + doc->ErrorName());
+    throw ModelError(file, xml_error_text(*doc));
   const XMLElement* top = doc->FirstChildElement("mujoco");
   if (!top) throw ModelError(file, "no <mujoco> element (an MJCF file, or a file it includes)");
   file_[doc.get()] = file;
@@ -129,6 +129,7 @@ void Document::read_compiler(const XMLElement& c) {
   compiler_.settotalmass = number(c, "settotalmass", none, compiler_.settotalmass);
   compiler_.balanceinertia = flag(c, "balanceinertia", none, compiler_.balanceinertia);
   compiler_.autolimits = flag(c, "autolimits", none, compiler_.autolimits);
+  compiler_.exact_mesh_inertia = flag(c, "exactmeshinertia", none, compiler_.exact_mesh_inertia);
   if (const char* coordinate = c.Attribute("coordinate");
       coordinate && std::strcmp(coordinate, "local") != 0)
     fail(c, "coordinate=\"global\" is refused (MuJoCo removed it; femdyn reads local frames)");

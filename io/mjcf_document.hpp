@@ -27,6 +27,8 @@ struct Compiler {
   double boundmass = 0, boundinertia = 0, settotalmass = -1;
   bool balanceinertia = false;
   bool autolimits = true;
+  bool exact_mesh_inertia = false;  // exactmeshinertia: signed volumes (else MuJoCo's legacy |V|)
+  bool every_mesh_exact = false;    // MjcfOptions::exact_mesh_inertia: over a mesh's own inertia
   std::string meshdir;  // where mesh files are (meshdir, else assetdir, else the file's folder)
 };
 
@@ -37,6 +39,7 @@ class Document {
 
   const XMLElement& root() const { return *root_; }
   const Compiler& compiler() const { return compiler_; }
+  void make_every_mesh_exact() { compiler_.every_mesh_exact = true; }
   const std::string& path() const { return path_; }
   // The children of `e` named `tag` (every child for nullptr), <include>s expanded in place.
   std::vector<const XMLElement*> children(const XMLElement& e, const char* tag = nullptr) const;

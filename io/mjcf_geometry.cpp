@@ -78,42 +78,55 @@ Pose pose_of(const Document& doc, const XMLElement& e, const std::string& cls) {
   return pose;
 }
 
-GeomMass primitive_geom_mass(const Document& doc, const XMLElement& geom, const std::string& cls) {
+GeomShape geom_shape(const Document& doc, const XMLElement& geom, const std::string& cls) {
   const char* type_c = doc.attr(geom, "type", cls);
-  const std::string type = type_c ? type_c : "sphere";
+  GeomShape g;
+  g.type = type_c ? type_c : "sphere";
   const std::vector<double> size = doc.numbers(geom, "size", cls, -1);
   const auto need = [&](std::size_t n) {
     if (size.size() < n)
-      doc.fail(geom,
-               "a " + type + " needs " + std::to_string(n) + " size number" + (n == 1 ? "" : "s"));
+      doc.fail(geom, "a " + g.type + " needs " + std::to_string(n) + " size number" +
+                         (n == 1 ? "" : "s"));
     for (std::size_t k = 0; k < n; ++k)
-      if (!(size[k] > 0)) doc.fail(geom, "size: a " + type + "'s sizes must be positive");
+      if (!(size[k] > 0)) doc.fail(geom, "size: a " + g.type + "'s sizes must be positive");
   };
-  GeomMass g;
   g.pose = pose_of(doc, geom, cls);
-  double r = 0, h = 0;
   if (const std::vector<double> ft = doc.numbers(geom, "fromto", cls, 6); !ft.empty()) {
-    if (type != "capsule" && type != "cylinder")
-      doc.fail(geom, "fromto on a " + type + " (femdyn reads it on a capsule or a cylinder)");
+    if (g.type != "capsule" && g.type != "cylinder")
+      doc.fail(geom, "fromto on a " + g.type + " (femdyn reads it on a capsule or a cylinder)");
     const Vec3 a(ft[0], ft[1], ft[2]), b(ft[3], ft[4], ft[5]);
     if (!((b - a).norm() > 0)) doc.fail(geom, "fromto: its two points coincide");
     g.pose.p = (a + b) / 2;
     g.pose.R = z_to((b - a).normalized()).toRotationMatrix();
     need(1);
-    r = size[0], h = (b - a).norm() / 2;
-  } else if (type == "capsule" || type == "cylinder") {
+    g.size = Vec3(size[0], (b - a).norm() / 2, 0);
+  } else if (g.type == "capsule" || g.type == "cylinder") {
     need(2);
-    r = size[0], h = size[1];
+    g.size = Vec3(size[0], size[1], 0);
+  } else if (g.type == "sphere") {
+    need(1);
+    g.size = Vec3(size[0], 0, 0);
+  } else if (g.type == "box" || g.type == "ellipsoid") {
+    need(3);
+    g.size = Vec3(size[0], size[1], size[2]);
   }
+  return g;
+}
+
+GeomMass primitive_geom_mass(const Document& doc, const XMLElement& geom, const std::string& cls) {
+  const GeomShape shape = geom_shape(doc, geom, cls);
+  const std::string& type = shape.type;
+  const Vec3& size = shape.size;
+  GeomMass g;
+  g.pose = shape.pose;
+  const double r = size[0], h = size[1];
   constexpr double pi = std::numbers::pi;
   double V = 0;
   Vec3 k = Vec3::Zero();  // I = m k, per axis
   if (type == "sphere") {
-    need(1);
     V = 4.0 / 3 * pi * std::pow(size[0], 3);
     k.setConstant(0.4 * size[0] * size[0]);
   } else if (type == "box" || type == "ellipsoid") {
-    need(3);
     const Vec3 s2(size[0] * size[0], size[1] * size[1], size[2] * size[2]);
     const double f = type == "box" ? 1.0 / 3 : 1.0 / 5;
     V = type == "box" ? 8 * size[0] * size[1] * size[2]

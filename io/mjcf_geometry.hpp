@@ -30,6 +30,16 @@ struct Pose {
 // An element's pos and orientation (the identity without them).
 Pose pose_of(const Document& doc, const XMLElement& e, const std::string& cls);
 
+// A geom's type, pose in the body frame (fromto on a capsule or cylinder sets it) and sizes as
+// MuJoCo gives them: sphere r; capsule, cylinder r and half-length; box half-edges; ellipsoid
+// radii (others: zero). Missing or non-positive sizes are refused, naming the geom.
+struct GeomShape {
+  std::string type;
+  Pose pose;
+  Vec3 size = Vec3::Zero();
+};
+GeomShape geom_shape(const Document& doc, const XMLElement& geom, const std::string& cls);
+
 // A geom's mass, centre and inertia in the body frame, or nullopt for a geom without volume
 // (a plane or height field: refused on a moving body by the caller). A mesh geom is read by
 // the caller, which knows the mesh (this throws for one).

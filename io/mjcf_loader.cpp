@@ -1,5 +1,6 @@
 #include "io/mjcf_loader.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -47,6 +48,8 @@ struct Walk {
   Tree tree;
   std::set<std::string> body_names, joint_names;
   std::vector<std::string> notes;
+  MjcfMeshes meshes;
+  std::vector<Visual> visuals;
   struct Massed {
     const XMLElement* body;  // the MuJoCo body
     std::size_t index;       // its femdyn body, in `bodies`
@@ -209,7 +212,8 @@ Placed read_body(Walk& w, const Visit& v, const std::string& childclass) {
   const Placed placed{w.bodies.back()["name"], Pose{-at, Mat3::Identity()},
                       v.world0 * pose_of(doc, body, "")};
   w.tree.bodies[name] = {placed.femdyn, at, placed.world0};
-  w.masses.push_back({&body, w.bodies.size() - 1, at, body_mass(doc, body, childclass)});
+  w.masses.push_back({&body, w.bodies.size() - 1, at, body_mass(doc, body, childclass, w.meshes)});
+  add_visuals(doc, body, childclass, placed.femdyn, placed.below, w.visuals);
   return placed;
 }
 
@@ -241,6 +245,7 @@ void walk_tree(Walk& w) {
   };
   for (const XMLElement* world : w.doc.sections("worldbody")) {
     count_unused(w, *world);
+    add_visuals(w.doc, *world, "", "world", Pose{}, w.visuals);
     push_children(*world, "world", Pose{}, Pose{}, "", nullptr);
     while (!stack.empty()) {
       const Visit v = stack.back();
@@ -304,7 +309,8 @@ std::string unused_text(Walk& w) {
 }  // namespace
 
 MjcfResult read_mjcf(const std::string& path, const MjcfOptions& options) {
-  const Document doc(path);
+  Document doc(path);
+  if (options.exact_mesh_inertia) doc.make_every_mesh_exact();
   Walk w{doc, options};
   w.tree.bodies["world"] = {"world", Vec3::Zero(), Pose{}};
   walk_tree(w);
@@ -320,7 +326,23 @@ MjcfResult read_mjcf(const std::string& path, const MjcfOptions& options) {
                {"gravity", vec3_json(gravity(w))},
                {"bodies", w.bodies}};
   read_equalities(doc, w.tree, out.model, w.notes);
+  if (!w.meshes.not_solid.empty()) {  // each mesh once, in file order
+    std::vector<std::string> names;
+    for (const std::string& m : w.meshes.not_solid)
+      if (std::find(names.begin(), names.end(), m) == names.end()) names.push_back(m);
+    std::string list;
+    for (const std::string& m : names) list += (list.empty() ? "" : ", ") + m;
+    w.notes.push_back(path + ": " + std::to_string(names.size()) +
+                      (names.size() == 1 ? " mesh is" : " meshes are") +
+                      " not convex, and MuJoCo's default (legacy) inertia, which femdyn "
+                      "follows, counts their folds twice (legacy volume / solid's): " +
+                      list +
+                      "; inertia=\"exact\" on a mesh, or <compiler "
+                      "exactmeshinertia=\"true\">, weighs the solid");
+  }
   out.warnings = std::move(w.notes);
+  out.meshes = std::move(w.meshes);
+  out.visuals = std::move(w.visuals);
   if (const std::string unused = unused_text(w); !unused.empty()) out.warnings.push_back(unused);
   return out;
 }

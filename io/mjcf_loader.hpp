@@ -9,8 +9,9 @@
 //     is in the joint's origin); a free joint's q is MuJoCo's qpos (the body's pose in the world).
 //   Mass: <inertial> (diaginertia or fullinertia, in its own frame), or the body's primitive
 //     geoms (<compiler inertiafromgeom>, mass or density, inertiagrouprange), boundmass,
-//     boundinertia, settotalmass, balanceinertia as MuJoCo's compiler. A mesh geom's mass is
-//     refused (femdyn does not read meshes yet), naming the body and the mesh.
+//     boundinertia, settotalmass, balanceinertia as MuJoCo's compiler. A mesh geom (STL or OBJ
+//     file, or inline vertex/face) weighs the solid it bounds, by MuJoCo's legacy algorithm or
+//     the exact one (exactmeshinertia, or the mesh's inertia="exact"): io/mjcf_mesh.cpp.
 //   Joint armature, damping, frictionloss (as Coulomb friction), stiffness/springref, range with
 //     limited/autolimits. <option gravity>. <equality> connect -> a ball constraint, weld -> a
 //     weld, joint -> a coupling (its polynomial).
@@ -22,16 +23,30 @@
 #include <vector>
 
 #include "io/params.hpp"
+#include "io/visual.hpp"
 
 namespace femdyn {
 
 struct MjcfOptions {
   bool balance_inertia = false;  // a body's non-physical inertia -> the nearest physical one
+  // Every mesh's exact solid, as <compiler exactmeshinertia="true"> (MuJoCo's default is its
+  // legacy inertia, which overcounts a non-convex mesh): how validate meets MuJoCo 2.2.
+  bool exact_mesh_inertia = false;
+};
+
+// Mesh geoms that gave a body mass: their number, and those whose MuJoCo legacy solid (each
+// tetrahedron's volume taken positive) is not the solid the mesh bounds (a non-convex mesh),
+// each "'name' (file 'x.stl') (×r)", r the legacy volume over the solid's (once per geom).
+struct MjcfMeshes {
+  int with_mass = 0;
+  std::vector<std::string> not_solid;
 };
 
 struct MjcfResult {
   Json model;                         // the femdyn model document
   std::vector<std::string> warnings;  // what is not modelled, what was repaired
+  MjcfMeshes meshes;
+  std::vector<Visual> visuals;  // what the bodies look like (io/mjcf_visuals.cpp)
 };
 
 MjcfResult read_mjcf(const std::string& path, const MjcfOptions& options = {});

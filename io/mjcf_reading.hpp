@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "io/centroidal_mass.hpp"
+#include "io/mesh.hpp"
 #include "io/mjcf_document.hpp"
 #include "io/mjcf_geometry.hpp"
 #include "io/mjcf_loader.hpp"
@@ -34,10 +35,13 @@ struct Tree {
   std::map<std::string, PlacedJoint> joints;  // by MuJoCo name
 };
 
+// The meshes that gave mass, and those whose legacy solid is not theirs (mjcf_loader.hpp).
+using MeshReport = MjcfMeshes;
+
 // A body's mass properties in its own frame, as MuJoCo's compiler makes them (before
 // settotalmass, which scales every body).
-CentroidalMass body_mass(const Document& doc, const XMLElement& body,
-                         const std::string& childclass);
+CentroidalMass body_mass(const Document& doc, const XMLElement& body, const std::string& childclass,
+                         MeshReport& meshes);
 
 // The body's rigid_body element (its frame shifted by `shift`), or null without mass; a
 // non-physical inertia balanced when asked, each change in `notes`.
@@ -47,6 +51,37 @@ Json mass_element(const Document& doc, const XMLElement& body, const CentroidalM
 // <equality>: constraints and couplings added to the model document.
 void read_equalities(const Document& doc, const Tree& tree, Json& model,
                      std::vector<std::string>& notes);
+
+// A mesh asset as MuJoCo's compiler reads it (io/mjcf_mesh.cpp): the triangles of its file
+// (meshdir-relative) or of its inline vertex/face, scaled; `source` names it in messages.
+struct MeshAsset {
+  TriangleMesh mesh;
+  std::string source;  // "'name' (file 'x.stl')"
+  std::string file;    // its path, or empty when inline
+  Vec3 scale = Vec3::Ones();
+};
+// The <mesh> asset a mesh geom names (its class, scale and file, meshdir-relative; no file for
+// an inline mesh), without reading it; or a one-line refusal naming the geom.
+struct MeshFile {
+  const XMLElement* asset = nullptr;
+  std::string cls, source, file;
+  Vec3 scale = Vec3::Ones();
+};
+MeshFile mesh_file_of(const Document& doc, const XMLElement& geom, const std::string& cls);
+
+// The <mesh> asset a mesh geom names, read, or a one-line refusal naming the geom.
+MeshAsset mesh_of(const Document& doc, const XMLElement& geom, const std::string& cls);
+
+// A mesh geom's mass in the body frame: the solid the mesh bounds, as MuJoCo's compiler computes
+// it (legacy |V| tetrahedra, or signed ones with exactmeshinertia; io/mesh.hpp), m = the geom's
+// mass or ρV, placed at the geom's pose; counted in `meshes`.
+CentroidalMass mesh_geom_mass(const Document& doc, const XMLElement& geom, const std::string& cls,
+                              MeshReport& meshes);
+
+// The geoms of `body` (or the world) MuJoCo's viewer draws by default (groups 0 to 2; no plane
+// or height field), in the frame `frame` places the body's frame in, on femdyn body `link`.
+void add_visuals(const Document& doc, const XMLElement& body, const std::string& childclass,
+                 const std::string& link, const Pose& frame, std::vector<Visual>& out);
 
 // A rotation's roll, pitch, yaw (R = Rz(y) Ry(p) Rx(r)).
 Vec3 rotation_rpy(const Mat3& R);

@@ -742,7 +742,10 @@ Json robot_document(const std::string& path, const LoadOptions& options) {
     throw ModelError(path,
                      "--floating-base is for URDF models: an MJCF model floats a body by its "
                      "own <freejoint/>");
-  return mjcf_document(path, {.balance_inertia = options.balance_inertia}, options);
+  return mjcf_document(path,
+                       {.balance_inertia = options.balance_inertia,
+                        .exact_mesh_inertia = options.exact_mesh_inertia},
+                       options);
 }
 
 // {"model": "mjcf", "params": {"file", "balance_inertia"}}: the MJCF file it names, with the

@@ -20,6 +20,7 @@ struct LoadOptions {
   CompileOptions compile;            // e.g. the routes (compile/compile.hpp)
   bool floating_base = false;        // URDF: a free joint under the root link (io/urdf_loader.hpp)
   bool balance_inertia = false;      // URDF: a non-physical body inertia -> the nearest physical
+  bool exact_mesh_inertia = false;   // MJCF: every mesh weighs its solid (io/mjcf_loader.hpp)
 };
 
 // A model file: femdyn JSON, or URDF by its extension .urdf (io/urdf_loader.hpp).

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,7 @@
 #include "core/names.hpp"
 #include "io/input_file.hpp"
 #include "io/urdf_reading.hpp"
+#include "io/xml_error.hpp"
 
 namespace femdyn {
 namespace {
@@ -58,8 +60,7 @@ std::string needs_xacro(const XMLElement* robot) {
 const XMLElement* robot_element(tinyxml2::XMLDocument& doc, const std::string& text,
                                 const std::string& source) {
   if (doc.Parse(text.c_str(), text.size()) != tinyxml2::XML_SUCCESS)
-    throw ModelError(source, std::string("malformed XML at line ") +
-                                 std::to_string(doc.ErrorLineNum()) + ": " + doc.ErrorName());
+    throw ModelError(source, xml_error_text(doc));
   const XMLElement* robot = doc.FirstChildElement("robot");
   if (!robot) throw ModelError(source, "no <robot> element");
   if (const std::string why = needs_xacro(robot); !why.empty())
@@ -87,20 +88,59 @@ std::optional<Eigen::Vector4d> material_color(const Ctx& c, const XMLElement* ro
   return std::nullopt;
 }
 
-UrdfVisual visual_of(const Ctx& c, const XMLElement* robot, const XMLElement* visual,
-                     const std::string& link) {
+// A mesh's file: package://NAME/rest in a folder NAME above the URDF (a ROS package's layout)
+// or under an entry of ROS_PACKAGE_PATH; file:///path; else relative to the URDF's folder.
+void find_mesh(const std::string& urdf_path, Visual& v) {
+  namespace fs = std::filesystem;
+  const fs::path folder = fs::absolute(fs::path(urdf_path)).parent_path();
+  std::vector<fs::path> candidates;
+  const std::string package = "package://", file = "file://";
+  if (v.mesh.rfind(package, 0) == 0) {
+    const std::string rest = v.mesh.substr(package.size());
+    const std::string name = rest.substr(0, rest.find('/'));
+    const std::string inside =
+        rest.find('/') == std::string::npos ? "" : rest.substr(rest.find('/') + 1);
+    for (fs::path up = folder; !up.empty(); up = up.parent_path()) {
+      if (up.filename() == name) candidates.push_back(up / inside);
+      candidates.push_back(up / name / inside);
+      if (up == up.parent_path()) break;
+    }
+    if (const char* ros = std::getenv("ROS_PACKAGE_PATH")) {
+      std::istringstream paths(ros);
+      for (std::string p; std::getline(paths, p, ':');)
+        if (!p.empty()) candidates.push_back(fs::path(p) / name / inside);
+    }
+  } else if (v.mesh.rfind(file, 0) == 0) {
+    candidates.push_back(v.mesh.substr(file.size()));
+  } else if (!v.mesh.empty()) {
+    candidates.push_back(fs::path(v.mesh).is_absolute() ? fs::path(v.mesh) : folder / v.mesh);
+  }
+  for (const fs::path& p : candidates) {
+    std::error_code ec;
+    if (fs::is_regular_file(p, ec)) {
+      v.mesh_path = p.lexically_normal().string();
+      return;
+    }
+  }
+  v.mesh_issue = "not found" + std::string(v.mesh.rfind(package, 0) == 0
+                                               ? " (its package folder is neither above the URDF "
+                                                 "nor on ROS_PACKAGE_PATH)"
+                                               : "");
+}
+
+Visual visual_of(const Ctx& c, const XMLElement* robot, const XMLElement* visual,
+                 const std::string& link) {
   const std::string who = "link " + quoted_text(link) + " <visual>";
   const XMLElement* geometry = visual->FirstChildElement("geometry");
   const XMLElement* shape = geometry ? geometry->FirstChildElement() : nullptr;
   if (!shape) c.fail(who, "no <geometry>");
   const Origin o = origin_of(c, visual, who);
-  UrdfVisual v{link,
-               shape->Name(),
-               Vec3::Zero(),
-               "",
-               o.xyz,
-               o.rpy,
-               material_color(c, robot, visual->FirstChildElement("material"), who)};
+  Visual v;
+  v.link = link;
+  v.shape = shape->Name();
+  v.xyz = o.xyz;
+  v.R = rpy_to_rotation(o.rpy);
+  v.rgba = material_color(c, robot, visual->FirstChildElement("material"), who);
   if (v.shape == "box") {
     v.size = vec_attr(c, shape, "size", Vec3::Zero(), who);
   } else if (v.shape == "cylinder") {
@@ -111,6 +151,7 @@ UrdfVisual visual_of(const Ctx& c, const XMLElement* robot, const XMLElement* vi
   } else if (v.shape == "mesh") {
     v.size = vec_attr(c, shape, "scale", Vec3::Ones(), who);
     v.mesh = shape->Attribute("filename") ? shape->Attribute("filename") : "";
+    find_mesh(c.source, v);
   } else {
     c.fail(who, "unknown geometry <" + echo_text(v.shape) + ">");
   }
@@ -120,11 +161,11 @@ UrdfVisual visual_of(const Ctx& c, const XMLElement* robot, const XMLElement* vi
 
 }  // namespace
 
-std::vector<UrdfVisual> urdf_visuals(const std::string& text, const std::string& source) {
+std::vector<Visual> urdf_visuals(const std::string& text, const std::string& source) {
   const Ctx c{source};
   tinyxml2::XMLDocument doc;
   const XMLElement* robot = robot_element(doc, text, source);
-  std::vector<UrdfVisual> out;
+  std::vector<Visual> out;
   for (const XMLElement* link = robot->FirstChildElement("link"); link;
        link = link->NextSiblingElement("link")) {
     const char* name = link->Attribute("name");

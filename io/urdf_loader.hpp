@@ -19,6 +19,7 @@
 #include "core/math.hpp"
 #include "io/model_format.hpp"
 #include "io/params.hpp"
+#include "io/visual.hpp"
 
 namespace femdyn {
 
@@ -35,18 +36,9 @@ UrdfResult urdf_to_model(const std::string& xml_text, const std::string& source,
                          const UrdfOptions& options = {});
 UrdfResult read_urdf(const std::string& path, const UrdfOptions& options = {});
 
-// A link's <visual>, in the link frame: a primitive (box: size x y z; cylinder: radius, length
-// along z; sphere: radius) or a mesh (its filename; size holds its scale). Read for the 3-D
-// view (view/scene.hpp); the equations never see it.
-struct UrdfVisual {
-  std::string link;
-  std::string shape;  // box, cylinder, sphere or mesh
-  Vec3 size = Vec3::Zero();
-  std::string mesh;
-  Vec3 xyz = Vec3::Zero(), rpy = Vec3::Zero();
-  std::optional<Eigen::Vector4d>
-      rgba;  // <material><color>, or that of the robot's material of its name
-};
-std::vector<UrdfVisual> urdf_visuals(const std::string& xml_text, const std::string& source);
+// The links' <visual>s (io/visual.hpp), each in its link's frame: box, cylinder, sphere, or a
+// mesh whose filename is found relative to the URDF's folder, as file://, or as
+// package://NAME/… in a folder NAME above the URDF or on ROS_PACKAGE_PATH.
+std::vector<Visual> urdf_visuals(const std::string& xml_text, const std::string& source);
 
 }  // namespace femdyn

@@ -22,12 +22,12 @@ using namespace femdyn::test;
 namespace {
 
 // The worst relative errors: along q, along v, of ∂q̈/∂τ.
-struct Agreement {
+struct LoopAgreement {
   double central = 0, richardson = 0, tau = 0;
   double central_v = 0, richardson_v = 0;
 };
 
-Agreement compare(const Model& m, const VecX& q, const VecX& v, const VecX& tau, double omega) {
+LoopAgreement compare(const Model& m, const VecX& q, const VecX& v, const VecX& tau, double omega) {
   Workspace ws(m), wf(m);
   LoopWorkspace lws(m), lf(m);
   DerivativeWorkspace d(m);
@@ -38,7 +38,7 @@ Agreement compare(const Model& m, const VecX& q, const VecX& v, const VecX& tau,
   REQUIRE(constrained_forward_dynamics_derivatives(m, ws, lws, d, q, v, tau, omega).ok);
   REQUIRE(constrained_forward_dynamics(m, wf, lf, q, v, tau, omega).ok);
   CHECK(rel_error(d.qdd, wf.qdd) < 1e-12);
-  Agreement a;
+  LoopAgreement a;
   for (const bool wrt_q : {true, false}) {
     const MatX& analytic = wrt_q ? d.dqdd_dq : d.dqdd_dv;
     const MatX c = central(m, qdd_of, q, v, wrt_q, 1e-6), r = richardson(m, qdd_of, q, v, wrt_q);
@@ -65,8 +65,8 @@ Agreement compare(const Model& m, const VecX& q, const VecX& v, const VecX& tau,
 }
 
 void check(const Model& m, const VecX& q, const VecX& v, const VecX& tau, double omega,
-           Agreement& worst, double richardson_tolerance = 1e-9) {
-  const Agreement a = compare(m, q, v, tau, omega);
+           LoopAgreement& worst, double richardson_tolerance = 1e-9) {
+  const LoopAgreement a = compare(m, q, v, tau, omega);
   CAPTURE(omega, a.central, a.richardson, a.central_v, a.richardson_v, a.tau);
   CHECK(std::max(a.central, a.central_v) < 1e-6);
   CHECK(std::max(a.richardson, a.richardson_v) < richardson_tolerance);
@@ -106,7 +106,7 @@ std::string mixed_loop_tree(unsigned seed) {
 }  // namespace
 
 TEST_CASE("loop derivatives: every constraint form, off the loops", "[loop_derivatives]") {
-  Agreement worst;
+  LoopAgreement worst;
   int states = 0;
   for (unsigned seed = 1; seed <= 8; ++seed)
     for (const double omega : {0.0, 20.0}) {
@@ -138,7 +138,7 @@ TEST_CASE("loop derivatives: every constraint form, off the loops", "[loop_deriv
 
 TEST_CASE("loop derivatives: assembled closable trees with a weld or a ball",
           "[loop_derivatives]") {
-  Agreement worst;
+  LoopAgreement worst;
   for (unsigned seed : {1u, 2u, 3u})
     for (const bool weld : {false, true}) {
       INFO("closable_tree " << seed << (weld ? " weld" : " ball"));
@@ -155,7 +155,7 @@ TEST_CASE("loop derivatives: assembled closable trees with a weld or a ball",
 }
 
 TEST_CASE("loop derivatives: the bundled loop models", "[loop_derivatives]") {
-  Agreement worst;
+  LoopAgreement worst;
   for (const char* file : {"andrews.json", "delta.json", "finger_fourbar_loop.json",
                            "five_bar.json", "iftomm_a02_nfourbar.json"}) {
     INFO(file);
@@ -170,7 +170,7 @@ TEST_CASE("loop derivatives: the bundled loop models", "[loop_derivatives]") {
     check(m, q, v, tau, 20.0, worst, richardson);
     // off the loops
     const VecX off = integrate_posture(m, q, random_uniform(m.n(), 0.02, rng));
-    Agreement one;
+    LoopAgreement one;
     check(m, off, v, tau, 20.0, one, richardson);
     check(m, q, v, tau, 0.0, one, richardson);
     WARN(file << ": central " << one.central << ", Richardson " << one.richardson << ", tau "
@@ -190,7 +190,7 @@ TEST_CASE("loop derivatives: Bricard's mechanism along v and tau", "[loop_deriva
   REQUIRE(assemble_state(m, q, v).assembly.status.ok);
   const VecX tau = moderate_tau(m, q, v, rng);
   for (const double omega : {0.0, 20.0}) {
-    const Agreement a = compare(m, q, v, tau, omega);
+    const LoopAgreement a = compare(m, q, v, tau, omega);
     CAPTURE(omega, a.central_v, a.richardson_v, a.tau);
     CHECK(a.central_v < 1e-6);
     CHECK(a.richardson_v < 1e-9);
@@ -209,7 +209,7 @@ TEST_CASE("loop derivatives: a planar loop closed by 3-D balls (redundant rows)"
   std::mt19937 rng(3);
   VecX v = random_uniform(m.n(), 20.0, rng);
   REQUIRE(assemble_state(m, q, v).assembly.status.ok);
-  Agreement worst;
+  LoopAgreement worst;
   const VecX tau = moderate_tau(m, q, v, rng);
   for (const double omega : {0.0, 20.0}) check(m, q, v, tau, omega, worst);
   LoopWorkspace lws(m);

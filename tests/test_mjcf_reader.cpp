@@ -64,9 +64,27 @@ TEST_CASE("MJCF: bad or unread input is one line naming the file, the element an
     CHECK_THAT(message, Catch::Contains(name) && Catch::Contains(expected));
     CHECK(message.find('\n') == std::string::npos);
   };
-  refused("mesh.xml", "<body><joint/><geom type=\"mesh\" mesh=\"m\"/></body>",
-          "<asset><mesh name=\"m\" file=\"m.stl\"/></asset>",
-          "<geom> (line 1): the body's mass comes from mesh 'm' (file 'm.stl')");
+  const std::string mesh_geom = "<body><joint/><geom type=\"mesh\" mesh=\"m\"/></body>";
+  refused("mesh.xml", mesh_geom, "<asset><mesh name=\"m\" file=\"m.stl\"/></asset>",
+          "<geom> (line 1): mesh 'm': ");
+  refused("dae.xml", mesh_geom, "<asset><mesh name=\"m\" file=\"m.dae\"/></asset>",
+          "a mesh femdyn does not read (.dae)");
+  refused("hull.xml", mesh_geom,
+          "<asset><mesh name=\"m\" vertex=\"0 0 0 1 0 0 0 1 0 0 0 1\"/></asset>",
+          "<mesh name='m'> (line 1): vertices without faces: MuJoCo takes their convex hull");
+  refused("flat.xml", mesh_geom,
+          "<asset><mesh name=\"m\" vertex=\"0 0 0 1 0 0 0 1 0\" face=\"0 1 2 0 2 1\"/></asset>",
+          "bounds no volume");
+  refused("convex.xml", mesh_geom,
+          "<asset><mesh name=\"m\" inertia=\"convex\" vertex=\"0 0 0 1 0 0 0 1 0 0 0 1\" "
+          "face=\"0 2 1 0 1 3 1 2 3 0 3 2\"/></asset>",
+          "inertia=\"convex\"");
+  refused("shell.xml",
+          "<body><joint/><geom type=\"mesh\" mesh=\"m\" shellinertia=\"true\"/></body>",
+          "<asset><mesh name=\"m\" vertex=\"0 0 0 1 0 0 0 1 0 0 0 1\" face=\"0 2 1 0 1 3 1 2 3 0 3 "
+          "2\"/></asset>",
+          "shellinertia");
+  refused("nomesh.xml", mesh_geom, "", "mesh 'm' is not an <asset> <mesh>");
   refused("class.xml", "<body><joint class=\"nope\"/>" + arm + "</body>", "",
           "<joint> (line 1): class 'nope' is not defined");
   refused("two.xml", "<body quat=\"1 0 0 0\" euler=\"0 0 1\"><joint/>" + arm + "</body>", "",
@@ -80,6 +98,10 @@ TEST_CASE("MJCF: bad or unread input is one line naming the file, the element an
   refused("frame.xml", "<body><frame><joint/></frame>" + arm + "</body>", "",
           "a joint inside a <frame> is not read yet");
   refused("empty.xml", "", "", "<worldbody> holds no body");
+  std::string deep;  // 100 bodies nested: beyond the XML reader's depth, and MuJoCo's
+  for (int k = 0; k < 100; ++k) deep += "<body><joint/>" + arm;
+  for (int k = 0; k < 100; ++k) deep += "</body>";
+  refused("deep.xml", deep, "", "elements nested deeper than 100 at line 1");
   const std::string twice =
       write("twice.xml", "", "<include file=\"part.xml\"/><include file=\"part.xml\"/>");
   std::ofstream((scratch.dir / "part.xml").string()) << "<mujoco/>";
@@ -170,4 +192,96 @@ TEST_CASE("MJCF: fullinertia is the same body as diaginertia turned by quat", "[
   mass_matrix(b, wb, q);
   CHECK(rel_error(wa.Ms, wb.Ms) < 1e-14);
   CHECK(wa.Ms.norm() > 0.01);
+}
+
+namespace {
+
+// A box's corners and faces as MJCF's inline mesh attributes, wound outward.
+std::string box_mesh_attributes(const Vec3& lo, const Vec3& hi) {
+  std::string v = "vertex=\"";
+  for (int k = 0; k < 8; ++k) {
+    const bool x = k == 1 || k == 2 || k == 5 || k == 6, y = k == 2 || k == 3 || k == 6 || k == 7;
+    char corner[120];
+    std::snprintf(corner, sizeof corner, "%.17g %.17g %.17g ", x ? hi.x() : lo.x(),
+                  y ? hi.y() : lo.y(), k >= 4 ? hi.z() : lo.z());
+    v += corner;
+  }
+  return v + "\" face=\"0 2 1 0 3 2 4 5 6 4 6 7 0 1 5 0 5 4 1 2 6 1 6 5 2 3 7 2 7 6 3 0 4 3 4 7\"";
+}
+
+// τ of two models at the same random states: the largest relative difference.
+double tau_difference(const Model& a, const Model& b) {
+  Workspace wa(a), wb(b);
+  std::mt19937 rng(17);
+  double worst = 0;
+  for (int k = 0; k < 4; ++k) {
+    const VecX q = random_posture(a, rng), qd = random_uniform(a.n(), 1, rng);
+    inverse_dynamics(a, wa, q, qd, qd);
+    inverse_dynamics(b, wb, q, qd, qd);
+    worst = std::max(worst, rel_error(wa.tau, wb.tau));
+  }
+  return worst;
+}
+
+}  // namespace
+
+// A mesh geom weighs the solid its mesh bounds: a box mesh equals the box geom, in any pose;
+// a non-convex mesh follows MuJoCo's legacy inertia (with a note) unless inertia="exact".
+TEST_CASE("MJCF: a mesh geom's mass is the solid its mesh bounds, as MuJoCo computes it",
+          "[mjcf][mesh]") {
+  Scratch scratch("mjcf_mesh");
+  const auto model = [&](const std::string& name, const std::string& assets,
+                         const std::string& geoms, std::vector<std::string>* warnings = nullptr) {
+    const std::string path = (scratch.dir / name).string();
+    std::ofstream(path) << "<mujoco><asset>" << assets
+                        << "</asset><worldbody><body name=\"a\" pos=\"0 0 1\"><joint/>"
+                           "<geom type=\"capsule\" fromto=\"0 0 0 0.3 0 0\" size=\"0.02\"/>"
+                           "<body name=\"b\" pos=\"0.3 0 0\"><joint axis=\"1 0 0\"/>"
+                        << geoms << "</body></body></worldbody></mujoco>";
+    LoadOptions options;
+    options.warn = [&](const std::string& w) {
+      if (warnings) warnings->push_back(w);
+    };
+    return load_model(path, options);
+  };
+  const std::string pose = "pos=\"0.1 0.02 -0.03\" euler=\"20 -35 50\"";
+  const Model primitive = model(
+      "box.xml", "", "<geom type=\"box\" size=\"0.1 0.03 0.02\" density=\"2700\" " + pose + "/>");
+  const Model inline_mesh =
+      model("inline.xml",
+            "<mesh name=\"m\" " +
+                box_mesh_attributes(Vec3(-0.1, -0.03, -0.02), Vec3(0.1, 0.03, 0.02)) + "/>",
+            "<geom type=\"mesh\" mesh=\"m\" density=\"2700\" " + pose + "/>");
+  CHECK(tau_difference(inline_mesh, primitive) < 1e-13);
+  // A box off the mesh's origin, and a mass given instead of a density.
+  const Model off = model(
+      "off.xml",
+      "<mesh name=\"m\" " + box_mesh_attributes(Vec3(0.3, 0.2, 0.1), Vec3(0.5, 0.26, 0.14)) + "/>",
+      "<geom type=\"mesh\" mesh=\"m\" mass=\"1.296\"/>");
+  const Model off_box =
+      model("off_box.xml", "",
+            "<geom type=\"box\" size=\"0.1 0.03 0.02\" pos=\"0.4 0.23 0.12\" mass=\"1.296\"/>");
+  CHECK(tau_difference(off, off_box) < 1e-13);
+  // Two boxes apart in one mesh: MuJoCo's legacy inertia counts more than the solid, and says
+  // so; inertia="exact" is the two boxes.
+  const std::string two =
+      "vertex=\"0 0 0 1 0 0 1 .2 0 0 .2 0 0 0 .2 1 0 .2 1 .2 .2 0 .2 .2 "
+      "0 0 .5 .2 0 .5 .2 .2 .5 0 .2 .5 0 0 1.5 .2 0 1.5 .2 .2 1.5 0 .2 1.5\" face=\"0 2 1 0 3 2 4 "
+      "5 6 4 6 7 "
+      "0 1 5 0 5 4 1 2 6 1 6 5 2 3 7 2 7 6 3 0 4 3 4 7 8 10 9 8 11 10 12 13 14 12 14 15 8 9 13 8 "
+      "13 12 9 10 14 9 14 13 10 11 15 10 15 14 11 8 12 11 12 15\"";
+  std::vector<std::string> warnings;
+  const Model legacy = model("legacy.xml", "<mesh name=\"m\" " + two + "/>",
+                             "<geom type=\"mesh\" mesh=\"m\" density=\"700\"/>", &warnings);
+  REQUIRE(warnings.size() == 2);  // the contacts, and the mesh
+  CHECK_THAT(warnings[0] + warnings[1],
+             Catch::Contains("1 mesh is not convex") && Catch::Contains("'m' (×1.73)"));
+  const Model exact = model("exact.xml", "<mesh name=\"m\" inertia=\"exact\" " + two + "/>",
+                            "<geom type=\"mesh\" mesh=\"m\" density=\"700\"/>");
+  const Model boxes =
+      model("boxes.xml", "",
+            "<geom type=\"box\" size=\"0.5 0.1 0.1\" pos=\"0.5 0.1 0.1\" density=\"700\"/>"
+            "<geom type=\"box\" size=\"0.1 0.1 0.5\" pos=\"0.1 0.1 1\" density=\"700\"/>");
+  CHECK(tau_difference(exact, boxes) < 1e-13);
+  CHECK(tau_difference(legacy, boxes) > 1e-2);
 }

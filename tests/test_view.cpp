@@ -2,14 +2,19 @@
 // the kinematics give them; the page is whole and its scene readable; the command refuses bad
 // trajectories in one line, never replaces a file without --force and never leaves half a
 // file. The page in a browser: tests/view_browser.py.
+#include <Eigen/Eigenvalues>
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 
+#include "core/body_inertia.hpp"
 #include "core/frames.hpp"
+#include "io/mesh.hpp"
+#include "io/mjcf_loader.hpp"
 #include "io/urdf_loader.hpp"
 #include "tests/helpers.hpp"
 #include "view/page.hpp"
@@ -102,8 +107,7 @@ TEST_CASE("view: every bundled model and URDF robot has a page of its posture", 
     const Model m = load_model(path);
     const std::string page = view::page_html(view::scene_json(
         m, view::posture(m, neutral_posture(m)),
-        is_urdf_path(path) ? urdf_visuals(read_file(path), path) : std::vector<UrdfVisual>{},
-        path));
+        is_urdf_path(path) ? urdf_visuals(read_file(path), path) : std::vector<Visual>{}, path));
     const nlohmann::json scene = scene_of_page(page);
     CHECK(scene["bodies"].size() == m.bodies.size());
     CHECK(scene["elements"].size() == m.elements.size());
@@ -150,10 +154,10 @@ TEST_CASE("view: a long trajectory keeps at most kMaxFrames, its first and last 
 TEST_CASE("view: a URDF's visual primitives and their colours are read", "[view]") {
   const std::string path = model_path("urdf/arm7.urdf");
   const std::string text = read_file(path);
-  const std::vector<UrdfVisual> visuals = urdf_visuals(text, path);
+  const std::vector<Visual> visuals = urdf_visuals(text, path);
   CHECK(visuals.size() == count_of(text, "<visual>"));
   std::set<std::string> shapes;
-  for (const UrdfVisual& v : visuals) {
+  for (const Visual& v : visuals) {
     shapes.insert(v.shape);
     CHECK(v.rgba.has_value());  // inline, or by the robot's material of that name
   }
@@ -228,4 +232,125 @@ TEST_CASE("femdyn view refuses a bad trajectory in one line and writes nothing",
   check_one_line_error(run("view " + finger + " --out " + finger + " --force"), "--out",
                        "is an input file");
   CHECK(!std::filesystem::exists(out));
+}
+
+namespace {
+
+std::string data_path(const std::string& name) {
+  return std::string(FEMDYN_SOURCE_DIR) + "/tests/data/" + name;
+}
+
+// The bytes of a base64 text (RFC 4648), to read back a mesh the scene embeds.
+std::vector<unsigned char> from_base64(const std::string& text) {
+  const std::string digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::vector<unsigned char> out;
+  unsigned bits = 0, n = 0;
+  for (const char c : text) {
+    if (c == '=') break;
+    bits = (bits << 6) | static_cast<unsigned>(digits.find(c));
+    if ((n += 6) >= 8) out.push_back(static_cast<unsigned char>((bits >> (n -= 8)) & 255));
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("view: an MJCF's geoms are drawn, its meshes embedded as the files hold them",
+          "[view][mjcf][mesh]") {
+  const std::string path = data_path("mjcf/meshes.xml");
+  const Model m = load_model(path);
+  const MjcfResult read = read_mjcf(path);
+  const nlohmann::json scene =
+      view::scene_json(m, view::posture(m, neutral_posture(m)), read.visuals, "meshes.xml");
+  CHECK(scene["visuals"].size() == 6);  // every geom of groups 0-2
+  REQUIRE(scene["not_drawn"].size() == 1);
+  CHECK(scene["not_drawn"][0]["why"] == "an inline mesh, which the page does not draw");
+  REQUIRE(scene["meshes"].size() == 3);
+  // The ball: its positions are the OBJ's vertices as float32, its indices the triangles.
+  const TriangleMesh ball = read_mesh(data_path("mjcf/meshes/ball.obj"));
+  bool found = false;
+  for (const auto& mesh : scene["meshes"]) {
+    if (mesh["triangles"] != ball.triangles.size()) continue;
+    found = true;
+    const std::vector<unsigned char> xyz = from_base64(mesh["positions"]);
+    const std::vector<unsigned char> idx = from_base64(mesh["indices"]);
+    REQUIRE(xyz.size() == ball.vertices.size() * 3 * sizeof(float));
+    REQUIRE(idx.size() == ball.triangles.size() * 3 * sizeof(std::uint32_t));
+    std::vector<float> p(xyz.size() / sizeof(float));
+    std::memcpy(p.data(), xyz.data(), xyz.size());
+    double worst = 0;
+    for (std::size_t v = 0; v < ball.vertices.size(); ++v)
+      for (int k = 0; k < 3; ++k)
+        worst = std::max(worst, std::abs(p[3 * v + k] - ball.vertices[v][k]));
+    CHECK(worst < 1e-8);
+    std::uint32_t last = 0;
+    std::memcpy(&last, idx.data() + idx.size() - 4, 4);
+    CHECK(last == ball.triangles.back()[2]);
+  }
+  CHECK(found);
+  // A geom sits where the body's frame puts it: the upper arm's wedge at its pos, turned by
+  // its euler (radians), in the frame of the femdyn body that carries the MuJoCo body.
+  for (const auto& v : scene["visuals"])
+    if (v["link"] == "upper") {
+      CHECK(v["body"] == 1);
+      CHECK(std::abs(v["p"][0].get<double>() - 0.02) < 1e-6);
+      CHECK(std::abs(v["p"][1].get<double>() - 0.01) < 1e-6);
+    }
+}
+
+TEST_CASE(
+    "view: a URDF's meshes are found (relative, package://, Collada) and placed on "
+    "their link's body",
+    "[view][mesh]") {
+  const std::string path = data_path("urdf/meshed/meshed_arm.urdf");
+  const Model m = load_model(path);
+  const std::vector<Visual> visuals = urdf_visuals(read_file(path), path);
+  REQUIRE(visuals.size() == 6);
+  for (const Visual& v : visuals)
+    if (v.shape == "mesh") CHECK(!v.mesh_path.empty());  // every file found
+  const nlohmann::json scene =
+      view::scene_json(m, view::posture(m, neutral_posture(m)), visuals, "meshed_arm.urdf");
+  CHECK(scene["not_drawn"].empty());
+  CHECK(scene["meshes"].size() == 4);  // bar, wedge ×(2 2 1), ball, the Collada camera
+  std::size_t collada = 0;
+  for (const auto& mesh : scene["meshes"]) collada += mesh.contains("collada");
+  CHECK(collada == 1);
+  CHECK(scene["counts"]["visuals"] == 6);
+  // The root link is welded to the world: its visual is drawn on the world (-1).
+  CHECK(scene["visuals"][0]["link"] == "base");
+  CHECK(scene["visuals"][0]["body"] == -1);
+  // A missing mesh is listed with why, and the page still written.
+  std::vector<Visual> missing = visuals;
+  missing[0].mesh_path.clear();
+  missing[0].mesh_issue = "not found";
+  const nlohmann::json partial =
+      view::scene_json(m, view::posture(m, neutral_posture(m)), missing, "meshed_arm.urdf");
+  REQUIRE(partial["not_drawn"].size() == 1);
+  CHECK(partial["not_drawn"][0]["why"] == "not found");
+}
+
+// A body without visuals is drawn as its inertia box: the box of the same mass whose principal
+// moments are the body's, m (b² + c²)/12 = I₁ and so on. A loop constraint's two places are in
+// the scene, on their bodies.
+TEST_CASE("view: inertia boxes hold each body's moments, and loop closures are in the scene",
+          "[view][loops]") {
+  const Model m = load_model(model_path("five_bar.json"));
+  const nlohmann::json scene =
+      view::scene_json(m, view::posture(m, neutral_posture(m)), {}, "five_bar.json");
+  const std::vector<MassProperties> mp = body_mass_properties(m);
+  std::size_t massive = 0;
+  for (const MassProperties& p : mp) massive += p.mass > 0;
+  REQUIRE(scene["inertia_boxes"].size() == massive);
+  for (const auto& box : scene["inertia_boxes"]) {
+    const MassProperties& p = mp[box["body"].get<std::size_t>()];
+    const Vec3 e(box["size"][0], box["size"][1], box["size"][2]);
+    const Vec3 moments =
+        Vec3(e[1] * e[1] + e[2] * e[2], e[0] * e[0] + e[2] * e[2], e[0] * e[0] + e[1] * e[1]) *
+        (p.mass / 12);
+    const Eigen::SelfAdjointEigenSolver<Mat3> principal(p.inertia_com());
+    CHECK((moments - principal.eigenvalues()).norm() < 1e-5 * principal.eigenvalues().norm());
+  }
+  REQUIRE(scene["constraints"].size() == m.constraints.size());
+  CHECK(scene["constraints"][0]["a"]["body"] == m.constraints[0].a.body);
+  CHECK(scene["constraints"][0]["b"]["body"] == m.constraints[0].b.body);
 }

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The page of `femdyn view` in a real browser: headless Chromium (Debian's `chromium`).
 
-usage: view_browser.py FEMDYN SOURCE_DIR WORK_DIR CASE      (CASE: finger, hand or arm7)
+usage: view_browser.py FEMDYN SOURCE_DIR WORK_DIR CASE
+       (CASE: finger, hand, arm7, meshes, loop or urdf_meshes)
 
 For the case's model it simulates a short trajectory, writes the page of one posture and the
 page of the trajectory, and in one headless Chromium (driven over the DevTools protocol):
@@ -11,7 +12,14 @@ page of the trajectory, and in one headless Chromium (driven over the DevTools p
     visuals counted in the URDF here);
   - takes screenshots of the trajectory's 3-D view at #t=0 and at its last time: not blank,
     and different from each other;
-  - moves the mouse over named objects: the tooltip names a body of the model.
+  - moves the mouse over named objects: the tooltip names a body of the model;
+  - meshes (MJCF, floating base) and urdf_meshes (URDF: relative, package:// and Collada meshes,
+    one on a welded link): the visuals and distinct meshes drawn equal those the file holds,
+    counted here from the XML;
+  - loop (a five-bar closed by a ball constraint): every constraint of `femdyn info` is drawn,
+    its two places together (within 1e-4 of the model's size) at every screenshot;
+  - finger, again in a Chromium without WebGL (--disable-3d-apis): the page says so, holds the
+    same counts and draws its plots.
 Exit 77 (ctest's SKIP_RETURN_CODE) when Chromium is absent; tools/setup.sh --all installs it.
 """
 import base64
@@ -37,6 +45,10 @@ CASES = {
     "hand": ("models/hand.json", ["--t-end", "0.6", "--every", "10"]),
     "arm7": ("models/urdf/arm7.urdf",
              ["--t-end", "0.6", "--q0", "0.3,0.6,0,0.8,0,0,0", "--every", "10"]),
+    "meshes": ("tests/data/mjcf/meshes.xml", ["--t-end", "0.4", "--every", "10"]),
+    "loop": ("models/five_bar.json", ["--t-end", "0.6", "--every", "10"]),
+    "urdf_meshes": ("tests/data/urdf/meshed/meshed_arm.urdf",
+                    ["--t-end", "0.6", "--q0", "0.5,0.2", "--every", "10"]),
 }
 
 
@@ -59,7 +71,7 @@ class Chromium:
     JSON messages ending in a NUL byte, written to its fd 3 and read from its fd 4): one browser
     for every page of a case. Software WebGL (SwiftShader); a fixed WIDTH x HEIGHT view."""
 
-    def __init__(self, exe, profile):
+    def __init__(self, exe, profile, extra_flags=()):
         self.log = profile + ".log"  # Chromium's messages, quoted when it fails
         self._log = open(self.log, "w")
         to_chrome, self._out = os.pipe()
@@ -75,7 +87,7 @@ class Chromium:
              "--enable-unsafe-swiftshader", "--no-first-run", "--disable-extensions",
              "--remote-debugging-pipe", f"--user-data-dir={profile}",
              f"--window-size={WIDTH},{HEIGHT}",
-             "--hide-scrollbars", "about:blank"],
+             "--hide-scrollbars", *extra_flags, "about:blank"],
             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=self._log,
             preexec_fn=child_fds, pass_fds=(3, 4))
         os.close(to_chrome)
@@ -220,14 +232,26 @@ def expected_counts(femdyn, model, source_dir):
     if model.endswith(".urdf"):
         robot = ET.parse(os.path.join(source_dir, model)).getroot()
         counts["visuals"] = len(robot.findall("./link/visual"))
+        meshes = {(m.get("filename"), m.get("scale")) for m in robot.iter("mesh")}
+        counts["meshes"] = len(meshes)
+    if model.endswith(".xml"):  # MJCF: the geoms MuJoCo's viewer draws (no class defaults here)
+        root = ET.parse(os.path.join(source_dir, model)).getroot()
+        inline = {m.get("name") for m in root.find("asset").iter("mesh") if m.get("file") is None}
+        geoms = [g for g in root.find("worldbody").iter("geom")
+                 if int(g.get("group", "0")) <= 2 and g.get("type") not in ("plane", "hfield")]
+        counts["visuals"] = sum(g.get("mesh") not in inline for g in geoms)
+        counts["not_drawn"] = sum(g.get("mesh") in inline for g in geoms)
+        counts["meshes"] = len({g.get("mesh") for g in geoms if g.get("mesh")} - inline)
+    counts["constraints"] = sum(c["type"] != "gear" for c in info.get("constraints", []))
     return info, counts
 
 
-def check_status(status, counts, frames_min, page):
+def check_status(status, counts, frames_min, page, webgl=True):
     where, data = os.path.basename(page), status["data"]
     assert not status["errors"], f"{where}: JavaScript errors: {status['errors']}"
     assert data.get("status") == "ok", f"{where}: status {data.get('status')}: {status['text']}"
-    assert data.get("webgl") == "true", f"{where}: no WebGL context"
+    want = "true" if webgl else "false"
+    assert data.get("webgl") == want, f"{where}: WebGL {data.get('webgl')}, expected {want}"
     for key, want in counts.items():
         got = data.get(key)
         assert got == str(want), f"{where}: the page drew {got} {key}, femdyn reports {want}"
@@ -255,6 +279,30 @@ def check_hover(browser, info, case):
     named = [n for n in names if n and any(b in n for b in bodies)]
     assert named, f"{case}: hovering named no body of the model: {names}"
     return named[0]
+
+
+def check_closures(browser, counts, case, t):
+    """Each loop constraint drawn with its two places together (a closed loop, drawn closed)."""
+    closures = browser.evaluate("window.femdynView.closures()")
+    assert len(closures) == counts["constraints"], f"{case}: {len(closures)} closures drawn"
+    for c in closures:
+        assert c["distance"] <= 1e-4 * c["extent"], \
+            f"{case}: at t = {t} a loop is drawn open by {c['distance']:.3g} m"
+    return len(closures)
+
+
+def check_without_webgl(exe, work, page, counts, case):
+    """The page in a Chromium without WebGL: it says so, holds the scene and draws its plots."""
+    browser = Chromium(exe, os.path.join(work, "profile-nogl"), ["--disable-3d-apis"])
+    try:
+        browser.open(f"file://{page}")
+        check_status(browser.status(), counts, 1, page, webgl=False)
+        note = browser.evaluate("(document.getElementById('no-webgl') || {}).textContent || ''")
+        assert "no WebGL" in note, f"{case}: without WebGL the page does not say so: {note!r}"
+        ink = browser.evaluate("window.femdynView.plotInk()")
+        assert all(share > 0.002 for share in ink), f"{case}: plots blank without WebGL: {ink}"
+    finally:
+        browser.close()
 
 
 def main():
@@ -289,18 +337,22 @@ def main():
         for page, frames_min in ((posture, 1), (moving, 2)):
             browser.open(f"file://{page}")
             check_status(browser.status(), counts, frames_min, page)
+        closures = 0
         for t in times:
             png = os.path.join(work, f"t{t:g}.png")
             browser.screenshot_at(t, png)
             shots.append(png_pixels(png)[2])
+            closures = check_closures(browser, counts, case, t)
         hovered = check_hover(browser, info, case)
         assert not browser.status()["errors"], f"{case}: JavaScript errors while playing"
     finally:
         browser.close()
     share = check_screenshots(case, shots, times)
+    if case == "finger":
+        check_without_webgl(exe, work, posture, counts, case)
     print(f"{case}: {counts}; page {os.path.getsize(moving) / 1e6:.2f} MB; {share:.1%} of the "
-          f"view changed from t = 0 to {times[1]}; hover: {hovered!r}; "
-          f"{time.monotonic() - start:.1f} s")
+          f"view changed from t = 0 to {times[1]}; {closures} loops drawn closed; "
+          f"hover: {hovered!r}; {time.monotonic() - start:.1f} s")
     return 0
 
 

@@ -276,6 +276,53 @@ mjModel* compiled(const std::string& text, const std::string& file, const std::s
 // asset removed, and what M, τ and q̈ do not depend on and MuJoCo 2.2 may not know: actuators,
 // sensors, tendons, keyframes, <option>'s integrator and flags, joints' actuator force ranges.
 // (Gravity compensation, which does change τ, is reported by the reader.)
+// The <mesh> assets whose files exist (their paths made absolute: the prepared text is compiled
+// from elsewhere) and the geoms that use them are marked femdyn-kept; the others go with the
+// assets. MuJoCo 2.2 takes a mesh's mass from its equivalent-inertia box unless exactmeshinertia,
+// where MuJoCo 3 and femdyn take the solid's volume: the peer compiles with exactmeshinertia.
+void keep_meshes(tinyxml2::XMLElement& root, const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path folder = fs::path(path).parent_path();
+  fs::path meshdir = folder;
+  tinyxml2::XMLElement* compiler = root.FirstChildElement("compiler");
+  if (!compiler)
+    compiler = root.InsertFirstChild(root.GetDocument()->NewElement("compiler"))->ToElement();
+  for (const char* dir : {"assetdir", "meshdir"})
+    if (const char* d = compiler->Attribute(dir))
+      meshdir = fs::path(d).is_absolute() ? fs::path(d) : folder / d;
+  compiler->SetAttribute("exactmeshinertia", "true");
+  std::set<std::string> kept;
+  std::vector<tinyxml2::XMLElement*> stack = {&root};
+  while (!stack.empty()) {
+    tinyxml2::XMLElement* e = stack.back();
+    stack.pop_back();
+    for (tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+      stack.push_back(c);
+      if (std::string(c->Name()) != "mesh" || std::string(e->Name()) != "asset") continue;
+      const char* file = c->Attribute("file");
+      const fs::path target =
+          file ? (fs::path(file).is_absolute() ? fs::path(file) : meshdir / file) : fs::path();
+      std::error_code ec;
+      if (file && !fs::is_regular_file(target, ec)) continue;
+      if (file) c->SetAttribute("file", target.string().c_str());
+      c->SetAttribute("femdyn-kept", true);
+      kept.insert(c->Attribute("name") ? c->Attribute("name")
+                                       : fs::path(file ? file : "").stem().string());
+    }
+  }
+  stack = {&root};
+  while (!stack.empty()) {
+    tinyxml2::XMLElement* e = stack.back();
+    stack.pop_back();
+    for (tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
+      stack.push_back(c);
+      if (std::string(c->Name()) == "geom" && c->Attribute("mesh") &&
+          kept.count(c->Attribute("mesh")))
+        c->SetAttribute("femdyn-kept", true);
+    }
+  }
+}
+
 std::string prepared_mjcf(const std::string& path) {
   tinyxml2::XMLDocument doc;
   const auto refuse = [&](const std::string& why) {
@@ -309,6 +356,7 @@ std::string prepared_mjcf(const std::string& path) {
       inc->Parent()->DeleteChild(inc);
     }
   }
+  keep_meshes(*root, path);
   std::vector<tinyxml2::XMLElement*> stack = {root}, doomed;
   while (!stack.empty()) {
     tinyxml2::XMLElement* e = stack.back();
@@ -321,11 +369,18 @@ std::string prepared_mjcf(const std::string& path) {
       const std::string tag = c->Name();
       const char* type = c->Attribute("type");
       const bool mesh_geom =
-          tag == "geom" && (c->Attribute("mesh") || (type && (std::string(type) == "mesh" ||
-                                                              std::string(type) == "hfield")));
-      const bool unused = tag == "asset" || tag == "contact" || tag == "skin" || tag == "flag" ||
-                          tag == "actuator" || tag == "sensor" || tag == "keyframe" ||
-                          tag == "tendon";
+          tag == "geom" && ((c->Attribute("mesh") && !c->BoolAttribute("femdyn-kept")) ||
+                            (type && std::string(type) == "hfield"));
+      c->DeleteAttribute("femdyn-kept");
+      if (tag == "asset") {  // only the meshes keep_meshes kept
+        for (tinyxml2::XMLElement* a = c->FirstChildElement(); a; a = a->NextSiblingElement())
+          if (!a->BoolAttribute("femdyn-kept")) doomed.push_back(a);
+        for (tinyxml2::XMLElement* a = c->FirstChildElement(); a; a = a->NextSiblingElement())
+          a->DeleteAttribute("femdyn-kept");
+        continue;
+      }
+      const bool unused = tag == "contact" || tag == "skin" || tag == "flag" || tag == "actuator" ||
+                          tag == "sensor" || tag == "keyframe" || tag == "tendon";
       (unused || mesh_geom ? doomed : stack).push_back(c);
     }
   }

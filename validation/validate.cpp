@@ -370,8 +370,9 @@ struct Validator::Impl {
     // Each body's elements must sum to a rigid body: nothing else can be built in Simbody.
     try {
       tm = twin_model(m);
-    } catch (const ModelError& e) {
+    } catch (const ModelError& e) {  // a model Simbody cannot hold: no verdict on femdyn
       r.failure = e.what();
+      r.not_comparable = true;
       return false;
     }
     if (tm.closed_loop())

@@ -11,7 +11,8 @@
 namespace femdyn::validation {
 
 std::optional<QuantityError> validate_mjcf_import(const Model& m, const std::string& path,
-                                                  const ValidationOptions& o, std::string& why) {
+                                                  int mesh_masses, const ValidationOptions& o,
+                                                  std::string& why) {
   std::vector<const Joint*> moving;  // in rate order, as the peer maps them
   for (const Body& b : m.bodies)
     if (b.joint.idx_v >= 0) moving.push_back(&b.joint);
@@ -35,7 +36,14 @@ std::optional<QuantityError> validate_mjcf_import(const Model& m, const std::str
     why = e.what();
     return std::nullopt;
   }
-  QuantityError e{"mujoco", 0, 0, o.tolerance > 0 ? o.tolerance : pointwise_tolerance(m)};
+  double tolerance = o.tolerance > 0 ? o.tolerance : pointwise_tolerance(m);
+  if (mesh_masses > 0) {  // MuJoCo rounds mesh vertices to float and re-centres them in float
+    tolerance = std::max(tolerance, 1e-6);
+    why = "the mass of " + std::to_string(mesh_masses) + " mesh geom" +
+          (mesh_masses > 1 ? "s" : "") +
+          " compared to 1e-6: MuJoCo holds mesh vertices in single precision";
+  }
+  QuantityError e{"mujoco", 0, 0, tolerance};
   Workspace ws(m);
   std::mt19937 rng(o.seed);
   for (int k = 0; k < o.states; ++k) {

@@ -16,8 +16,8 @@ std::string page_html(const Json& scene);
 // only with `replace` (--force). Errors are femdyn::Error naming the path.
 void write_page(const std::string& path, const Json& scene, bool replace);
 
-// The page of `model`, read from `model_path` (a URDF's visuals are drawn; the page names the
-// file without its directory), showing `motion`: what `femdyn view` and Model.view write.
+// The page of `model`, read from `model_path` (a URDF's or MJCF's visuals are drawn; the page names
+// the file without its directory), showing `motion`: what `femdyn view` and Model.view write.
 void write_model_page(const std::string& path, const Model& model, const std::string& model_path,
                       const Motion& motion, bool replace);
 

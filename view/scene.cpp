@@ -1,12 +1,20 @@
 #include "view/scene.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
+#include <map>
+#include <set>
 
+#include "core/body_inertia.hpp"
 #include "core/errors.hpp"
 #include "core/joints/joint_type.hpp"
 #include "core/kinematics.hpp"
+#include "core/loops/constraint.hpp"
 #include "core/workspace.hpp"
+#include "io/input_file.hpp"
+#include "io/mesh.hpp"
 
 namespace femdyn::view {
 namespace {
@@ -66,15 +74,154 @@ Json element_json(const ElementEntry& e) {
           {"nodes", nodes}};
 }
 
-Json visual_json(const Model& m, const UrdfVisual& v) {
-  Json out = {{"body", body_named(m, v.link)},
-              {"link", v.link},
-              {"shape", v.shape},
-              {"size", vec_json(v.size)},
-              {"p", vec_json(v.xyz)},
-              {"quaternion", quaternion_json(rpy_to_rotation(v.rpy))}};
-  if (!v.mesh.empty()) out["mesh"] = v.mesh;
+// Base64 of raw bytes (RFC 4648), for the meshes' arrays.
+std::string base64(const void* data, std::size_t bytes) {
+  static constexpr char digits[] =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  const auto* b = static_cast<const unsigned char*>(data);
+  std::string out;
+  out.reserve((bytes + 2) / 3 * 4);
+  for (std::size_t i = 0; i < bytes; i += 3) {
+    const unsigned x =
+        (b[i] << 16) | (i + 1 < bytes ? b[i + 1] << 8 : 0) | (i + 2 < bytes ? b[i + 2] : 0);
+    out += digits[(x >> 18) & 63];
+    out += digits[(x >> 12) & 63];
+    out += i + 1 < bytes ? digits[(x >> 6) & 63] : '=';
+    out += i + 2 < bytes ? digits[x & 63] : '=';
+  }
+  return out;
+}
+
+// The meshes the visuals name, each file and scale read once, as base64 arrays the page turns
+// into geometry: positions float32 x y z per vertex, indices uint32 per triangle corner. At most
+// kMaxPageTriangles in all: a page stays one that a browser opens.
+struct MeshTable {
+  Json meshes = Json::array();
+  std::map<std::pair<std::string, std::string>, int> index;  // (path, scale) -> entry
+  std::size_t triangles = 0, collada_bytes = 0;
+
+  // The entry of v's mesh, or -1 with `why`.
+  int entry(const Visual& v, std::string& why) {
+    if (v.mesh_path.empty()) {
+      why = v.mesh_issue.empty() ? "not found" : v.mesh_issue;
+      return -1;
+    }
+    const std::pair<std::string, std::string> key{v.mesh_path, vec_json(v.size).dump()};
+    if (const auto it = index.find(key); it != index.end()) return it->second;
+    if (is_collada(v.mesh_path)) return collada(v, key, why);
+    TriangleMesh mesh;
+    try {
+      mesh = read_mesh(v.mesh_path, v.size);
+    } catch (const Error& e) {
+      why = e.what();
+      return -1;
+    }
+    if (triangles + mesh.triangles.size() > kMaxPageTriangles) {
+      why = "over the page's budget of " + std::to_string(kMaxPageTriangles) + " triangles";
+      return -1;
+    }
+    triangles += mesh.triangles.size();
+    std::vector<float> xyz;
+    xyz.reserve(3 * mesh.vertices.size());
+    for (const Vec3& p : mesh.vertices)
+      for (int k = 0; k < 3; ++k) xyz.push_back(static_cast<float>(p[k]));
+    meshes.push_back({{"triangles", mesh.triangles.size()},
+                      {"positions", base64(xyz.data(), xyz.size() * sizeof(float))},
+                      {"indices", base64(mesh.triangles.data(),
+                                         mesh.triangles.size() * sizeof(mesh.triangles[0]))}});
+    return index[key] = static_cast<int>(meshes.size()) - 1;
+  }
+
+  static bool is_collada(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return ext == ".dae";
+  }
+
+  // A Collada file goes in as its text, for three.js's Collada loader in the page (at most
+  // kMaxPageColladaBytes in all); its scale is applied there.
+  int collada(const Visual& v, const std::pair<std::string, std::string>& key, std::string& why) {
+    std::string text;
+    try {
+      text = read_input_file(v.mesh_path);
+    } catch (const Error& e) {
+      why = e.what();
+      return -1;
+    }
+    if (collada_bytes + text.size() > kMaxPageColladaBytes) {
+      why = "over the page's budget of " + std::to_string(kMaxPageColladaBytes >> 20) +
+            " MiB of Collada";
+      return -1;
+    }
+    collada_bytes += text.size();
+    meshes.push_back({{"collada", std::move(text)}, {"scale", vec_json(v.size)}});
+    return index[key] = static_cast<int>(meshes.size()) - 1;
+  }
+};
+
+// A visual on the body its link is (or is welded into: a named frame), in that body's frame;
+// on the world when the link is not in the model (a URDF's root welded to the world).
+Json visual_json(const Model& m, const Visual& v, MeshTable& table, Json& not_drawn) {
+  int body = -1;
+  Mat3 R = v.R;
+  Vec3 p = v.xyz;
+  for (const Frame& f : m.frames)
+    if (f.name == v.link) {
+      body = f.body;
+      R = f.R_BF * v.R;
+      p = f.p_BF + f.R_BF * v.xyz;
+      break;
+    }
+  Json out = {{"body", body},     {"link", v.link},
+              {"shape", v.shape}, {"size", vec_json(v.size)},
+              {"p", vec_json(p)}, {"quaternion", quaternion_json(R)}};
+  if (v.shape == "mesh") {
+    std::string why;
+    out["mesh"] = table.entry(v, why);
+    out["file"] = v.mesh;
+    if (!why.empty()) not_drawn.push_back({{"link", v.link}, {"mesh", v.mesh}, {"why", why}});
+  }
   if (v.rgba) out["rgba"] = vec_json(*v.rgba);
+  return out;
+}
+
+// A body without visuals drawn as the box of its inertia: the same mass and principal moments
+// (edges √(6 (I_j + I_k − I_i)/m)), at its centre of mass along its principal axes.
+Json inertia_boxes_json(const Model& m, const std::vector<Visual>& visuals) {
+  std::set<int> seen;
+  for (const Visual& v : visuals)
+    for (const Frame& f : m.frames)
+      if (f.name == v.link) seen.insert(f.body);
+  Json out = Json::array();
+  const std::vector<MassProperties> mp = body_mass_properties(m);
+  for (std::size_t b = 0; b < m.bodies.size(); ++b) {
+    if (seen.count(static_cast<int>(b)) || !(mp[b].mass > 0)) continue;
+    const Eigen::SelfAdjointEigenSolver<Mat3> principal(mp[b].inertia_com());
+    const Vec3 I = principal.eigenvalues();
+    const Vec3 edges(std::sqrt(std::max(0.0, 6 * (I[1] + I[2] - I[0]) / mp[b].mass)),
+                     std::sqrt(std::max(0.0, 6 * (I[0] + I[2] - I[1]) / mp[b].mass)),
+                     std::sqrt(std::max(0.0, 6 * (I[0] + I[1] - I[2]) / mp[b].mass)));
+    if (edges.maxCoeff() < 1e-9) continue;  // a point mass: its element marker shows it
+    const Mat3 axes = principal.eigenvectors().determinant() < 0 ? Mat3(-principal.eigenvectors())
+                                                                 : Mat3(principal.eigenvectors());
+    out.push_back({{"body", b},
+                   {"com", vec_json(mp[b].com)},
+                   {"size", vec_json(edges)},
+                   {"quaternion", quaternion_json(axes)}});
+  }
+  return out;
+}
+
+// Each loop constraint's two places (body, point in its frame; -1: the world).
+Json constraints_json(const Model& m) {
+  Json out = Json::array();
+  for (const LoopConstraint& c : m.constraints) {
+    if (c.type == ConstraintType::Gear) continue;  // between coordinates: no place to draw
+    out.push_back({{"name", c.name},
+                   {"type", constraint_type_name(c.type)},
+                   {"a", {{"body", c.a.body}, {"p", vec_json(c.a.p)}}},
+                   {"b", {{"body", c.b.body}, {"p", vec_json(c.b.p)}}}});
+  }
   return out;
 }
 
@@ -116,10 +263,10 @@ Json motion_json(const Model& m, const Motion& motion) {
 
 }  // namespace
 
-Json scene_json(const Model& m, const Motion& motion, const std::vector<UrdfVisual>& visuals,
+Json scene_json(const Model& m, const Motion& motion, const std::vector<Visual>& visuals,
                 const std::string& source) {
   Json bodies = Json::array(), frames = Json::array(), elements = Json::array(),
-       shapes = Json::array();
+       shapes = Json::array(), not_drawn = Json::array();
   for (const Body& b : m.bodies) bodies.push_back(body_json(b));
   for (std::size_t f = m.bodies.size(); f < m.frames.size(); ++f)
     frames.push_back({{"name", m.frames[f].name},
@@ -127,7 +274,9 @@ Json scene_json(const Model& m, const Motion& motion, const std::vector<UrdfVisu
                       {"p", vec_json(m.frames[f].p_BF)},
                       {"quaternion", quaternion_json(m.frames[f].R_BF)}});
   for (const ElementEntry& e : m.elements) elements.push_back(element_json(e));
-  for (const UrdfVisual& v : visuals) shapes.push_back(visual_json(m, v));
+  MeshTable table;
+  for (const Visual& v : visuals) shapes.push_back(visual_json(m, v, table, not_drawn));
+  const Json boxes = inertia_boxes_json(m, visuals), constraints = constraints_json(m);
   int joints = 0;
   for (const Body& b : m.bodies) joints += b.joint.type != JointType::Fixed;
   return {{"model", m.name},
@@ -138,13 +287,21 @@ Json scene_json(const Model& m, const Motion& motion, const std::vector<UrdfVisu
           {"frames", frames},
           {"elements", elements},
           {"visuals", shapes},
+          {"meshes", table.meshes},
+          {"not_drawn", not_drawn},
+          {"inertia_boxes", boxes},
+          {"constraints", constraints},
           {"motion", motion_json(m, motion)},
           {"counts",
            {{"bodies", bodies.size()},
             {"joints", joints},
             {"elements", elements.size()},
             {"frames", frames.size()},
-            {"visuals", shapes.size()},
+            {"visuals", shapes.size() - not_drawn.size()},
+            {"meshes", table.meshes.size()},
+            {"not_drawn", not_drawn.size()},
+            {"inertia_boxes", boxes.size()},
+            {"constraints", constraints.size()},
             {"motion_frames", motion.frames.size()}}}};
 }
 

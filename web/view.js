@@ -41,9 +41,21 @@
 
   // ---- Scene -------------------------------------------------------------------------------
   const container = document.getElementById('view3d');
-  const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-  renderer.setPixelRatio(window.devicePixelRatio || 1);
-  container.appendChild(renderer.domElement);
+  // Without WebGL (a browser or a headless run without it) the page still holds the scene, its
+  // legends and its plots, and says in the 3-D view why nothing is drawn there.
+  let renderer = null;
+  try {
+    renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+    renderer.setPixelRatio(window.devicePixelRatio || 1);
+    container.appendChild(renderer.domElement);
+  } catch (e) {
+    const note = document.createElement('div');
+    note.id = 'no-webgl';
+    note.textContent = 'This browser gives the page no WebGL, so the 3-D view is not drawn ' +
+        '(' + (e && e.message ? e.message : e) + '); the legends and plots still are. In ' +
+        'headless Chromium, --use-angle=swiftshader --enable-unsafe-swiftshader gives WebGL.';
+    container.appendChild(note);
+  }
   const scene = new THREE.Scene();
   scene.background = new THREE.Color(0xf4f6f8);
   const g = v3(data.gravity);
@@ -56,14 +68,21 @@
   scene.add(sun);
 
   const pickable = [];  // meshes named on hover
-  const counts = { bodies: 0, joints: 0, elements: 0, frames: 0, visuals: 0, meshes_skipped: 0 };
+  const counts = { bodies: 0, joints: 0, elements: 0, frames: 0, visuals: 0, meshes: 0,
+                   not_drawn: 0, inertia_boxes: 0, constraints: 0 };
+  // What each toggle shows or hides (the side panel's check boxes).
+  const layers = { visuals: [], elements: [], frames: [], joints: [], inertia: [], constraints: [] };
+  function inLayer(layer, object) { layers[layer].push(object); return object; }
   const material = (color, opacity) => new THREE.MeshStandardMaterial(
       { color: color, roughness: 0.55, metalness: 0.1, transparent: opacity < 1,
         opacity: opacity === undefined ? 1 : opacity });
-  function labelled(mesh, label) {
-    mesh.userData.label = label;
-    pickable.push(mesh);
-    return mesh;
+  function labelled(object, label) {  // a mesh, or each mesh of a group (a Collada file)
+    object.traverse((o) => {
+      if (!o.isMesh) return;
+      o.userData.label = label;
+      pickable.push(o);
+    });
+    return object;
   }
 
   // One group per body, placed at the body's pose; the world's group stays put.
@@ -78,11 +97,11 @@
   // The body frames, and the links: parent origin to the joint's origin, in the parent's colour.
   data.bodies.forEach((body, b) => {
     const axes = new THREE.AxesHelper(0.06 * L);
-    groups[b].add(axes);
+    groups[b].add(inLayer('joints', axes));
     const link = new THREE.BufferGeometry().setFromPoints(
         [new THREE.Vector3(), v3(body.joint.origin)]);
     const linkMaterial = new THREE.LineBasicMaterial({ color: bodyColor(body.parent) });
-    groupOf(body.parent).add(new THREE.Line(link, linkMaterial));
+    groupOf(body.parent).add(inLayer('joints', new THREE.Line(link, linkMaterial)));
   });
 
   // The joints and their axes (in the body frame: the joint frame after its motion).
@@ -96,12 +115,11 @@
     if (j.type === 'fixed') return;
     counts.joints += 1;
     const label = `joint ${j.name} (${j.type}) of ${body.name}`;
-    if (['revolute', 'prismatic', 'helical', 'universal'].includes(j.type))
-      groups[b].add(axisArrow(j.axis, jointColor));
-    if (j.type === 'universal') groups[b].add(axisArrow(j.axis2, 0x7a4a00));
-    if (j.type === 'planar') groups[b].add(axisArrow(j.axis, jointColor));
+    if (['revolute', 'prismatic', 'helical', 'universal', 'planar'].includes(j.type))
+      groups[b].add(inLayer('joints', axisArrow(j.axis, jointColor)));
+    if (j.type === 'universal') groups[b].add(inLayer('joints', axisArrow(j.axis2, 0x7a4a00)));
     const marker = new THREE.Mesh(new THREE.SphereGeometry(0.007 * L, 12, 8), material(jointColor));
-    groups[b].add(labelled(marker, label));
+    groups[b].add(inLayer('joints', labelled(marker, label)));
   });
 
   // Named frames: a smaller triad at their place on their body.
@@ -112,7 +130,7 @@
     grp.add(new THREE.AxesHelper(0.05 * L));
     const dot = new THREE.Mesh(new THREE.SphereGeometry(0.01 * L, 8, 6), material(0x222222));
     grp.add(labelled(dot, `frame ${fr.name} on ${bodyName(fr.body)}`));
-    groupOf(fr.body).add(grp);
+    groupOf(fr.body).add(inLayer('frames', grp));
     counts.frames += 1;
   }
 
@@ -165,7 +183,7 @@
     const amount = e.type === 'rotary_node' ? `I ${Math.max(...e.moments).toPrecision(3)} kg·m²`
                                             : `${e.mass.toPrecision(3)} kg`;
     const label = `${bodyName(e.body)}: ${e.type} #${k}, ${amount}`;
-    const mesh = labelled(elementMesh(e), label);
+    const mesh = inLayer('elements', labelled(elementMesh(e), label));
     (mesh.userData.spans ? world : groupOf(e.body)).add(mesh);
     counts.elements += 1;
     for (const n of e.nodes) {  // the nodes each element uses, once per place
@@ -174,43 +192,132 @@
       nodesSeen.add(key);
       const dot = new THREE.Mesh(nodeGeometry, nodeMaterial);
       dot.position.copy(v3(n.p));
-      groupOf(n.body).add(labelled(dot, `node ${n.label || ''} on ${bodyName(n.body)}`));
+      groupOf(n.body).add(inLayer('elements',
+                                  labelled(dot, `node ${n.label || ''} on ${bodyName(n.body)}`)));
     }
   });
 
-  // ---- URDF visuals --------------------------------------------------------------------------
+  // ---- The robot file's visuals, and each body without any as its inertia box ------------
+  function bytesOf(b64) {
+    const text = atob(b64), out = new Uint8Array(text.length);
+    for (let i = 0; i < text.length; ++i) out[i] = text.charCodeAt(i);
+    return out.buffer;
+  }
+  // A Collada mesh is three.js's parse of its text: a group, turned back to the file's own axes
+  // (the loader turns a Z_UP file to three.js's Y_UP; robot files mean the link's frame).
+  function colladaGroup(m) {
+    const parsed = new THREE.ColladaLoader().parse(m.collada, '');
+    if (!parsed || !parsed.scene) throw new Error('a Collada mesh three.js cannot read');
+    parsed.scene.rotation.set(0, 0, 0);
+    parsed.scene.scale.multiply(v3(m.scale));
+    counts.meshes += 1;
+    return parsed.scene;
+  }
+  const meshGeometries = (data.meshes || []).map((m) => {
+    if (m.collada !== undefined) return { collada: colladaGroup(m) };
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute('position',
+                          new THREE.BufferAttribute(new Float32Array(bytesOf(m.positions)), 3));
+    geometry.setIndex(new THREE.BufferAttribute(new Uint32Array(bytesOf(m.indices)), 1));
+    geometry.computeVertexNormals();
+    counts.meshes += 1;
+    return geometry;
+  });
+  function visualGeometry(v) {  // three.js's round shapes lie along y, the files' along z
+    const s = v.size;
+    if (v.shape === 'box') return new THREE.BoxGeometry(s[0], s[1], s[2]);
+    if (v.shape === 'cylinder')
+      return new THREE.CylinderGeometry(s[0], s[0], s[1], 24).rotateX(Math.PI / 2);
+    if (v.shape === 'capsule')
+      return new THREE.CapsuleGeometry(s[0], s[1], 6, 16).rotateX(Math.PI / 2);
+    if (v.shape === 'sphere') return new THREE.SphereGeometry(s[0], 24, 16);
+    if (v.shape === 'ellipsoid') return new THREE.SphereGeometry(1, 24, 16).scale(s[0], s[1], s[2]);
+    if (v.shape === 'mesh' && v.mesh >= 0) return meshGeometries[v.mesh];
+    return null;
+  }
   for (const v of data.visuals) {
-    let geometry = null;
-    if (v.shape === 'box') geometry = new THREE.BoxGeometry(v.size[0], v.size[1], v.size[2]);
-    else if (v.shape === 'cylinder')
-      geometry = new THREE.CylinderGeometry(v.size[0], v.size[0], v.size[1], 24)
-          .rotateX(Math.PI / 2);  // three.js's cylinders lie along y, URDF's along z
-    else if (v.shape === 'sphere') geometry = new THREE.SphereGeometry(v.size[0], 24, 16);
-    if (!geometry) { counts.meshes_skipped += 1; continue; }
+    const geometry = visualGeometry(v);
+    if (!geometry) continue;  // listed in data.not_drawn, with why
     const color = v.rgba ? new THREE.Color(v.rgba[0], v.rgba[1], v.rgba[2]) : bodyColor(v.body);
-    const mesh = new THREE.Mesh(geometry, material(color, 0.45));
+    const paint = material(color, v.shape === 'mesh' ? 0.8 : 0.45);
+    let mesh;
+    if (geometry.collada) {  // its own meshes, in the visual's colour
+      mesh = geometry.collada.clone();
+      mesh.traverse((o) => { if (o.isMesh) o.material = paint; });
+    } else {
+      mesh = new THREE.Mesh(geometry, paint);
+    }
     mesh.position.copy(v3(v.p));
     mesh.quaternion.copy(quat(v.quaternion));
-    groupOf(v.body).add(labelled(mesh, `${v.link}: visual ${v.shape}`));
+    const what = v.shape === 'mesh' ? `mesh ${v.file}` : v.shape;
+    groupOf(v.body).add(inLayer('visuals', labelled(mesh, `${v.link}: visual ${what}`)));
     counts.visuals += 1;
   }
+  counts.not_drawn = (data.not_drawn || []).length;
+  for (const box of data.inertia_boxes || []) {
+    const mesh = new THREE.Mesh(new THREE.BoxGeometry(box.size[0], box.size[1], box.size[2]),
+                                material(bodyColor(box.body), 0.3));
+    mesh.position.copy(v3(box.com));
+    mesh.quaternion.copy(quat(box.quaternion));
+    groups[box.body].add(inLayer('inertia',
+                                 labelled(mesh, `${bodyName(box.body)}: its inertia box`)));
+    counts.inertia_boxes += 1;
+  }
 
-  // ---- Legend, summary -----------------------------------------------------------------------
+  // ---- Loop constraints: a line between each one's two places, placed again at every frame --
+  const closures = [];
+  const closureMaterial = new THREE.LineDashedMaterial({ color: 0xd62728, dashSize: 0.02 * L,
+                                                          gapSize: 0.01 * L });
+  for (const c of data.constraints || []) {
+    const line = new THREE.Line(new THREE.BufferGeometry().setFromPoints(
+        [new THREE.Vector3(), new THREE.Vector3()]), closureMaterial);
+    world.add(inLayer('constraints', line));
+    const ends = [c.a, c.b].map((end) => {
+      const dot = new THREE.Mesh(new THREE.SphereGeometry(0.01 * L, 10, 8), material(0xd62728));
+      dot.position.copy(v3(end.p));
+      groupOf(end.body).add(inLayer('constraints', labelled(dot, `constraint ${c.name} (${c.type})`)));
+      return dot;
+    });
+    closures.push({ line: line, ends: ends });
+    counts.constraints += 1;
+  }
+
+  // ---- Summary, legends, toggles -------------------------------------------------------------
   document.getElementById('model-name').textContent = `${data.model} (${data.source})`;
   document.getElementById('summary').textContent =
       `${counts.bodies} bodies, ${counts.joints} moving joints, ${counts.elements} elements, ` +
-      `${counts.frames} named frames, ${counts.visuals} visuals` +
-      (counts.meshes_skipped ? ` (${counts.meshes_skipped} meshes not drawn)` : '') +
+      `${counts.frames} named frames, ${counts.visuals} visuals (${counts.meshes} meshes), ` +
+      `${counts.constraints} loop constraints` +
+      (counts.inertia_boxes ? `, ${counts.inertia_boxes} bodies drawn as their inertia box` : '') +
       (motion.trajectory ? `; ${motion.t.length} frames` : '; one posture');
-  const legend = document.getElementById('legend');
-  data.bodies.forEach((body, b) => {
+  const notDrawn = document.getElementById('not-drawn');
+  for (const n of data.not_drawn || []) {
+    const row = document.createElement('div');
+    row.textContent = `${n.link}: ${n.mesh}: ${n.why}`;
+    notDrawn.append(row);
+  }
+  notDrawn.hidden = counts.not_drawn === 0;
+  notDrawn.querySelector('summary').textContent = `${counts.not_drawn} meshes not drawn`;
+  function swatchRow(color, text) {
     const row = document.createElement('div');
     const swatch = document.createElement('span');
     swatch.className = 'swatch';
-    swatch.style.background = '#' + bodyColor(b).getHexString();
-    row.append(swatch, document.createTextNode(body.name));
-    legend.append(row);
-  });
+    swatch.style.background = color;
+    row.append(swatch, document.createTextNode(text));
+    return row;
+  }
+  const bodyLegend = document.getElementById('body-legend');
+  bodyLegend.querySelector('summary').textContent = `bodies (${nb})`;
+  data.bodies.forEach((body, b) => bodyLegend.append(swatchRow('#' + bodyColor(b).getHexString(),
+                                                                 body.name)));
+  for (const name of Object.keys(layers)) {
+    const box = document.getElementById('show-' + name);
+    box.disabled = layers[name].length === 0;
+    box.addEventListener('change', () => {
+      for (const object of layers[name]) object.visible = box.checked;
+      if (!state.playing) show();
+    });
+  }
 
   // ---- Motion --------------------------------------------------------------------------------
   const T = motion.t;
@@ -236,6 +343,10 @@
     for (const sp of spanning)
       bar(sp.mesh, groupOf(sp.a.body).localToWorld(v3(sp.a.p)),
           groupOf(sp.b.body).localToWorld(v3(sp.b.p)), sp.radius);
+    for (const c of closures) {
+      c.line.geometry.setFromPoints(c.ends.map((dot) => dot.getWorldPosition(new THREE.Vector3())));
+      c.line.computeLineDistances();
+    }
   }
 
   // ---- Plots: the coordinates and the energy balance against time ----------------------------
@@ -245,12 +356,27 @@
   const total = energy.kinetic.map((k, i) => k + energy.potential[i]);
   const balance = total.map((e, i) => e - energy.work[i]);
   const plots = [
-    { canvas: document.getElementById('plot-q'),
+    { canvas: document.getElementById('plot-q'), legend: document.getElementById('q-legend'),
       series: data.coordinates.map((name, i) => ({ name: name, y: motion.q.map((q) => q[i]) })) },
     { canvas: document.getElementById('plot-energy'),
+      legend: document.getElementById('energy-legend'),
       series: [{ name: 'kinetic', y: energy.kinetic }, { name: 'potential', y: energy.potential },
                { name: 'total E', y: total }, { name: 'E − W', y: balance }] },
   ];
+  // Each plot's legend holds every series: a click hides or shows one.
+  for (const plot of plots) {
+    plot.legend.querySelector('summary').textContent += ` (${plot.series.length})`;
+    plot.series.forEach((s, i) => {
+      const row = swatchRow(palette[i % palette.length], s.name);
+      row.className = 'series';
+      row.addEventListener('click', () => {
+        s.hidden = !s.hidden;
+        row.classList.toggle('off', !!s.hidden);
+        drawPlot(plot, state.t);
+      });
+      plot.legend.append(row);
+    });
+  }
   function drawPlot(plot, t) {
     const c = plot.canvas, ratio = window.devicePixelRatio || 1;
     c.width = c.clientWidth * ratio;
@@ -259,7 +385,8 @@
     ctx.scale(ratio, ratio);
     const w = c.clientWidth, h = c.clientHeight, m = 6;
     let lo = Infinity, hi = -Infinity;
-    for (const s of plot.series)
+    const shown = plot.series.filter((s) => !s.hidden);
+    for (const s of shown)
       for (const y of s.y) {
         lo = Math.min(lo, y);
         hi = Math.max(hi, y);
@@ -270,12 +397,12 @@
     const Y = (y) => h - m - (h - 2 * m) * (y - lo) / (hi - lo);
     ctx.font = '10px sans-serif';
     plot.series.forEach((s, i) => {
+      if (s.hidden) return;
       ctx.strokeStyle = ctx.fillStyle = palette[i % palette.length];
       ctx.beginPath();
       s.y.forEach((y, k) => (k ? ctx.lineTo(X(T[k]), Y(y)) : ctx.moveTo(X(T[k]), Y(y))));
       if (T.length === 1) ctx.arc(X(T[0]), Y(s.y[0]), 2, 0, 2 * Math.PI);
       ctx.stroke();
-      if (i < 8) ctx.fillText(s.name, w - 70, 12 + 11 * i);
     });
     ctx.fillStyle = '#555';
     ctx.fillText(hi.toPrecision(3), m, 10);
@@ -288,7 +415,8 @@
   }
 
   // ---- Controls --------------------------------------------------------------------------------
-  const controls = new THREE.OrbitControls(camera, renderer.domElement);
+  const controls = renderer ? new THREE.OrbitControls(camera, renderer.domElement)
+                            : { target: new THREE.Vector3(), update() {} };
   const center = extent.getCenter(new THREE.Vector3());
   {  // framed on the model: seen from a corner, a little above
     const side = new THREE.Vector3(1, 0, 0);
@@ -333,7 +461,7 @@
   // Hover: the name of what is under the pointer.
   const tooltip = document.getElementById('tooltip');
   const raycaster = new THREE.Raycaster();
-  renderer.domElement.addEventListener('pointermove', (ev) => {
+  if (renderer) renderer.domElement.addEventListener('pointermove', (ev) => {
     const r = renderer.domElement.getBoundingClientRect();
     const pointer = new THREE.Vector2(((ev.clientX - r.left) / r.width) * 2 - 1,
                                       -((ev.clientY - r.top) / r.height) * 2 + 1);
@@ -348,7 +476,7 @@
 
   function resize() {
     const w = Math.max(container.clientWidth, 1), h = Math.max(container.clientHeight, 1);
-    renderer.setSize(w, h);
+    if (renderer) renderer.setSize(w, h);
     camera.aspect = w / h;
     camera.updateProjectionMatrix();
   }
@@ -358,7 +486,7 @@
   // ---- The loop ------------------------------------------------------------------------------
   function show() {
     placeBodies(state.t);
-    renderer.render(scene, camera);
+    if (renderer) renderer.render(scene, camera);
     plots.forEach((p) => drawPlot(p, state.t));
     slider.value = t1 > t0 ? Math.round(1000 * (state.t - t0) / (t1 - t0)) : 0;
     timeLabel.textContent = `t = ${state.t.toFixed(3)} s`;
@@ -383,7 +511,19 @@
 
   // Where each named object is on the screen (CSS pixels), for the hover test.
   window.femdynView = {
-    labelsOnScreen: () => pickable.map((mesh) => {
+    // Each loop constraint's two places as drawn (world coordinates) and their distance.
+    closures: () => closures.map((c) => {
+      const [a, b] = c.ends.map((dot) => dot.getWorldPosition(new THREE.Vector3()));
+      return { a: a.toArray(), b: b.toArray(), distance: a.distanceTo(b), extent: L };
+    }),
+    // The share of each plot's pixels drawn (not blank), WebGL or not.
+    plotInk: () => plots.map((plot) => {
+      const c = plot.canvas, px = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+      let ink = 0;
+      for (let i = 3; i < px.length; i += 4) ink += px[i] > 0;
+      return ink / (px.length / 4);
+    }),
+    labelsOnScreen: () => (renderer ? pickable : []).filter((mesh) => mesh.visible).map((mesh) => {
       const p = mesh.getWorldPosition(new THREE.Vector3()).project(camera);
       const r = renderer.domElement.getBoundingClientRect();
       return { label: mesh.userData.label, x: r.left + (p.x + 1) / 2 * r.width,
@@ -392,8 +532,8 @@
   };
 
   // What the page holds, for its reader and its tests (tests/view_browser.py).
-  const gl = renderer.getContext();
-  window.femdynScene = Object.assign({ motionFrames: T.length, webgl: !!gl }, counts);
+  window.femdynScene = Object.assign({ motionFrames: T.length,
+                                       webgl: !!(renderer && renderer.getContext()) }, counts);
   for (const [k, v] of Object.entries(window.femdynScene)) statusBox.dataset[k] = v;
   if (window.femdynErrors.length === 0) {
     statusBox.dataset.status = 'ok';

@@ -1,0 +1,27 @@
+// What a robot file says a body looks like: its visual geometry, read for `femdyn view`
+// (view/scene.hpp) by the URDF and MJCF readers; the equations never see it.
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/math.hpp"
+
+namespace femdyn {
+
+// One shape, in the frame of `link`: a body of the model or a frame welded to one (a URDF link
+// on a fixed joint). Sizes: box — the full edges x y z; cylinder and capsule — radius and the
+// length of the cylinder along z; sphere — radius; ellipsoid — the three radii; mesh — its scale.
+struct Visual {
+  std::string link;
+  std::string shape;  // box, cylinder, capsule, sphere, ellipsoid or mesh
+  Vec3 size = Vec3::Zero();
+  std::string mesh;        // a mesh's file as the robot file names it
+  std::string mesh_path;   // where it was found, or empty (then the page says why)
+  std::string mesh_issue;  // why it was not found
+  Vec3 xyz = Vec3::Zero();
+  Mat3 R = Mat3::Identity();
+  std::optional<Eigen::Vector4d> rgba;
+};
+
+}  // namespace femdyn
