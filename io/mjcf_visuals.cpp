@@ -61,8 +61,12 @@ void add_visuals(const Document& doc, const XMLElement& body, const std::string&
       v.xyz = placed.p;
       v.R = placed.R;
       out.push_back(std::move(v));
-    } catch (const Error&) {
-      // A geom the equations do not use and the page cannot draw: it breaks no load.
+    } catch (const Error& e) {  // listed by the page as not drawn; it breaks no load
+      Visual bad;
+      bad.link = link;
+      bad.shape = "invalid";
+      bad.mesh_issue = e.what();
+      out.push_back(std::move(bad));
     }
 }
 

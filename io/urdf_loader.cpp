@@ -148,14 +148,15 @@ Visual visual_of(const Ctx& c, const XMLElement* robot, const XMLElement* visual
               number_attr(c, shape, "length", 0, who, true), 0};
   } else if (v.shape == "sphere") {
     v.size = {number_attr(c, shape, "radius", 0, who, true), 0, 0};
-  } else if (v.shape == "mesh") {
+  } else if (v.shape == "mesh") {  // a negative scale mirrors it
     v.size = vec_attr(c, shape, "scale", Vec3::Ones(), who);
+    if ((v.size.array() == 0).any()) c.fail(who, "a mesh scale of 0");
     v.mesh = shape->Attribute("filename") ? shape->Attribute("filename") : "";
     find_mesh(c.source, v);
   } else {
     c.fail(who, "unknown geometry <" + echo_text(v.shape) + ">");
   }
-  if ((v.size.array() < 0).any()) c.fail(who, "a negative size");
+  if (v.shape != "mesh" && (v.size.array() < 0).any()) c.fail(who, "a negative size");
   return v;
 }
 
@@ -171,7 +172,15 @@ std::vector<Visual> urdf_visuals(const std::string& text, const std::string& sou
     const char* name = link->Attribute("name");
     for (const XMLElement* v = link->FirstChildElement("visual"); v && name;
          v = v->NextSiblingElement("visual"))
-      out.push_back(visual_of(c, robot, v, name));
+      try {
+        out.push_back(visual_of(c, robot, v, name));
+      } catch (const Error& e) {  // listed by the page as not drawn; the model still loads
+        Visual bad;
+        bad.link = name;
+        bad.shape = "invalid";
+        bad.mesh_issue = e.what();
+        out.push_back(std::move(bad));
+      }
   }
   return out;
 }

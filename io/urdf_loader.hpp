@@ -38,7 +38,8 @@ UrdfResult read_urdf(const std::string& path, const UrdfOptions& options = {});
 
 // The links' <visual>s (io/visual.hpp), each in its link's frame: box, cylinder, sphere, or a
 // mesh whose filename is found relative to the URDF's folder, as file://, or as
-// package://NAME/… in a folder NAME above the URDF or on ROS_PACKAGE_PATH.
+// package://NAME/… in a folder NAME above the URDF or on ROS_PACKAGE_PATH. A visual that cannot
+// be read comes back with shape "invalid" and why in mesh_issue (it stops no load).
 std::vector<Visual> urdf_visuals(const std::string& xml_text, const std::string& source);
 
 }  // namespace femdyn

@@ -14,11 +14,11 @@ namespace femdyn {
 // length of the cylinder along z; sphere — radius; ellipsoid — the three radii; mesh — its scale.
 struct Visual {
   std::string link;
-  std::string shape;  // box, cylinder, capsule, sphere, ellipsoid or mesh
+  std::string shape;  // box, cylinder, capsule, sphere, ellipsoid, mesh; "invalid": not read
   Vec3 size = Vec3::Zero();
   std::string mesh;        // a mesh's file as the robot file names it
   std::string mesh_path;   // where it was found, or empty (then the page says why)
-  std::string mesh_issue;  // why it was not found
+  std::string mesh_issue;  // why the mesh was not found, or the visual not read
   Vec3 xyz = Vec3::Zero();
   Mat3 R = Mat3::Identity();
   std::optional<Eigen::Vector4d> rgba;

@@ -164,8 +164,10 @@ TEST_CASE("view: a URDF's visual primitives and their colours are read", "[view]
   CHECK(shapes == std::set<std::string>{"box", "cylinder", "sphere"});
   const std::string bad = R"(<robot name="r"><link name="a"><visual><geometry>
       <cylinder radius="x" length="1"/></geometry></visual></link></robot>)";
-  CHECK_THROWS_WITH(urdf_visuals(bad, "bad.urdf"),
-                    Catch::Contains("bad.urdf") && Catch::Contains("link 'a'"));
+  const std::vector<Visual> unread = urdf_visuals(bad, "bad.urdf");  // listed, never fatal
+  REQUIRE(unread.size() == 1);
+  CHECK(unread[0].shape == "invalid");
+  CHECK_THAT(unread[0].mesh_issue, Catch::Contains("bad.urdf") && Catch::Contains("link 'a'"));
 }
 
 TEST_CASE("femdyn view writes the page once, replaces it only with --force", "[view][cli]") {
@@ -353,4 +355,28 @@ TEST_CASE("view: inertia boxes hold each body's moments, and loop closures are i
   REQUIRE(scene["constraints"].size() == m.constraints.size());
   CHECK(scene["constraints"][0]["a"]["body"] == m.constraints[0].a.body);
   CHECK(scene["constraints"][0]["b"]["body"] == m.constraints[0].b.body);
+}
+
+// A visual the page cannot draw never stops the view: it is listed with its link and why; a
+// mesh's negative scale (a mirror image, as humanoids' left and right limbs share one file) is
+// drawn.
+TEST_CASE("view: a bad visual is listed as not drawn, a mirrored mesh is drawn", "[view][mesh]") {
+  Scratch dir("view_bad_visual");
+  const std::string path = dir / "arm.urdf";
+  std::ofstream(path) << "<robot name='arm'><link name='base'/><link name='arm'><inertial><mass "
+                         "value='1'/><inertia ixx='1' ixy='0' ixz='0' iyy='1' iyz='0' izz='1'/>"
+                         "</inertial><visual><geometry><box size='0.1 -0.2 0.1'/></geometry>"
+                         "</visual><visual><geometry><mesh filename='"
+                      << data_path("mjcf/meshes/bar.stl")
+                      << "' scale='-1 1 1'/></geometry></visual></link><joint name='j' "
+                         "type='continuous'><parent link='base'/><child link='arm'/></joint>"
+                         "</robot>";
+  const Model m = load_model(path);
+  const nlohmann::json scene = view::scene_json(m, view::posture(m, neutral_posture(m)),
+                                                urdf_visuals(read_file(path), path), "arm.urdf");
+  REQUIRE(scene["not_drawn"].size() == 1);
+  CHECK(scene["not_drawn"][0]["link"] == "arm");
+  CHECK_THAT(scene["not_drawn"][0]["why"].get<std::string>(), Catch::Contains("a negative size"));
+  CHECK(scene["meshes"].size() == 1);
+  CHECK(scene["counts"]["visuals"] == 1);
 }

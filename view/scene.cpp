@@ -175,6 +175,8 @@ Json visual_json(const Model& m, const Visual& v, MeshTable& table, Json& not_dr
   Json out = {{"body", body},     {"link", v.link},
               {"shape", v.shape}, {"size", vec_json(v.size)},
               {"p", vec_json(p)}, {"quaternion", quaternion_json(R)}};
+  if (v.shape == "invalid")
+    not_drawn.push_back({{"link", v.link}, {"mesh", "<visual>"}, {"why", v.mesh_issue}});
   if (v.shape == "mesh") {
     std::string why;
     out["mesh"] = table.entry(v, why);

@@ -75,7 +75,8 @@
   function inLayer(layer, object) { layers[layer].push(object); return object; }
   const material = (color, opacity) => new THREE.MeshStandardMaterial(
       { color: color, roughness: 0.55, metalness: 0.1, transparent: opacity < 1,
-        opacity: opacity === undefined ? 1 : opacity });
+        opacity: opacity === undefined ? 1 : opacity,
+        side: THREE.DoubleSide });  // a mirrored mesh (negative scale) turns its faces inside out
   function labelled(object, label) {  // a mesh, or each mesh of a group (a Collada file)
     object.traverse((o) => {
       if (!o.isMesh) return;
