@@ -294,8 +294,8 @@ int cmd_validate(int argc, char** argv) {
       // The import itself, against MuJoCo's own compile of the file: where the Simbody twin
       // cannot hold the model (armature), MuJoCo's comparison stands alone, said in a note.
       std::string why;
-      const MjcfMeshes meshes =
-          read_mjcf(a.positional[i], {.balance_inertia = a.has("balance-inertia")}).meshes;
+      const MjcfMassNotes meshes =
+          read_mjcf(a.positional[i], {.balance_inertia = a.has("balance-inertia")}).mass_notes;
       // MuJoCo 2.2 has no legacy solid of a non-convex mesh: both sides then weigh every mesh
       // by its exact solid, said in a note.
       std::optional<Model> exact;
@@ -309,8 +309,9 @@ int cmd_validate(int argc, char** argv) {
                           " geoms of non-convex meshes, whose legacy inertia MuJoCo 2.2 does not "
                           "compute): the rest of the model is the one checked above");
       }
-      if (auto e = validation::validate_mjcf_import(exact ? *exact : models[i], a.positional[i],
-                                                    meshes.with_mass, o, why)) {
+      if (auto e =
+              validation::validate_mjcf_import(exact ? *exact : models[i], a.positional[i],
+                                               meshes.mesh_geoms, meshes.full_inertias, o, why)) {
         r.quantities.push_back(*e);
         if (!why.empty()) r.notes.push_back(why);
         if (!r.failure.empty()) {

@@ -10,17 +10,19 @@ namespace femdyn::mjcf {
 namespace {
 
 // <inertial pos orientation mass diaginertia | fullinertia="ixx iyy izz ixy ixz iyz">.
-CentroidalMass inertial_mass(const Document& doc, const XMLElement& in) {
+CentroidalMass inertial_mass(const Document& doc, const XMLElement& in, MassNotes& notes) {
   const double m = doc.number(in, "mass", "", -1);
   if (m < 0) doc.fail(in, "needs a mass ≥ 0");
   const std::vector<double> d = doc.numbers(in, "diaginertia", "", 3);
   const std::vector<double> f = doc.numbers(in, "fullinertia", "", 6);
   if (d.empty() == f.empty()) doc.fail(in, "needs one of diaginertia and fullinertia");
   Mat3 I;
-  if (!d.empty())
+  if (!d.empty()) {
     I = Vec3(d[0], d[1], d[2]).asDiagonal();
-  else
+  } else {
     I << f[0], f[3], f[4], f[3], f[1], f[5], f[4], f[5], f[2];
+    ++notes.full_inertias;
+  }
   const Pose pose = pose_of(doc, in, "");
   if (!f.empty() && !pose.R.isIdentity(0))
     doc.fail(in, "fullinertia gives the axes itself: no orientation with it (as MuJoCo)");
@@ -30,7 +32,7 @@ CentroidalMass inertial_mass(const Document& doc, const XMLElement& in) {
 // The geoms in inertiagrouprange, welded: a plane or height field adds nothing, a mesh the solid
 // it bounds (io/mjcf_mesh.cpp).
 CentroidalMass geoms_mass(const Document& doc, const XMLElement& body, const std::string& inherited,
-                          MeshReport& meshes) {
+                          MassNotes& meshes) {
   CentroidalMass sum;
   for (const XMLElement* geom : doc.children(body, "geom")) {
     const std::string cls = doc.class_of(*geom, inherited);
@@ -62,7 +64,7 @@ void principal_rebuild(CentroidalMass& mp, const auto& change) {
 }  // namespace
 
 CentroidalMass body_mass(const Document& doc, const XMLElement& body, const std::string& childclass,
-                         MeshReport& meshes) {
+                         MassNotes& meshes) {
   const Compiler& c = doc.compiler();
   const std::vector<const XMLElement*> inertial = doc.children(body, "inertial");
   if (inertial.size() > 1) doc.fail(body, "more than one <inertial>");
@@ -71,7 +73,7 @@ CentroidalMass body_mass(const Document& doc, const XMLElement& body, const std:
       (c.inertia_from_geom == Compiler::FromGeom::automatic && inertial.empty()))
     mp = geoms_mass(doc, body, childclass, meshes);
   else if (!inertial.empty())
-    mp = inertial_mass(doc, *inertial[0]);
+    mp = inertial_mass(doc, *inertial[0], meshes);
   if (c.boundmass > 0 && mp.mass < c.boundmass) mp.mass = c.boundmass;
   if (c.boundinertia > 0) principal_rebuild(mp, [&](Vec3& d) { d = d.cwiseMax(c.boundinertia); });
   if (c.balanceinertia)  // a principal moment beyond the other two's sum: all three their mean

@@ -48,7 +48,7 @@ struct Walk {
   Tree tree;
   std::set<std::string> body_names, joint_names;
   std::vector<std::string> notes;
-  MjcfMeshes meshes;
+  MjcfMassNotes mass_notes;
   std::vector<Visual> visuals;
   struct Massed {
     const XMLElement* body;  // the MuJoCo body
@@ -212,7 +212,8 @@ Placed read_body(Walk& w, const Visit& v, const std::string& childclass) {
   const Placed placed{w.bodies.back()["name"], Pose{-at, Mat3::Identity()},
                       v.world0 * pose_of(doc, body, "")};
   w.tree.bodies[name] = {placed.femdyn, at, placed.world0};
-  w.masses.push_back({&body, w.bodies.size() - 1, at, body_mass(doc, body, childclass, w.meshes)});
+  w.masses.push_back(
+      {&body, w.bodies.size() - 1, at, body_mass(doc, body, childclass, w.mass_notes)});
   add_visuals(doc, body, childclass, placed.femdyn, placed.below, w.visuals);
   return placed;
 }
@@ -326,9 +327,9 @@ MjcfResult read_mjcf(const std::string& path, const MjcfOptions& options) {
                {"gravity", vec3_json(gravity(w))},
                {"bodies", w.bodies}};
   read_equalities(doc, w.tree, out.model, w.notes);
-  if (!w.meshes.not_solid.empty()) {  // each mesh once, in file order
+  if (!w.mass_notes.not_solid.empty()) {  // each mesh once, in file order
     std::vector<std::string> names;
-    for (const std::string& m : w.meshes.not_solid)
+    for (const std::string& m : w.mass_notes.not_solid)
       if (std::find(names.begin(), names.end(), m) == names.end()) names.push_back(m);
     std::string list;
     for (const std::string& m : names) list += (list.empty() ? "" : ", ") + m;
@@ -341,7 +342,7 @@ MjcfResult read_mjcf(const std::string& path, const MjcfOptions& options) {
                       "exactmeshinertia=\"true\">, weighs the solid");
   }
   out.warnings = std::move(w.notes);
-  out.meshes = std::move(w.meshes);
+  out.mass_notes = std::move(w.mass_notes);
   out.visuals = std::move(w.visuals);
   if (const std::string unused = unused_text(w); !unused.empty()) out.warnings.push_back(unused);
   return out;

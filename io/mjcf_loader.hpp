@@ -34,18 +34,21 @@ struct MjcfOptions {
   bool exact_mesh_inertia = false;
 };
 
-// Mesh geoms that gave a body mass: their number, and those whose MuJoCo legacy solid (each
-// tetrahedron's volume taken positive) is not the solid the mesh bounds (a non-convex mesh),
-// each "'name' (file 'x.stl') (×r)", r the legacy volume over the solid's (once per geom).
-struct MjcfMeshes {
-  int with_mass = 0;
+// Where the bodies' mass came from, for validate's comparison with MuJoCo (whose compiler holds
+// meshes in single precision and diagonalises a full tensor by an iteration that stops early):
+// mesh geoms that gave mass, those whose MuJoCo legacy solid (each tetrahedron's volume taken
+// positive) is not the solid the mesh bounds (a non-convex mesh), each "'name' (file 'x.stl')
+// (×r)", r the legacy volume over the solid's, and the <inertial fullinertia> read.
+struct MjcfMassNotes {
+  int mesh_geoms = 0;
   std::vector<std::string> not_solid;
+  int full_inertias = 0;
 };
 
 struct MjcfResult {
   Json model;                         // the femdyn model document
   std::vector<std::string> warnings;  // what is not modelled, what was repaired
-  MjcfMeshes meshes;
+  MjcfMassNotes mass_notes;
   std::vector<Visual> visuals;  // what the bodies look like (io/mjcf_visuals.cpp)
 };
 

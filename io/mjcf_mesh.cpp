@@ -131,7 +131,7 @@ MeshAsset mesh_of(const Document& doc, const XMLElement& geom, const std::string
 }
 
 CentroidalMass mesh_geom_mass(const Document& doc, const XMLElement& geom, const std::string& cls,
-                              MeshReport& meshes) {
+                              MassNotes& meshes) {
   if (doc.flag(geom, "shellinertia", cls, false))
     doc.fail(geom, "shellinertia: femdyn computes a mesh's volume inertia, not its shell's");
   const MeshAsset asset = mesh_of(doc, geom, cls);
@@ -145,7 +145,7 @@ CentroidalMass mesh_geom_mass(const Document& doc, const XMLElement& geom, const
   if (exact) V = V_solid;
   if (!(V > 1e-15))
     doc.fail(geom, "mesh " + asset.source + " bounds no volume (an open or flat mesh)");
-  ++meshes.with_mass;
+  ++meshes.mesh_geoms;
   if (!exact && std::abs(V - V_solid) > 1e-9 * V) {
     char ratio[32];
     std::snprintf(ratio, sizeof ratio, "%.3g", V / V_solid);

@@ -36,12 +36,12 @@ struct Tree {
 };
 
 // The meshes that gave mass, and those whose legacy solid is not theirs (mjcf_loader.hpp).
-using MeshReport = MjcfMeshes;
+using MassNotes = MjcfMassNotes;
 
 // A body's mass properties in its own frame, as MuJoCo's compiler makes them (before
 // settotalmass, which scales every body).
 CentroidalMass body_mass(const Document& doc, const XMLElement& body, const std::string& childclass,
-                         MeshReport& meshes);
+                         MassNotes& meshes);
 
 // The body's rigid_body element (its frame shifted by `shift`), or null without mass; a
 // non-physical inertia balanced when asked, each change in `notes`.
@@ -76,7 +76,7 @@ MeshAsset mesh_of(const Document& doc, const XMLElement& geom, const std::string
 // it (legacy |V| tetrahedra, or signed ones with exactmeshinertia; io/mesh.hpp), m = the geom's
 // mass or ρV, placed at the geom's pose; counted in `meshes`.
 CentroidalMass mesh_geom_mass(const Document& doc, const XMLElement& geom, const std::string& cls,
-                              MeshReport& meshes);
+                              MassNotes& meshes);
 
 // The geoms of `body` (or the world) MuJoCo's viewer draws by default (groups 0 to 2; no plane
 // or height field), in the frame `frame` places the body's frame in, on femdyn body `link`.

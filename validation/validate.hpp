@@ -182,10 +182,14 @@ QuantityError validate_urdf_import(const Model& model, const std::string& urdf_p
 // `why` when it cannot be compared: MuJoCo cannot read the file (Debian's 2.2 knows no MuJoCo 3
 // element), or femdyn holds an <equality joint> as a coupling (fewer coordinates than dofs).
 // `mesh_masses`: the number of mesh geoms that gave mass (MuJoCo holds meshes in single
-// precision: the tolerance is then 1e-6, said in `why`). The peer weighs every mesh by its exact
+// precision: the tolerance is then 1e-6, said in `why`); `full_inertias`, the <inertial
+// fullinertia> read (MuJoCo's compiler diagonalises each by an iteration that stops early, about
+// 1e-8 relative: the tolerance is then 1e-7, said in `why`). A model with couplings is compared
+// through them (validation/validate_mjcf.cpp). The peer weighs every mesh by its exact
 // solid (exactmeshinertia; MuJoCo 2.2's legacy takes the equivalent box's volume).
 std::optional<QuantityError> validate_mjcf_import(const Model& model, const std::string& path,
-                                                  int mesh_masses, const ValidationOptions& options,
+                                                  int mesh_masses, int full_inertias,
+                                                  const ValidationOptions& options,
                                                   std::string& why);
 
 // ‖x_femdyn − x_reference‖∞ / max(‖x_reference‖∞, floor) into e's largest errors (the absolute
