@@ -11,84 +11,14 @@
 #include "core/limits.hpp"
 #include "core/names.hpp"
 #include "io/catalog.hpp"
+#include "io/coupling_json.hpp"
 #include "io/input_file.hpp"
-#include "io/mjcf_loader.hpp"
+#include "io/json_text.hpp"
 #include "io/params.hpp"
-#include "io/urdf_loader.hpp"
+#include "io/robot_reference.hpp"
 
 namespace femdyn {
 namespace {
-
-std::string line_col(const std::string& text, std::size_t byte) {
-  std::size_t line = 1, col = 1;
-  for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
-    if (text[i] == '\n') {
-      ++line;
-      col = 1;
-    } else {
-      ++col;
-    }
-  }
-  return "line " + std::to_string(line) + ", column " + std::to_string(col);
-}
-
-// What one linear pass over a JSON text tells before it is parsed: whether it nests deeper
-// than kMaxNesting, and how many items its top-level "bodies" array holds. nlohmann's parser
-// with a callback (the earlier depth check) rescans the enclosing array at every object it
-// closes, which is quadratic in long arrays of objects; this scan and a plain parse are linear.
-struct JsonOutline {
-  bool too_deep = false;
-  std::size_t bodies = 0;  // items of the top-level "bodies" array (0: none, or not an array)
-};
-
-// The index just past the string whose opening quote is text[i], escapes respected.
-std::size_t past_string(const std::string& text, std::size_t i) {
-  for (++i; i < text.size(); ++i) {
-    if (text[i] == '\\')
-      ++i;  // (the escaped character, a quote included)
-    else if (text[i] == '"')
-      return i + 1;
-  }
-  return text.size();
-}
-
-JsonOutline outline(const std::string& text) {
-  JsonOutline out;
-  int depth = 0;            // containers open
-  bool bodies_key = false;  // at depth 1, the last token was the string "bodies" (or its ':')
-  bool in_bodies = false;   // inside the top-level "bodies" array (a later one replaces it)
-  bool counted = false;     // its current item is counted (until the next ',')
-  for (std::size_t i = 0; i < text.size();) {
-    const char c = text[i];
-    if (std::isspace(static_cast<unsigned char>(c))) {
-      ++i;
-      continue;
-    }
-    if (in_bodies && depth == 2 && c != ']') {
-      if (c != ',' && !counted) ++out.bodies;  // an item begins
-      counted = c != ',';
-    }
-    if (c == '"') {
-      const std::size_t end = past_string(text, i);
-      if (depth == 1) bodies_key = text.compare(i, end - i, "\"bodies\"") == 0;
-      i = end;
-      continue;
-    }
-    if (c == '[' || c == '{') {
-      if (++depth > kMaxNesting) return {.too_deep = true};
-      if (depth == 2 && c == '[' && bodies_key) {
-        in_bodies = true;
-        counted = false;
-        out.bodies = 0;
-      }
-    } else if (c == ']' || c == '}') {
-      if (--depth == 1) in_bodies = false;
-    }
-    if (c != ':') bodies_key = false;  // the key is "bodies" only when ':' follows it
-    ++i;
-  }
-  return out;
-}
 
 JointType joint_type(const Params& p) {
   const std::string t = p.string("type");
@@ -224,146 +154,6 @@ BodySpec read_body(const Catalog& catalog, const Json& jb, const std::string& wh
   return b;
 }
 
-// A nonlinear law: "polynomial", "spline" or "four_bar" (docs/model-format.md#couplings).
-std::shared_ptr<const CouplingFunction> read_law(const Params& p, int arity) {
-  const auto numbers = [&](const Json& row, const std::string& where) {
-    if (!row.is_array()) throw ModelError(where, "expected an array of numbers");
-    std::vector<double> v;
-    for (std::size_t i = 0; i < row.size(); ++i)
-      v.push_back(json_number(row[i], where + "/" + std::to_string(i)));
-    return v;
-  };
-  if (p.has("polynomial")) {
-    // [[c, p_1, …, p_k], …]: c Π θ_i^{p_i}
-    const Json& terms = p.json().at("polynomial");
-    if (!terms.is_array() || terms.empty())
-      p.fail("polynomial", "expected a non-empty array of [coefficient, power per joint]");
-    std::vector<PolynomialCoupling::Term> list;
-    for (std::size_t t = 0; t < terms.size(); ++t) {
-      const std::string where = p.path("polynomial") + "/" + std::to_string(t);
-      const std::vector<double> v = numbers(terms[t], where);
-      if (static_cast<int>(v.size()) != arity + 1)
-        throw ModelError(where, "expected [coefficient, " + std::to_string(arity) +
-                                    " power(s)]: one power per followed joint");
-      PolynomialCoupling::Term term{v[0], {}};
-      check_magnitude(v[0], where + "/0", "coefficient");
-      for (int k = 1; k <= arity; ++k) {
-        if (!(v[k] >= 0 && v[k] <= 16 && v[k] == std::floor(v[k])))
-          throw ModelError(where + "/" + std::to_string(k), "a power is an integer from 0 to 16");
-        term.powers.push_back(static_cast<int>(v[k]));
-      }
-      list.push_back(std::move(term));
-    }
-    return std::make_shared<PolynomialCoupling>(arity, std::move(list));
-  }
-  if (arity != 1) p.fail("follows", "a spline or four-bar law follows exactly one joint");
-  if (p.has("spline")) {
-    // [[θ_in, θ_out], …], θ_in strictly increasing
-    const Json& pts = p.json().at("spline");
-    if (!pts.is_array() || pts.size() < 2)
-      p.fail("spline", "expected at least 2 points [θ_in, θ_out]");
-    std::vector<double> x, y;
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      const std::string where = p.path("spline") + "/" + std::to_string(i);
-      const std::vector<double> v = numbers(pts[i], where);
-      if (v.size() != 2) throw ModelError(where, "expected a point [θ_in, θ_out]");
-      check_magnitude(v[0], where + "/0", "θ_in");
-      check_magnitude(v[1], where + "/1", "θ_out");
-      if (!x.empty() && !(v[0] > x.back()))
-        throw ModelError(where + "/0", "θ_in must increase strictly from point to point");
-      x.push_back(v[0]);
-      y.push_back(v[1]);
-    }
-    return std::make_shared<SplineCoupling>(std::move(x), std::move(y));
-  }
-  const Params f = p.child("four_bar");
-  f.allow_only({"ground", "input", "coupler", "output", "branch", "input_offset", "input_sign",
-                "output_offset", "output_sign"});
-  FourBarCoupling::Geometry g;
-  g.ground = f.positive("ground");
-  g.input = f.positive("input");
-  g.coupler = f.positive("coupler");
-  g.output = f.positive("output");
-  const auto sign = [&](const char* key) {
-    const double v = f.number_or(key, 1.0);
-    if (v != 1 && v != -1) f.fail(key, "expected 1 or -1");
-    return v;
-  };
-  g.branch = static_cast<int>(sign("branch"));
-  g.input_sign = sign("input_sign");
-  g.output_sign = sign("output_sign");
-  g.input_offset = f.number_or("input_offset", 0.0);
-  if (f.has("output_offset")) {
-    g.output_offset = f.number("output_offset");
-  } else {  // θ_out = 0 where θ_in = 0: ψ0 = ψ(φ0)
-    const auto psi0 = FourBarCoupling::output_angle_at_zero(g);
-    if (!psi0)
-      f.fail("input_offset",
-             "the linkage cannot assemble at θ_in = 0, so θ_out = 0 there cannot be the default: "
-             "give output_offset");
-    g.output_offset = *psi0;
-  }
-  check_magnitude(g.input_offset, f.path("input_offset"), "input_offset");
-  check_magnitude(g.output_offset, f.path("output_offset"), "output_offset");
-  for (double len : {g.ground, g.input, g.coupler, g.output})
-    check_magnitude(len, f.where(), "link length");
-  return std::make_shared<FourBarCoupling>(g);
-}
-
-// "follows": f with "ratio": k, or "follows": [{"joint": f1, "ratio": k1}, …] (a linear
-// coupling's, or a gear constraint's, terms).
-std::vector<std::pair<std::string, double>> read_linear_terms(const Params& p) {
-  std::vector<std::pair<std::string, double>> terms;
-  const Json& f = p.json().contains("follows") ? p.json().at("follows") : Json();
-  if (f.is_string()) {
-    terms.emplace_back(f.get<std::string>(), p.number_or("ratio", 1.0));
-  } else if (f.is_array()) {
-    if (p.has("ratio")) p.fail("ratio", "give ratios inside \"follows\" when it is a list");
-    for (std::size_t i = 0; i < f.size(); ++i) {
-      const Params t(f[i], p.path("follows") + "/" + std::to_string(i));
-      t.allow_only({"joint", "ratio"});
-      terms.emplace_back(t.string("joint"), t.number("ratio"));
-    }
-  } else {
-    p.fail("follows", "expected a joint name or a list of {joint, ratio}");
-  }
-  return terms;
-}
-
-CouplingSpec read_coupling(const Params& p) {
-  // {"joint": j, "follows": f, "ratio": k, "offset": o}
-  // or {"joint": j, "follows": [{"joint": f1, "ratio": k1}, …], "offset": o}
-  // or {"joint": j, "follows": f or [f1, f2, …], "polynomial" | "spline" | "four_bar": …}
-  p.allow_only({"joint", "follows", "ratio", "offset", "polynomial", "spline", "four_bar"});
-  CouplingSpec c;
-  c.where = p.where();
-  c.joint = p.string("joint");
-  const Json& f = p.json().contains("follows") ? p.json().at("follows") : Json();
-  int laws = 0;
-  for (const char* key : {"polynomial", "spline", "four_bar"}) laws += p.has(key) ? 1 : 0;
-  if (laws > 1) p.fail("follows", "give one law: polynomial, spline or four_bar");
-  if (laws == 1) {
-    for (const char* key : {"ratio", "offset"})
-      if (p.has(key)) p.fail(key, "belongs to a linear coupling, not to a law");
-    if (f.is_string()) {
-      c.follows.push_back(f.get<std::string>());
-    } else if (f.is_array() && !f.empty()) {
-      for (std::size_t i = 0; i < f.size(); ++i) {
-        if (!f[i].is_string())
-          throw ModelError(p.path("follows") + "/" + std::to_string(i), "expected a joint name");
-        c.follows.push_back(f[i].get<std::string>());
-      }
-    } else {
-      p.fail("follows", "expected a joint name or a non-empty list of joint names");
-    }
-    c.law = read_law(p, static_cast<int>(c.follows.size()));
-    return c;
-  }
-  c.offset = p.number_or("offset", 0.0);
-  c.terms = read_linear_terms(p);
-  return c;
-}
-
 // The bodies' JSON objects by name (a list: a duplicate name is reported by compile()).
 using BodiesByName = std::map<std::string, std::vector<const Json*>>;
 
@@ -481,32 +271,6 @@ LoadSpec read_load(const Params& p, const BodiesByName& bodies) {
 // {"model": NAME, "params": {…}, "name", "description", "gravity", "loads"}: the plugin writes
 // the bodies (and couplings, loads, table); the file's own name, gravity and loads apply on top.
 MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std::string& source);
-
-// {"model": "urdf", "params": {"file": F, "root_joint": "fixed" | "free"}, …}: a URDF by
-// reference (F relative to the JSON file), read from a file only (read_spec, model_document);
-// {"model": "mjcf", "params": {"file": F}} an MJCF file the same way.
-constexpr const char* kUrdfReference = "urdf";
-constexpr const char* kMjcfReference = "mjcf";
-
-// The file's own name, description, gravity and loads on top of the document it expands to.
-void apply_overrides(const Json& root, const Params& p, Json& doc) {
-  for (const char* key : {"name", "description", "gravity"})
-    if (root.contains(key)) doc[key] = root[key];
-  for (const char* list : {"loads", "frames", "constraints", "springs"})
-    if (root.contains(list)) {
-      if (!root[list].is_array()) p.fail(list, "expected an array");
-      if (!doc.contains(list)) doc[list] = Json::array();
-      for (const Json& l : root[list]) doc[list].push_back(l);
-    }
-}
-
-// {"model", "params", …}: the keys of a plugin's (or a URDF reference's) form, checked.
-Params plugin_form(const Json& root, const std::string& source) {
-  Params p(root, source + ": ");
-  p.allow_only({"model", "params", "name", "description", "gravity", "loads", "frames",
-                "constraints", "springs", "$schema"});
-  return p;
-}
 
 Json expand_plugin(const Catalog& catalog, const Json& root, const std::string& source) {
   const Params p = plugin_form(root, source);
@@ -639,38 +403,6 @@ SpringSpec parse_spring(const Json& spring, const std::string& where, std::size_
   return read_spring(Params(spring, where), {}, index);
 }
 
-namespace {
-
-// The text as JSON, its nesting and body count bounded first; malformed JSON named by line and
-// column.
-Json parse_json(const std::string& text, const std::string& source) {
-  // The nesting depth and the number of bodies are bounded (core/limits.hpp) by one pass over
-  // the text, before a deep or huge document can cost anything.
-  const JsonOutline shape = outline(text);
-  if (shape.too_deep)
-    throw ModelError(source, "JSON nested deeper than " + std::to_string(kMaxNesting) +
-                                 " levels (femdyn's limit)");
-  if (shape.bodies > static_cast<std::size_t>(kMaxBodies))
-    throw ModelError(source + ": /bodies", too_many_bodies_text(shape.bodies));
-  Json root;
-  try {
-    root = Json::parse(text);
-  } catch (const Json::parse_error& e) {
-    std::string what = e.what();
-    const auto colon = what.rfind(": ");
-    throw ModelError(source, "malformed JSON at " + line_col(text, e.byte == 0 ? 0 : e.byte - 1) +
-                                 (colon == std::string::npos ? "" : ": " + what.substr(colon + 2)));
-  } catch (const Json::exception& e) {  // e.g. number overflow (1e999)
-    std::string what = e.what();
-    const auto bracket = what.find("] ");
-    throw ModelError(source, "malformed JSON: " +
-                                 (bracket == std::string::npos ? what : what.substr(bracket + 2)));
-  }
-  return root;
-}
-
-}  // namespace
-
 MechanismSpec parse_spec(const std::string& text, const std::string& source,
                          const Catalog& catalog) {
   return parse_model_json(parse_json(text, source), source, catalog);
@@ -688,137 +420,12 @@ namespace {
 
 std::string read_text(const std::string& path) { return read_input_file(path); }
 
-// Errors found after conversion name the robot file's link (MJCF: body) and joint, not the
-// generated JSON path: "robot.urdf: /bodies/3/joint: …" becomes "robot.urdf: joint 'elbow'
-// (link 'forearm'): …".
-[[noreturn]] void rethrow_for_urdf(const ModelError& e, const Json& doc, const std::string& path) {
-  const std::string link = is_mjcf_path(path) ? "body" : "link";
-  const std::string mimic = is_mjcf_path(path) ? "' <equality>" : "' <mimic>";
-  std::string msg = e.what();
-  // "/bodies/N…" names a joint and its child link; "/couplings/N…" a joint's <mimic>.
-  for (const std::string section : {"bodies", "couplings"}) {
-    const std::string prefix = path + ": /" + section + "/";
-    if (msg.rfind(prefix, 0) != 0) continue;
-    std::size_t i = prefix.size(), end = i;
-    while (end < msg.size() && std::isdigit(static_cast<unsigned char>(msg[end]))) ++end;
-    const std::size_t rest = msg.find(": ", end);
-    if (end == i || rest == std::string::npos) break;
-    const Json& item = doc[section][std::stoul(msg.substr(i, end - i))];
-    const std::string who = section == "bodies"
-                                ? "joint '" + item["joint"]["name"].get<std::string>() + "' (" +
-                                      link + " '" + item["name"].get<std::string>() + "')"
-                                : "joint '" + item["joint"].get<std::string>() + mimic;
-    msg = path + ": " + who + msg.substr(rest);
-  }
-  throw ModelError("", msg);
-}
-
-}  // namespace
-
-namespace {
-
-Json urdf_document(const std::string& urdf, UrdfOptions urdf_options, const LoadOptions& options) {
-  UrdfResult r = read_urdf(urdf, urdf_options);
-  if (options.warn)
-    for (const std::string& w : r.warnings) options.warn(w);
-  return std::move(r.model);
-}
-
-Json mjcf_document(const std::string& mjcf, MjcfOptions mjcf_options, const LoadOptions& options) {
-  MjcfResult r = read_mjcf(mjcf, mjcf_options);
-  if (options.warn)
-    for (const std::string& w : r.warnings) options.warn(w);
-  return std::move(r.model);
-}
-
-// A URDF or MJCF file as femdyn JSON. --floating-base is for URDF: MJCF floats a body by its own
-// free joint.
-Json robot_document(const std::string& path, const LoadOptions& options) {
-  if (is_urdf_path(path))
-    return urdf_document(
-        path, {.floating_base = options.floating_base, .balance_inertia = options.balance_inertia},
-        options);
-  if (options.floating_base)
-    throw ModelError(path,
-                     "--floating-base is for URDF models: an MJCF model floats a body by its "
-                     "own <freejoint/>");
-  return mjcf_document(path,
-                       {.balance_inertia = options.balance_inertia,
-                        .exact_mesh_inertia = options.exact_mesh_inertia},
-                       options);
-}
-
-// {"model": "mjcf", "params": {"file", "balance_inertia"}}: the MJCF file it names, with the
-// reference's own name, description, gravity and loads.
-std::pair<Json, std::string> mjcf_reference(const std::string& path, const Json& root,
-                                            const Params& p, const Params& params,
-                                            const LoadOptions& options) {
-  params.allow_only({"file", "balance_inertia"});
-  std::filesystem::path file(params.string("file"));
-  if (file.is_relative()) file = std::filesystem::path(path).parent_path() / file;
-  if (!is_mjcf_path(file.string())) params.fail("file", "expected an MJCF file (<mujoco>)");
-  Json doc;
-  try {
-    doc = mjcf_document(
-        file.string(),
-        {.balance_inertia = options.balance_inertia || params.boolean_or("balance_inertia", false)},
-        options);
-  } catch (const Error& e) {
-    params.fail("file", e.what());
-  }
-  apply_overrides(root, p, doc);
-  return {std::move(doc), file.string()};
-}
-
-// A JSON file {"model": "urdf", …}: the URDF it names as femdyn JSON (with the file's own name,
-// description, gravity and loads), and that URDF's path for messages; nullopt for any other file.
-std::optional<std::pair<Json, std::string>> urdf_reference(const std::string& path,
-                                                           const Json& root,
-                                                           const LoadOptions& options) {
-  if (!root.is_object() || !root.contains("model") ||
-      (root["model"] != kUrdfReference && root["model"] != kMjcfReference))
-    return std::nullopt;
-  const Params p = plugin_form(root, path);
-  const Params params = p.child("params");
-  if (root["model"] == kMjcfReference) return mjcf_reference(path, root, p, params, options);
-  params.allow_only({"file", "root_joint", "balance_inertia"});
-  const std::string root_joint = params.has("root_joint") ? params.string("root_joint") : "fixed";
-  if (root_joint != "fixed" && root_joint != "free")
-    params.fail("root_joint", "expected \"fixed\" or \"free\", got " + quoted_text(root_joint));
-  const std::string file = params.string("file");
-  std::filesystem::path urdf(file);
-  if (urdf.is_relative()) urdf = std::filesystem::path(path).parent_path() / urdf;
-  if (!is_urdf_path(urdf.string())) params.fail("file", "expected a *.urdf file");
-  Json doc;
-  try {
-    doc = urdf_document(
-        urdf.string(),
-        {.floating_base = root_joint == "free",
-         .balance_inertia = options.balance_inertia || params.boolean_or("balance_inertia", false)},
-        options);
-  } catch (const Error& e) {
-    params.fail("file", e.what());
-  }
-  apply_overrides(root, p, doc);
-  return std::pair{std::move(doc), urdf.string()};
-}
-
-// --balance-inertia repairs what an exporter wrote; a JSON model's inertias are the author's own,
-// refused with the element named, to be corrected there.
-void refuse_balance_on_json(const std::string& path, const LoadOptions& options) {
-  if (options.balance_inertia)
-    throw ModelError(path,
-                     "--balance-inertia is for URDF models (and URDF references, \"params\": "
-                     "{\"balance_inertia\": true}): a JSON model's inertias are its own, to be "
-                     "corrected where a refusal names them");
-}
-
 }  // namespace
 
 Json model_document(const std::string& path, const LoadOptions& options) {
   if (is_robot_file(path)) return robot_document(path, options);
   const Json root = parse_json(read_text(path), path);
-  if (auto ref = urdf_reference(path, root, options)) return std::move(ref->first);
+  if (auto ref = robot_reference(path, root, options)) return std::move(ref->first);
   refuse_balance_on_json(path, options);
   const Catalog& catalog = options.catalog ? *options.catalog : default_catalog();
   (void)parse_model_json(root, path, catalog);  // reports every model error by its path
@@ -834,11 +441,11 @@ MechanismSpec read_spec(const std::string& path, const LoadOptions& options) {
                      "reference by \"root_joint\": \"free\"");
   if (!is_robot_file(path)) {
     const Json root = parse_json(read_text(path), path);
-    if (auto ref = urdf_reference(path, root, options)) {
+    if (auto ref = robot_reference(path, root, options)) {
       try {
         return parse_model_json(ref->first, ref->second, catalog);
       } catch (const ModelError& e) {
-        rethrow_for_urdf(e, ref->first, ref->second);
+        rethrow_for_robot_file(e, ref->first, ref->second);
       }
     }
     refuse_balance_on_json(path, options);
@@ -848,7 +455,7 @@ MechanismSpec read_spec(const std::string& path, const LoadOptions& options) {
   try {
     return parse_model_json(doc, path, catalog);
   } catch (const ModelError& e) {
-    rethrow_for_urdf(e, doc, path);
+    rethrow_for_robot_file(e, doc, path);
   }
 }
 
@@ -862,7 +469,7 @@ Model load_model(const std::string& path, const LoadOptions& options) {
   try {
     return compile(std::move(spec), options.compile);
   } catch (const ModelError& e) {
-    rethrow_for_urdf(e, model_document(path, options), path);
+    rethrow_for_robot_file(e, model_document(path, options), path);
   }
 }
 

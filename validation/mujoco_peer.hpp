@@ -44,11 +44,13 @@ class MujocoPeer {
   // An MJCF file compiled by MuJoCo itself (docs/validation.md, "MJCF"): `joints` are femdyn's
   // moving joints in its coordinate order, each by name with its rates (1; 3 for a ball; 6 for a
   // free joint, whose q is MuJoCo's qpos and whose v is in the body's axes, as above). An
-  // unnamed MuJoCo joint is "joint<i>", i its index. Mesh geoms (whose mass the MJCF reader
-  // refuses), assets and contact pairs are removed first, so that a model loads without its
-  // mesh files, and actuators, sensors, tendons, keyframes and the integrator, which the
-  // quantities compared do not depend on (and MuJoCo 2.2 may not read); constraints, contacts
-  // and fluid forces (which the reader reports as not modelled) are off.
+  // unnamed MuJoCo joint is "joint<i>", i its index (for a coupled model, the joints' θ order).
+  // Meshes whose files exist are kept (paths made absolute, exactmeshinertia: see
+  // keep_meshes); other mesh geoms, assets and contact pairs are removed, so that a model loads
+  // without its visual meshes, and actuators, sensors, tendons, keyframes and the integrator,
+  // which the quantities compared do not depend on (and MuJoCo 2.2 may not read); constraints
+  // (equalities included), contacts and fluid forces are off, and damping and springs on ball
+  // and free joints are zeroed: what the reader reports as not modelled.
   struct MjcfJoint {
     std::string name;
     int rates;

@@ -91,23 +91,24 @@ std::optional<QuantityError> validate_mjcf_import(const Model& m, const std::str
   for (int k = 0; k < o.states; ++k) {
     const VecX q = random_posture(m, rng), qd = random_uniform(m.n(), o.qd_scale, rng);
     const VecX qdd = random_uniform(m.n(), 1, rng), tau = random_uniform(m.n(), 1, rng);
-    const VecX friction = coulomb_forces(m, qd);
     const JointLevel at = joint_level(m, q, qd, qdd);
     const MatX& G = at.G;
+    const VecX friction = coulomb_joint_forces(m, at.theta_dot);  // θ level
     const MatX M = peer->mass(at.theta);
     mass_matrix(m, ws, q);
     accumulate(e, ws.Ms, G.transpose() * M * G);
     inverse_dynamics(m, ws, q, qd, qdd);
     accumulate(e, ws.tau,
-               G.transpose() * peer->inverse(at.theta, at.theta_dot, at.theta_ddot) - friction,
+               G.transpose() * (peer->inverse(at.theta, at.theta_dot, at.theta_ddot) - friction),
                bias_floor(ws.Ms, qd));
     // The peer's equalities are off: the spanning tree's q̈ (a model's loops ignored) is compared.
     if (!tree_forward_dynamics(m, ws, q, qd, tau).ok) continue;
-    // MuJoCo's q̈ on the coupling: Gᵀ M G q̈ = τ + friction − Gᵀ τ_MuJoCo(θ, θ̇, θ̈ = γ).
+    // MuJoCo's q̈ on the coupling: Gᵀ M G q̈ = τ + Gᵀ (friction − τ_MuJoCo(θ, θ̇, θ̈ = γ)).
     const JointLevel free = joint_level(m, q, qd, VecX::Zero(m.n()));
-    const VecX bias = G.transpose() * peer->inverse(free.theta, free.theta_dot, free.theta_ddot);
+    const VecX bias =
+        G.transpose() * (peer->inverse(free.theta, free.theta_dot, free.theta_ddot) - friction);
     const MatX reduced = G.transpose() * M * G;
-    accumulate(e, ws.qdd, reduced.ldlt().solve(tau + friction - bias));
+    accumulate(e, ws.qdd, reduced.ldlt().solve(tau - bias));
   }
   return e;
 }

@@ -29,8 +29,18 @@ inline double coulomb_force(const Joint& j, double theta_dot) {
 struct StopForce {
   double force = 0, elastic = 0;
 };
-// The Coulomb forces on every coordinate at q̇, for a model without couplings (q̇ = θ̇): what the
-// MuJoCo peer is handed as an applied force (its frictionloss is a constraint, off there).
+// The Coulomb forces on every joint rate at θ̇ (n_θ entries, in θ̇ order): what the MuJoCo peer
+// is handed as an applied force (its frictionloss is a constraint, off there). On the
+// coordinates they act as Gᵀ f (G = ∂θ/∂q).
+inline VecX coulomb_joint_forces(const Model& m, const VecX& theta_dot) {
+  VecX f = VecX::Zero(m.n_theta());
+  for (const Body& b : m.bodies)
+    if (b.joint.friction != 0 && b.joint.nv == 1 && b.joint.idx_v >= 0)
+      f[b.joint.idx_v] += coulomb_force(b.joint, theta_dot[b.joint.idx_v]);
+  return f;
+}
+
+// The same on every coordinate at q̇, for a model without couplings (q̇ = θ̇).
 inline VecX coulomb_forces(const Model& m, const VecX& qd) {
   VecX f = VecX::Zero(m.n());
   for (const Body& b : m.bodies)
