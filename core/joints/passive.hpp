@@ -41,13 +41,7 @@ inline VecX coulomb_joint_forces(const Model& m, const VecX& theta_dot) {
 }
 
 // The same on every coordinate at q̇, for a model without couplings (q̇ = θ̇).
-inline VecX coulomb_forces(const Model& m, const VecX& qd) {
-  VecX f = VecX::Zero(m.n());
-  for (const Body& b : m.bodies)
-    if (b.joint.friction != 0 && b.joint.nv == 1 && b.joint.idx_v >= 0)
-      f[b.joint.idx_v] += coulomb_force(b.joint, qd[b.joint.idx_v]);
-  return f;
-}
+inline VecX coulomb_forces(const Model& m, const VecX& qd) { return coulomb_joint_forces(m, qd); }
 
 inline StopForce stop_force(const Joint& j, double theta, double theta_dot) {
   if (theta > j.upper) {
