@@ -50,6 +50,7 @@ struct Walk {
   std::vector<std::string> notes;
   MjcfMassNotes mass_notes;
   std::vector<Visual> visuals;
+  Json sites = Json::array();  // named sites, as frames on their femdyn bodies
   struct Massed {
     const XMLElement* body;  // the MuJoCo body
     std::size_t index;       // its femdyn body, in `bodies`
@@ -154,6 +155,24 @@ struct Placed {
   Pose below, world0;
 };
 
+// A body's named sites, as frames on the femdyn body that carries it (an unnamed one is
+// counted as not used).
+void read_sites(Walk& w, const XMLElement& body, const std::string& childclass,
+                const Placed& placed) {
+  for (const XMLElement* site : w.doc.children(body, "site")) {
+    const char* name = site->Attribute("name");
+    if (!name) {
+      ++w.unused["unnamed sites"];
+      continue;
+    }
+    const Pose F = placed.below * pose_of(w.doc, *site, w.doc.class_of(*site, childclass));
+    w.sites.push_back({{"name", name},
+                       {"body", placed.femdyn},
+                       {"xyz", vec3_json(F.p)},
+                       {"rpy", vec3_json(rotation_rpy(F.R))}});
+  }
+}
+
 // A MuJoCo body: its chain of femdyn bodies (one per joint, or one welded), its mass on the last.
 Placed read_body(Walk& w, const Visit& v, const std::string& childclass) {
   const Document& doc = w.doc;
@@ -215,17 +234,19 @@ Placed read_body(Walk& w, const Visit& v, const std::string& childclass) {
   w.masses.push_back(
       {&body, w.bodies.size() - 1, at, body_mass(doc, body, childclass, w.mass_notes)});
   add_visuals(doc, body, childclass, placed.femdyn, placed.below, w.visuals);
+  read_sites(w, body, childclass, placed);
   return placed;
 }
 
-// What a body holds that femdyn does not model, counted for the one-line report.
-void count_unused(Walk& w, const XMLElement& e) {
+// What a body (or the world, or a <frame>) holds that femdyn does not model, counted for the
+// one-line report; a body's sites are frames (read_sites).
+void count_unused(Walk& w, const XMLElement& e, bool body) {
   for (const XMLElement* c : w.doc.children(e)) {
     const std::string tag = c->Name();
     if (tag == "geom")
       ++w.unused["geoms' contacts"];
-    else if (tag == "site")
-      ++w.unused["sites"];
+    else if (tag == "site" && !body)
+      ++w.unused["sites outside bodies"];
     else if (tag == "camera" || tag == "light")
       ++w.unused["cameras and lights"];
     else if (tag == "composite" || tag == "flexcomp" || tag == "replicate" || tag == "attach")
@@ -245,7 +266,7 @@ void walk_tree(Walk& w) {
         stack.push_back({*it, parent, in, world0, cls, body});
   };
   for (const XMLElement* world : w.doc.sections("worldbody")) {
-    count_unused(w, *world);
+    count_unused(w, *world, false);
     add_visuals(w.doc, *world, "", "world", Pose{}, w.visuals);
     push_children(*world, "world", Pose{}, Pose{}, "", nullptr);
     while (!stack.empty()) {
@@ -255,14 +276,14 @@ void walk_tree(Walk& w) {
       if (!std::strcmp(v.e->Name(), "frame")) {
         const Pose F = pose_of(w.doc, *v.e, "");
         check_frame(w.doc, *v.e, v.body);
-        count_unused(w, *v.e);
+        count_unused(w, *v.e, false);
         push_children(*v.e, v.parent, v.in_parent * F, v.world0 * F, childclass, v.body);
         continue;
       }
       if (w.mj_body >= kMaxBodies)
         throw ModelError(w.doc.path(), too_many_bodies_text(w.mj_body + 1));
       const Placed placed = read_body(w, v, childclass);
-      count_unused(w, *v.e);
+      count_unused(w, *v.e, true);
       push_children(*v.e, placed.femdyn, placed.below, placed.world0, childclass, v.e);
     }
   }
@@ -307,6 +328,22 @@ std::string unused_text(Walk& w) {
   return list.empty() ? "" : doc.path() + ": not modelled by femdyn (listed, not used): " + list;
 }
 
+// The sites as the model's frames; one named like a body or an earlier site is counted as not
+// used (a frame's name is unique among bodies and frames).
+void add_sites(Walk& w, Json& model) {
+  std::set<std::string> names;
+  for (const Json& b : w.bodies) names.insert(b["name"].get<std::string>());
+  Json frames = Json::array();
+  for (Json& site : w.sites) {
+    if (!names.insert(site["name"].get<std::string>()).second) {
+      ++w.unused["sites named like a body or another site"];
+      continue;
+    }
+    frames.push_back(std::move(site));
+  }
+  if (!frames.empty()) model["frames"] = std::move(frames);
+}
+
 }  // namespace
 
 MjcfResult read_mjcf(const std::string& path, const MjcfOptions& options) {
@@ -326,6 +363,7 @@ MjcfResult read_mjcf(const std::string& path, const MjcfOptions& options) {
                {"description", "imported from " + path + " (MJCF)"},
                {"gravity", vec3_json(gravity(w))},
                {"bodies", w.bodies}};
+  add_sites(w, out.model);
   read_equalities(doc, w.tree, out.model, w.notes);
   if (!w.mass_notes.not_solid.empty()) {  // each mesh once, in file order
     std::vector<std::string> names;

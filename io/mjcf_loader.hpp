@@ -15,7 +15,8 @@
 //   Joint armature, damping, frictionloss (as Coulomb friction), stiffness/springref, range with
 //     limited/autolimits. <option gravity>. <equality> connect -> a ball constraint, weld -> a
 //     weld, joint -> a coupling (its polynomial).
-//   What femdyn does not model (contacts, actuators, sensors, tendons, sites, keyframes, …) is
+//   A body's named sites -> frames on its femdyn body.
+//   What femdyn does not model (contacts, actuators, sensors, tendons, keyframes, …) is
 //   reported once, in one line.
 // Errors: ModelError "arm.xml: <joint name='elbow'> (line 12): axis is zero".
 #pragma once

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "core/equations.hpp"
+#include "core/frames.hpp"
 #include "core/loops/assembly.hpp"
 #include "core/loops/constraint_kinematics.hpp"
 #include "core/sampling.hpp"
@@ -284,4 +285,35 @@ TEST_CASE("MJCF: a mesh geom's mass is the solid its mesh bounds, as MuJoCo comp
             "<geom type=\"box\" size=\"0.1 0.1 0.5\" pos=\"0.1 0.1 1\" density=\"700\"/>");
   CHECK(tau_difference(exact, boxes) < 1e-13);
   CHECK(tau_difference(legacy, boxes) > 1e-2);
+}
+
+// A body's named sites are frames on it, where MuJoCo puts them: a hinge about y at the body's
+// origin (1 m up) turns the site at (0.2, 0, 0) in its frame to (0.2 cos q, 0, 1 − 0.2 sin q).
+TEST_CASE("MJCF: a body's named sites are the model's frames", "[mjcf][frames]") {
+  Scratch scratch("mjcf_sites");
+  const std::string path = (scratch.dir / "sites.xml").string();
+  std::ofstream(path) << "<mujoco><worldbody><site name='floor'/><body name='arm' pos='0 0 1'>"
+                         "<joint axis='0 1 0'/><geom type='capsule' fromto='0 0 0 0.2 0 0' "
+                         "size='0.02'/><site name='tip' pos='0.2 0 0' euler='0 0 90'/><site/>"
+                         "<site name='arm'/></body></worldbody></mujoco>";
+  std::vector<std::string> warnings;
+  LoadOptions options;
+  options.warn = [&](const std::string& w) { warnings.push_back(w); };
+  const Model m = load_model(path, options);
+  const int tip = find_frame(m, "tip");
+  REQUIRE(tip >= 0);
+  CHECK(m.frames.size() == m.bodies.size() + 1);  // 'tip' only
+  REQUIRE(warnings.size() == 1);
+  CHECK_THAT(warnings[0], Catch::Contains("1 sites named like a body or another site") &&
+                              Catch::Contains("1 sites outside bodies") &&
+                              Catch::Contains("1 unnamed sites"));
+  Workspace ws(m);
+  FrameKinematics k;
+  const double q = 0.3;
+  frame_kinematics(m, ws, VecX::Constant(1, q), VecX::Zero(1), tip, FrameAxes::World, k);
+  CHECK((k.p - Vec3(0.2 * std::cos(q), 0, 1 - 0.2 * std::sin(q))).norm() < 1e-15);
+  // Its axes: the body's turned by 90° about z (euler in degrees, MJCF's default).
+  const Mat3 expected = Eigen::AngleAxisd(q, Vec3::UnitY()).toRotationMatrix() *
+                        Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitZ()).toRotationMatrix();
+  CHECK((k.R - expected).norm() < 1e-14);
 }
