@@ -15,6 +15,7 @@
 #include "io/mjcf_loader.hpp"
 #include "io/output.hpp"
 #include "io/urdf_loader.hpp"
+#include "validation/file_rows.hpp"
 
 namespace femdyn::cli {
 namespace {
@@ -282,49 +283,7 @@ int cmd_validate(int argc, char** argv) {
       r = validators[i]->run();
       validators[i].reset();  // its workspace and twin
     }
-    if (is_urdf_path(a.positional[i]) && r.failure.empty()) {
-      // The import itself, against a Simbody model read straight from the XML.
-      std::string failure;
-      r.quantities.push_back(validation::validate_urdf_import(models[i], a.positional[i], o,
-                                                              failure, a.has("balance-inertia")));
-      if (!failure.empty()) r.failure = failure;
-    }
-#ifdef FEMDYN_WITH_MUJOCO
-    if (is_mjcf_path(a.positional[i])) {
-      // The import itself, against MuJoCo's own compile of the file: where the Simbody twin
-      // cannot hold the model (armature), MuJoCo's comparison stands alone, said in a note.
-      std::string why;
-      const MjcfMassNotes meshes =
-          read_mjcf(a.positional[i], {.balance_inertia = a.has("balance-inertia")}).mass_notes;
-      // MuJoCo 2.2 has no legacy solid of a non-convex mesh: both sides then weigh every mesh
-      // by its exact solid, said in a note.
-      std::optional<Model> exact;
-      if (!meshes.not_solid.empty()) {
-        LoadOptions same = load_options(a);
-        same.warn = [](const std::string&) {};  // said once, by the first load
-        same.exact_mesh_inertia = true;
-        exact = load_model(a.positional[i], same);
-        r.notes.push_back("compared with MuJoCo with every mesh weighed by its exact solid (" +
-                          std::to_string(meshes.not_solid.size()) +
-                          " geoms of non-convex meshes, whose legacy inertia MuJoCo 2.2 does not "
-                          "compute): the rest of the model is the one checked above");
-      }
-      if (auto e =
-              validation::validate_mjcf_import(exact ? *exact : models[i], a.positional[i],
-                                               meshes.mesh_geoms, meshes.full_inertias, o, why)) {
-        r.quantities.push_back(*e);
-        if (!why.empty()) r.notes.push_back(why);
-        if (!r.failure.empty()) {
-          r.notes.push_back("compared with MuJoCo only: " + r.failure);
-          r.trajectory.skipped = "the Simbody twin cannot hold the model (note below)";
-          r.failure.clear();
-          r.not_comparable = false;
-        }
-      } else {
-        r.notes.push_back("not compared with MuJoCo's compile of the file: " + why);
-      }
-    }
-#endif
+    validation::add_file_rows(r, models[i], a.positional[i], o, load_options(a));
     any_failed = any_failed || (!r.pass() && !r.not_comparable);
     any_not_compared = any_not_compared || r.not_comparable;
     if (a.has("json"))

@@ -54,6 +54,8 @@ std::unique_ptr<PyModel> load(const std::string& path, const OptArray& gravity, 
     model = std::make_unique<PyModel>(load_model(text_arg(path, "path"), options));
   }
   model->source = path;
+  model->load = options;
+  model->load.warn = nullptr;  // the warnings were given once, here
   for (const std::string& w : warnings)
     if (PyErr_WarnEx(PyExc_UserWarning, safe_message(w).c_str(), 1) != 0)
       throw py::error_already_set();

@@ -6,6 +6,7 @@
 
 #include "python/py_model.hpp"
 #ifdef FEMDYN_WITH_SIMBODY
+#include "validation/file_rows.hpp"
 #include "validation/validate.hpp"
 #endif
 
@@ -45,6 +46,9 @@ py::dict validate(const PyModel& self, int states, unsigned seed, std::optional<
     validation::Validator v(*self.model, o);
     refusal = v.refusal(self.model->where.empty() ? self.model->name : self.model->where);
     if (refusal.empty()) r = v.run();
+    // As `femdyn validate FILE`: the import against the robot file it was read from.
+    if (refusal.empty() && !self.source.empty())
+      validation::add_file_rows(r, *self.model, self.source, o, self.load);
   }
   if (!refusal.empty()) throw py::value_error(refusal);
   py::dict quantities;
@@ -113,7 +117,8 @@ void bind_validate(py::module_& m) {
         py::arg("budget") = validation::kDefaultBudget, py::arg("max_memory") = py::none(),
         "The model against its Simbody twin (docs/validation.md): M, h, Q, qdd, tau at `states` "
         "seeded random states and a passive trajectory of t_end s (what `femdyn validate` does, "
-        "less its URDF import check); tolerance None is the CLI's default, max(1e-10, eps d^2) "
+        "with its rows for the URDF or MJCF file the model was loaded from: 'urdf import', "
+        "'mujoco'); tolerance None is the CLI's default, max(1e-10, eps d^2) "
         "for a tree d bodies deep (q-ddot: at least 10 eps cond(M^s)). Estimated first: beyond "
         "`budget` seconds or `max_memory` "
         "GB (default: half the available memory) a ValueError with `femdyn validate`'s message. "

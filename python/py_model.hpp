@@ -9,6 +9,7 @@
 #include "core/loops/constrained_dynamics.hpp"
 #include "core/memory.hpp"
 #include "core/workspace.hpp"
+#include "io/model_loader.hpp"
 #include "python/arrays.hpp"
 
 namespace femdyn::python {
@@ -26,6 +27,7 @@ struct PyModel {
   std::unique_ptr<LoopWorkspace> loops;              // with closed loops: their buffers (else null)
   std::unique_ptr<DerivativeWorkspace> derivatives;  // made by the first derivatives call
   std::string source;  // the file it was loaded from (femdyn.load), else ""
+  LoadOptions load;    // how it was loaded (gravity, floating base, inertia balancing)
 };
 
 // M, h, Q and q̈ at one state; qdd is absent when forward dynamics failed (then `failure`

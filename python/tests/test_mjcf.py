@@ -26,3 +26,20 @@ def test_mjcf_equals_its_import_and_the_cli(tmp_path):
     assert np.max(np.abs(a.h - b.h)) <= 1e-13 * max(1.0, np.max(np.abs(a.h)))
     cli = cli_json("equations", FEATURES, "--q", numbers(q), "--qd", numbers(v), "--json")
     assert np.allclose(np.array(cli["M"]), a.M, rtol=0, atol=1e-13 * np.max(np.abs(a.M)))
+
+
+def test_validate_checks_the_file_it_was_loaded_from_as_the_cli_does():
+    """femdyn.validate of a model loaded from an MJCF or URDF file has the CLI's rows against
+    that file ('mujoco', 'import'), with the same numbers at the same seed."""
+    import warnings
+
+    loops = ROOT / "tests" / "data" / "mjcf" / "loops.xml"
+    arm = ROOT / "models" / "urdf" / "arm7.urdf"
+    for path, row in ((loops, "mujoco"), (arm, "import")):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            py = femdyn.validate(femdyn.load(str(path)), t_end=0)
+        cli = cli_json("validate", path, "--t-end", "0", "--json")
+        assert py["pass"] and cli["pass"]
+        assert row in py["quantities"], f"{path.name}: no {row!r} row in Python"
+        assert py["quantities"][row]["max_rel"] == cli["max_rel_error"][row]
