@@ -5,7 +5,10 @@
 //     without one).
 //   joint joint1 joint2 polycoef a0…a4 -> a coupling, y − y0 = Σ a_k (x − x0)^k with y, x the two
 //     joints' qpos and y0, x0 their refs: linear, or the polynomial expanded in x.
+//   tendon tendon1 [tendon2] polycoef a0 a1 -> a linear coupling among the fixed tendons' joints
+//     (tendon_coupling).
 // MuJoCo keeps equalities soft (solref, solimp); femdyn's hold exactly (docs/loops.md).
+#include <algorithm>
 #include <cstring>
 
 #include "core/names.hpp"
@@ -102,6 +105,63 @@ Json joint_coupling(const Document& doc, const Tree& tree, const XMLElement& e) 
   return coupling;
 }
 
+// A <fixed> tendon's joints and coefficients, L = Σ a_i q_i.
+std::vector<std::pair<const PlacedJoint*, double>> fixed_tendon(const Document& doc,
+                                                                const Tree& tree,
+                                                                const XMLElement& e,
+                                                                const char* attr) {
+  const char* name = e.Attribute(attr);
+  if (!name) doc.fail(e, std::string("needs ") + attr);
+  for (const XMLElement* section : doc.sections("tendon"))
+    for (const XMLElement* t : doc.children(*section)) {
+      if (!t->Attribute("name", name)) continue;
+      if (std::strcmp(t->Name(), "fixed") != 0)
+        doc.fail(e, std::string(attr) + ": tendon " + quoted_text(name) +
+                        " is spatial (femdyn reads an equality on fixed tendons)");
+      std::vector<std::pair<const PlacedJoint*, double>> out;
+      for (const XMLElement* j : doc.children(*t, "joint"))
+        out.push_back({&joint_named(doc, tree, *j, "joint"), doc.number(*j, "coef", "", 0)});
+      if (out.empty()) doc.fail(*t, "a fixed tendon without joints");
+      return out;
+    }
+  doc.fail(e, std::string(attr) + ": no tendon " + quoted_text(name));
+}
+
+// tendon tendon1 [tendon2] polycoef p: L1 − L1₀ = p0 + p1 (L2 − L2₀) on fixed tendons (L₀ their
+// lengths at qpos0): a linear relation among their joints, held by making tendon1's first joint
+// that tendon2 does not hold follow the others. A nonlinear polycoef is refused.
+Json tendon_coupling(const Document& doc, const Tree& tree, const XMLElement& e) {
+  std::vector<double> p = doc.numbers(e, "polycoef", "", 5);
+  if (p.empty()) p = {0, 1, 0, 0, 0};
+  if (p[2] != 0 || p[3] != 0 || p[4] != 0)
+    doc.fail(e, "a nonlinear tendon equality (femdyn reads polycoef a0 a1 0 0 0)");
+  const auto t1 = fixed_tendon(doc, tree, e, "tendon1");
+  const auto t2 = e.Attribute("tendon2") ? fixed_tendon(doc, tree, e, "tendon2")
+                                         : std::vector<std::pair<const PlacedJoint*, double>>{};
+  // Σ_i a_i q_i − p1 Σ_j b_j q_j = c, c = L1₀ + p0 − p1 L2₀, gathered per joint.
+  std::vector<std::pair<const PlacedJoint*, double>> k;
+  const auto add = [&](const PlacedJoint* j, double x) {
+    for (auto& [jj, kk] : k)
+      if (jj == j) return void(kk += x);
+    k.push_back({j, x});
+  };
+  double c = p[0];
+  for (const auto& [j, a] : t1) add(j, a), c += a * j->ref;
+  if (!t2.empty())
+    for (const auto& [j, b] : t2) add(j, -p[1] * b), c -= p[1] * b * j->ref;
+  const auto follower =
+      std::find_if(k.begin(), k.end(), [](const auto& t) { return t.second != 0; });
+  if (follower == k.end()) doc.fail(e, "the tendons' joints cancel: no joint to hold");
+  Json follows = Json::array();
+  for (const auto& [j, x] : k)
+    if (j != follower->first && x != 0)
+      follows.push_back({{"joint", j->femdyn_joint}, {"ratio", -x / follower->second}});
+  if (follows.empty()) doc.fail(e, "holds one joint at a constant (femdyn holds it by a coupling)");
+  return {{"joint", follower->first->femdyn_joint},
+          {"follows", follows},
+          {"offset", c / follower->second}};
+}
+
 }  // namespace
 
 void read_equalities(const Document& doc, const Tree& tree, Json& model,
@@ -120,10 +180,15 @@ void read_equalities(const Document& doc, const Tree& tree, Json& model,
         item = weld(doc, tree, *e);
       else if (tag == "joint")
         item = joint_coupling(doc, tree, *e);
+      else if (tag == "tendon")
+        item = tendon_coupling(doc, tree, *e);
       else
-        doc.fail(*e, "an equality femdyn does not read yet (connect, weld and joint are read)");
-      if (const char* name = e->Attribute("name"); name && tag != "joint") item["name"] = name;
-      model[tag == "joint" ? "couplings" : "constraints"].push_back(item);
+        doc.fail(*e,
+                 "an equality femdyn does not read yet (connect, weld, joint and tendon "
+                 "are read)");
+      const bool coupling = tag == "joint" || tag == "tendon";
+      if (const char* name = e->Attribute("name"); name && !coupling) item["name"] = name;
+      model[coupling ? "couplings" : "constraints"].push_back(item);
     }
 }
 

@@ -14,7 +14,7 @@
 //     the exact one (exactmeshinertia, or the mesh's inertia="exact"): io/mjcf_mesh.cpp.
 //   Joint armature, damping, frictionloss (as Coulomb friction), stiffness/springref, range with
 //     limited/autolimits. <option gravity>. <equality> connect -> a ball constraint, weld -> a
-//     weld, joint -> a coupling (its polynomial).
+//     weld, joint -> a coupling (its polynomial), tendon (fixed, linear) -> a linear coupling.
 //   A body's named sites -> frames on its femdyn body.
 //   What femdyn does not model (contacts, actuators, sensors, tendons, keyframes, …) is
 //   reported once, in one line.

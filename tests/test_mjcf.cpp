@@ -108,4 +108,8 @@ TEST_CASE("MJCF: femdyn validate compares with MuJoCo's compile of the file, or 
       nlohmann::json::parse(coupled.out.substr(coupled.out.find("\n{") + 1));
   REQUIRE(report["max_rel_error"].contains("mujoco"));
   CHECK(report["max_rel_error"]["mujoco"].get<double>() < 1e-10);
+  // Tendon equalities (two fixed tendons, and a differential) held as linear couplings.
+  const Run tendons = run("validate " + mjcf_path("tendons.xml") + " --budget 60");
+  CHECK(tendons.code == 0);
+  CHECK_THAT(tendons.out, Catch::Contains("MuJoCo's 6 dofs projected on femdyn's 4"));
 }

@@ -317,3 +317,27 @@ TEST_CASE("MJCF: a body's named sites are the model's frames", "[mjcf][frames]")
                         Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitZ()).toRotationMatrix();
   CHECK((k.R - expected).norm() < 1e-14);
 }
+
+// A tendon equality holds where MuJoCo writes it: L1 − L1₀ = a0 + a1 (L2 − L2₀) on fixed tendons,
+// L₀ the lengths at qpos0 (the joints' refs), whatever the free coordinates.
+TEST_CASE("MJCF: tendon equalities hold their fixed tendons' relation", "[mjcf][couplings]") {
+  const Model m = load_model(mjcf_path("tendons.xml"));
+  CHECK(m.n() == m.n_theta() - 2);  // two joints follow
+  const auto theta_of = [&](const VecX& q, const std::string& joint) {
+    const VecX theta = m.C_configuration * q + m.theta0_configuration;
+    for (const Body& b : m.bodies)
+      if (b.joint.name == joint) return theta[b.joint.idx_q];
+    FAIL("no joint " << joint);
+    return 0.0;
+  };
+  std::mt19937 rng(8);
+  for (int k = 0; k < 5; ++k) {
+    const VecX q = random_posture(m, rng);
+    const auto t = [&](const char* j) { return theta_of(q, j); };
+    const double L1 = 0.5 * t("s1") + 0.8 * t("s2") - 0.3 * t("w");
+    const double L2 = 1.5 * t("w") + t("e");
+    const double L1_0 = 0.5 * 0.2 - 0.3 * -0.4, L2_0 = 1.5 * -0.4 + 0.01;
+    CHECK(std::abs((L1 - L1_0) - (0.1 + 2 * (L2 - L2_0))) < 1e-14);
+    CHECK(std::abs(t("g2") - t("g1")) < 1e-15);  // the differential, at its length as written
+  }
+}

@@ -84,7 +84,7 @@ std::optional<QuantityError> validate_mjcf_import(const Model& m, const std::str
   if (m.n_theta() != m.n())
     why += std::string(why.empty() ? "" : "; ") + "compared through the couplings: MuJoCo's " +
            std::to_string(m.n_theta()) + " dofs projected on femdyn's " + std::to_string(m.n()) +
-           " coordinates (M^s = Gᵀ M G, τ = Gᵀ τ(θ̈ = G q̈ + γ)), the <equality joint> off in MuJoCo";
+           " coordinates (M^s = Gᵀ M G, τ = Gᵀ τ(θ̈ = G q̈ + γ)), the equalities off in MuJoCo";
   QuantityError e{"mujoco", 0, 0, tolerance};
   Workspace ws(m);
   std::mt19937 rng(o.seed);
