@@ -12,7 +12,6 @@
 
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
-#include "io/mjcf_loader.hpp"
 #include "io/output.hpp"
 #include "io/urdf_loader.hpp"
 #include "validation/file_rows.hpp"

@@ -59,6 +59,14 @@ TriangleMesh binary_stl(const std::string& bytes) {
   return mesh;
 }
 
+// The three numbers after a text mesh's vertex keyword ("vertex" in STL, "v" in OBJ).
+Vec3 vertex(std::istringstream& words, const std::string& path, int line_no) {
+  Vec3 v;
+  if (!(words >> v[0] >> v[1] >> v[2]))
+    fail(path, "line " + std::to_string(line_no) + ": a vertex needs three numbers");
+  return v;
+}
+
 // ASCII STL: "solid … facet normal … outer loop vertex x y z (×3) endloop endfacet … endsolid".
 TriangleMesh ascii_stl(const std::string& path, const std::string& text) {
   TriangleMesh mesh;
@@ -71,10 +79,7 @@ TriangleMesh ascii_stl(const std::string& path, const std::string& text) {
     std::string word;
     if (!(words >> word)) continue;
     if (word == "vertex") {
-      Vec3 v;
-      if (!(words >> v[0] >> v[1] >> v[2]))
-        fail(path, "line " + std::to_string(line_no) + ": a vertex needs three numbers");
-      mesh.vertices.push_back(v);
+      mesh.vertices.push_back(vertex(words, path, line_no));
       ++in_facet;
     } else if (word == "endloop") {
       if (in_facet != 3)
@@ -118,10 +123,7 @@ TriangleMesh obj(const std::string& path, const std::string& text) {
     std::string word;
     if (!(words >> word)) continue;
     if (word == "v") {
-      Vec3 v;
-      if (!(words >> v[0] >> v[1] >> v[2]))
-        fail(path, "line " + std::to_string(line_no) + ": a vertex needs three numbers");
-      mesh.vertices.push_back(v);
+      mesh.vertices.push_back(vertex(words, path, line_no));
     } else if (word == "f") {
       face.clear();
       while (words >> word) face.push_back(obj_index(path, line_no, word, mesh.vertices.size()));

@@ -89,6 +89,31 @@ CentroidalMass legacy_solid_mass(const TriangleMesh& mesh, double density, doubl
   return {density * volume, com, second.trace() * Mat3::Identity() - second};
 }
 
+// The triangles of the mesh a geom names (its file or inline vertex/face), scaled, after the
+// asset's unread attributes are refused.
+TriangleMesh mesh_of(const Document& doc, const XMLElement& geom, const std::string& cls,
+                     const MeshFile& f) {
+  for (const char* unsupported : {"refpos", "refquat"})
+    if (f.asset->Attribute(unsupported))
+      doc.fail(*f.asset, std::string(unsupported) + " is not read by femdyn (MuJoCo removed it)");
+  if (const char* inertia = doc.attr(*f.asset, "inertia", f.cls);
+      inertia && std::strcmp(inertia, "legacy") && std::strcmp(inertia, "exact"))
+    doc.fail(*f.asset, std::string("inertia=\"") + inertia +
+                           "\": femdyn computes a mesh's legacy or exact volume inertia");
+  TriangleMesh out;
+  if (!f.file.empty()) {
+    try {
+      out = read_mesh(f.file, f.scale);
+    } catch (const Error& e) {
+      doc.fail(geom, "mesh " + quoted_text(doc.attr(geom, "mesh", cls)) + ": " + e.what());
+    }
+  } else {
+    out = inline_mesh(doc, *f.asset, f.cls);
+    for (Vec3& v : out.vertices) v = v.cwiseProduct(f.scale);
+  }
+  return out;
+}
+
 }  // namespace
 
 MeshFile mesh_file_of(const Document& doc, const XMLElement& geom, const std::string& cls) {
@@ -107,49 +132,26 @@ MeshFile mesh_file_of(const Document& doc, const XMLElement& geom, const std::st
   return out;
 }
 
-MeshAsset mesh_of(const Document& doc, const XMLElement& geom, const std::string& cls) {
-  const MeshFile f = mesh_file_of(doc, geom, cls);
-  for (const char* unsupported : {"refpos", "refquat"})
-    if (f.asset->Attribute(unsupported))
-      doc.fail(*f.asset, std::string(unsupported) + " is not read by femdyn (MuJoCo removed it)");
-  if (const char* inertia = doc.attr(*f.asset, "inertia", f.cls);
-      inertia && std::strcmp(inertia, "legacy") && std::strcmp(inertia, "exact"))
-    doc.fail(*f.asset, std::string("inertia=\"") + inertia +
-                           "\": femdyn computes a mesh's legacy or exact volume inertia");
-  MeshAsset out{{}, f.source, f.file, f.scale};
-  if (!f.file.empty()) {
-    try {
-      out.mesh = read_mesh(f.file, f.scale);
-    } catch (const Error& e) {
-      doc.fail(geom, "mesh " + quoted_text(doc.attr(geom, "mesh", cls)) + ": " + e.what());
-    }
-  } else {
-    out.mesh = inline_mesh(doc, *f.asset, f.cls);
-    for (Vec3& v : out.mesh.vertices) v = v.cwiseProduct(f.scale);
-  }
-  return out;
-}
-
 CentroidalMass mesh_geom_mass(const Document& doc, const XMLElement& geom, const std::string& cls,
                               MassNotes& meshes) {
   if (doc.flag(geom, "shellinertia", cls, false))
     doc.fail(geom, "shellinertia: femdyn computes a mesh's volume inertia, not its shell's");
-  const MeshAsset asset = mesh_of(doc, geom, cls);
   const MeshFile file = mesh_file_of(doc, geom, cls);
+  const TriangleMesh mesh = mesh_of(doc, geom, cls, file);
   const char* inertia = doc.attr(*file.asset, "inertia", file.cls);
   const bool exact = doc.compiler().every_mesh_exact ||
                      (inertia ? !std::strcmp(inertia, "exact") : doc.compiler().exact_mesh_inertia);
   double V = 0, V_solid = 0;
-  const CentroidalMass solid_unit = solid_mass(asset.mesh, 1, &V_solid);
-  const CentroidalMass unit = exact ? solid_unit : legacy_solid_mass(asset.mesh, 1, V);
+  const CentroidalMass solid_unit = solid_mass(mesh, 1, &V_solid);
+  const CentroidalMass unit = exact ? solid_unit : legacy_solid_mass(mesh, 1, V);
   if (exact) V = V_solid;
   if (!(V > 1e-15))
-    doc.fail(geom, "mesh " + asset.source + " bounds no volume (an open or flat mesh)");
+    doc.fail(geom, "mesh " + file.source + " bounds no volume (an open or flat mesh)");
   ++meshes.mesh_geoms;
   if (!exact && std::abs(V - V_solid) > 1e-9 * V) {
     char ratio[32];
     std::snprintf(ratio, sizeof ratio, "%.3g", V / V_solid);
-    meshes.not_solid.push_back(asset.source + " (×" + ratio + ")");
+    meshes.not_solid.push_back(file.source + " (×" + ratio + ")");
   }
   const std::vector<double> given = doc.numbers(geom, "mass", cls, 1);
   const double density = given.empty() ? doc.number(geom, "density", cls, 1000) : given[0] / V;

@@ -52,25 +52,15 @@ Json mass_element(const Document& doc, const XMLElement& body, const CentroidalM
 void read_equalities(const Document& doc, const Tree& tree, Json& model,
                      std::vector<std::string>& notes);
 
-// A mesh asset as MuJoCo's compiler reads it (io/mjcf_mesh.cpp): the triangles of its file
-// (meshdir-relative) or of its inline vertex/face, scaled; `source` names it in messages.
-struct MeshAsset {
-  TriangleMesh mesh;
-  std::string source;  // "'name' (file 'x.stl')"
-  std::string file;    // its path, or empty when inline
-  Vec3 scale = Vec3::Ones();
-};
 // The <mesh> asset a mesh geom names (its class, scale and file, meshdir-relative; no file for
-// an inline mesh), without reading it; or a one-line refusal naming the geom.
+// an inline mesh; `source` names it in messages), without reading it; or a one-line refusal
+// naming the geom.
 struct MeshFile {
   const XMLElement* asset = nullptr;
   std::string cls, source, file;
   Vec3 scale = Vec3::Ones();
 };
 MeshFile mesh_file_of(const Document& doc, const XMLElement& geom, const std::string& cls);
-
-// The <mesh> asset a mesh geom names, read, or a one-line refusal naming the geom.
-MeshAsset mesh_of(const Document& doc, const XMLElement& geom, const std::string& cls);
 
 // A mesh geom's mass in the body frame: the solid the mesh bounds, as MuJoCo's compiler computes
 // it (legacy |V| tetrahedra, or signed ones with exactmeshinertia; io/mesh.hpp), m = the geom's

@@ -62,11 +62,7 @@ void add_visuals(const Document& doc, const XMLElement& body, const std::string&
       v.R = placed.R;
       out.push_back(std::move(v));
     } catch (const Error& e) {  // listed by the page as not drawn; it breaks no load
-      Visual bad;
-      bad.link = link;
-      bad.shape = "invalid";
-      bad.mesh_issue = e.what();
-      out.push_back(std::move(bad));
+      out.push_back(unread_visual(link, e.what()));
     }
 }
 

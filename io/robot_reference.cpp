@@ -94,26 +94,36 @@ Json robot_document(const std::string& path, const LoadOptions& options) {
 
 namespace {
 
-// {"model": "mjcf", "params": {"file", "balance_inertia"}}: the MJCF file it names, with the
-// reference's own name, description, gravity and loads.
-std::pair<Json, std::string> mjcf_reference(const std::string& path, const Json& root,
-                                            const Params& p, const Params& params,
-                                            const LoadOptions& options) {
-  params.allow_only({"file", "balance_inertia"});
+// The robot file a reference's "file" names (relative to the JSON file `path`), of the kind
+// `is_kind` says, read by `read` into femdyn JSON with the reference's own name, description,
+// gravity and loads on top; a problem in it reported at /params/file. Also its path.
+template <class Read>
+std::pair<Json, std::string> referenced(const std::string& path, const Json& root, const Params& p,
+                                        const Params& params, bool (*is_kind)(const std::string&),
+                                        const char* expected, const Read& read) {
   std::filesystem::path file(params.string("file"));
   if (file.is_relative()) file = std::filesystem::path(path).parent_path() / file;
-  if (!is_mjcf_path(file.string())) params.fail("file", "expected an MJCF file (<mujoco>)");
+  if (!is_kind(file.string())) params.fail("file", expected);
   Json doc;
   try {
-    doc = mjcf_document(
-        file.string(),
-        {.balance_inertia = options.balance_inertia || params.boolean_or("balance_inertia", false)},
-        options);
+    doc = read(file.string());
   } catch (const Error& e) {
     params.fail("file", e.what());
   }
   apply_overrides(root, p, doc);
   return {std::move(doc), file.string()};
+}
+
+// {"model": "mjcf", "params": {"file", "balance_inertia"}}: the MJCF file it names.
+std::pair<Json, std::string> mjcf_reference(const std::string& path, const Json& root,
+                                            const Params& p, const Params& params,
+                                            const LoadOptions& options) {
+  params.allow_only({"file", "balance_inertia"});
+  const bool balance = options.balance_inertia || params.boolean_or("balance_inertia", false);
+  return referenced(path, root, p, params, is_mjcf_path, "expected an MJCF file (<mujoco>)",
+                    [&](const std::string& file) {
+                      return mjcf_document(file, {.balance_inertia = balance}, options);
+                    });
 }
 
 }  // namespace
@@ -133,22 +143,12 @@ std::optional<std::pair<Json, std::string>> robot_reference(const std::string& p
   const std::string root_joint = params.has("root_joint") ? params.string("root_joint") : "fixed";
   if (root_joint != "fixed" && root_joint != "free")
     params.fail("root_joint", "expected \"fixed\" or \"free\", got " + quoted_text(root_joint));
-  const std::string file = params.string("file");
-  std::filesystem::path urdf(file);
-  if (urdf.is_relative()) urdf = std::filesystem::path(path).parent_path() / urdf;
-  if (!is_urdf_path(urdf.string())) params.fail("file", "expected a *.urdf file");
-  Json doc;
-  try {
-    doc = urdf_document(
-        urdf.string(),
-        {.floating_base = root_joint == "free",
-         .balance_inertia = options.balance_inertia || params.boolean_or("balance_inertia", false)},
-        options);
-  } catch (const Error& e) {
-    params.fail("file", e.what());
-  }
-  apply_overrides(root, p, doc);
-  return std::pair{std::move(doc), urdf.string()};
+  const bool balance = options.balance_inertia || params.boolean_or("balance_inertia", false);
+  return referenced(
+      path, root, p, params, is_urdf_path, "expected a *.urdf file", [&](const std::string& file) {
+        return urdf_document(
+            file, {.floating_base = root_joint == "free", .balance_inertia = balance}, options);
+      });
 }
 
 // --balance-inertia repairs what an exporter wrote; a JSON model's inertias are the author's own,

@@ -175,11 +175,7 @@ std::vector<Visual> urdf_visuals(const std::string& text, const std::string& sou
       try {
         out.push_back(visual_of(c, robot, v, name));
       } catch (const Error& e) {  // listed by the page as not drawn; the model still loads
-        Visual bad;
-        bad.link = name;
-        bad.shape = "invalid";
-        bad.mesh_issue = e.what();
-        out.push_back(std::move(bad));
+        out.push_back(unread_visual(name, e.what()));
       }
   }
   return out;

@@ -24,4 +24,13 @@ struct Visual {
   std::optional<Eigen::Vector4d> rgba;
 };
 
+// A visual the reader could not read, on `link`: the page lists it with `why`; no load stops.
+inline Visual unread_visual(const std::string& link, const std::string& why) {
+  Visual v;
+  v.link = link;
+  v.shape = "invalid";
+  v.mesh_issue = why;
+  return v;
+}
+
 }  // namespace femdyn

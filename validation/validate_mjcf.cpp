@@ -104,9 +104,8 @@ std::optional<QuantityError> validate_mjcf_import(const Model& m, const std::str
     // The peer's equalities are off: the spanning tree's q̈ (a model's loops ignored) is compared.
     if (!tree_forward_dynamics(m, ws, q, qd, tau).ok) continue;
     // MuJoCo's q̈ on the coupling: Gᵀ M G q̈ = τ + Gᵀ (friction − τ_MuJoCo(θ, θ̇, θ̈ = γ)).
-    const JointLevel free = joint_level(m, q, qd, VecX::Zero(m.n()));
-    const VecX bias =
-        G.transpose() * (peer->inverse(free.theta, free.theta_dot, free.theta_ddot) - friction);
+    const VecX gamma = at.theta_ddot - G * qdd;  // θ̈ at q̈ = 0
+    const VecX bias = G.transpose() * (peer->inverse(at.theta, at.theta_dot, gamma) - friction);
     const MatX reduced = G.transpose() * M * G;
     accumulate(e, ws.qdd, reduced.ldlt().solve(tau - bias));
   }

@@ -189,11 +189,9 @@ Json visual_json(const Model& m, const Visual& v, MeshTable& table, Json& not_dr
 
 // A body without visuals drawn as the box of its inertia: the same mass and principal moments
 // (edges √(6 (I_j + I_k − I_i)/m)), at its centre of mass along its principal axes.
-Json inertia_boxes_json(const Model& m, const std::vector<Visual>& visuals) {
-  std::set<int> seen;
-  for (const Visual& v : visuals)
-    for (const Frame& f : m.frames)
-      if (f.name == v.link) seen.insert(f.body);
+Json inertia_boxes_json(const Model& m, const Json& visuals) {
+  std::set<int> seen;  // the bodies visual_json placed visuals on
+  for (const Json& v : visuals) seen.insert(v["body"].get<int>());
   Json out = Json::array();
   const std::vector<MassProperties> mp = body_mass_properties(m);
   for (std::size_t b = 0; b < m.bodies.size(); ++b) {
@@ -278,7 +276,7 @@ Json scene_json(const Model& m, const Motion& motion, const std::vector<Visual>&
   for (const ElementEntry& e : m.elements) elements.push_back(element_json(e));
   MeshTable table;
   for (const Visual& v : visuals) shapes.push_back(visual_json(m, v, table, not_drawn));
-  const Json boxes = inertia_boxes_json(m, visuals), constraints = constraints_json(m);
+  const Json boxes = inertia_boxes_json(m, shapes), constraints = constraints_json(m);
   int joints = 0;
   for (const Body& b : m.bodies) joints += b.joint.type != JointType::Fixed;
   return {{"model", m.name},
