@@ -22,8 +22,9 @@ namespace {
 constexpr const char* kInfoHelp = R"(usage: femdyn info MODEL [--json] [--gravity gx,gy,gz]
 
 Prints the generalized coordinates, joints (with the coupling level θ = C q + θ0), bodies and
-their elements, the transition coordinates u kept and those left out, and the correlation
-table N_m (one row per element; per node x y z rx ry rz; 0 = left out).
+their elements, the transition coordinates u kept and those left out, the routes (which
+algorithm computes M^s, h and τ, q̈, and the closed loops' q̈: docs/design.md), and the
+correlation table N_m (one row per element; per node x y z rx ry rz; 0 = left out).
 A model whose M^s is singular (a massless chain end) is described all the same, with a note
 naming the coordinates that move no inertia (--json: "mass_matrix_singular"); import and view
 load it too, and the commands that compute motion refuse it.
@@ -40,9 +41,10 @@ With closed loops (docs/loops.md) M^s, h, Q are the spanning tree's and q̈ is t
 mechanism's, M^s q̈ + h = Q + Φ_qᵀ λ with Φ_q q̈ = −Φ̇_q q̇, printed with λ and Φ_qᵀ λ; the state
 must close the loops (else exit 1 naming the constraint), and without --q the neutral
 configuration is assembled onto them first (q̇ projected), as simulate starts.
---json prints one object: {"n", "coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd"[, "D"]}
-(n the number of coordinates, "coordinates" their names; with loops also "lambda" and
-"constraint_forces"; "failure" when qdd is null).
+--json prints one object: {"n", "coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd",
+"routes"[, "D"]} (n the number of coordinates, "coordinates" their names, "routes" which
+algorithm computed each, as info prints them; with loops also "lambda" and "constraint_forces";
+"failure" when qdd is null).
 M^s and its printed form grow as n²: beyond the memory limit (--max-memory GB, default half the
 available memory) the command is refused before any work, with the memory it would need.
 )";
@@ -118,6 +120,16 @@ VecX configuration_vector(const Args& a, const std::string& opt, const Model& m)
   if (const std::string bad = normalize_quaternions(m, q); !bad.empty())
     throw CliError("--" + opt + ": " + bad);
   return q;
+}
+
+CommandState command_state(const Args& a, const Model& m) {
+  CommandState s{configuration_vector(a, "q", m), state_vector(a, "qd", m),
+                 state_vector(a, "tau", m)};
+  if (!m.constraints.empty() && !a.has("q"))
+    if (const StateAssembly loops = assemble_state(m, s.q, s.qd); !loops.assembly.status.ok)
+      throw StateError(a.positional[0] +
+                       ": the neutral configuration: " + loops.assembly.status.message);
+  return s;
 }
 
 double number_option(const Args& a, const std::string& opt, double fallback) {
@@ -243,14 +255,7 @@ int cmd_equations(int argc, char** argv) {
     return 0;
   }
   const Model m = load(a);
-  VecX q = configuration_vector(a, "q", m), qd = state_vector(a, "qd", m);
-  const VecX tau = state_vector(a, "tau", m);
-  // Closed loops and no --q: the neutral configuration assembled onto them (and q̇ projected),
-  // as simulate starts; a --q given is taken as it is, and must close them.
-  if (!m.constraints.empty() && !a.has("q"))
-    if (const StateAssembly s = assemble_state(m, q, qd); !s.assembly.status.ok)
-      throw StateError(a.positional[0] +
-                       ": the neutral configuration: " + s.assembly.status.message);
+  const auto [q, qd, tau] = command_state(a, m);
   require_memory(
       a.positional[0] + ": the equations of n = " + std::to_string(m.n()) + " coordinates",
       equations_bytes(m, a.has("json")), max_memory(a),

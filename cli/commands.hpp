@@ -31,7 +31,15 @@ std::vector<double> parse_numbers(const std::string& opt, const std::string& tex
 // q from --opt (n_q values, each quaternion of norm 1 within 1e-6, then normalised), or the
 // neutral configuration.
 VecX configuration_vector(const Args& a, const std::string& opt, const Model& m);
-VecX state_vector(const Args& a, const std::string& opt, const Model& m);      // zero if absent
+VecX state_vector(const Args& a, const std::string& opt, const Model& m);  // zero if absent
+// The state of a command that evaluates one (equations, linearize, kinematics): --q (default the
+// neutral configuration), --qd and --tau (default 0). With closed loops and no --q: the neutral
+// configuration assembled onto them and q̇ projected, as simulate starts (StateError if they
+// cannot close); a --q given is taken as it is, as the Python module takes it.
+struct CommandState {
+  VecX q, qd, tau;
+};
+CommandState command_state(const Args& a, const Model& m);
 LoadOptions load_options(const Args& a);                                       // --gravity
 double number_option(const Args& a, const std::string& opt, double fallback);  // one number
 double integer_option(const Args& a, const std::string& opt, double fallback, double min,

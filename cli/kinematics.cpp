@@ -20,8 +20,8 @@ constexpr const char* kKinematicsHelp =
     R"(usage: femdyn kinematics MODEL [--q …] [--qd …] [--frame NAME[,NAME…]]
                           [--axes local_world_aligned|local|world] [--json] [--gravity gx,gy,gz]
 
-The kinematics of frames at the state (--q: n_q values, default the neutral configuration; --qd:
-n rates, default 0): each frame's position p and orientation R (world), its Jacobian J (6 × n,
+The kinematics of frames at the state (--q: n_q values, default the neutral configuration, on a
+model with closed loops assembled onto them as simulate starts; --qd: n rates, default 0): each frame's position p and orientation R (world), its Jacobian J (6 × n,
 linear rows then angular), its velocity J v and J̇v, the acceleration at q̈ = 0, in the chosen
 axes (docs/notation.md#frames):
   local_world_aligned (default)  about the frame's origin, world axes
@@ -92,7 +92,7 @@ int cmd_kinematics(int argc, char** argv) {
   FrameAxes axes = FrameAxes::LocalWorldAligned;
   if (a.has("axes") && !parse_frame_axes(a.options.at("axes"), axes))
     throw CliError("--axes expects local_world_aligned, local or world");
-  const VecX q = configuration_vector(a, "q", m), qd = state_vector(a, "qd", m);
+  const auto [q, qd, tau] = command_state(a, m);
   const std::vector<int> frames = chosen_frames(a, m);
   Workspace ws(m);
   FrameKinematics k;

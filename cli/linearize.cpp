@@ -9,7 +9,6 @@
 #include "cli/commands.hpp"
 #include "core/derivatives/derivatives.hpp"
 #include "core/equations.hpp"
-#include "core/loops/assembly.hpp"
 #include "core/names.hpp"
 #include "io/output.hpp"
 
@@ -31,9 +30,11 @@ q ⊗ exp(ξ_r)) on a free joint (also −[v]× from ξ̇_p = exp(ξ_r) v). By a
 the dynamics (docs/derivatives.md): trees with linear couplings, springs, dampers, friction,
 rotors, stops and loads, closed loops; other models are refused in one line.
 
-A model with closed loops (docs/loops.md) is linearised at the state assembled onto its loops
-(as femdyn simulate starts; --json gives the assembled q and qd), through its constrained
-equations with Baumgarte's stabilisation at --baumgarte W (1/s; default 20, the simulator's):
+A model with closed loops (docs/loops.md) is linearised through its constrained equations with
+Baumgarte's stabilisation at --baumgarte W (1/s; default 20, the simulator's), at the state as
+given (as the Python module's Model.linearize; off the loops, the stabilised equations there),
+or without --q at the neutral configuration assembled onto the loops, as femdyn simulate starts
+(--json gives the state used):
 B's lower block is then the projected inverse M⁻¹ − Y S⁺ Yᵀ (Y = M⁻¹ Φ_qᵀ, S = Φ_q Y: no
 torque moves q̈ off the loops), and at an equilibrium A has the pair −W for each direction off
 the loops (at W = 0 a double zero).
@@ -52,8 +53,7 @@ int cmd_linearize(int argc, char** argv) {
     return 0;
   }
   const Model m = load(a);
-  VecX q = configuration_vector(a, "q", m), qd = state_vector(a, "qd", m);
-  const VecX tau = state_vector(a, "tau", m);
+  const auto [q, qd, tau] = command_state(a, m);
   Workspace ws(m);
   DerivativeWorkspace d(m);  // a model it does not cover: one line, exit 1
   if (a.has("baumgarte")) {
@@ -62,22 +62,10 @@ int cmd_linearize(int argc, char** argv) {
     if (!(d.baumgarte >= 0) || !std::isfinite(d.baumgarte))
       throw CliError("--baumgarte expects a rate >= 0 (1/s; 0: off)");
   }
-  if (!m.constraints.empty()) {  // the state onto the loops, as a run starts
-    const StateAssembly loops = assemble_state(m, q, qd);
-    if (!loops.assembly.status.ok)
-      throw StateError(a.positional[0] + ": the state: " + loops.assembly.status.message);
-  }
-  const Status st = forward_dynamics_derivatives(m, ws, d, q, qd, tau);
-  if (!st.ok) {
+  MatX A, B;
+  if (const Status st = linearize_state(m, ws, d, q, qd, tau, A, B); !st.ok) {
     std::cerr << "femdyn linearize: " << escaped(a.positional[0]) << ": at this state "
               << safe_message(st.message) << "\n";
-    return 1;
-  }
-  MatX A, B;
-  linearization(m, d, qd, A, B);
-  if (!A.allFinite() || !B.allFinite()) {
-    std::cerr << "femdyn linearize: " << escaped(a.positional[0])
-              << ": at this state A or B is NaN or Inf (the state overflows double precision)\n";
     return 1;
   }
   if (a.has("json")) {

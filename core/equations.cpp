@@ -297,6 +297,12 @@ EquationRoutes choose_equation_routes(const Model& model) {
     r.energy = chain::energy;
     r.joint_state = chain::joint_state;
     r.propagate_bilinear = chain::propagate_bilinear;
+    r.names = {"the tree's M_θ through the coupling law: Gᵀ M_θ G, G = ∂θ/∂q",
+               tree_by_bodies ? "the tree's recursive Newton–Euler through the coupling law"
+                              : "the tree's node sweeps through the coupling law",
+               r.forward_dynamics == chain::forward_dynamics_by_bodies
+                   ? "joint-space sweeps through the coupling law, then Cholesky"
+                   : "the equations through the coupling law, then Cholesky"};
     return r;
   }
   r.evaluate = evaluate_levels;
@@ -309,12 +315,20 @@ EquationRoutes choose_equation_routes(const Model& model) {
   const bool by_bodies = model.force_route == ForceRoute::Bodies;
   r.evaluate_bias = by_bodies ? bias_by_bodies : bias_by_nodes;
   r.inverse_dynamics = by_bodies ? inverse_by_bodies : inverse_by_nodes;
-  if (model.dynamics_route == DynamicsRoute::Articulated)
+  r.names.mass = model.mass_route == MassRoute::Composite ? "composite body inertias"
+                                                          : "Tᵀ M T (the transform T)";
+  r.names.force = by_bodies ? "recursive Newton–Euler over the bodies" : "node sweeps (Tᵀ, T')";
+  if (model.dynamics_route == DynamicsRoute::Articulated) {
     r.forward_dynamics = articulated_forward_dynamics;
-  else if (by_bodies && model.mass_route == MassRoute::Composite && model.spanning_masses.empty())
+    r.names.forward = "articulated bodies";
+  } else if (by_bodies && model.mass_route == MassRoute::Composite &&
+             model.spanning_masses.empty()) {
     r.forward_dynamics = coupled_forward_dynamics;
-  else
+    r.names.forward = "joint-space sweeps, then Cholesky";
+  } else {
     r.forward_dynamics = forward_by_cholesky;
+    r.names.forward = "the equations, then Cholesky";
+  }
   return r;
 }
 
@@ -420,6 +434,39 @@ Energy energy(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) 
   Energy E = model.routes.energy(model, ws, q, qd);
   if (!model.springs.empty()) E.potential += spring_potential(model, ws, q);
   return E;
+}
+
+std::vector<std::pair<std::string, std::string>> RouteReport::fields() const {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const auto& [key, name] : {std::pair<const char*, const std::string*>{"mass", &mass},
+                                  {"force", &force},
+                                  {"forward_dynamics", &forward},
+                                  {"solver", &solver},
+                                  {"loops", &loops}})
+    if (!name->empty()) out.emplace_back(key, *name);
+  return out;
+}
+
+RouteReport route_report(const Model& model) {
+  const RouteNames& names = model.routes.names;
+  RouteReport r{names.mass, names.force, names.forward, "", ""};
+  if (model.routes.forward_dynamics != articulated_forward_dynamics)
+    switch (model.mass_pattern.solver) {
+      case SolverKind::Dense:
+        r.solver = "dense Cholesky (LLᵀ)";
+        break;
+      case SolverKind::Sparse:
+        r.solver = "sparse Cholesky (CHOLMOD)";
+        break;
+      case SolverKind::Tree:
+        r.solver = "the coordinate tree's LTDL";
+        break;
+    }
+  if (!model.constraints.empty())
+    r.loops =
+        "the constrained q̈ of M^s q̈ + h = Q + Φ_qᵀ λ, Φ_q q̈ = −Φ̇_q q̇ (S = Φ_q (M^s)⁻¹ Φ_qᵀ by "
+        "pivoted Cholesky)";
+  return r;
 }
 
 }  // namespace femdyn

@@ -7,6 +7,7 @@
 // Only what the state needs is computed: no h at rest (q̇ = 0), no T at all for h alone.
 #pragma once
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/status.hpp"
@@ -69,5 +70,16 @@ Energy energy(const Model& model, Workspace& ws, const VecX& q, const VecX& qd);
 // θ̇ = C q̇, or through a nonlinear coupling level θ = g(q), θ̇ = G q̇ (throws StateError where a
 // law is not defined). For reports and comparisons joint by joint (validation, studies).
 void joint_state(const Model& model, Workspace& ws, const VecX& q, const VecX& qd);
+
+// Which route computes what on this model, by name (EquationRoutes::names): M^s, h and τ, the
+// tree's q̈, the factorisation of M^s where q̈ goes through one ("" on the articulated route), and
+// the closed loops' constrained q̈ ("" without loops). `femdyn info`, `equations --json`, the
+// run reports and Python's Model.routes print it.
+struct RouteReport {
+  std::string mass, force, forward, solver, loops;
+  // (key, name) of those that apply: "mass", "force", "forward_dynamics", "solver", "loops".
+  std::vector<std::pair<std::string, std::string>> fields() const;
+};
+RouteReport route_report(const Model& model);
 
 }  // namespace femdyn

@@ -17,6 +17,14 @@ struct Status;
 struct Energy;
 struct KinematicsRequest;
 
+// What each route is, named where choose_equation_routes chooses it, so that reports say which
+// one ran (route_report, core/equations.hpp).
+struct RouteNames {
+  const char* mass = "";     // M^s
+  const char* force = "";    // h and τ
+  const char* forward = "";  // the tree's q̈
+};
+
 struct EquationRoutes {
   void (*evaluate)(const Model&, Workspace&, const VecX& q, const VecX& qd,
                    const VecX& tau) = nullptr;
@@ -32,6 +40,7 @@ struct EquationRoutes {
   void (*joint_state)(const Model&, Workspace&, const VecX& q, const VecX& qd) = nullptr;
   void (*propagate_bilinear)(const Model&, Workspace&, const VecX& q, const VecX& x, const VecX& y,
                              KinematicsRequest request) = nullptr;
+  RouteNames names;
 };
 
 // The table for `model`, from its route enums and coupling level (core/equations.cpp). compile()

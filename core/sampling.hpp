@@ -20,8 +20,9 @@ VecX integrate_posture(const Model& model, const VecX& q, const VecX& xi);
 VecX chart_rates(const Model& model, const VecX& q, const VecX& xi, const VecX& v);
 // Whether every joint is flat (q holds one entry per rate, q ⊕ ξ = q + ξ).
 bool flat_model(const Model& model);
-// Each quaternion in q normalised; "" if each had norm 1 within 1e-6, else the first that did
-// not ("quaternion of joint 'base' has norm 0.5, expected 1").
+// Each quaternion in q normalised (one already unit to within 4 ε left as it is: normalising
+// twice changes no bit); "" if each had norm 1 within 1e-6, else the first that did not
+// ("quaternion of joint 'base' has norm 0.5, expected 1").
 std::string normalize_quaternions(const Model& model, VecX& q);  // each entry in ±scale
 
 }  // namespace femdyn

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <system_error>
 
+#include "core/equations.hpp"
 #include "core/joints/kernel.hpp"
 #include "io/atomic_file.hpp"
 
@@ -70,6 +71,12 @@ std::string json_text(const Json& doc) {
   return out;
 }
 
+Json routes_json(const Model& model) {
+  Json j = Json::object();
+  for (const auto& [key, name] : route_report(model).fields()) j[key] = name;
+  return j;
+}
+
 Json equations_json(const Model& model, const Workspace& ws, const VecX& q, const VecX& qd,
                     const VecX& tau, const Status& dynamics, const LoopWorkspace* loops,
                     const std::vector<MatX>& D) {
@@ -84,6 +91,7 @@ Json equations_json(const Model& model, const Workspace& ws, const VecX& q, cons
   j["Q"] = vector_json(ws.Q);
   j["qdd"] = dynamics.ok ? vector_json(ws.qdd) : Json();
   if (!dynamics.ok) j["failure"] = dynamics.message;
+  j["routes"] = routes_json(model);
   if (loops && dynamics.ok) {
     j["lambda"] = vector_json(loops->lambda);
     j["constraint_forces"] = vector_json(loops->k.J.transpose() * loops->lambda);
@@ -302,6 +310,9 @@ std::string info_text(const Model& model) {
     out << "approximations made by the table (" << model.approximations.size() << "):\n";
     for (const auto& s : model.approximations) out << "  " << s << "\n";
   }
+  out << "routes (which algorithm computes what; docs/design.md):\n";
+  for (const auto& [key, name] : route_report(model).fields())
+    out << "  " << key << ": " << name << "\n";
   out << correlation_table_text(model);
   return out.str();
 }
@@ -317,6 +328,7 @@ Json info_json(const Model& model) {
   j["transition_coordinates"] = u;
   j["left_out"] = model.left_out;
   j["approximations"] = model.approximations;
+  j["routes"] = routes_json(model);
   Json table = Json::array();
   for (const ElementEntry& e : model.elements) table.push_back(e.table_row);
   j["correlation_table"] = table;

@@ -30,6 +30,8 @@ std::string equations_text(const Model& model, const Workspace& ws, const VecX& 
 
 std::string info_text(const Model& model);
 Json info_json(const Model& model);
+// route_report's names as {"mass", "force", "forward_dynamics"[, "solver"][, "loops"]}.
+Json routes_json(const Model& model);
 // The actuated coordinates' names (Model::actuated), in order.
 std::vector<std::string> actuated_names(const Model& model);
 

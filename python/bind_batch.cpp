@@ -186,11 +186,11 @@ struct DerivativeScratch {
   DerivativeScratch(const Model& m, double omega) : d(m) { d.baumgarte = omega; }
 };
 
-// Every row's derivatives into a thread's s.d (the row's state loaded into r), on `nthreads`
-// threads with the GIL released, then put(i, s, r); a failure names the row.
-template <class Put>
+// Every row's state loaded into r, then row(ws, s, r, i) with a thread's buffers s, on
+// `nthreads` threads with the GIL released; a NumericalError it throws names the row.
+template <class Row>
 void for_each_derivative_row(const Model& m, const Batch& b, int nthreads, double omega,
-                             Put&& put) {
+                             Row&& row) {
   py::gil_scoped_release release;
   for_each_row_with(
       m, b.k, nthreads, [&] { return DerivativeScratch(m, omega); },
@@ -198,11 +198,10 @@ void for_each_derivative_row(const Model& m, const Batch& b, int nthreads, doubl
         thread_local RowState r;
         r.load(b, i);
         try {
-          forward_derivatives_at(m, ws, s.d, r.q, r.qd, r.x);
+          row(ws, s, r, i);
         } catch (const NumericalError& e) {
           throw NumericalError("row " + std::to_string(i) + ": " + e.what());
         }
-        put(i, s, r);
       });
 }
 
@@ -223,7 +222,8 @@ py::dict derivatives_batch(const PyModel& self, const Array& q, const OptArray& 
   double *pqdd = qdd.mutable_data(), *pq = dq.mutable_data(), *pv = dv.mutable_data(),
          *pM = Minv.mutable_data();
   for_each_derivative_row(m, b, nthreads, omega,
-                          [&](Eigen::Index i, DerivativeScratch& s, RowState&) {
+                          [&](Workspace& ws, DerivativeScratch& s, RowState& r, Eigen::Index i) {
+                            forward_derivatives_at(m, ws, s.d, r.q, r.qd, r.x);
                             store(pqdd, i, s.d.qdd);
                             store(pq, i, s.d.dqdd_dq);
                             store(pv, i, s.d.dqdd_dv);
@@ -252,9 +252,9 @@ std::pair<py::array_t<double>, py::array_t<double>> linearize_batch(
   py::array_t<double> A = new_array({k, 2 * n, 2 * n}), B = new_array({k, 2 * n, n_a});
   double *pA = A.mutable_data(), *pB = B.mutable_data();
   for_each_derivative_row(m, b, nthreads, omega,
-                          [&](Eigen::Index i, DerivativeScratch& s, RowState& r) {
-                            linearization(m, s.d, r.qd, s.A, s.B);
-                            store(pA, i, s.A);
+                          [&](Workspace& ws, DerivativeScratch& s, RowState& r, Eigen::Index i) {
+                            linearize_at(m, ws, s.d, r.q, r.qd, r.x, s.A, s.B);  // (the single
+                            store(pA, i, s.A);  // call's, so each row is its numbers bit for bit)
                             store(pB, i, s.B);
                           });
   return {A, B};

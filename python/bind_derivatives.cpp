@@ -67,10 +67,12 @@ py::dict inverse(PyModel& self, const Array& q, const OptArray& qd, const OptArr
 
 std::pair<MatX, MatX> linearize(PyModel& self, const Array& q, const OptArray& qd,
                                 const OptArray& tau, const OptRate& baumgarte) {
-  VecX v;
-  const DerivativeWorkspace& d = forward_at(self, q, qd, tau, baumgarte, v);
+  const Model& m = *self.model;
+  DerivativeWorkspace& d = derivative_workspace(self);
+  d.baumgarte = baumgarte_arg(m, baumgarte);
   MatX A, B;
-  linearization(*self.model, d, v, A, B);
+  linearize_at(m, self.ws, d, configuration_arg(q, "q", m), vector_arg(qd, "qd", m),
+               vector_arg(tau, "tau", m, Entries::Bounded), A, B);
   return {A, B};
 }
 

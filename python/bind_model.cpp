@@ -286,6 +286,16 @@ void bind_model(py::module_& m) {
           "every rate but a free joint's and those of a joint with actuated=False; "
           "linearize's B has these columns, and a run's tau is zero off them")
       .def_property_readonly(
+          "routes",
+          [](const PyModel& s) {
+            py::dict d;
+            for (const auto& [key, name] : route_report(*s.model).fields()) d[key.c_str()] = name;
+            return d;
+          },
+          "which algorithm computes what on this model, by name: mass (M^s), force (h and tau), "
+          "forward_dynamics (the tree's qdd), solver (M^s's factorisation, where qdd uses one), "
+          "loops (closed loops' constrained qdd); as femdyn info and equations --json")
+      .def_property_readonly(
           "configuration", [](const PyModel& s) { return s.model->configuration_names; },
           "the names of q's entries (base.x, …, base.qw, …, joint names)")
       .def(

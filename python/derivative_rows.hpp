@@ -37,4 +37,12 @@ inline void forward_derivatives_at(const Model& m, Workspace& ws, DerivativeWork
   require_finite(d.dqdd_dv, "dqdd_dv");
 }
 
+// A and B of the linearisation at (q, v, τ) (linearize_state, as `femdyn linearize`); its failure
+// is a NumericalError.
+inline void linearize_at(const Model& m, Workspace& ws, DerivativeWorkspace& d, const VecX& q,
+                         const VecX& v, const VecX& tau, MatX& A, MatX& B) {
+  if (const Status st = linearize_state(m, ws, d, q, v, tau, A, B); !st.ok)
+    throw NumericalError("at this state " + st.message);
+}
+
 }  // namespace femdyn::python

@@ -1,5 +1,7 @@
 #include "sim/run_report.hpp"
 
+#include "core/equations.hpp"
+
 namespace femdyn {
 
 Json run_summary_json(const Model& model, const RecordedRun& run, bool conservative) {
@@ -55,6 +57,9 @@ Json simulation_json(const Model& model, const SimulationRequest& request,
             {"ok", st.ok},
             {"diverged", st.diverged},
             {"failure", st.ok ? std::string() : st.message}});
+  Json routes = Json::object();  // which algorithms ran (core/equations.hpp, route_report)
+  for (const auto& [key, name] : route_report(model).fields()) routes[key] = name;
+  j["routes"] = routes;
   const IntegratorOptions& o = request.options;
   if (is_adaptive(o.kind))
     j["options"] = {{"rtol", o.adaptive.rtol}, {"atol", o.adaptive.atol}};

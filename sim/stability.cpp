@@ -168,10 +168,9 @@ Linearization linearize(const Model& m, Workspace& ws, const VecX& q, const VecX
   Linearization lin;
   DerivativeWorkspace d(m);
   d.baumgarte = baumgarte;  // (closed loops: the constrained q̈ at this rate)
-  lin.status = forward_dynamics_derivatives(m, ws, d, q, qd, tau);
+  MatX B;                   // (femdyn linearize's A and B: the same function)
+  lin.status = linearize_state(m, ws, d, q, qd, tau, lin.A, B);
   if (!lin.status.ok) return lin;
-  MatX B;
-  linearization(m, d, qd, lin.A, B);
   analyse(lin);
   return lin;
 }

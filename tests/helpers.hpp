@@ -1,5 +1,7 @@
 // Test helpers: loading models, seeded random mechanisms, finite differences, matrix checks.
 #pragma once
+#include <unistd.h>
+
 #include <filesystem>
 #include <iterator>
 #include <random>
@@ -69,10 +71,13 @@ Run run_shell(const std::string& command);  // any shell command
 
 // A scratch directory for one test case (in the system's temporary directory, named after the
 // case), emptied at the start and removed afterwards.
+// A test's own folder under the temporary directory, per process (two suites at once, such as
+// the sanitizer build's and the release build's, never share one), removed when done.
 struct Scratch {
   std::filesystem::path dir;
   explicit Scratch(const std::string& name)
-      : dir(std::filesystem::temp_directory_path() / ("femdyn_" + name)) {
+      : dir(std::filesystem::temp_directory_path() /
+            ("femdyn_" + name + "_" + std::to_string(::getpid()))) {
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
   }

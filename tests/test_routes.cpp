@@ -410,3 +410,30 @@ TEST_CASE("coupling laws on the tree's body-level sweeps equal the reference rou
   }
   CHECK(rods_seen > 0);
 }
+
+TEST_CASE("the routes' names say which function the table calls", "[routes]") {
+  // Each name is set where the route is chosen: a model asked for a route reports that route,
+  // and the names tell the body level from the reference, and loops from none.
+  const std::string text = mixed_tree_json(3, 7, 0.4, false, true);
+  const Model body_level = load_text(text);
+  const Model reference = load_text(text, {.routes = {.mass = MassRoute::Transform,
+                                                      .force = ForceRoute::Nodes,
+                                                      .dynamics = DynamicsRoute::Cholesky}});
+  REQUIRE(body_level.routes.forward_dynamics == &articulated_forward_dynamics);
+  const RouteReport a = route_report(body_level), b = route_report(reference);
+  CHECK(a.mass == "composite body inertias");
+  CHECK(a.force == "recursive Newton–Euler over the bodies");
+  CHECK(a.forward == "articulated bodies");
+  CHECK(a.solver.empty());  // (no factorisation of M^s on the articulated route)
+  CHECK(b.mass == "Tᵀ M T (the transform T)");
+  CHECK(b.force == "node sweeps (Tᵀ, T')");
+  CHECK(b.forward == "the equations, then Cholesky");
+  CHECK_FALSE(b.solver.empty());
+  CHECK(a.loops.empty());
+  // A coupling law: the chain's names; closed loops: the constrained q̈ named.
+  CHECK_THAT(route_report(load_model(model_path("finger_fourbar.json"))).mass,
+             Catch::Contains("coupling law"));
+  const RouteReport loops = route_report(load_model(model_path("five_bar.json")));
+  CHECK_THAT(loops.loops, Catch::Contains("Φ_q q̈ = −Φ̇_q q̇"));
+  CHECK(loops.fields().size() == 4);  // mass, force, forward_dynamics (articulated), loops
+}

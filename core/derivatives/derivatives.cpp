@@ -379,4 +379,15 @@ void linearization(const Model& m, const DerivativeWorkspace& d, const VecX& qd,
   }
 }
 
+Status linearize_state(const Model& m, Workspace& ws, DerivativeWorkspace& d, const VecX& q,
+                       const VecX& qd, const VecX& tau, MatX& A, MatX& B) {
+  if (Status st = forward_dynamics_derivatives(m, ws, d, q, qd, tau); !st.ok) return st;
+  linearization(m, d, qd, A, B);
+  for (const auto& [what, x] : {std::pair<const char*, const MatX*>{"A", &A}, {"B", &B}})
+    if (!x->allFinite())
+      return {false, std::string(what) + " is NaN or Inf (the state overflows double precision)",
+              -1, true};
+  return {};
+}
+
 }  // namespace femdyn

@@ -147,4 +147,11 @@ Status forward_dynamics_derivatives(const Model& model, Workspace& ws, Derivativ
 void linearization(const Model& model, const DerivativeWorkspace& d, const VecX& qd, MatX& A,
                    MatX& B);
 
+// The linearisation every door gives at the state (q, v, τ) as it is given (`femdyn linearize`,
+// Model.linearize and its batch): forward_dynamics_derivatives, then linearization. Its failure,
+// or A or B not finite (a state that overflows double precision), is the failed Status, its
+// message to follow "at this state ".
+Status linearize_state(const Model& model, Workspace& ws, DerivativeWorkspace& d, const VecX& q,
+                       const VecX& qd, const VecX& tau, MatX& A, MatX& B);
+
 }  // namespace femdyn

@@ -97,6 +97,35 @@ def test_the_cli_and_the_module_agree_on_a_closed_mechanism(tmp_path):
     assert np.array_equal(again["qdd"], cli["qdd"])
 
 
+@pytest.mark.parametrize("name", ["models/five_bar.json", "models/space_robot.json",
+                                  "models/finger.json", "models/iftomm_a04_bricard.json"])
+def test_linearize_is_one_answer_at_every_door(name):
+    """femdyn linearize --json, Model.linearize and linearize_batch give the same A and B bit for
+    bit, at the state as given (off a closed loop: the stabilised equations there), and the CLI
+    without --q at the state it prints (the neutral configuration, assembled onto the loops)."""
+    path = model_path(name)
+    m = femdyn.load(path)
+    cli = cli_json("linearize", path, "--json")
+    q, qd = np.array(cli["q"]), np.array(cli["qd"])
+    A, B = m.linearize(q, qd)
+    assert np.array_equal(A, cli["A"]) and np.array_equal(B, np.array(cli["B"]).reshape(B.shape))
+    rng = np.random.default_rng(43)
+    q = q.copy()
+    q[-1] += 0.01  # (off the loops of a closed mechanism; a quaternion's last entry stays close)
+    if m.n_q != m.n:
+        q[3:7] /= np.linalg.norm(q[3:7])
+    qd, tau = rng.uniform(-0.3, 0.3, m.n), rng.uniform(-0.1, 0.1, m.n)
+    if len(m.actuated) < m.n:
+        tau[[i for i in range(m.n) if i not in m.actuated]] = 0
+    cli = cli_json("linearize", path, f"--q={numbers(q)}", f"--qd={numbers(qd)}",
+                   f"--tau={numbers(tau)}", "--json")
+    assert np.array_equal(cli["q"], q)
+    A, B = m.linearize(q, qd, tau)
+    Ab, Bb = m.linearize_batch(np.stack([q, q]), np.stack([qd, qd]), np.stack([tau, tau]))
+    assert np.array_equal(A, cli["A"]) and np.array_equal(B, np.array(cli["B"]).reshape(B.shape))
+    assert np.array_equal(Ab[1], A) and np.array_equal(Bb[0], B)
+
+
 def test_simulator_run_reports_what_simulate_reports():
     """Simulator.run's stats carry simulate's run summary: the energy balance, limit crossings,
     velocity excesses and effort saturations (one RecordedRun for both, sim/recorded_run.hpp)."""
@@ -172,6 +201,20 @@ def test_simulate_reports_equal_the_cli(name, args, kwargs):
     assert stats["ok"] and stats["rows"] > 2
     if name == "models/five_bar.json":  # the start was off the loops, and assembled
         assert stats["loops"]["assembly_iterations"] > 0 and stats["loops"]["baumgarte"] == 35
+
+
+@pytest.mark.parametrize("name", ["models/five_bar.json", "models/finger_fourbar.json",
+                                  "models/space_robot.json", "models/finger_paper.json"])
+def test_every_door_names_the_same_routes(name):
+    """Model.routes, info --json, equations --json and a run's report name the same algorithms;
+    the closed loops' constrained q̈ is named where the model has loops."""
+    m = femdyn.load(model_path(name))
+    routes = m.routes
+    assert {"mass", "force", "forward_dynamics"} <= set(routes)
+    assert ("loops" in routes) == bool(m.constraints)
+    assert cli_json("info", model_path(name), "--json")["routes"] == routes
+    assert cli_json("equations", model_path(name), "--json")["routes"] == routes
+    assert femdyn.simulate(m, 0.01)["stats"]["routes"] == routes
 
 
 def cli_error(*args):
