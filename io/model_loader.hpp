@@ -44,5 +44,10 @@ SpringSpec parse_spring(const Json& spring, const std::string& where, std::size_
 // The model document a file describes (a URDF converted, a plugin expanded), as JSON that
 // loads back to the same equations: what `femdyn import` writes.
 Json model_document(const std::string& path, const LoadOptions& options = {});
+// The robot file whose bodies the model in `path` has: `path` itself for a URDF or MJCF file,
+// the file a JSON reference names ({"model": "urdf" | "mjcf", "params": {"file"}}, relative to
+// it), "" for any other model. For what reads the robot file's other parts (femdyn view's
+// visuals).
+std::string robot_file_of(const std::string& path);
 
 }  // namespace femdyn

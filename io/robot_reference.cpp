@@ -7,6 +7,8 @@
 
 #include "core/errors.hpp"
 #include "core/names.hpp"
+#include "io/input_file.hpp"
+#include "io/json_text.hpp"
 #include "io/mjcf_loader.hpp"
 #include "io/model_format.hpp"
 #include "io/urdf_loader.hpp"
@@ -159,6 +161,24 @@ void refuse_balance_on_json(const std::string& path, const LoadOptions& options)
                      "--balance-inertia is for URDF models (and URDF references, \"params\": "
                      "{\"balance_inertia\": true}): a JSON model's inertias are its own, to be "
                      "corrected where a refusal names them");
+}
+
+std::string robot_file_of(const std::string& path) {
+  if (is_urdf_path(path) || is_mjcf_path(path)) return path;
+  Json root;
+  try {
+    root = parse_json(read_input_file(path), path);
+  } catch (const Error&) {
+    return "";  // (not JSON either: no robot file)
+  }
+  if (!root.is_object() || !root.contains("model") || !root.contains("params")) return "";
+  const Json& model = root["model"];
+  const Json& params = root["params"];
+  if (model != kUrdfReference && model != kMjcfReference) return "";
+  if (!params.is_object() || !params.contains("file") || !params["file"].is_string()) return "";
+  std::filesystem::path file(params["file"].get<std::string>());
+  if (file.is_relative()) file = std::filesystem::path(path).parent_path() / file;
+  return file.string();
 }
 
 }  // namespace femdyn

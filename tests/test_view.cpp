@@ -318,6 +318,21 @@ TEST_CASE(
   for (const auto& mesh : scene["meshes"]) collada += mesh.contains("collada");
   CHECK(collada == 1);
   CHECK(scene["counts"]["visuals"] == 6);
+  // Each visual's bounding sphere about its origin frames the camera: a mesh's is its farthest
+  // vertex (scaled), a primitive's from its sizes.
+  for (std::size_t k = 0; k < visuals.size(); ++k) {
+    const Visual& v = visuals[k];
+    const auto& shown = scene["visuals"][k];
+    if (v.shape == "box") CHECK(shown["radius"] == Approx(0.5 * v.size.norm()).margin(1e-6));
+    if (v.shape == "mesh" && !shown.contains("radius")) continue;  // (Collada: the page's)
+    if (v.shape == "mesh" && !scene["meshes"][shown["mesh"].get<int>()].contains("collada")) {
+      const TriangleMesh mesh = read_mesh(v.mesh_path, v.size);
+      double r = 0;
+      for (const Vec3& p : mesh.vertices) r = std::max(r, p.norm());
+      CHECK(shown["radius"] == Approx(r).margin(1e-6));
+      CHECK(r > 0);
+    }
+  }
   // The root link is welded to the world: its visual is drawn on the world (-1).
   CHECK(scene["visuals"][0]["link"] == "base");
   CHECK(scene["visuals"][0]["body"] == -1);
@@ -379,4 +394,38 @@ TEST_CASE("view: a bad visual is listed as not drawn, a mirrored mesh is drawn",
   CHECK_THAT(scene["not_drawn"][0]["why"].get<std::string>(), Catch::Contains("a negative size"));
   CHECK(scene["meshes"].size() == 1);
   CHECK(scene["counts"]["visuals"] == 1);
+}
+
+TEST_CASE("view: a JSON file that refers to a URDF or MJCF draws that file's visuals",
+          "[view][cli][one-truth]") {
+  // The same robot through another door looks the same: the page of {"model": "urdf" | "mjcf",
+  // "params": {"file"}} holds the visuals, meshes and their bodies that the robot file's page
+  // holds (the file named relative to the JSON file, a free root on the URDF).
+  Scratch dir("view_reference");
+  struct Case {
+    std::string robot, reference;
+  };
+  const std::string urdf = data_path("urdf/meshed/meshed_arm.urdf");
+  const std::string mjcf = data_path("mjcf/meshes.xml");
+  for (const Case& c :
+       {Case{urdf, R"({"model": "urdf", "params": {"file": "FILE"}})"},
+        Case{mjcf, R"({"model": "mjcf", "params": {"file": "FILE"}, "gravity": [0, 0, -1]})"}}) {
+    const std::filesystem::path robot(c.robot);
+    std::string text = c.reference;
+    const std::string relative =
+        std::filesystem::relative(robot, std::filesystem::path(dir.dir)).string();
+    text.replace(text.find("FILE"), 4, relative);
+    const std::string json = dir / "robot.json";
+    std::ofstream(json) << text;
+    INFO(text);
+    REQUIRE(run("view " + c.robot + " --out " + dir / "robot.html --force").code == 0);
+    REQUIRE(run("view " + json + " --out " + dir / "json.html --force").code == 0);
+    const nlohmann::json direct = scene_of_page(read_file(dir / "robot.html")),
+                         referred = scene_of_page(read_file(dir / "json.html"));
+    CHECK(referred["counts"]["visuals"] == direct["counts"]["visuals"]);
+    CHECK(direct["counts"]["visuals"] > 0);
+    CHECK(referred["visuals"] == direct["visuals"]);
+    CHECK(referred["meshes"] == direct["meshes"]);
+    CHECK(referred["not_drawn"] == direct["not_drawn"]);
+  }
 }

@@ -5,6 +5,7 @@
 
 #include "io/input_file.hpp"
 #include "io/mjcf_loader.hpp"
+#include "io/model_loader.hpp"
 #include "io/output.hpp"
 #include "io/urdf_loader.hpp"
 #include "view/assets.hpp"
@@ -70,10 +71,12 @@ void write_page(const std::string& path, const Json& scene, bool replace) {
 
 void write_model_page(const std::string& path, const Model& model, const std::string& model_path,
                       const Motion& motion, bool replace) {
-  const std::vector<Visual> visuals = is_urdf_path(model_path)
-                                          ? urdf_visuals(read_input_file(model_path), model_path)
-                                      : is_mjcf_path(model_path) ? read_mjcf(model_path).visuals
-                                                                 : std::vector<Visual>{};
+  // The robot file's visuals, also where a JSON file refers to it (the same robot, drawn alike).
+  const std::string robot = robot_file_of(model_path);
+  const std::vector<Visual> visuals = is_urdf_path(robot)
+                                          ? urdf_visuals(read_input_file(robot), robot)
+                                      : is_mjcf_path(robot) ? read_mjcf(robot).visuals
+                                                            : std::vector<Visual>{};
   const std::string name = std::filesystem::path(model_path).filename().string();
   write_page(path, scene_json(model, motion, visuals, name.empty() ? model.name : name), replace);
 }

@@ -97,6 +97,7 @@ std::string base64(const void* data, std::size_t bytes) {
 // kMaxPageTriangles in all: a page stays one that a browser opens.
 struct MeshTable {
   Json meshes = Json::array();
+  std::vector<double> radius;  // each entry's largest distance of a vertex from its origin
   std::map<std::pair<std::string, std::string>, int> index;  // (path, scale) -> entry
   std::size_t triangles = 0, collada_bytes = 0;
 
@@ -125,6 +126,9 @@ struct MeshTable {
     xyz.reserve(3 * mesh.vertices.size());
     for (const Vec3& p : mesh.vertices)
       for (int k = 0; k < 3; ++k) xyz.push_back(static_cast<float>(p[k]));
+    double r = 0;
+    for (const Vec3& p : mesh.vertices) r = std::max(r, p.norm());
+    radius.push_back(r);
     meshes.push_back({{"triangles", mesh.triangles.size()},
                       {"positions", base64(xyz.data(), xyz.size() * sizeof(float))},
                       {"indices", base64(mesh.triangles.data(),
@@ -154,10 +158,21 @@ struct MeshTable {
       return -1;
     }
     collada_bytes += text.size();
+    radius.push_back(0);  // (its extent is known once the page's loader has read it)
     meshes.push_back({{"collada", std::move(text)}, {"scale", vec_json(v.size)}});
     return index[key] = static_cast<int>(meshes.size()) - 1;
   }
 };
+
+// A primitive's bounding sphere about its origin (Visual's sizes: box edges; cylinder and capsule
+// radius and length; sphere radius; ellipsoid radii).
+double bounding_radius(const std::string& shape, const Vec3& size) {
+  if (shape == "box") return 0.5 * size.norm();
+  if (shape == "cylinder") return std::hypot(size[0], 0.5 * size[1]);
+  if (shape == "capsule") return size[0] + 0.5 * size[1];
+  if (shape == "sphere") return size[0];
+  return size.cwiseAbs().maxCoeff();  // ellipsoid
+}
 
 // A visual on the body its link is (or is welded into: a named frame), in that body's frame;
 // on the world when the link is not in the model (a URDF's root welded to the world).
@@ -179,9 +194,13 @@ Json visual_json(const Model& m, const Visual& v, MeshTable& table, Json& not_dr
     not_drawn.push_back({{"link", v.link}, {"mesh", "<visual>"}, {"why", v.mesh_issue}});
   if (v.shape == "mesh") {
     std::string why;
-    out["mesh"] = table.entry(v, why);
+    const int entry = table.entry(v, why);
+    out["mesh"] = entry;
     out["file"] = v.mesh;
+    if (entry >= 0) out["radius"] = rounded(table.radius[entry]);
     if (!why.empty()) not_drawn.push_back({{"link", v.link}, {"mesh", v.mesh}, {"why", why}});
+  } else if (v.shape != "invalid") {
+    out["radius"] = rounded(bounding_radius(v.shape, v.size));
   }
   if (v.rgba) out["rgba"] = vec_json(*v.rgba);
   return out;

@@ -26,13 +26,18 @@
     return v3(p).applyQuaternion(pose.q).add(pose.p);
   }
 
-  // The model's extent at every frame: body origins, element nodes, visuals.
+  // The model's extent at every frame: body origins, element nodes, and each visual's bounding
+  // sphere (its radius about its origin, meshes included) at the first frame.
   const extent = new THREE.Box3();
   for (let f = 0; f < motion.t.length; ++f)
     for (let b = 0; b < nb; ++b) extent.expandByPoint(poseOf(f, b).p);
   for (const e of data.elements)
     for (const n of e.nodes) extent.expandByPoint(worldPoint(0, n.body, n.p));
-  for (const v of data.visuals) extent.expandByPoint(worldPoint(0, v.body, v.p));
+  for (const v of data.visuals) {
+    const d = 2 * (v.radius || 0);
+    extent.union(new THREE.Box3().setFromCenterAndSize(worldPoint(0, v.body, v.p),
+                                                        new THREE.Vector3(d, d, d)));
+  }
   extent.expandByPoint(new THREE.Vector3());
   const L = Math.max(extent.getSize(new THREE.Vector3()).length(), 0.05);
   const R0 = 0.035 * L;  // the largest element marker
