@@ -16,8 +16,9 @@ void check_finite(double x, const std::string& where, const char* what) {
   if (std::isfinite(x)) check_magnitude(x, where, what);
 }
 
+// What only a joint of one coordinate takes (armature aside: a spherical joint takes one too).
 bool has_actuator(const JointSpec& js) {
-  return js.armature != 0 || js.friction != 0 || std::isfinite(js.effort_limit) ||
+  return js.gear != 1 || js.friction != 0 || std::isfinite(js.effort_limit) ||
          std::isfinite(js.velocity_limit) || js.stop;
 }
 
@@ -35,8 +36,15 @@ void compile_actuator(const JointSpec& js, Joint& j) {
   check_finite(js.stop_dissipation, w + "/stop/dissipation", "stop dissipation");
   if (has_actuator(js) && j.nv != 1)
     throw ModelError(w, std::string("a ") + std::string(joint_type_name(j.type)) +
-                            " joint takes no armature, friction, effort or velocity limit or "
+                            " joint takes no gear, friction, effort or velocity limit or "
                             "stop (only joints of one coordinate do)");
+  // A spherical joint's armature is a rotor of inertia I_a about every axis: I_a on each of its
+  // rates ω (body axes), no gyroscopic term (ω × I_a ω = 0), as MuJoCo's dof_armature on a ball.
+  // On a free joint's translation in body axes it would need the term I_a ω × v: not modelled.
+  if (js.armature != 0 && j.nv != 1 && j.type != JointType::Spherical)
+    throw ModelError(w + "/armature", std::string("a ") + std::string(joint_type_name(j.type)) +
+                                          " joint takes no armature (joints of one coordinate "
+                                          "and spherical joints do)");
   if (!(js.armature >= 0) || !std::isfinite(js.armature))
     throw ModelError(w + "/armature",
                      "must be finite and not negative, got " + format_number(js.armature));

@@ -78,10 +78,10 @@ Status check_regularity(const Model& model, Workspace& ws) {
                    nullptr, ws.subspace.data() + J.idx_v, A.V, A.c);
 }
 
-// Step 2 for a joint of N > 1 rates: U = I^A S, D = Sᵀ U, u = τ − Sᵀ p^A; D = W Δ Wᵀ (W unit
-// upper triangular, eliminating the last rate first as the tree LTDL does, so that the pivots Δ
-// are the Cholesky route's); K = D⁻¹ Uᵀ, D⁻¹ u and D⁻¹ itself (for articulated_solve) kept for
-// step 3, and with a parent, I^A −= U K, p^A += I^a c + U D⁻¹ u. Fixed sizes: no allocation.
+// Step 2 for a joint of N > 1 rates: U = I^A S, D = Sᵀ U (+ its rotor), u = τ − Sᵀ p^A; D = W Δ Wᵀ
+// (W unit upper triangular, eliminating the last rate first as the tree LTDL does, so that the
+// pivots Δ are the Cholesky route's); K = D⁻¹ Uᵀ, D⁻¹ u and D⁻¹ itself (for articulated_solve) kept
+// for step 3, and with a parent, I^A −= U K, p^A += I^a c + U D⁻¹ u. Fixed sizes: no allocation.
 template <int N>
 void block_step(const Joint& J, ArticulatedBody& A, const Vec6* columns, ArticulatedRate* rates,
                 const VecX& tau, bool has_parent) {
@@ -91,6 +91,7 @@ void block_step(const Joint& J, ArticulatedBody& A, const Vec6* columns, Articul
   U.noalias() = A.IA * S;
   MatN D;
   D.noalias() = S.transpose() * U;
+  D.diagonal().array() += J.reflected_inertia;  // D = Sᵀ I^A S + I_a G² (a spherical joint's rotor)
   Eigen::Matrix<double, N, 7 + N> X;  // [Uᵀ u I], solved in place for [K, D⁻¹ u, D⁻¹]
   X.template leftCols<6>() = U.transpose();
   X.template rightCols<N>().setIdentity();

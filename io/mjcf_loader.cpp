@@ -114,12 +114,18 @@ void one_coordinate(Walk& w, const XMLElement& j, const std::string& cls, bool h
   }
 }
 
-// A ball or free joint: armature is refused (it changes M, and femdyn models it on joints of one
-// coordinate); damping, a spring or friction loss reported as left out of τ and q̈.
-void many_coordinates(Walk& w, const XMLElement& j, const std::string& cls) {
+// A ball or free joint: a ball's armature is its rotor (I_a on each rate, as MuJoCo's
+// dof_armature); a free joint's is refused (on its translation in body axes it would need a term
+// femdyn does not model); damping, a spring or friction loss reported as left out of τ and q̈.
+void many_coordinates(Walk& w, const XMLElement& j, const std::string& cls, bool ball,
+                      Json& joint) {
   const Document& doc = w.doc;
-  if (doc.number(j, "armature", cls, 0) != 0)
-    doc.fail(j, "armature on a ball or free joint (femdyn models it on one-coordinate joints)");
+  if (const double a = doc.number(j, "armature", cls, 0); a != 0) {
+    if (!ball)
+      doc.fail(j, "armature on a free joint (femdyn models it on one-coordinate and ball joints)");
+    if (a < 0) doc.fail(j, "armature is negative");
+    joint["armature"] = a;
+  }
   for (const char* name : {"damping", "stiffness", "frictionloss"})
     if (doc.number(j, name, cls, 0) != 0)
       ++w.unused[std::string(name) + " on a ball or free joint"];
@@ -140,7 +146,7 @@ Json joint_json(Walk& w, const XMLElement& j, const std::string& cls, const std:
     one_coordinate(w, j, cls, type == "hinge", a.normalized(), origin, joint);
   } else if (type == "ball" || type == "free") {
     joint["type"] = type == "ball" ? "spherical" : "free";
-    many_coordinates(w, j, cls);
+    many_coordinates(w, j, cls, type == "ball", joint);
   } else {
     doc.fail(j, "type " + quoted_text(type) + ": expected hinge, slide, ball or free");
   }

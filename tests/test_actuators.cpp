@@ -196,6 +196,51 @@ TEST_CASE("armature: every route adds Gᵀ diag(I_a G²) G to M^s, and to τ, q�
   check_rotors(a, b, 3);
 }
 
+// tree_with_rotors with every third joint made spherical, its rotor I_a on each of its three
+// rates (no gear: a ball's rotor turns with it).
+Json tree_with_ball_rotors(unsigned seed, int bodies) {
+  Json doc = tree_with_rotors(seed, bodies, false);
+  for (std::size_t b = 0; b < doc["bodies"].size(); b += 3) {
+    Json& j = doc["bodies"][b]["joint"];
+    j["type"] = "spherical";
+    j.erase("axis");
+    j.erase("gear");
+    j.erase("limits");
+  }
+  return doc;
+}
+
+TEST_CASE("armature on a spherical joint: I_a on each of its rates, on every route",
+          "[actuators]") {
+  // As MuJoCo's dof_armature on a ball (tests/data/mjcf/features.xml compares with it): the
+  // articulated-body recursion adds it to the joint's 3 × 3 D, the other routes to M^s.
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    INFO("seed " << seed);
+    const Json doc = tree_with_ball_rotors(seed, 8), plain = without_rotors(doc);
+    for (const RouteChoice& r : {RouteChoice{}, RouteChoice{.mass = MassRoute::Transform,
+                                                .force = ForceRoute::Nodes,
+                                                .dynamics = DynamicsRoute::Cholesky}}) {
+      const Model a = on_route(doc, r), b = on_route(plain, r);
+      REQUIRE(a.n_q() > a.n());  // (a quaternion: a spherical joint)
+      CHECK(a.has_armature);
+      check_rotors(a, b, seed);
+      Workspace wa(a), wr(a);
+      std::mt19937 rng(seed);
+      const VecX q = random_posture(a, rng), qd = random_uniform(a.n(), 2, rng),
+                 tau = random_uniform(a.n(), 3, rng);
+      REQUIRE(forward_dynamics(a, wa, q, qd, tau).ok);
+      evaluate(a, wr, q, qd, tau);
+      const VecX qdd = wr.Ms.llt().solve(wr.Q - wr.h);  // the plain solve of M^s q̈ = Q − h
+      CHECK(rel_error(wa.qdd, qdd) < 1e-10);
+    }
+  }
+  // A free joint's translation would need I_a ω × v in body axes: refused in one line.
+  CHECK_THAT(text_error(R"({"name": "b", "bodies": [{"name": "a", "parent": "world",
+      "joint": {"type": "free", "armature": 0.1}, "elements": [{"type": "rigid_body",
+      "mass": 1, "com": [0, 0, 0], "inertia": {"ixx": 1, "iyy": 1, "izz": 1}}]}]})"),
+             Catch::Contains("/bodies/0/joint/armature") && Catch::Contains("free joint"));
+}
+
 TEST_CASE("armature: a spring arm oscillates at sqrt(k / (I + I_a G²)), its energy conserved",
           "[actuators]") {
   // 1 kg·m² on a spring k = 4 behind a rotor of 0.01 kg·m² at gear 10: I = 1 + 1 = 2, ω = √2.
@@ -392,9 +437,9 @@ TEST_CASE("bad actuator input: one line naming the file, the JSON path and the p
   builder.lumped_point("a", Vec3(1, 0, 0), 1.0);
   CHECK_THROWS_WITH(builder.build(),
                     Catch::Contains("/bodies/0/joint/armature") && Catch::Contains("NaN"));
-  // A spherical joint takes none of them.
+  // A spherical joint takes none of them but its rotor.
   CHECK_THAT(text_error(R"({"name": "b", "bodies": [{"name": "a", "parent": "world",
-      "joint": {"type": "spherical", "armature": 0.1}, "elements": [{"type": "rigid_body",
+      "joint": {"type": "spherical", "gear": 2}, "elements": [{"type": "rigid_body",
       "mass": 1, "com": [0, 0, 0], "inertia": {"ixx": 1, "iyy": 1, "izz": 1}}]}]})"),
              Catch::Contains("only joints of one coordinate"));
   // A fixed joint none either.
