@@ -108,11 +108,13 @@ class Simulator {
   }
 
   void reset(const OptArray& q, const OptArray& qd, double t) {
+    not_running("reset");
     if (!std::isfinite(t) || std::abs(t) > 1e9) throw py::value_error("t: expected |t| <= 1e9 s");
     loop_->reset(t, configuration_arg(q, "q", *model_), vector_arg(qd, "qd", *model_));
   }
 
   void step(const Array& tau_in) {
+    not_running("step");
     const VecX tau = vector_arg(tau_in, "tau", *model_, Entries::Bounded);
     Status st;
     {
@@ -133,6 +135,7 @@ class Simulator {
   }
 
   py::dict run(const py::object& controller, double t_end, const std::string& mode, bool check) {
+    not_running("run");
     const bool hold = text_arg(mode, "mode") == "hold";
     if (!hold && mode != "evaluation")
       throw py::value_error(
@@ -172,6 +175,11 @@ class Simulator {
       ControlLoop& loop;
       ~Unset() { loop.set_controller({}); }
     } unset{*loop_};
+    struct Running {  // while the run lasts, whatever ends it: reset, step and run refuse
+      bool& flag;
+      explicit Running(bool& f) : flag(f) { flag = true; }
+      ~Running() { flag = false; }
+    } running{running_};
     long calls = 0;
     if (!hold)
       loop_->set_controller([&](double t, const VecX& q, const VecX& qd, VecX& out) {
@@ -259,8 +267,20 @@ class Simulator {
   std::string integrator() const { return loop_->integrator().name(); }
 
  private:
+  // A call from inside this Simulator's own run (its controller calling reset, step or run)
+  // would move the state under the running integrator: refused, naming the call.
+  void not_running(const char* what) const {
+    if (running_)
+      throw std::runtime_error(std::string("Simulator.") + what +
+                               ": called while this Simulator's run() is in progress (from its "
+                               "controller): a controller returns tau and leaves the state to "
+                               "run(); call " +
+                               what + " after run() returns");
+  }
+
   std::shared_ptr<const Model> model_;
   std::unique_ptr<ControlLoop> loop_;
+  bool running_ = false;
 };
 
 }  // namespace

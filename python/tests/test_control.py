@@ -111,6 +111,53 @@ def test_bad_controllers_are_named(finger):
         femdyn.Simulator(finger, dt=0)
 
 
+@pytest.mark.parametrize("integrator", ["rk4", "dopri", "bdf"])
+@pytest.mark.parametrize("mode", ["evaluation", "hold"])
+@pytest.mark.parametrize("call", ["reset", "step", "run"])
+def test_a_controller_that_calls_its_own_simulator_is_refused(finger, integrator, mode, call):
+    """reset, step or run from inside the Simulator's own run (it crashed the interpreter with
+    dopri and bdf and hung with rk4): a RuntimeError naming the call, once, and the Simulator
+    usable afterwards."""
+    sim = femdyn.Simulator(finger, integrator=integrator, dt=1e-3, q0=Q0)
+
+    def controller(t, q, qd):
+        {"reset": lambda: sim.reset(Q0), "step": lambda: sim.step(TAU),
+         "run": lambda: sim.run(lambda *_: TAU, 1.0)}[call]()
+        return TAU
+
+    with pytest.raises(RuntimeError, match=rf"Simulator\.{call}: called while this Simulator's "
+                                           r"run\(\) is in progress"):
+        sim.run(controller, 0.01, mode=mode)
+    sim.reset(Q0)
+    sim.step(TAU)
+    r = sim.run(lambda t, q, qd: TAU, sim.t + 0.005, mode=mode)
+    assert r["stats"]["ok"] and sim.t == pytest.approx(0.006)
+
+
+@pytest.mark.parametrize("integrator", ["rk4", "dopri", "bdf"])
+def test_a_controller_that_raises_leaves_the_simulator_usable(finger, integrator):
+    """The controller's exception propagates once (in evaluation mode from inside the
+    integrator's step); step, a held run and reset then step work afterwards."""
+    sim = femdyn.Simulator(finger, integrator=integrator, dt=1e-3, q0=Q0)
+    calls = [0]
+
+    def controller(t, q, qd):
+        calls[0] += 1
+        if calls[0] > 3:
+            raise KeyError("the controller's own failure")
+        return TAU
+
+    with pytest.raises(KeyError, match="the controller's own failure"):
+        sim.run(controller, 0.01)
+    t = sim.t
+    sim.step(TAU)
+    assert sim.t == pytest.approx(t + 1e-3)
+    assert sim.run(lambda *_: TAU, sim.t + 0.003, mode="hold")["stats"]["ok"]
+    sim.reset(Q0)
+    sim.step(TAU)
+    assert sim.t == pytest.approx(1e-3) and np.all(np.isfinite(sim.state["q"]))
+
+
 def test_a_diverging_run_raises_numerical_error_with_its_cause(finger):
     stiff = lambda t, q, qd: -1e4 * q  # noqa: E731  far beyond rk4's stability at 1 ms
     sim = femdyn.Simulator(finger, dt=1e-3, q0=Q0)
