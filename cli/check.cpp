@@ -406,6 +406,11 @@ int cmd_check(int argc, char** argv) {
       progress.update(k + 1);
     }
   }
+  // Loops that close at none of the states tried leave nothing to diagnose: refused as simulate
+  // refuses them (exit 1), never a report of empty ranges.
+  if (!m.constraints.empty() && d.unassembled == K)
+    throw StateError(a.positional[0] + ": the loops close at none of the " + std::to_string(K) +
+                     " states tried: " + d.unassembled_message);
   const int pressed = diagnose_stops(m, ws, dampers, d);
   const std::vector<SuspiciousBody> bodies = suspicious_bodies(m);
   bool flagged = false;

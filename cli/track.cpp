@@ -91,10 +91,11 @@ int cmd_track(int argc, char** argv) {
     std::cout << kTrackHelp;
     return 0;
   }
+  if (a.positional.size() != 1) throw CliError("expected one MODEL file (try --help)");
   if (a.has("csv")) {  // refused before any work if it would clobber a file
     const std::string& out = a.options.at("csv");
     std::error_code ec;
-    if (std::filesystem::equivalent(out, a.positional.at(0), ec))
+    if (std::filesystem::equivalent(out, a.positional[0], ec))
       throw CliError("--csv " + out + " is the model file itself");
     if (std::filesystem::exists(out, ec) && !a.has("force"))
       throw CliError("--csv " + out + ": exists (use --force to replace it)");

@@ -428,3 +428,52 @@ TEST_CASE("a 10,000-link URDF is read, its links are checked in one walk", "[har
       urdf_to_model(many + "</robot>", "many.urdf"),
       "many.urdf: 200001 bodies: more than femdyn's limit of 200000 (one per <link> but the root)");
 }
+
+TEST_CASE("every command given options but no MODEL says so in one line, exit 2",
+          "[hardening][cli]") {
+  // `track --csv F` without a MODEL printed a foreign range-check text: each command's options
+  // that name files are looked at only once its MODEL is known.
+  struct Case {
+    const char* command;
+    const char* expected;
+  };
+  for (const Case& c :
+       {Case{"track --csv /tmp/femdyn_no_model.csv --to 1", "one MODEL"},
+        Case{"simulate --out /tmp/femdyn_no_model.csv", "one MODEL"},
+        Case{"view --out /tmp/femdyn_no_model.html", "one MODEL"},
+        Case{"import -o /tmp/femdyn_no_model.json", "one MODEL"},
+        Case{"linearize --json", "one MODEL"}, Case{"kinematics --q 1", "one MODEL"},
+        Case{"equations --json", "one MODEL"}, Case{"check", "one MODEL"},
+        Case{"info", "one MODEL"}, Case{"validate", "a MODEL"}, Case{"compare", "two MODEL"},
+        Case{"bench", "one MODEL"}}) {
+    INFO(c.command);
+    const Run r = run(c.command);
+    CHECK(r.code == 2);
+    CHECK_THAT(r.out, Catch::Contains(c.expected) && Catch::EndsWith("(try --help)\n"));
+    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
+  }
+}
+
+TEST_CASE("check on loops that cannot close refuses as simulate does, no NaN report",
+          "[hardening][loops]") {
+  // The five-bar's tips held 10 m apart: they are at most about 1 m apart. check printed
+  // "cond from beyond 1.8e308 to 0", rank -1 and "unlimited" steps, and exited 0.
+  Scratch dir("check_far_loop");
+  json doc = json::parse(read_file(model_path("five_bar.json")));
+  doc["constraints"] = json::parse(R"([{"name": "far", "type": "distance", "length": 10,
+      "a": {"body": "left_distal", "xyz": [0.3, 0, 0]},
+      "b": {"body": "right_distal", "xyz": [0.3, 0, 0]}}])");
+  const std::string file = dir / "far.json";
+  std::ofstream(file) << doc.dump();
+  for (const char* json_flag : {"", " --json"}) {
+    const Run r = run("check " + file + json_flag);
+    INFO(r.out);
+    CHECK(r.code == 1);
+    CHECK_THAT(r.out, Catch::StartsWith("femdyn check: " + file +
+                                        ": the loops close at none of the 10 states tried: ") &&
+                          Catch::Contains("'far'"));
+    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
+    CHECK(r.out.find("nan") == std::string::npos);
+  }
+  CHECK(run("simulate " + file + " --t-end 0.1").code == 1);
+}
