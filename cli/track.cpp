@@ -58,6 +58,22 @@ struct ComputedTorque {
   }
 };
 
+// A failed run's message; a diverged one under feedback adds whether the PD gains made the
+// loop at the start grow (sim/controller_diagnosis.hpp: the gain K of the law by differences, the
+// closed loop held over each step or inside f), so the report names them as the suspect.
+std::string failure_text(const Status& st, const ControlLoop& loop, ComputedTorque& law,
+                         const VecX& q_start, bool feedback, ControlMode mode) {
+  if (!feedback || !st.diverged) return st.message;
+  const Control u = [&law](double t, const VecX& q, const VecX& v, VecX& out) {
+    law(t, q, v, out);
+  };
+  const std::string why = loop.controller_clause(u, 0, q_start, VecX::Zero(law.m.n()),
+                                                 mode == ControlMode::ZeroOrderHold);
+  return why.empty() ? st.message
+                     : st.message + "; " + why + " (--kp " + format_number(law.kp) + ", --kd " +
+                           format_number(law.kd) + ")";
+}
+
 // Computed torque puts a τ on every coordinate. A model where that is not the mechanism's own
 // actuation is refused, naming what would be ignored: closed loops (the open tree's τ would be
 // applied, and the loops' forces left out) and a coordinate no actuator drives (Model::actuated:
@@ -172,7 +188,9 @@ int cmd_track(int argc, char** argv) {
     csv << "\n";
     if (k == N) break;
     const Status st = feedback ? loop.step() : rk4.advance_to((k + 1) * dt);
-    if (!st.ok) throw CliError(st.message);
+    if (!st.ok)
+      throw StateError(a.positional[0] + ": " +
+                       failure_text(st, loop, law, q_start, feedback, mode));
   }
   if (a.has("csv")) {
     try {

@@ -242,3 +242,43 @@ TEST_CASE("joint limits left are reported once per joint with the time and the v
   // θ(t) ≈ 0.5 near t = √(2 · 0.5 / g) for small angles (the exact fall is a little slower).
   CHECK(c["t"].get<double>() == Approx(0.33).margin(0.05));
 }
+
+TEST_CASE("track: gains beyond the step's stability are named, with the theory's limits",
+          "[divergence][control]") {
+  // Computed torque leaves the tracking error ë + kd ė + kp e = 0: at kp = 1e8, kd = 2e4 a double
+  // root λ = −1e4 1/s. Inside f, rk4 is stable for |λ| dt ≤ 2.785: dt ≤ 2.785e-4 s. Held over
+  // each step, e_{k+1} = Φ e_k with Φ = [[1 − kp dt²/2, dt − kd dt²/2], [−kp dt, 1 − kd dt]]
+  // (the double integrator under a held input), stable while ρ(Φ) ≤ 1. The report's limits are
+  // the controller diagnosis's (differences of the law, Van Loan), compared with these.
+  const double kp = 1e8, kd = 2e4;
+  double lo = 1e-9, hi = 1e-2;  // the held loop's largest stable period, by bisection
+  for (int i = 0; i < 200; ++i) {
+    const double dt = std::sqrt(lo * hi);
+    Eigen::Matrix2d Phi;
+    Phi << 1 - kp * dt * dt / 2, dt - kd * dt * dt / 2, -kp * dt, 1 - kd * dt;
+    (Phi.eigenvalues().cwiseAbs().maxCoeff() <= 1 + 1e-12 ? lo : hi) = dt;
+  }
+  const std::string track = "track " + model_path("finger.json") +
+                            " --to 0.5,0.5,0.5,0.5 --kp 1e8 --kd 2e4 --duration 0.1";
+  // The number after `key`, looked for after `from`.
+  const auto number_after = [](const std::string& text, const std::string& key,
+                               const std::string& from = "") {
+    const std::size_t at = text.find(key, text.find(from));
+    REQUIRE(at != std::string::npos);
+    return std::stod(text.substr(at + key.size()));
+  };
+  const Run in_f = run(track + " --steps 300 --control evaluation");  // dt = 3.33e-4 s
+  INFO(in_f.out);
+  CHECK(in_f.code == 1);
+  CHECK_THAT(in_f.out, Catch::Contains("the controller is the likely cause") &&
+                           Catch::Contains("(--kp 1e+08, --kd 20000)"));
+  CHECK(number_after(in_f.out, " s (", "limit of the step ") == Approx(2.785e-4).epsilon(0.01));
+  const Run held = run(track + " --steps 300");
+  INFO(held.out);
+  CHECK(held.code == 1);
+  CHECK(number_after(held.out, "below a period of about ") == Approx(lo).epsilon(0.02));
+  CHECK(held.out.find("nan") == std::string::npos);
+  // Inside both limits the same gains track.
+  CHECK(run(track + " --steps 1000 --control evaluation").code == 0);
+  CHECK(run(track + " --steps " + std::to_string(static_cast<int>(0.1 / (0.7 * lo)))).code == 0);
+}
