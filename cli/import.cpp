@@ -3,6 +3,8 @@
 #include <iostream>
 
 #include "cli/commands.hpp"
+#include "io/atomic_file.hpp"
+#include "io/model_loader.hpp"
 #include "io/output.hpp"
 
 namespace femdyn::cli {
@@ -33,8 +35,8 @@ int cmd_import(int argc, char** argv) {
   if (!a.has("output")) throw CliError("-o OUT.json is required (try --help)");
   const std::string& out = a.options.at("output");
   std::error_code ec;
-  if (std::filesystem::equivalent(out, a.positional[0], ec))
-    throw CliError("-o " + out + " is the model file itself");
+  if (const std::string input = input_at(out, model_inputs(a.positional[0])); !input.empty())
+    throw CliError("-o " + out + " is " + input);
   if (std::filesystem::exists(out, ec) && !a.has("force"))
     throw CliError(out + ": exists (use --force to replace it)");
   const LoadOptions opt = load_options(a);

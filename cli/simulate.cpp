@@ -14,6 +14,7 @@
 #include "core/names.hpp"
 #include "io/actuation_table.hpp"
 #include "io/atomic_file.hpp"
+#include "io/model_loader.hpp"
 #include "io/output.hpp"
 #include "io/trajectory_csv.hpp"
 #include "sim/run_report.hpp"
@@ -179,9 +180,10 @@ SimulationRequest simulation_request(const Args& a, const Model& m, const Door& 
 void open_output(const Args& a, std::optional<AtomicFile>& out) {
   if (!a.has("out")) return;
   const std::string& path = a.options.at("out");
-  std::error_code ec;
-  if (std::filesystem::equivalent(path, a.positional[0], ec))
-    throw CliError("--out " + path + " is the model file itself");
+  std::vector<RunInput> inputs = model_inputs(a.positional[0]);
+  if (a.has("tau-csv")) inputs.emplace_back(a.options.at("tau-csv"), "the --tau-csv file");
+  if (const std::string input = input_at(path, inputs); !input.empty())
+    throw CliError("--out " + path + " is " + input);
   try {
     out.emplace(path, a.has("force"));
   } catch (const std::runtime_error& e) {

@@ -8,7 +8,9 @@
 
 #include "cli/commands.hpp"
 #include "compile/actuators.hpp"
+#include "io/atomic_file.hpp"
 #include "io/csv.hpp"
+#include "io/model_loader.hpp"
 #include "io/output.hpp"
 #include "sim/control_loop.hpp"
 #include "sim/fixed_step.hpp"
@@ -111,8 +113,8 @@ int cmd_track(int argc, char** argv) {
   if (a.has("csv")) {  // refused before any work if it would clobber a file
     const std::string& out = a.options.at("csv");
     std::error_code ec;
-    if (std::filesystem::equivalent(out, a.positional[0], ec))
-      throw CliError("--csv " + out + " is the model file itself");
+    if (const std::string input = input_at(out, model_inputs(a.positional[0])); !input.empty())
+      throw CliError("--csv " + out + " is " + input);
     if (std::filesystem::exists(out, ec) && !a.has("force"))
       throw CliError("--csv " + out + ": exists (use --force to replace it)");
   }

@@ -4,6 +4,8 @@
 
 #include "cli/commands.hpp"
 #include "core/names.hpp"
+#include "io/atomic_file.hpp"
+#include "io/model_loader.hpp"
 #include "view/page.hpp"
 
 namespace femdyn::cli {
@@ -40,9 +42,10 @@ int cmd_view(int argc, char** argv) {
   if (!singular.empty()) std::cerr << "femdyn view: note: " << safe_message(singular) << "\n";
   const std::string out = a.has("out") ? a.options.at("out") : "view.html";
   std::error_code ec;
-  for (const std::string& input : {a.positional[0], a.has("traj") ? a.options.at("traj") : ""})
-    if (std::filesystem::equivalent(out, input, ec))
-      throw CliError("--out " + out + " is an input file itself");
+  std::vector<RunInput> inputs = model_inputs(a.positional[0]);
+  if (a.has("traj")) inputs.emplace_back(a.options.at("traj"), "the --traj file");
+  if (const std::string input = input_at(out, inputs); !input.empty())
+    throw CliError("--out " + out + " is " + input);
   if (std::filesystem::exists(out, ec) && !a.has("force"))
     throw CliError(out + ": exists (use --force to replace it)");
   const view::Motion motion = a.has("traj") ? view::read_trajectory(m, a.options.at("traj"))

@@ -91,6 +91,7 @@ void compile_gear(const ConstraintSpec& s, const Model& m, LoopConstraint& c) {
 }
 
 LoopConstraint compile_constraint(const ConstraintSpec& s, const Model& m) {
+  check_name(s.name, s.where + "/name", "constraint name");  // (printed by info, check, reports)
   LoopConstraint c;
   c.name = s.name;
   c.where = s.where;
@@ -132,6 +133,7 @@ LoopConstraint compile_constraint(const ConstraintSpec& s, const Model& m) {
 }
 
 TwoPointSpring compile_spring(const SpringSpec& s, const Model& m) {
+  check_name(s.name, s.where + "/name", "spring name");
   TwoPointSpring k;
   k.name = s.name;
   k.where = s.where;

@@ -59,4 +59,11 @@ void AtomicFile::commit() {
   open_ = false;
 }
 
+std::string input_at(const std::string& out, const std::vector<RunInput>& inputs) {
+  std::error_code ec;
+  for (const auto& [path, label] : inputs)
+    if (!path.empty() && std::filesystem::equivalent(out, path, ec)) return label;
+  return "";
+}
+
 }  // namespace femdyn

@@ -6,6 +6,8 @@
 #pragma once
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace femdyn {
 
@@ -31,5 +33,13 @@ class AtomicFile {
   std::ofstream out_;
   bool open_ = false;
 };
+
+// An input of a run: its path and what it is in a message ("the model file itself").
+using RunInput = std::pair<std::string, std::string>;
+
+// What `out` would destroy: the label of the first input it is (the same file through symlinks
+// and relative paths, whether or not --force is given), or "". Every command and the Python
+// module ask it before writing: --force replaces an older output, never an input of the run.
+std::string input_at(const std::string& out, const std::vector<RunInput>& inputs);
 
 }  // namespace femdyn

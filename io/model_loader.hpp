@@ -4,6 +4,8 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "compile/compile.hpp"
 #include "core/model.hpp"
@@ -49,5 +51,8 @@ Json model_document(const std::string& path, const LoadOptions& options = {});
 // it), "" for any other model. For what reads the robot file's other parts (femdyn view's
 // visuals).
 std::string robot_file_of(const std::string& path);
+// The files a model in `path` is read from, as run inputs: the file itself and the robot file a
+// JSON reference names (io/atomic_file.hpp, input_at).
+std::vector<std::pair<std::string, std::string>> model_inputs(const std::string& path);
 
 }  // namespace femdyn

@@ -181,4 +181,11 @@ std::string robot_file_of(const std::string& path) {
   return file.string();
 }
 
+std::vector<std::pair<std::string, std::string>> model_inputs(const std::string& path) {
+  std::vector<std::pair<std::string, std::string>> inputs = {{path, "the model file itself"}};
+  if (const std::string robot = robot_file_of(path); !robot.empty() && robot != path)
+    inputs.emplace_back(robot, "the robot file the model refers to (" + robot + ")");
+  return inputs;
+}
+
 }  // namespace femdyn

@@ -2,6 +2,8 @@
 // wraps it as Model.view, which also shows the page inline in Jupyter (docs/view.md).
 #include <pybind11/stl.h>
 
+#include "io/atomic_file.hpp"
+#include "io/model_loader.hpp"
 #include "python/py_model.hpp"
 #include "view/page.hpp"
 
@@ -21,6 +23,13 @@ void write_view(const PyModel& self, const std::string& path, bool force,
                 const std::optional<std::string>& traj_path,
                 const std::optional<std::string>& traj_text, const std::optional<Array>& q) {
   const Model& m = *self.model;
+  // --force replaces an older page, never an input of this view (the model's own files, the
+  // trajectory), as at the CLI's door.
+  std::vector<RunInput> inputs =
+      self.source.empty() ? std::vector<RunInput>{} : model_inputs(self.source);
+  if (traj_path) inputs.emplace_back(*traj_path, "the trajectory file (traj)");
+  if (const std::string input = input_at(text_arg(path, "path"), inputs); !input.empty())
+    throw py::value_error("path: " + path + " is " + input);
   const view::Motion motion = motion_of(m, text_arg(traj_path, "traj"), traj_text, q);
   py::gil_scoped_release release;
   view::write_model_page(text_arg(path, "path"), m, self.source, motion, force);

@@ -174,10 +174,10 @@ Status Integrator::diverged() {
   if (tau0.size() != n) tau0.setZero(n);
   // (an energy that overflowed is said so, never printed as NaN)
   const double gain = watch_.gain();
-  const std::string held = std::isfinite(gain) ? "the state holds " + format_short(gain) +
-                                                     " J more energy than the "
-                                               : "the state's energy overflowed (NaN or Inf), "
-                                                 "from the ";
+  const std::string held =
+      std::isfinite(gain) ? "the state holds " + format_short(gain) + " J more energy than the "
+                          : "the state's energy overflowed (NaN or Inf), "
+                            "from the ";
   Status st{false,
             at_time(t_) + "the solution diverges (" + held + format_short(watch_.supplied()) +
                 " J it started with and was given): " +

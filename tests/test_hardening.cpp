@@ -162,6 +162,17 @@ TEST_CASE("names with control characters are refused and user text is echoed esc
       "2J";
   CHECK_THAT(text_error(c1.dump()),
              Catch::Contains("'hinge\\xc2\\x9b2J' contains a control character"));
+  // Constraint and spring names reach info, check and the reports too (issue 45).
+  json loop = json::parse(read_file(model_path("five_bar.json")));
+  loop["constraints"][0]["name"] = "end\x1b[31m";
+  CHECK(text_error(loop.dump()) ==
+        "test: /constraints/0/name: constraint name 'end\\x1b[31m' contains a control character "
+        "(names must be printable)");
+  json spring = pendulum_model();
+  spring["springs"] = json::parse(R"([{"a": "world", "b": "bob", "stiffness": 1}])");
+  spring["springs"][0]["name"] = "k\x07";
+  CHECK_THAT(text_error(spring.dump()),
+             Catch::Contains("/springs/0/name: spring name 'k\\x07' contains a control character"));
   const Run cli =
       run("equations " + model_path("finger.json") + " --q \"$(printf '0,0,0,1\\033[2J')\"");
   CHECK(cli.code == 2);
@@ -476,4 +487,45 @@ TEST_CASE("check on loops that cannot close refuses as simulate does, no NaN rep
     CHECK(r.out.find("nan") == std::string::npos);
   }
   CHECK(run("simulate " + file + " --t-end 0.1").code == 1);
+}
+
+TEST_CASE("with --force too, no output replaces an input of the run", "[hardening]") {
+  // The robot file a JSON model refers to, and a run's --tau-csv or --traj, are inputs as much
+  // as the model file: each command refuses to write onto them, with --force too (issue 45).
+  Scratch dir("force_onto_input");
+  const std::string urdf = dir / "robot.urdf", model = dir / "robot.json", tau = dir / "tau.csv",
+                    traj = dir / "traj.csv";
+  fs::copy_file(model_path("urdf/arm7.urdf"), urdf);
+  std::ofstream(model) << R"({"model": "urdf", "params": {"file": "robot.urdf"}})";
+  std::ofstream(tau) << "t,theta\n0,0\n0.1,0\n";
+  const std::string before = read_file(urdf), tau_before = read_file(tau);
+  const std::string pendulum = model_path("pendulum.json");
+  REQUIRE(run("simulate " + pendulum + " --t-end 0.01 --out " + traj).code == 0);
+  const std::string traj_before = read_file(traj);
+  struct Case {
+    std::string command, refusal;
+  };
+  for (const Case& c : {Case{"import " + model + " -o " + urdf + " --force",
+                             "-o " + urdf + " is the robot file the model refers to"},
+                        Case{"simulate " + model + " --t-end 0.01 --out " + urdf + " --force",
+                             "--out " + urdf + " is the robot file the model refers to"},
+                        Case{"view " + model + " --out " + urdf + " --force",
+                             "--out " + urdf + " is the robot file the model refers to"},
+                        Case{"track " + model + " --to 0,0,0,0,0,0,0.1 --csv " + urdf + " --force",
+                             "--csv " + urdf + " is the robot file the model refers to"},
+                        Case{"simulate " + pendulum + " --tau-csv " + tau + " --t-end 0.01 --out " +
+                                 tau + " --force",
+                             "--out " + tau + " is the --tau-csv file"},
+                        Case{"view " + pendulum + " --traj " + traj + " --out " + traj + " --force",
+                             "--out " + traj + " is the --traj file"},
+                        Case{"import " + model + " -o " + model + " --force",
+                             "-o " + model + " is the model file itself"}}) {
+    INFO(c.command);
+    const Run r = run(c.command);
+    CHECK(r.code == 2);
+    CHECK_THAT(r.out, Catch::Contains(c.refusal));
+  }
+  CHECK(read_file(urdf) == before);
+  CHECK(read_file(tau) == tau_before);
+  CHECK(read_file(traj) == traj_before);
 }

@@ -232,7 +232,7 @@ TEST_CASE("femdyn view refuses a bad trajectory in one line and writes nothing",
                        "view", "--traj and --q");
   check_one_line_error(run("view " + finger + " --q 0,nan,0,0 --out " + out), "--q", "NaN");
   check_one_line_error(run("view " + finger + " --out " + finger + " --force"), "--out",
-                       "is an input file");
+                       "is the model file itself");
   CHECK(!std::filesystem::exists(out));
 }
 

@@ -123,3 +123,25 @@ def test_inline_in_a_notebook(tmp_path, monkeypatch):
 def test_not_in_a_notebook_here():
     from femdyn import _view
     assert not _view._in_notebook()
+
+
+def test_view_never_writes_onto_an_input_even_with_force(tmp_path):
+    """Model.view(path=…, force=True) replaces an older page, never the model's own file, the
+    robot file it refers to, or the trajectory it draws (as the CLI refuses them)."""
+    import shutil
+    urdf = tmp_path / "robot.urdf"
+    shutil.copy(model_path("models/urdf/arm7.urdf"), urdf)
+    ref = tmp_path / "robot.json"
+    ref.write_text('{"model": "urdf", "params": {"file": "robot.urdf"}}')
+    m = femdyn.load(str(ref))
+    before = urdf.read_text()
+    for target, what in ((ref, "the model file itself"),
+                         (urdf, "the robot file the model refers to")):
+        with pytest.raises(ValueError, match=re.escape(f"is {what}")):
+            m.view(path=str(target), force=True)
+    assert urdf.read_text() == before
+    traj = tmp_path / "traj.csv"
+    subprocess.run([str(BINARY), "simulate", str(ref), "--t-end", "0.01", "--out", str(traj)],
+                   check=True, capture_output=True)
+    with pytest.raises(ValueError, match="is the trajectory file"):
+        m.view(traj=str(traj), path=str(traj), force=True)
