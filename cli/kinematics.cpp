@@ -21,9 +21,9 @@ constexpr const char* kKinematicsHelp =
                           [--axes local_world_aligned|local|world] [--json] [--gravity gx,gy,gz]
 
 The kinematics of frames at the state (--q: n_q values, default the neutral configuration, on a
-model with closed loops assembled onto them as simulate starts; --qd: n rates, default 0): each frame's position p and orientation R (world), its Jacobian J (6 × n,
-linear rows then angular), its velocity J v and J̇v, the acceleration at q̈ = 0, in the chosen
-axes (docs/notation.md#frames):
+model with closed loops assembled onto them as simulate starts; --qd: n rates, default 0): each
+frame's position p and orientation R (world), its Jacobian J (6 × n, linear rows then angular),
+its velocity J v and J̇v, the acceleration at q̈ = 0, in the chosen axes (docs/notation.md#frames):
   local_world_aligned (default)  about the frame's origin, world axes
   local                          about the frame's origin, the frame's own axes
   world                          the body point at the world origin, world axes (spatial)
