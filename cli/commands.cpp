@@ -55,12 +55,20 @@ available memory) the command is refused before any work, with the memory it wou
 // (16 bytes, in arrays of at most twice the capacity), then its text the same way (about 24
 // bytes a number, 3x). An upper bound by construction, not a measurement.
 double equations_bytes(const Model& m, bool json) {
-  const double n = m.n(), numbers = n * n + 5 * n;
-  const double printed = json ? (2 * 16 + 3 * 24) * numbers : 3 * 18 * numbers;
-  return evaluation_bytes(m) + printed;
+  const double n = m.n();
+  return evaluation_bytes(m) + printed_bytes(n * n + 5 * n, json);
 }
 
 }  // namespace
+
+double printed_bytes(double numbers, bool json) {
+  return json ? (2 * 16 + 3 * 24) * numbers : 3 * 18 * numbers;
+}
+
+void require_command_memory(const Args& a, const std::string& what, double bytes) {
+  require_memory(a.positional[0] + ": " + what, bytes, max_memory(a),
+                 "use " + max_memory_option(bytes) + " if that much memory is free");
+}
 
 std::vector<double> parse_numbers(const std::string& opt, const std::string& text) {
   std::vector<double> out;

@@ -9,6 +9,7 @@
 #include "cli/commands.hpp"
 #include "core/errors.hpp"
 #include "core/frames.hpp"
+#include "core/memory.hpp"
 #include "core/momentum.hpp"
 #include "core/names.hpp"
 #include "io/output.hpp"
@@ -19,6 +20,7 @@ namespace {
 constexpr const char* kKinematicsHelp =
     R"(usage: femdyn kinematics MODEL [--q …] [--qd …] [--frame NAME[,NAME…]]
                           [--axes local_world_aligned|local|world] [--json] [--gravity gx,gy,gz]
+                          [--max-memory GB]
 
 The kinematics of frames at the state (--q: n_q values, default the neutral configuration, on a
 model with closed loops assembled onto them as simulate starts; --qd: n rates, default 0): each
@@ -40,6 +42,8 @@ J* v_m + drift with the base floating, v_m the rates of every joint but the base
 "R", "J", "velocity", "bias"[, "generalized_jacobian": {"rates", "J", "drift"}]}],
 "centroidal": {"mass", "com", "Jcom", "com_velocity", "com_bias", "inertia_com", "momentum",
 "A", "bias"}}.
+Each frame's Jacobians grow as n: beyond the memory limit (--max-memory GB, default half the
+available memory) the command is refused before any work, with the memory it would need.
 )";
 
 // The frames asked for, by name; by default the named frames, else the leaf bodies.
@@ -82,8 +86,8 @@ bool floating_tree(const Model& m) {
 }  // namespace
 
 int cmd_kinematics(int argc, char** argv) {
-  const Args a =
-      parse_args(argc, argv, 2, {"help", "json"}, {"q", "qd", "frame", "axes", "gravity"});
+  const Args a = parse_args(argc, argv, 2, {"help", "json"},
+                            {"q", "qd", "frame", "axes", "gravity", "max-memory"});
   if (a.has("help")) {
     std::cout << kKinematicsHelp;
     return 0;
@@ -94,6 +98,13 @@ int cmd_kinematics(int argc, char** argv) {
     throw CliError("--axes expects local_world_aligned, local or world");
   const auto [q, qd, tau] = command_state(a, m);
   const std::vector<int> frames = chosen_frames(a, m);
+  // At most: the workspace, and per frame its Jacobians (J and the generalized one, 12n numbers
+  // with p, R and the rest), the momentum's (A_G, J_c: 9n), held and printed.
+  const double n = m.n(), numbers = frames.size() * (12 * n + 30) + 9 * n + 30;
+  require_command_memory(a,
+                         "the kinematics of " + std::to_string(frames.size()) +
+                             " frames of n = " + std::to_string(m.n()) + " coordinates",
+                         evaluation_bytes(m) + 8 * numbers + printed_bytes(numbers, a.has("json")));
   Workspace ws(m);
   FrameKinematics k;
   Json list = Json::array();

@@ -17,6 +17,16 @@ namespace {
 using OptArray = std::optional<Array>;
 using OptRate = std::optional<double>;
 
+// Refuses, before any work, derivatives whose buffers (twelve n × n matrices bound them, as for
+// `femdyn linearize`) and `results` dense n × n results, copied out to numpy, exceed the memory
+// limit (femdyn.set_max_memory).
+void require_derivative_memory(const Model& m, const char* what, double results) {
+  const double n = m.n(), bytes = evaluation_bytes(m) + dense_bytes(12 * n, n) +
+                                  2 * results * dense_bytes(n, n);
+  require_memory(std::string(what) + " of n = " + std::to_string(m.n()) + " coordinates", bytes, 0,
+                 set_max_memory_text(bytes));
+}
+
 // The model's derivative buffers, made on first use (a model they do not cover: ModelError).
 DerivativeWorkspace& derivative_workspace(PyModel& self) {
   if (!self.derivatives) self.derivatives = std::make_unique<DerivativeWorkspace>(*self.model);
@@ -28,6 +38,7 @@ DerivativeWorkspace& derivative_workspace(PyModel& self) {
 DerivativeWorkspace& forward_at(PyModel& self, const Array& q, const OptArray& qd,
                                 const OptArray& tau, const OptRate& baumgarte, VecX& v) {
   const Model& m = *self.model;
+  require_derivative_memory(m, "derivatives", 4);
   DerivativeWorkspace& d = derivative_workspace(self);
   d.baumgarte = baumgarte_arg(m, baumgarte);
   v = vector_arg(qd, "qd", m);
@@ -51,6 +62,7 @@ py::dict forward(PyModel& self, const Array& q, const OptArray& qd, const OptArr
 py::dict inverse(PyModel& self, const Array& q, const OptArray& qd, const OptArray& qdd) {
   const Model& m = *self.model;
   require_open_tree(m, "inverse_derivatives");
+  require_derivative_memory(m, "inverse_derivatives", 2);
   DerivativeWorkspace& d = derivative_workspace(self);
   const VecX qv = configuration_arg(q, "q", m), v = vector_arg(qd, "qd", m),
              a = vector_arg(qdd, "qdd", m);
@@ -68,6 +80,7 @@ py::dict inverse(PyModel& self, const Array& q, const OptArray& qd, const OptArr
 std::pair<MatX, MatX> linearize(PyModel& self, const Array& q, const OptArray& qd,
                                 const OptArray& tau, const OptRate& baumgarte) {
   const Model& m = *self.model;
+  require_derivative_memory(m, "linearize", 6);  // (A: 4 n², B: up to 2 n²)
   DerivativeWorkspace& d = derivative_workspace(self);
   d.baumgarte = baumgarte_arg(m, baumgarte);
   MatX A, B;

@@ -61,3 +61,19 @@ def test_validate_samples_are_refused_up_front(finger):
     the estimate, so it is refused before any state."""
     with pytest.raises(ValueError, match=r"validating n = 4 coordinates .* of memory, beyond"):
         femdyn.validate(finger, samples=10**9, max_memory=1.0)
+
+
+def test_derivatives_are_refused_up_front():
+    """derivatives, linearize and inverse_derivatives estimate their n × n buffers and results
+    first (they ended in numpy's MemoryError on a 10,000-body tree: issue 45)."""
+    m = femdyn.load(model_path("models/hand.json"))
+    q = m.neutral_configuration()
+    femdyn.set_max_memory(1e-5)  # 10 kB: below the hand's 22 x 22 buffers
+    try:
+        for call in ("derivatives", "linearize", "inverse_derivatives"):
+            with pytest.raises(ValueError, match=rf"^{call} of n = 22 coordinates needs .* "
+                                                 r"femdyn\.set_max_memory\("):
+                getattr(m, call)(q)
+    finally:
+        femdyn.set_max_memory(None)
+    assert m.linearize(q)[0].shape == (44, 44)
