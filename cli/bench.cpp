@@ -461,6 +461,8 @@ int cmd_bench(int argc, char** argv) {
     std::cout << kBenchHelp;
     return 0;
   }
+  // (the command line's errors first, exit 2, whatever the build)
+  if (a.positional.size() != 1) throw CliError("expected one MODEL file (try --help)");
   refuse_debug_build();
   const int K = static_cast<int>(integer_option(a, "states", 16, 1, 10000));
   const Model m = load(a);
