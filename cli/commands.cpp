@@ -264,11 +264,8 @@ int cmd_equations(int argc, char** argv) {
   }
   const Model m = load(a);
   const auto [q, qd, tau] = command_state(a, m);
-  require_memory(
-      a.positional[0] + ": the equations of n = " + std::to_string(m.n()) + " coordinates",
-      equations_bytes(m, a.has("json")), max_memory(a),
-      "use " + max_memory_option(equations_bytes(m, a.has("json"))) +
-          " if that much memory is free");
+  require_command_memory(a, "the equations of n = " + std::to_string(m.n()) + " coordinates",
+                         equations_bytes(m, a.has("json")));
   Workspace ws(m);
   // q̈ of the mechanism: with closed loops the constrained one, at a state on the loops.
   const std::unique_ptr<LoopWorkspace> loops =

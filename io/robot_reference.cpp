@@ -96,6 +96,12 @@ Json robot_document(const std::string& path, const LoadOptions& options) {
 
 namespace {
 
+// A reference's "file" as a path: relative to the JSON file `path` that names it, or absolute.
+std::filesystem::path beside(const std::string& path, const std::string& file) {
+  const std::filesystem::path f(file);
+  return f.is_relative() ? std::filesystem::path(path).parent_path() / f : f;
+}
+
 // The robot file a reference's "file" names (relative to the JSON file `path`), of the kind
 // `is_kind` says, read by `read` into femdyn JSON with the reference's own name, description,
 // gravity and loads on top; a problem in it reported at /params/file. Also its path.
@@ -103,8 +109,7 @@ template <class Read>
 std::pair<Json, std::string> referenced(const std::string& path, const Json& root, const Params& p,
                                         const Params& params, bool (*is_kind)(const std::string&),
                                         const char* expected, const Read& read) {
-  std::filesystem::path file(params.string("file"));
-  if (file.is_relative()) file = std::filesystem::path(path).parent_path() / file;
+  const std::filesystem::path file = beside(path, params.string("file"));
   if (!is_kind(file.string())) params.fail("file", expected);
   Json doc;
   try {
@@ -176,9 +181,7 @@ std::string robot_file_of(const std::string& path) {
   const Json& params = root["params"];
   if (model != kUrdfReference && model != kMjcfReference) return "";
   if (!params.is_object() || !params.contains("file") || !params["file"].is_string()) return "";
-  std::filesystem::path file(params["file"].get<std::string>());
-  if (file.is_relative()) file = std::filesystem::path(path).parent_path() / file;
-  return file.string();
+  return beside(path, params["file"].get<std::string>()).string();
 }
 
 std::vector<std::pair<std::string, std::string>> model_inputs(const std::string& path) {
