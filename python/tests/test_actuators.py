@@ -95,3 +95,35 @@ def test_a_controllers_torque_is_saturated_and_recorded_as_applied():
     assert np.all(r["tau"] == 2.0)
     assert r["stats"]["saturated_evaluations"] == r["stats"]["rhs_evals"] >= 400
     assert r["q"][-1, 0] == pytest.approx(1.0, rel=1e-12)  # (m, n_q) even for n_q = 1
+
+
+def test_a_ball_joint_rotor_is_the_same_from_the_builder_and_from_json(tmp_path):
+    """armature on a spherical joint: I_a on each of its three rates, the same model whether the
+    Builder or a JSON file says it (one compile check behind both); a free joint's is refused."""
+    inertia = np.diag([0.01, 0.02, 0.03])
+    b = femdyn.Builder("ball")
+    b.body("l", type="spherical", armature=0.1)
+    b.rigid_body("l", 1.0, [0.3, 0, 0], inertia)
+    built = b.build()
+    doc = {"name": "ball", "bodies": [{"name": "l", "parent": "world",
+           "joint": {"name": "l", "type": "spherical", "armature": 0.1},
+           "elements": [{"type": "rigid_body", "mass": 1.0, "com": [0.3, 0, 0],
+                         "inertia": inertia.tolist()}]}]}
+    path = tmp_path / "ball.json"
+    path.write_text(json.dumps(doc))
+    loaded = femdyn.load(str(path))
+    q = np.array([0.9, 0.1, -0.3, 0.2])
+    q /= np.linalg.norm(q)
+    qd = np.array([0.4, -1.0, 0.7])
+    a, c = built.equations(q, qd), loaded.equations(q, qd)
+    assert np.array_equal(a.M, c.M) and np.array_equal(a.h, c.h)
+    # M^s about the pivot plus I_a on each rate: diag(0.01, 0.02 + 0.09, 0.03 + 0.09) + 0.1
+    plain = femdyn.Builder("plain")
+    plain.body("l", type="spherical")
+    plain.rigid_body("l", 1.0, [0.3, 0, 0], inertia)
+    assert np.allclose(a.M - plain.build().equations(q, qd).M, 0.1 * np.eye(3), atol=1e-15)
+    free = femdyn.Builder("free")
+    free.body("l", type="free", armature=0.1)
+    free.rigid_body("l", 1.0, [0.3, 0, 0], inertia)
+    with pytest.raises(femdyn.ModelError, match="a free joint takes no armature"):
+        free.build()
