@@ -38,13 +38,12 @@ void compile_actuator(const JointSpec& js, Joint& j) {
     throw ModelError(w, std::string("a ") + std::string(joint_type_name(j.type)) +
                             " joint takes no gear, friction, effort or velocity limit or "
                             "stop (only joints of one coordinate do)");
-  // A spherical joint's armature is a rotor of inertia I_a about every axis: I_a on each of its
-  // rates ω (body axes), no gyroscopic term (ω × I_a ω = 0), as MuJoCo's dof_armature on a ball.
-  // On a free joint's translation in body axes it would need the term I_a ω × v: not modelled.
-  if (js.armature != 0 && j.nv != 1 && j.type != JointType::Spherical)
+  // A spherical or free joint's armature is I_a on each of its rates, as MuJoCo's dof_armature
+  // (core/joints/rotor.hpp: a free joint's adds h_a = I_a ω × v on its linear rates).
+  if (js.armature != 0 && j.nv != 1 && j.type != JointType::Spherical && j.type != JointType::Free)
     throw ModelError(w + "/armature", std::string("a ") + std::string(joint_type_name(j.type)) +
-                                          " joint takes no armature (joints of one coordinate "
-                                          "and spherical joints do)");
+                                          " joint takes no armature (joints of one coordinate, "
+                                          "spherical and free joints do)");
   if (!(js.armature >= 0) || !std::isfinite(js.armature))
     throw ModelError(w + "/armature",
                      "must be finite and not negative, got " + format_number(js.armature));
@@ -102,6 +101,11 @@ void compile_actuators(Model& m) {
   m.armature_mass.resize(n, n);
   m.armature_mass.setFromTriplets(entries.begin(), entries.end());
   m.armature_mass.makeCompressed();
+  m.free_rotors.clear();  // (a free joint is coupled to nothing: its rates are q̇'s own)
+  for (const CoordinateJoint& c : m.coordinate_joints)
+    if (const Joint& J = m.bodies[c.body].joint;
+        J.type == JointType::Free && J.reflected_inertia != 0 && J.idx_v >= 0)
+      m.free_rotors.push_back({c.v, J.idx_v, J.reflected_inertia});
 
   // Effort limits, on the rates of q that the joints own. A coupled joint's is kept but not
   // applied: no τ acts on it directly (simulate says so, sim/recorded_run.hpp).

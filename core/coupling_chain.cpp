@@ -3,6 +3,7 @@
 #include "core/body_inertia.hpp"
 #include "core/coupled_dynamics.hpp"
 #include "core/errors.hpp"
+#include "core/joints/rotor.hpp"
 #include "core/newton_euler.hpp"
 #include "core/span_inertia.hpp"
 
@@ -109,6 +110,7 @@ void evaluate_bias_by_bodies(const Model& m, Workspace& ws, const VecX& q, const
   Workspace& t = *ws.tree;
   newton_euler(tree, t, s.theta, s.theta_dot, &s.gamma, false, s.f_theta);
   if (tree.has_armature) s.f_theta.noalias() += tree.armature_mass * s.gamma;
+  add_rotor_bias(tree, s.theta_dot, 1.0, s.f_theta);  // (the tree's q̇ is θ̇)
   reduce_force(s, s.f_theta, ws.h);
   share_bodies(ws);
 }
@@ -171,6 +173,7 @@ Status forward_dynamics_by_bodies(const Model& m, Workspace& ws, const VecX& q, 
   t.theta_dot = s->theta_dot;
   joint_force_sweeps(tree, t, &s->gamma);
   add_span_forces(tree, t, t.tau_theta);
+  add_rotor_bias(tree, s->theta_dot, 1.0, t.tau_theta);
   whole_mass_from_composites(tree, t);
   return solve_reduced(ws, *s, tau);
 }

@@ -12,6 +12,7 @@
 #include "core/coupling_chain.hpp"
 #include "core/joints/kernel.hpp"
 #include "core/joints/passive.hpp"
+#include "core/joints/rotor.hpp"
 #include "core/kinematics.hpp"
 #include "core/mass_solver.hpp"
 #include "core/newton_euler.hpp"
@@ -345,6 +346,7 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
   require_state(model, "evaluate", q, &qd, "qd");
   require_size(model, "evaluate", "tau", tau, ArgumentKind::Actuation);
   model.routes.evaluate(model, ws, q, qd, tau);
+  add_rotor_bias(model, qd, 1.0, ws.h);
   if (model.springs.empty()) return;
   spring_forces(model, ws, q, qd);
   ws.Q += ws.Q_springs;
@@ -353,18 +355,25 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
 void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
   require_state(model, "evaluate_bias", q, &qd, "qd");
   model.routes.evaluate_bias(model, ws, q, qd);
+  add_rotor_bias(model, qd, 1.0, ws.h);
 }
 
 namespace {
 
-// The spanning tree's q̈ by the model's route, the arguments checked.
+// The spanning tree's q̈ by the model's route, the arguments checked. The springs' Q_s and the
+// free rotors' −h_a are applied forces to every route's q̈ (h_a depends on q̇ alone).
 Status tree_accelerations(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                           const VecX& tau) {
   const VecX* applied = &tau;
-  if (!model.springs.empty()) {
-    spring_forces(model, ws, q, qd);
-    ws.tau_applied = ws.Q_springs;
+  if (!model.springs.empty() || !model.free_rotors.empty()) {
+    if (!model.springs.empty()) {
+      spring_forces(model, ws, q, qd);
+      ws.tau_applied = ws.Q_springs;
+    } else {
+      ws.tau_applied.setZero(model.n());
+    }
     if (tau.size()) ws.tau_applied += tau;  // (none: no actuation)
+    add_rotor_bias(model, qd, -1.0, ws.tau_applied);
     applied = &ws.tau_applied;
   }
   const Status st = model.routes.forward_dynamics(model, ws, q, qd, *applied);
@@ -409,6 +418,7 @@ void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const Ve
   require_state(model, "inverse_dynamics", q, &qd, "qd");
   require_size(model, "inverse_dynamics", "qdd", qdd, ArgumentKind::Rate);
   model.routes.inverse_dynamics(model, ws, q, qd, qdd);
+  add_rotor_bias(model, qd, 1.0, ws.tau);
   if (model.springs.empty()) return;
   spring_forces(model, ws, q, qd);
   ws.tau -= ws.Q_springs;
@@ -421,7 +431,9 @@ std::vector<MatX> transform_hessian(const Model& model, Workspace& ws, const Vec
 
 std::vector<MatX> third_order_tensor(const Model& model, Workspace& ws, const VecX& q) {
   require_state(model, "third_order_tensor", q);
-  return model.routes.third_order_tensor(model, ws, q);
+  std::vector<MatX> D = model.routes.third_order_tensor(model, ws, q);
+  add_rotor_bias_tensor(model, D);
+  return D;
 }
 
 void joint_state(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {

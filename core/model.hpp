@@ -235,6 +235,14 @@ struct Model {
   // effort limit |τ_i| ≤ effort_limit_i of its joint (+inf: none; empty without limits).
   bool has_armature = false;
   SpMat armature_mass;
+  // The free joints' rotors (core/joints/rotor.hpp): their velocity term a ω × v, at q̇'s rate
+  // `v` (the joint's first, linear rate; ω follows at v + 3), θ̇'s rate `theta`, a = I_a G².
+  // Empty on a model with a coupling law: its tree's equations hold them.
+  struct FreeRotor {
+    int v = 0, theta = 0;
+    double a = 0;
+  };
+  std::vector<FreeRotor> free_rotors;
   VecX effort_limit;
   bool has_effort_limits = false;
   // Actuation (docs/control.md#actuation): the rates of q an actuator drives, ascending (n_a of

@@ -114,15 +114,12 @@ void one_coordinate(Walk& w, const XMLElement& j, const std::string& cls, bool h
   }
 }
 
-// A ball or free joint: a ball's armature is its rotor (I_a on each rate, as MuJoCo's
-// dof_armature); a free joint's is refused (on its translation in body axes it would need a term
-// femdyn does not model); damping, a spring or friction loss reported as left out of τ and q̈.
+// A ball or free joint: its armature is its rotor (I_a on each rate, as MuJoCo's dof_armature;
+// core/joints/rotor.hpp); damping, a spring or friction loss reported as left out of τ and q̈.
 void many_coordinates(Walk& w, const XMLElement& j, const std::string& cls, bool ball,
                       Json& joint) {
   const Document& doc = w.doc;
   if (const double a = doc.number(j, "armature", cls, 0); a != 0) {
-    if (!ball)
-      doc.fail(j, "armature on a free joint (femdyn models it on one-coordinate and ball joints)");
     if (a < 0) doc.fail(j, "armature is negative");
     joint["armature"] = a;
   }
@@ -130,7 +127,7 @@ void many_coordinates(Walk& w, const XMLElement& j, const std::string& cls, bool
     if (doc.number(j, name, cls, 0) != 0)
       ++w.unused[std::string(name) + " on a ball or free joint"];
   if (const std::vector<double> range = doc.numbers(j, "range", cls, 2);
-      !range.empty() && range[1] > 0)
+      ball && !range.empty() && range[1] > 0)
     ++w.unused["a ball joint's cone limit"];
 }
 

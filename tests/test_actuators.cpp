@@ -3,12 +3,14 @@
 // with its counts; velocity-limit reports; enforced stops. Against closed forms (a spring arm's
 // period with the rotor, a Coulomb block's deceleration, a stop's bounce), finite differences
 // (dE/dt = P_nc), and one-line errors for bad input.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <fstream>
 #include <numbers>
 #include <random>
 
+#include "core/momentum.hpp"
 #include "io/params.hpp"
 #include "models/builder.hpp"
 #include "models/random_tree.hpp"
@@ -234,11 +236,122 @@ TEST_CASE("armature on a spherical joint: I_a on each of its rates, on every rou
       CHECK(rel_error(wa.qdd, qdd) < 1e-10);
     }
   }
-  // A free joint's translation would need I_a ω × v in body axes: refused in one line.
-  CHECK_THAT(text_error(R"({"name": "b", "bodies": [{"name": "a", "parent": "world",
-      "joint": {"type": "free", "armature": 0.1}, "elements": [{"type": "rigid_body",
-      "mass": 1, "com": [0, 0, 0], "inertia": {"ixx": 1, "iyy": 1, "izz": 1}}]}]})"),
-             Catch::Contains("/bodies/0/joint/armature") && Catch::Contains("free joint"));
+}
+
+// tree_with_rotors with free joints in place of some (their rotors I_a on all six rates, no gear):
+// the root (a floating base) unless `couplings` name it, and bodies 2 and 6.
+Json tree_with_free_rotors(unsigned seed, int bodies, bool couplings) {
+  Json doc = tree_with_rotors(seed, bodies, couplings);
+  for (const std::size_t b : {std::size_t{0}, std::size_t{2}, std::size_t{6}}) {
+    if (b >= doc["bodies"].size() || (couplings && b == 0)) continue;
+    Json& j = doc["bodies"][b]["joint"];
+    j = {{"name", j["name"]}, {"type", "free"}, {"armature", 0.05 * (1 + b)}};
+  }
+  return doc;
+}
+
+// h_a − h_b on `a`'s free joints' linear rates is I_a ω × v (core/joints/rotor.hpp), read off
+// the coordinate names; 0 on every other rate.
+VecX free_rotor_bias(const Model& a, const VecX& qd) {
+  VecX h = VecX::Zero(a.n());
+  for (const Body& body : a.bodies) {
+    const Joint& J = body.joint;
+    if (J.type != JointType::Free || J.armature == 0) continue;
+    const auto at = [&](const char* rate) {
+      const auto& names = a.coordinate_names;
+      return std::find(names.begin(), names.end(), J.name + "." + rate) - names.begin();
+    };
+    const Vec3 v(qd[at("vx")], qd[at("vy")], qd[at("vz")]),
+        w(qd[at("wx")], qd[at("wy")], qd[at("wz")]);
+    const Vec3 f = J.armature * w.cross(v);
+    h[at("vx")] = f[0], h[at("vy")] = f[1], h[at("vz")] = f[2];
+  }
+  return h;
+}
+
+TEST_CASE("armature on a free joint: I_a on its six rates and I_a ω × v in h, on every route",
+          "[actuators]") {
+  const RouteChoice routes[] = {{},
+                                {.mass = MassRoute::Transform,
+                                 .force = ForceRoute::Nodes,
+                                 .dynamics = DynamicsRoute::Cholesky},
+                                {.mass = MassRoute::Composite,
+                                 .force = ForceRoute::Bodies,
+                                 .dynamics = DynamicsRoute::Cholesky}};
+  // `b` has no rotor; `c` only the free joints' removed (a law's coupled rotors add to h too).
+  const auto check = [](const Model& a, const Model& b, const Model& c, unsigned seed) {
+    check_rotors(a, b, seed);
+    Workspace wa(a), wb(c);
+    std::mt19937 rng(seed + 10);
+    const VecX q = random_posture(a, rng), qd = random_uniform(a.n(), 2, rng);
+    evaluate(a, wa, q, qd, VecX());
+    evaluate(c, wb, q, qd, VecX());
+    const VecX expected = free_rotor_bias(a, qd);
+    REQUIRE(expected.norm() > 1e-2);
+    CHECK(rel_error(wa.h - wb.h, expected, wb.h.cwiseAbs().maxCoeff()) < 1e-12);
+  };
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    INFO("seed " << seed);
+    const Json doc = tree_with_free_rotors(seed, 9, false), plain = without_rotors(doc);
+    for (const RouteChoice& r : routes) {
+      const Model a = on_route(doc, r), b = on_route(plain, r);
+      REQUIRE(a.free_rotors.size() == 3);
+      check(a, b, b, seed);
+    }
+  }
+  // Linear couplings (C ≠ I) and a nonlinear law (the tree's equations hold the rotors).
+  const Json coupled = tree_with_free_rotors(4, 8, true);
+  const Model coupled_bare = load_text(without_rotors(coupled).dump());
+  check(load_text(coupled.dump()), coupled_bare, coupled_bare, 4);
+  Json law = Json::parse(nonlinear_coupled_tree_json(3));
+  for (Json& body : law["bodies"]) body["joint"]["armature"] = 0.05, body["joint"]["gear"] = 4;
+  law["bodies"].push_back(Json::parse(R"({"name": "drifter", "parent": "b5", "joint": {"name": "f",
+      "type": "free", "armature": 0.2}, "elements": [{"type": "rigid_body", "mass": 2,
+      "com": [0.1, -0.05, 0.2], "inertia": {"ixx": 0.03, "iyy": 0.02, "izz": 0.04}}]})"));
+  const Model a = load_text(law.dump()), b = load_text(without_rotors(law).dump());
+  law["bodies"].back()["joint"].erase("armature");
+  const Model c = load_text(law.dump());
+  REQUIRE(a.coupling_level);
+  REQUIRE(a.tree->free_rotors.size() == 1);
+  check(a, b, c, 3);
+}
+
+TEST_CASE(
+    "armature on a floating base: the momentum conjugate to translation, P + I_a ṗ, is "
+    "conserved",
+    "[actuators]") {
+  // Noether: in zero gravity with no outside force, L = T is unchanged by a translation of the
+  // whole mechanism, so ∂T/∂ṗ = P + I_a ṗ (the bodies' momentum and the root rotor's, ṗ = R v the
+  // root's world velocity) is constant. Without the rotor's ω × v term it drifts by I_a ω × v.
+  Json doc = tree_with_free_rotors(5, 7, false);
+  doc["gravity"] = {0, 0, 0};
+  const Model m = load_text(doc.dump());
+  const double Ia = m.bodies[0].joint.reflected_inertia;
+  REQUIRE(Ia > 0);
+  std::mt19937 rng(5);
+  const VecX q0 = random_posture(m, rng), v0 = random_uniform(m.n(), 1.5, rng);
+  const auto conjugate = [&](const VecX& q, const VecX& v) {
+    Workspace ws(m);
+    MomentumKinematics k;
+    momentum_kinematics(m, ws, q, v, k);
+    return Vec3(k.momentum.head<3>() + Ia * ws.body[0].R * v.head<3>());
+  };
+  IntegratorOptions o;
+  o.kind = IntegratorKind::Dopri;
+  o.adaptive.rtol = 1e-12;
+  o.adaptive.atol = 1e-12;
+  auto integ = make_integrator(m, o);
+  integ->reset(0, q0, v0);
+  REQUIRE(integ->advance_to(2.0).ok);
+  const Vec3 p0 = conjugate(q0, v0), p1 = conjugate(integ->q(), integ->qd());
+  CAPTURE(p0.transpose(), p1.transpose());
+  CHECK((p1 - p0).norm() < 1e-8 * p0.norm());
+  // The rotor matters here: the bodies' momentum P alone is not conserved.
+  Workspace ws(m);
+  MomentumKinematics k0, k1;
+  momentum_kinematics(m, ws, q0, v0, k0);
+  momentum_kinematics(m, ws, integ->q(), integ->qd(), k1);
+  CHECK((k1.momentum.head<3>() - k0.momentum.head<3>()).norm() > 1e-4 * p0.norm());
 }
 
 TEST_CASE("armature: a spring arm oscillates at sqrt(k / (I + I_a G²)), its energy conserved",

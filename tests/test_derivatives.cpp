@@ -191,21 +191,25 @@ TEST_CASE("derivatives agree with differences on coupled random trees", "[deriva
   WARN("coupled trees: central " << worst.central << ", Richardson " << worst.richardson);
 }
 
-TEST_CASE("derivatives agree with differences with rotors on spherical joints", "[derivatives]") {
-  // The rotor enters D of the joint's block on the articulated route, and so (M^s)⁻¹.
+TEST_CASE("derivatives agree with differences with rotors on spherical and free joints",
+          "[derivatives]") {
+  // The rotor enters D of the joint's block on the articulated route, and so (M^s)⁻¹; a free
+  // joint's also h_a = I_a ω × v, whose ∂/∂v̇ is I_a [ω]× and ∂/∂ω −I_a [v]×.
   Agreement worst;
-  for (unsigned seed = 1; seed <= 3; ++seed) {
+  for (unsigned seed = 1; seed <= 4; ++seed) {
     Json doc = Json::parse(mixed_tree_json(seed, 9, 0.4, false, true));
     int balls = 0;
     for (Json& b : doc["bodies"])
-      if (b["joint"]["type"] == "spherical") b["joint"]["armature"] = 0.02 * ++balls;
-    INFO("seed " << seed << ", " << balls << " spherical joints");
+      if (b["joint"]["type"] == "spherical" || b["joint"]["type"] == "free")
+        b["joint"]["armature"] = 0.02 * ++balls;
+    INFO("seed " << seed << ", " << balls << " spherical and free joints");
     const Model m = load_text(doc.dump());
     if (balls == 0) continue;
     REQUIRE(m.has_armature);
     check_model(m, seed, worst);
   }
-  WARN("spherical rotors: central " << worst.central << ", Richardson " << worst.richardson);
+  WARN("spherical and free rotors: central " << worst.central << ", Richardson "
+                                             << worst.richardson);
 }
 
 TEST_CASE("derivatives agree with differences above the dense-product size", "[derivatives]") {

@@ -161,7 +161,7 @@ TEST_CASE("memory: linearize and kinematics estimate up front and refuse beyond 
   const std::string tree = (s.dir / "tree.json").string();
   std::ofstream(tree)
       << R"({"model": "random_tree", "params": {"seed": 1, "bodies": 10000, "branching": 0.5}})";
-  for (const std::string& command : {"linearize", "kinematics"}) {
+  for (const std::string command : {"linearize", "kinematics"}) {
     INFO(command);
     const Run r = run(command + " " + tree + " --json --max-memory 4");
     CHECK(r.code == 1);

@@ -34,12 +34,6 @@ Json quaternion_json(const Mat3& R) {
   return vec_json(Eigen::Vector4d(q.x(), q.y(), q.z(), q.w()));
 }
 
-int body_named(const Model& m, const std::string& name) {
-  for (std::size_t b = 0; b < m.bodies.size(); ++b)
-    if (m.bodies[b].name == name) return static_cast<int>(b);
-  return -1;
-}
-
 Json body_json(const Body& b) {
   const Joint& j = b.joint;
   return {{"name", b.name},

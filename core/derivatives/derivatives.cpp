@@ -10,6 +10,7 @@
 #include "core/errors.hpp"
 #include "core/joints/kernel.hpp"
 #include "core/joints/passive.hpp"
+#include "core/joints/rotor.hpp"
 #include "core/kinematics.hpp"
 
 namespace femdyn {
@@ -234,6 +235,7 @@ void add_passive(const Model& m, const Workspace& ws, const DerivativeWorkspace&
     Kq(j, j) += J.stop_stiffness * (1 + sign * J.stop_dissipation * w);
     Kv(j, j) += J.stop_stiffness * x * sign * J.stop_dissipation;
   }
+  add_rotor_bias_rate_derivative(m, d.theta_dot, Kv);  // τ ∋ +h_a
 }
 
 // ∂τ_θ/∂θ, ∂τ_θ/∂θ̇ (nθ × nθ) into Kq, Kv.

@@ -99,7 +99,8 @@ def test_a_controllers_torque_is_saturated_and_recorded_as_applied():
 
 def test_a_ball_joint_rotor_is_the_same_from_the_builder_and_from_json(tmp_path):
     """armature on a spherical joint: I_a on each of its three rates, the same model whether the
-    Builder or a JSON file says it (one compile check behind both); a free joint's is refused."""
+    Builder or a JSON file says it (one compile check behind both); a free joint's adds
+    I_a ω × v; a universal joint's is refused."""
     inertia = np.diag([0.01, 0.02, 0.03])
     b = femdyn.Builder("ball")
     b.body("l", type="spherical", armature=0.1)
@@ -122,8 +123,23 @@ def test_a_ball_joint_rotor_is_the_same_from_the_builder_and_from_json(tmp_path)
     plain.body("l", type="spherical")
     plain.rigid_body("l", 1.0, [0.3, 0, 0], inertia)
     assert np.allclose(a.M - plain.build().equations(q, qd).M, 0.1 * np.eye(3), atol=1e-15)
+    # A free joint's rotor: I_a on its six rates, and I_a ω × v in h on its linear rates (its
+    # rates are in the body's axes), the same from the Builder and from JSON.
     free = femdyn.Builder("free")
     free.body("l", type="free", armature=0.1)
     free.rigid_body("l", 1.0, [0.3, 0, 0], inertia)
-    with pytest.raises(femdyn.ModelError, match="a free joint takes no armature"):
-        free.build()
+    bare = femdyn.Builder("bare")
+    bare.body("l", type="free")
+    bare.rigid_body("l", 1.0, [0.3, 0, 0], inertia)
+    qf = np.array([0.1, -0.2, 0.3, *q])
+    vf = np.array([0.5, -0.4, 0.9, *qd])
+    a, c = free.build().equations(qf, vf), bare.build().equations(qf, vf)
+    assert np.allclose(a.M - c.M, 0.1 * np.eye(6), atol=1e-15)
+    expected = np.zeros(6)
+    expected[:3] = 0.1 * np.cross(vf[3:], vf[:3])
+    assert np.allclose(a.h - c.h, expected, rtol=0, atol=1e-14)
+    with pytest.raises(femdyn.ModelError, match="a universal joint takes no armature"):
+        u = femdyn.Builder("u")
+        u.body("l", type="universal", axis=[1, 0, 0], axis2=[0, 1, 0], armature=0.1)
+        u.rigid_body("l", 1.0, [0.3, 0, 0], inertia)
+        u.build()
