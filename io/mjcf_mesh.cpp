@@ -6,6 +6,7 @@
 
 #include "core/errors.hpp"
 #include "core/names.hpp"
+#include "io/convex_hull.hpp"
 #include "io/mjcf_reading.hpp"
 
 namespace femdyn::mjcf {
@@ -24,17 +25,23 @@ const XMLElement* mesh_asset(const Document& doc, const std::string& name) {
   return nullptr;
 }
 
-// vertex="x y z …" face="i j k …".
+// The convex hull of a mesh's vertices, or the one line saying why it has none.
+TriangleMesh hull_of(const Document& doc, const XMLElement& mesh, const std::vector<Vec3>& points) {
+  try {
+    return convex_hull(points, "the vertices");
+  } catch (const Error& e) {
+    doc.fail(mesh, e.what());
+  }
+}
+
+// vertex="x y z …" face="i j k …"; without faces, the vertices' convex hull (as MuJoCo).
 TriangleMesh inline_mesh(const Document& doc, const XMLElement& mesh, const std::string& cls) {
   const std::vector<double> v = doc.numbers(mesh, "vertex", cls, -1);
   const std::vector<double> f = doc.numbers(mesh, "face", cls, -1);
-  if (f.empty())
-    doc.fail(mesh,
-             "vertices without faces: MuJoCo takes their convex hull, which femdyn "
-             "does not compute; give face=\"…\"");
   if (v.size() % 3 || f.size() % 3) doc.fail(mesh, "vertex and face need triples of numbers");
   TriangleMesh out;
   for (std::size_t k = 0; k < v.size(); k += 3) out.vertices.emplace_back(v[k], v[k + 1], v[k + 2]);
+  if (f.empty()) return hull_of(doc, mesh, out.vertices);
   for (std::size_t k = 0; k < f.size(); k += 3) {
     std::array<std::uint32_t, 3> t{};
     for (int i = 0; i < 3; ++i) {
@@ -96,10 +103,11 @@ TriangleMesh mesh_of(const Document& doc, const XMLElement& geom, const std::str
   for (const char* unsupported : {"refpos", "refquat"})
     if (f.asset->Attribute(unsupported))
       doc.fail(*f.asset, std::string(unsupported) + " is not read by femdyn (MuJoCo removed it)");
-  if (const char* inertia = doc.attr(*f.asset, "inertia", f.cls);
-      inertia && std::strcmp(inertia, "legacy") && std::strcmp(inertia, "exact"))
+  const char* inertia = doc.attr(*f.asset, "inertia", f.cls);
+  if (inertia && std::strcmp(inertia, "legacy") && std::strcmp(inertia, "exact") &&
+      std::strcmp(inertia, "convex"))
     doc.fail(*f.asset, std::string("inertia=\"") + inertia +
-                           "\": femdyn computes a mesh's legacy or exact volume inertia");
+                           "\": femdyn computes a mesh's legacy, exact or convex volume inertia");
   TriangleMesh out;
   if (!f.file.empty()) {
     try {
@@ -111,6 +119,7 @@ TriangleMesh mesh_of(const Document& doc, const XMLElement& geom, const std::str
     out = inline_mesh(doc, *f.asset, f.cls);
     for (Vec3& v : out.vertices) v = v.cwiseProduct(f.scale);
   }
+  if (inertia && !std::strcmp(inertia, "convex")) return hull_of(doc, *f.asset, out.vertices);
   return out;
 }
 

@@ -5,8 +5,10 @@
 #include <cmath>
 #include <fstream>
 #include <numbers>
+#include <random>
 
 #include "core/errors.hpp"
+#include "io/convex_hull.hpp"
 #include "io/mesh.hpp"
 #include "tests/helpers.hpp"
 
@@ -146,4 +148,50 @@ TEST_CASE("mesh: a bad mesh file is one line naming the file and the problem", "
   refused(write("short.stl", std::string(80, ' ') + std::string("\x05\0\0\0", 4) + "xyz"),
           "a mesh with no triangle");
   refused((scratch.dir / "missing.stl").string(), "missing.stl");
+}
+
+TEST_CASE("mesh: a point cloud's convex hull is the solid it spans, wound outward", "[mesh]") {
+  // The regular octahedron |x| + |y| + |z| ≤ a: V = 4a³/3, centre 0, I = m a²/5 · 1 (its second
+  // moment ∫x² dV is 2a⁵/15). Its six vertices and points inside it, shuffled, moved far away.
+  const double a = 0.3, rho = 500;
+  std::vector<Vec3> points;
+  for (int k = 0; k < 3; ++k)
+    points.push_back(a * Vec3::Unit(k)), points.push_back(-a * Vec3::Unit(k));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-a / 3, a / 3);
+  for (int k = 0; k < 40; ++k) points.emplace_back(u(rng), u(rng), u(rng));
+  std::shuffle(points.begin(), points.end(), rng);
+  const Vec3 far(40, -25, 60);
+  for (Vec3& p : points) p += far;
+  const TriangleMesh hull = convex_hull(points, "cloud");
+  CHECK(hull.vertices.size() == 6);
+  CHECK(hull.triangles.size() == 8);
+  double signed_volume = 0;  // Σ (a − o)·((b − o) × (c − o)) / 6, positive when wound outward
+  for (const auto& t : hull.triangles) {
+    const Vec3 p = hull.vertices[t[0]] - far, q = hull.vertices[t[1]] - far,
+               r = hull.vertices[t[2]] - far;
+    CHECK(p.dot(q.cross(r)) > 0);  // each face, seen from the centre, counter-clockwise outside
+    signed_volume += p.dot(q.cross(r)) / 6;
+  }
+  const double m = rho * 4 * a * a * a / 3;
+  CHECK(signed_volume == Approx(4 * a * a * a / 3).epsilon(1e-13));
+  check_equal(solid_mass(hull, rho), {m, far, Mat3::Identity() * (m * a * a / 5)}, 1e-9);
+  // Nothing to weigh: fewer than four points, or all on one plane.
+  const auto refusal = [](const std::vector<Vec3>& p) {
+    try {
+      (void)convex_hull(p, "cloud");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(a hull)");
+  };
+  CHECK_THAT(
+      refusal({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)}),
+      Catch::Equals("cloud: its convex hull bounds no volume (3 vertices; a solid needs 4)"));
+  std::vector<Vec3> flat;
+  for (int k = 0; k < 20; ++k) flat.emplace_back(u(rng), u(rng), 2.0);
+  CHECK_THAT(refusal(flat), Catch::Contains("cloud: its convex hull bounds no volume (the vertices "
+                                            "are all on one plane or line)"));
+  CHECK_THAT(refusal({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, NAN, 0), Vec3(0, 0, 1)}),
+             Catch::Contains("cloud: a vertex is NaN or infinite"));
 }

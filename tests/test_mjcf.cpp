@@ -88,7 +88,7 @@ TEST_CASE("MJCF: mesh geoms weigh as in MuJoCo's compile of the same file",
   CHECK(e.forward < 1e-6);
   const Run run_ = run("validate " + mjcf_path("meshes.xml") + " --budget 60");
   CHECK(run_.code == 0);
-  CHECK_THAT(run_.out, Catch::Contains("the mass of 4 mesh geoms compared to 1e-6"));
+  CHECK_THAT(run_.out, Catch::Contains("the mass of 5 mesh geoms compared to 1e-6"));
 }
 
 TEST_CASE("MJCF: femdyn validate compares with MuJoCo's compile of the file, or says why not",

@@ -71,15 +71,18 @@ TEST_CASE("MJCF: bad or unread input is one line naming the file, the element an
   refused("dae.xml", mesh_geom, "<asset><mesh name=\"m\" file=\"m.dae\"/></asset>",
           "a mesh femdyn does not read (.dae)");
   refused("hull.xml", mesh_geom,
-          "<asset><mesh name=\"m\" vertex=\"0 0 0 1 0 0 0 1 0 0 0 1\"/></asset>",
-          "<mesh name='m'> (line 1): vertices without faces: MuJoCo takes their convex hull");
+          "<asset><mesh name=\"m\" vertex=\"0 0 0 1 0 0 0 1 0 1 1 0 0.3 0.2 0\"/></asset>",
+          "<mesh name='m'> (line 1): the vertices: its convex hull bounds no volume (the vertices "
+          "are all on one plane or line)");
+  refused("three.xml", mesh_geom, "<asset><mesh name=\"m\" vertex=\"0 0 0 1 0 0 0 1 0\"/></asset>",
+          "its convex hull bounds no volume (3 vertices; a solid needs 4)");
   refused("flat.xml", mesh_geom,
           "<asset><mesh name=\"m\" vertex=\"0 0 0 1 0 0 0 1 0\" face=\"0 1 2 0 2 1\"/></asset>",
           "bounds no volume");
-  refused("convex.xml", mesh_geom,
-          "<asset><mesh name=\"m\" inertia=\"convex\" vertex=\"0 0 0 1 0 0 0 1 0 0 0 1\" "
+  refused("shell_inertia.xml", mesh_geom,
+          "<asset><mesh name=\"m\" inertia=\"shell\" vertex=\"0 0 0 1 0 0 0 1 0 0 0 1\" "
           "face=\"0 2 1 0 1 3 1 2 3 0 3 2\"/></asset>",
-          "inertia=\"convex\"");
+          "inertia=\"shell\"");
   refused("shell.xml",
           "<body><joint/><geom type=\"mesh\" mesh=\"m\" shellinertia=\"true\"/></body>",
           "<asset><mesh name=\"m\" vertex=\"0 0 0 1 0 0 0 1 0 0 0 1\" face=\"0 2 1 0 1 3 1 2 3 0 3 "
@@ -285,6 +288,23 @@ TEST_CASE("MJCF: a mesh geom's mass is the solid its mesh bounds, as MuJoCo comp
             "<geom type=\"box\" size=\"0.1 0.1 0.5\" pos=\"0.1 0.1 1\" density=\"700\"/>");
   CHECK(tau_difference(exact, boxes) < 1e-13);
   CHECK(tau_difference(legacy, boxes) > 1e-2);
+  // Vertices alone: their convex hull (by Qhull, as MuJoCo). A box's corners, points inside it
+  // and on its faces, in any order, are the box.
+  const std::string cloud =
+      "vertex=\"0.3 0.26 0.1  0.4 0.23 0.12  0.5 0.2 0.1  0.3 0.2 0.14  0.5 0.26 0.14 0.45 0.2 "
+      "0.13  0.3 0.2 0.1  0.5 0.2 0.14  0.3 0.26 0.14  0.35 0.21 0.11  0.5 0.26 0.1  0.3 0.23 "
+      "0.12\"";
+  CHECK(tau_difference(model("cloud.xml", "<mesh name=\"m\" " + cloud + "/>",
+                             "<geom type=\"mesh\" mesh=\"m\" mass=\"1.296\"/>"),
+                       off_box) < 1e-13);
+  // inertia="convex" (MuJoCo 3) weighs the hull of a mesh's vertices: of the two boxes apart, the
+  // hull of their 16 corners, as those corners alone give it, and more than the two boxes.
+  const std::string corners = two.substr(0, two.find("face") - 1);
+  const Model convex = model("convex.xml", "<mesh name=\"m\" inertia=\"convex\" " + two + "/>",
+                             "<geom type=\"mesh\" mesh=\"m\" density=\"700\"/>");
+  CHECK(tau_difference(convex, model("corners.xml", "<mesh name=\"m\" " + corners + "/>",
+                                     "<geom type=\"mesh\" mesh=\"m\" density=\"700\"/>")) < 1e-13);
+  CHECK(tau_difference(convex, boxes) > 1e-2);
 }
 
 // A body's named sites are frames on it, where MuJoCo puts them: a hinge about y at the body's

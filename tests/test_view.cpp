@@ -264,9 +264,10 @@ TEST_CASE("view: an MJCF's geoms are drawn, its meshes embedded as the files hol
   const MjcfResult read = read_mjcf(path);
   const nlohmann::json scene =
       view::scene_json(m, view::posture(m, neutral_posture(m)), read.visuals, "meshes.xml");
-  CHECK(scene["visuals"].size() == 6);  // every geom of groups 0-2
-  REQUIRE(scene["not_drawn"].size() == 1);
-  CHECK(scene["not_drawn"][0]["why"] == "an inline mesh, which the page does not draw");
+  CHECK(scene["visuals"].size() == 7);      // every geom of groups 0-2
+  REQUIRE(scene["not_drawn"].size() == 2);  // the two inline meshes (faces, and vertices alone)
+  for (const auto& n : scene["not_drawn"])
+    CHECK(n["why"] == "an inline mesh, which the page does not draw");
   REQUIRE(scene["meshes"].size() == 3);
   // The ball: its positions are the OBJ's vertices as float32, its indices the triangles.
   const TriangleMesh ball = read_mesh(data_path("mjcf/meshes/ball.obj"));

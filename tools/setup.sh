@@ -20,7 +20,7 @@ esac
 
 # The command-line program: a compiler, CMake, Ninja and the libraries femdyn links.
 packages=(cmake g++ make ninja-build libeigen3-dev libsuitesparse-dev nlohmann-json3-dev
-          libtinyxml2-dev libsundials-dev)
+          libtinyxml2-dev libsundials-dev libqhull-dev)
 if [ "$all" = 1 ]; then
   packages+=(catch2 libsimbody-dev libmujoco-dev libbenchmark-dev gnuplot-nox
              fonts-dejavu-core clang libclang-rt-14-dev clang-format

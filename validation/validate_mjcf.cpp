@@ -13,6 +13,7 @@
 #include "core/errors.hpp"
 #include "core/joints/passive.hpp"
 #include "core/sampling.hpp"
+#include "core/workspace.hpp"
 #include "validation/mujoco_peer.hpp"
 #include "validation/validate.hpp"
 
@@ -24,6 +25,24 @@ struct JointLevel {
   VecX theta, theta_dot, theta_ddot;
   MatX G;
 };
+
+// The size of the parts gravity's τ is summed from, |g| m D (D: the largest distance between the
+// bodies' origins and centres of mass, from the poses of ws's last propagate): with MuJoCo's
+// single-precision mesh vertices, a gravity torque that cancels to near 0 at some posture still
+// carries its parts' rounding, so τ is measured against them as h is against bias_floor.
+double gravity_floor(const Model& m, const Workspace& ws) {
+  if (m.body_inertia.size() != m.bodies.size()) return 0;  // (no body-level form: no floor)
+  double mass = 0, reach = 0;
+  const Vec3 o = ws.body.empty() ? Vec3::Zero() : ws.body[0].p;
+  for (std::size_t b = 0; b < m.bodies.size(); ++b) {
+    const RigidInertia& I = m.body_inertia[b];
+    const BodyState& B = ws.body[b];
+    mass += I.m;
+    reach = std::max(reach, (B.p - o).norm());
+    if (I.m > 0) reach = std::max(reach, (B.p + B.R * (I.h / I.m) - o).norm());
+  }
+  return m.gravity.norm() * mass * 2 * reach;
+}
 
 JointLevel joint_level(const Model& m, const VecX& q, const VecX& qd, const VecX& qdd) {
   JointLevel j;
@@ -97,10 +116,11 @@ std::optional<QuantityError> validate_mjcf_import(const Model& m, const std::str
     const MatX M = peer->mass(at.theta);
     mass_matrix(m, ws, q);
     accumulate(e, ws.Ms, G.transpose() * M * G);
+    const double floor = std::max(bias_floor(ws.Ms, qd), mesh_masses ? gravity_floor(m, ws) : 0);
     inverse_dynamics(m, ws, q, qd, qdd);
     accumulate(e, ws.tau,
                G.transpose() * (peer->inverse(at.theta, at.theta_dot, at.theta_ddot) - friction),
-               bias_floor(ws.Ms, qd));
+               floor);
     // The peer's equalities are off: the spanning tree's q̈ (a model's loops ignored) is compared.
     if (!tree_forward_dynamics(m, ws, q, qd, tau).ok) continue;
     // MuJoCo's q̈ on the coupling: Gᵀ M G q̈ = τ + Gᵀ (friction − τ_MuJoCo(θ, θ̇, θ̈ = γ)).
