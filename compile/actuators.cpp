@@ -101,11 +101,15 @@ void compile_actuators(Model& m) {
   m.armature_mass.resize(n, n);
   m.armature_mass.setFromTriplets(entries.begin(), entries.end());
   m.armature_mass.makeCompressed();
-  m.free_rotors.clear();  // (a free joint is coupled to nothing: its rates are q̇'s own)
-  for (const CoordinateJoint& c : m.coordinate_joints)
-    if (const Joint& J = m.bodies[c.body].joint;
-        J.type == JointType::Free && J.reflected_inertia != 0 && J.idx_v >= 0)
+  m.free_rotors.clear();  // (a free or spherical joint is coupled to nothing: its rates are q̇'s)
+  m.rate_dampers.clear();
+  for (const CoordinateJoint& c : m.coordinate_joints) {
+    const Joint& J = m.bodies[c.body].joint;
+    if (J.type == JointType::Free && J.reflected_inertia != 0 && J.idx_v >= 0)
       m.free_rotors.push_back({c.v, J.idx_v, J.reflected_inertia});
+    if (J.nv > 1 && J.damping != 0 && J.idx_v >= 0)
+      m.rate_dampers.push_back({c.v, J.idx_v, J.nv, J.damping});
+  }
 
   // Effort limits, on the rates of q that the joints own. A coupled joint's is kept but not
   // applied: no τ acts on it directly (simulate says so, sim/recorded_run.hpp).

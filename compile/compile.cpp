@@ -118,11 +118,14 @@ Joint compile_joint(const JointSpec& js, const std::string& body_name) {
   for (auto [x, what] :
        {std::pair{js.stiffness, "stiffness"}, {js.rest, "rest"}, {js.damping, "damping"}})
     check_magnitude(x, js.where, what);
-  if (j.nv != 1 &&
-      (js.stiffness != 0 || js.damping != 0 || std::isfinite(js.lower) || std::isfinite(js.upper)))
+  // A damper −c on each rate is isotropic on a spherical or free joint (the same in any axes,
+  // as MuJoCo's dof_damping); on a universal or planar joint's mixed rates it would not be.
+  const bool damped_rates = j.type == JointType::Spherical || j.type == JointType::Free;
+  if (j.nv != 1 && (js.stiffness != 0 || (js.damping != 0 && !damped_rates) ||
+                    std::isfinite(js.lower) || std::isfinite(js.upper)))
     throw ModelError(js.where, std::string("a ") + std::string(joint_type_name(j.type)) +
                                    " joint takes no spring, damper or limits (only joints of "
-                                   "one coordinate do)");
+                                   "one coordinate do, and a spherical or free joint a damper)");
   if (js.stiffness < 0) throw ModelError(js.where + "/spring", "negative stiffness");
   if (js.damping < 0) throw ModelError(js.where + "/damping", "negative damping");
   if (std::isnan(js.lower) || std::isnan(js.upper) || js.lower > js.upper)

@@ -184,7 +184,8 @@ Model compile_with_coupling_level(MechanismSpec spec, const CompileOptions& opti
   configuration_coupling(m);
   m.mass_pattern = MassPattern{};  // (M^s is reduced and factorised densely: coupling_chain)
   m.dynamics_route = DynamicsRoute::Cholesky;
-  m.free_rotors.clear();  // (its tree's equations add their velocity term: core/coupling_chain)
+  m.free_rotors.clear();  // (its tree's equations add these: core/coupling_chain)
+  m.rate_dampers.clear();
   m.coupling_level = std::move(level);
   m.tree = std::make_shared<const Model>(std::move(tree));
   m.routes = choose_equation_routes(m);  // the law chain

@@ -3,6 +3,7 @@
 #include "core/body_inertia.hpp"
 #include "core/coupled_dynamics.hpp"
 #include "core/errors.hpp"
+#include "core/joints/passive.hpp"
 #include "core/joints/rotor.hpp"
 #include "core/newton_euler.hpp"
 #include "core/span_inertia.hpp"
@@ -174,6 +175,7 @@ Status forward_dynamics_by_bodies(const Model& m, Workspace& ws, const VecX& q, 
   joint_force_sweeps(tree, t, &s->gamma);
   add_span_forces(tree, t, t.tau_theta);
   add_rotor_bias(tree, s->theta_dot, 1.0, t.tau_theta);
+  add_rate_dampers(tree, s->theta_dot, -1.0, t.tau_theta);
   whole_mass_from_composites(tree, t);
   return solve_reduced(ws, *s, tau);
 }

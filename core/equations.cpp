@@ -347,6 +347,7 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
   require_size(model, "evaluate", "tau", tau, ArgumentKind::Actuation);
   model.routes.evaluate(model, ws, q, qd, tau);
   add_rotor_bias(model, qd, 1.0, ws.h);
+  add_rate_dampers(model, qd, 1.0, ws.Q);
   if (model.springs.empty()) return;
   spring_forces(model, ws, q, qd);
   ws.Q += ws.Q_springs;
@@ -360,12 +361,13 @@ void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX&
 
 namespace {
 
-// The spanning tree's q̈ by the model's route, the arguments checked. The springs' Q_s and the
-// free rotors' −h_a are applied forces to every route's q̈ (h_a depends on q̇ alone).
+// The spanning tree's q̈ by the model's route, the arguments checked. The springs' Q_s, the
+// spherical and free joints' dampers and the free rotors' −h_a are applied forces to every
+// route's q̈ (the last two depend on q̇ alone).
 Status tree_accelerations(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                           const VecX& tau) {
   const VecX* applied = &tau;
-  if (!model.springs.empty() || !model.free_rotors.empty()) {
+  if (!model.springs.empty() || !model.free_rotors.empty() || !model.rate_dampers.empty()) {
     if (!model.springs.empty()) {
       spring_forces(model, ws, q, qd);
       ws.tau_applied = ws.Q_springs;
@@ -374,6 +376,7 @@ Status tree_accelerations(const Model& model, Workspace& ws, const VecX& q, cons
     }
     if (tau.size()) ws.tau_applied += tau;  // (none: no actuation)
     add_rotor_bias(model, qd, -1.0, ws.tau_applied);
+    add_rate_dampers(model, qd, 1.0, ws.tau_applied);
     applied = &ws.tau_applied;
   }
   const Status st = model.routes.forward_dynamics(model, ws, q, qd, *applied);
@@ -419,6 +422,7 @@ void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const Ve
   require_size(model, "inverse_dynamics", "qdd", qdd, ArgumentKind::Rate);
   model.routes.inverse_dynamics(model, ws, q, qd, qdd);
   add_rotor_bias(model, qd, 1.0, ws.tau);
+  add_rate_dampers(model, qd, -1.0, ws.tau);
   if (model.springs.empty()) return;
   spring_forces(model, ws, q, qd);
   ws.tau -= ws.Q_springs;

@@ -41,7 +41,8 @@ struct Joint {
   double lower = 0, upper = 0;
   double stiffness = 0, rest = 0, damping = 0;
   double initial = 0;  // θ in the model's initial configuration (1-DOF joints; JSON "initial")
-  // Actuator and friction (core/joints/passive.hpp; 1-DOF joints only): rotor inertia I_a and
+  // Actuator and friction (core/joints/passive.hpp; 1-DOF joints, but a rotor and a damper also
+  // on spherical and free joints): rotor inertia I_a and
   // gear ratio G (reflected inertia I_a G² on θ̇, derived below), Coulomb friction F_c with its
   // regularisation velocity v_s, effort and velocity limits (+inf: none), and an enforced stop at
   // [lower, upper] (Simbody's MobilityLinearStop: stiffness k, Hunt–Crossley dissipation d).
@@ -243,6 +244,13 @@ struct Model {
     double a = 0;
   };
   std::vector<FreeRotor> free_rotors;
+  // The spherical and free joints' dampers (core/joints/passive.hpp): −c on each of the `nv`
+  // rates from q̇'s `v` (θ̇'s `theta`). Empty on a model with a coupling law, as free_rotors.
+  struct RateDamper {
+    int v = 0, theta = 0, nv = 0;
+    double c = 0;
+  };
+  std::vector<RateDamper> rate_dampers;
   VecX effort_limit;
   bool has_effort_limits = false;
   // Actuation (docs/control.md#actuation): the rates of q an actuator drives, ascending (n_a of

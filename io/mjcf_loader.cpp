@@ -115,7 +115,8 @@ void one_coordinate(Walk& w, const XMLElement& j, const std::string& cls, bool h
 }
 
 // A ball or free joint: its armature is its rotor (I_a on each rate, as MuJoCo's dof_armature;
-// core/joints/rotor.hpp); damping, a spring or friction loss reported as left out of τ and q̈.
+// core/joints/rotor.hpp), its damping a damper on each rate (core/joints/passive.hpp); a spring
+// or friction loss reported as left out of τ and q̈.
 void many_coordinates(Walk& w, const XMLElement& j, const std::string& cls, bool ball,
                       Json& joint) {
   const Document& doc = w.doc;
@@ -123,7 +124,11 @@ void many_coordinates(Walk& w, const XMLElement& j, const std::string& cls, bool
     if (a < 0) doc.fail(j, "armature is negative");
     joint["armature"] = a;
   }
-  for (const char* name : {"damping", "stiffness", "frictionloss"})
+  if (const double c = doc.number(j, "damping", cls, 0); c != 0) {
+    if (c < 0) doc.fail(j, "damping is negative");
+    joint["damping"] = c;
+  }
+  for (const char* name : {"stiffness", "frictionloss"})
     if (doc.number(j, name, cls, 0) != 0)
       ++w.unused[std::string(name) + " on a ball or free joint"];
   if (const std::vector<double> range = doc.numbers(j, "range", cls, 2);

@@ -23,7 +23,10 @@ double nonconservative_power(const Model& model, const Workspace& ws, const VecX
   double P = tau.size() == qd.size() ? qd.dot(tau) : 0.0;
   for (int j = 0; j < model.n_theta(); ++j) {
     const Joint& J = model.bodies[model.theta_joint[j]].joint;
-    if (J.nv == 1 && dissipates(J)) P += passive_joint_power(J, ws.theta[J.idx_q], ws.theta_dot[j]);
+    if (J.nv == 1 && dissipates(J))
+      P += passive_joint_power(J, ws.theta[J.idx_q], ws.theta_dot[j]);
+    else if (J.nv > 1)  // a spherical or free joint's damper on each rate
+      P -= J.damping * ws.theta_dot[j] * ws.theta_dot[j];
   }
   for (const BodyTorque& t : model.torques) P += t.torque.dot(ws.body[t.body].w);
   if (!model.springs.empty()) P += ws.spring_power;  // (of this state: forward dynamics set it)

@@ -354,6 +354,82 @@ TEST_CASE(
   CHECK((k1.momentum.head<3>() - k0.momentum.head<3>()).norm() > 1e-4 * p0.norm());
 }
 
+TEST_CASE("damping on spherical and free joints: −c on each rate on every route, power −c|θ̇|²",
+          "[actuators]") {
+  // As MuJoCo's dof_damping on ball and free joints (tests/data/mjcf/floating.xml compares with
+  // it), and Simbody's MobilityLinearDamper on each u of Ball and Free (the twin, below).
+  Json doc = tree_with_free_rotors(6, 8, false);
+  for (Json& b : doc["bodies"])
+    if (b["joint"]["type"] == "free") b["joint"]["damping"] = 0.3;
+  doc["bodies"][4]["joint"] = {{"name", "ball"}, {"type", "spherical"}, {"damping", 0.2}};
+  Json plain = doc;
+  for (Json& b : plain["bodies"])
+    if (b["joint"]["type"] != "revolute" && b["joint"]["type"] != "prismatic")
+      b["joint"].erase("damping");
+  for (const RouteChoice& r : {RouteChoice{}, RouteChoice{.mass = MassRoute::Transform,
+                                              .force = ForceRoute::Nodes,
+                                              .dynamics = DynamicsRoute::Cholesky}}) {
+    const Model a = on_route(doc, r), b = on_route(plain, r);
+    REQUIRE(a.rate_dampers.size() == 4);
+    Workspace wa(a), wb(b);
+    std::mt19937 rng(6);
+    const VecX q = random_posture(a, rng), qd = random_uniform(a.n(), 2, rng),
+               tau = random_uniform(a.n(), 3, rng);
+    evaluate(a, wa, q, qd, tau);
+    evaluate(b, wb, q, qd, tau);
+    VecX expected = VecX::Zero(a.n());  // −c on each rate of the damped joints, by name
+    for (std::size_t k = 0; k < a.coordinate_names.size(); ++k) {
+      const std::string& name = a.coordinate_names[k];
+      const std::string joint = name.substr(0, name.find('.'));
+      for (const Body& body : a.bodies)
+        if (body.joint.name == joint && body.joint.nv > 1)
+          expected[k] = -body.joint.damping * qd[k];
+    }
+    CHECK(rel_error(wa.Q - wb.Q, expected, wb.Q.cwiseAbs().maxCoeff()) < 1e-13);
+    CHECK(rel_error(wa.h, wb.h) < 1e-14);
+    const MatX Ms = wa.Ms;
+    const VecX h = wa.h, Q = wa.Q;
+    REQUIRE(forward_dynamics(a, wa, q, qd, tau).ok);
+    CHECK(rel_error(Ms * wa.qdd + h, Q) < 1e-9);
+    inverse_dynamics(a, wa, q, qd, wa.qdd);
+    CHECK(rel_error(wa.tau, tau, Ms.cwiseAbs().maxCoeff() * wa.qdd.cwiseAbs().maxCoeff()) < 1e-9);
+  }
+  // The energy balance of a run: E − E₀ = ∫ P dt with P = −Σ c |θ̇_j|² (and no other work), to
+  // the integrator's tolerance; the model loses energy.
+  doc["gravity"] = {0, 0, -9.81};
+  const Model m = load_text(doc.dump());
+  std::mt19937 rng(8);
+  IntegratorOptions o;
+  o.kind = IntegratorKind::Dopri;
+  o.adaptive.rtol = 1e-11;
+  o.adaptive.atol = 1e-12;
+  auto integ = make_integrator(m, o);
+  integ->reset(0, random_posture(m, rng), random_uniform(m.n(), 1, rng));
+  REQUIRE(integ->advance_to(1.0).ok);
+  const double E1 = integ->motion().energy_at(integ->y().data()).total(),
+               E0 = integ->divergence().initial().total();
+  CHECK(integ->work() < -1e-2);
+  CHECK(std::abs(E1 - E0 - integ->work()) < 1e-7 * std::abs(integ->work()));
+}
+
+TEST_CASE("damping on spherical and free joints agrees with Simbody's dampers on Ball and Free",
+          "[actuators][validation]") {
+  Scratch s("rate_dampers");
+  Json doc = Json::parse(mixed_tree_json(3, 7, 0.4, false, true));
+  int damped = 0;
+  for (Json& b : doc["bodies"])
+    if (b["joint"]["type"] == "spherical" || b["joint"]["type"] == "free")
+      b["joint"]["damping"] = 0.05 * ++damped;
+  REQUIRE(damped >= 2);
+  const std::string path = (s.dir / "damped.json").string();
+  std::ofstream(path) << doc.dump();
+  const Run r = run("validate " + path + " --budget 60 --t-end 0.3");
+  INFO(r.out);
+  CHECK(r.code == 0);
+  CHECK_THAT(r.out, Catch::Contains("PASS") && !Catch::Contains("FAIL") &&
+                        !Catch::Contains("not compared"));
+}
+
 TEST_CASE("armature: a spring arm oscillates at sqrt(k / (I + I_a G²)), its energy conserved",
           "[actuators]") {
   // 1 kg·m² on a spring k = 4 behind a rotor of 0.01 kg·m² at gear 10: I = 1 + 1 = 2, ω = √2.

@@ -401,14 +401,10 @@ MujocoPeer::MujocoPeer(const std::string& mjcf_path, const Eigen::Vector3d& grav
   for (int k = 0; k < 3; ++k) m.opt.gravity[k] = gravity[k], m.opt.wind[k] = 0;
   m.opt.density = m.opt.viscosity = 0;  // fluid forces: reported by the reader, not modelled
   m.opt.disableflags |= mjDSBL_CONSTRAINT | mjDSBL_CONTACT;
-  // What the reader reports leaving out, left out here too: damping and springs on ball and free
-  // joints (femdyn's joint dampers and springs act on one coordinate).
+  // What the reader reports leaving out, left out here too: springs on ball and free joints
+  // (femdyn's joint springs act on one coordinate; their dampers are read).
   for (int j = 0; j < m.njnt; ++j)
-    if (m.jnt_type[j] == mjJNT_BALL || m.jnt_type[j] == mjJNT_FREE) {
-      m.jnt_stiffness[j] = 0;
-      const int dofs = m.jnt_type[j] == mjJNT_BALL ? 3 : 6;
-      for (int k = 0; k < dofs; ++k) m.dof_damping[m.jnt_dofadr[j] + k] = 0;
-    }
+    if (m.jnt_type[j] == mjJNT_BALL || m.jnt_type[j] == mjJNT_FREE) m.jnt_stiffness[j] = 0;
   const auto refuse = [&](const std::string& why) {
     throw std::runtime_error(mjcf_path + ": MuJoCo peer: " + why);
   };

@@ -112,6 +112,12 @@ void SimbodyTwin::Impl::add_body(const TwinBody& j) {
     const bool one_rate = j.joint == TwinBody::Joint::Revolute ||
                           j.joint == TwinBody::Joint::Prismatic ||
                           j.joint == TwinBody::Joint::Helical;
+    // A spherical or free joint's damper: −c on each u (Ball's ω, Free's ω and v, in F's axes:
+    // the same wrench as femdyn's −c on each rate in the body's axes, the damper being isotropic).
+    if (j.theta >= 0 && j.damping != 0 &&
+        (j.joint == TwinBody::Joint::Spherical || j.joint == TwinBody::Joint::Free))
+      for (int u = 0; u < (j.joint == TwinBody::Joint::Free ? 6 : 3); ++u)
+        Force::MobilityLinearDamper(forces, mobod.back(), MobilizerUIndex(u), j.damping);
     if (j.theta >= 0 && one_rate) {
       if (j.stiffness != 0)
         Force::MobilityLinearSpring(forces, mobod.back(), MobilizerQIndex(0), j.stiffness, j.rest);

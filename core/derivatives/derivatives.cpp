@@ -219,7 +219,10 @@ void add_passive(const Model& m, const Workspace& ws, const DerivativeWorkspace&
                  MatX& Kv) {
   for (int j = 0; j < m.n_theta(); ++j) {
     const Joint& J = m.bodies[m.theta_joint[j]].joint;
-    if (J.nv != 1) continue;
+    if (J.nv != 1) {  // a spherical or free joint's damper, −c on each rate
+      Kv(j, j) += J.damping;
+      continue;
+    }
     const double th = ws.theta[J.idx_q], w = d.theta_dot[j];
     Kq(j, j) += J.stiffness;  // −∂(−k (θ − θ_rest))/∂θ
     Kv(j, j) += J.damping;

@@ -90,6 +90,15 @@ inline double passive_joint_power(const Joint& j, double theta, double theta_dot
   return P;
 }
 
+// A spherical or free joint's damper: −c on each of its rates (ω, and v of a free joint, in the
+// body's axes). Isotropic, so it is the wrench (−c v, −c ω) whatever the axes, as MuJoCo's
+// dof_damping in its world-axes ṗ (ṗ = R v: Rᵀ(−c R v) = −c v). Power −c |θ̇_j|².
+// y += sign · (−c θ̇) over q̇ (Model::RateDamper::v), rates over q̇.
+inline void add_rate_dampers(const Model& m, const VecX& rates, double sign, VecX& y) {
+  for (const Model::RateDamper& d : m.rate_dampers)
+    y.segment(d.v, d.nv) -= (sign * d.c) * rates.segment(d.v, d.nv);
+}
+
 // Whether the joint dissipates energy (damper, friction or a stop's dissipation).
 inline bool dissipates(const Joint& j) {
   return j.damping != 0 || j.friction != 0 || (j.stop && j.stop_dissipation != 0);
