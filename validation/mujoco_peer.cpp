@@ -291,6 +291,9 @@ void keep_meshes(tinyxml2::XMLElement& root, const std::string& path) {
     if (const char* d = compiler->Attribute(dir))
       meshdir = fs::path(d).is_absolute() ? fs::path(d) : folder / d;
   compiler->SetAttribute("exactmeshinertia", "true");
+  // MuJoCo 3's default, which femdyn's reader follows: a range without `limited` is a limit
+  // (MuJoCo 2.2 refuses it otherwise; limits are constraints, off in the peer).
+  if (!compiler->Attribute("autolimits")) compiler->SetAttribute("autolimits", "true");
   std::set<std::string> kept;
   std::vector<tinyxml2::XMLElement*> stack = {&root};
   while (!stack.empty()) {
@@ -363,7 +366,8 @@ std::string prepared_mjcf(const std::string& path) {
     stack.pop_back();
     for (const char* a :
          {"material", "texture", "hfield", "meshdir", "assetdir", "texturedir", "integrator",
-          "actuatorfrcrange", "actuatorfrclimited", "actuatorgravcomp", "gravcomp"})
+          "actuatorfrcrange", "actuatorfrclimited", "actuatorforcerange", "actuatorforcelimited",
+          "actuatorgravcomp", "gravcomp"})
       e->DeleteAttribute(a);
     for (tinyxml2::XMLElement* c = e->FirstChildElement(); c; c = c->NextSiblingElement()) {
       const std::string tag = c->Name();
@@ -379,8 +383,16 @@ std::string prepared_mjcf(const std::string& path) {
           a->DeleteAttribute("femdyn-kept");
         continue;
       }
+      // An actuator's defaults go with the actuators (MuJoCo 3's kv or inheritrange on them stop
+      // MuJoCo 2.2 reading the file).
+      const bool actuator_default =
+          std::string(e->Name()) == "default" &&
+          (tag == "general" || tag == "motor" || tag == "position" || tag == "velocity" ||
+           tag == "intvelocity" || tag == "damper" || tag == "cylinder" || tag == "muscle" ||
+           tag == "adhesion");
       const bool unused = tag == "contact" || tag == "skin" || tag == "flag" || tag == "actuator" ||
-                          tag == "sensor" || tag == "keyframe" || tag == "tendon";
+                          tag == "sensor" || tag == "keyframe" || tag == "tendon" ||
+                          actuator_default;
       (unused || mesh_geom ? doomed : stack).push_back(c);
     }
   }
