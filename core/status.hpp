@@ -8,9 +8,10 @@ namespace femdyn {
 struct Status {
   bool ok = true;
   std::string message;
-  int coordinate = -1;      // the coordinate a failure is attributed to, if any
-  bool non_finite = false;  // the failure is a NaN or Inf (an overflow), not a singular matrix
-  bool diverged = false;    // the numerical solution blew up (sim/divergence.hpp)
+  int coordinate = -1;       // the coordinate a failure is attributed to, if any
+  bool non_finite = false;   // the failure is a NaN or Inf (an overflow), not a singular matrix
+  bool diverged = false;     // the numerical solution blew up (sim/divergence.hpp)
+  bool interrupted = false;  // stopped at the caller's request (Ctrl-C): not a failure of the run
 };
 
 // The failure of a diagonal entry M^s(a, a) against the largest diagonal entry: no inertia at

@@ -3,6 +3,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "core/errors.hpp"
@@ -124,13 +125,16 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
   SimulationReport report;
   {
     py::gil_scoped_release release;
-    // Ctrl-C reaches the run: Python's signal check every 256 steps (the GIL taken briefly).
-    long step = 0;
+    // Ctrl-C reaches the run, inside its steps too: Python's signal check every 20 ms of wall
+    // time (the GIL taken briefly).
+    auto next_look = std::chrono::steady_clock::now();
     report = run_simulation(
         m, request, loops,
         [&rows](const Integrator& i, const Energy& E) { rows.add(i.t(), i.state(), E, i.work()); },
-        [&step](double) {
-          if (++step % 256 != 0) return false;
+        [&next_look](double) {
+          const auto now = std::chrono::steady_clock::now();
+          if (now < next_look) return false;
+          next_look = now + std::chrono::milliseconds(20);
           py::gil_scoped_acquire acquire;
           return PyErr_CheckSignals() != 0;
         });

@@ -95,6 +95,22 @@ py::array_t<double> table(const std::vector<double>& x, py::ssize_t cols) {
   return a;
 }
 
+// Ctrl-C inside a step (a long adaptive step, a Newton iteration): while it lives, the motion
+// asks Python's signal check every 20 ms of wall time, the GIL taken briefly; a pending signal
+// stops the step with Status::interrupted, its KeyboardInterrupt left set for the caller.
+struct CtrlC {
+  Motion& motion;
+  explicit CtrlC(Motion& m) : motion(m) {
+    motion.set_interrupt([] {
+      py::gil_scoped_acquire acquire;
+      return PyErr_CheckSignals() != 0;
+    });
+  }
+  ~CtrlC() { motion.set_interrupt({}); }
+  CtrlC(const CtrlC&) = delete;
+  CtrlC& operator=(const CtrlC&) = delete;
+};
+
 class Simulator {
  public:
   Simulator(const PyModel& model, const std::string& integrator, double dt,
@@ -118,9 +134,11 @@ class Simulator {
     const VecX tau = vector_arg(tau_in, "tau", *model_, Entries::Bounded);
     Status st;
     {
+      const CtrlC hook(loop_->integrator().motion());
       py::gil_scoped_release release;
       st = loop_->step(tau);
     }
+    if (st.interrupted) throw py::error_already_set();  // (KeyboardInterrupt, set by the hook)
     if (!st.ok) throw NumericalError(st.message);
   }
 
@@ -211,9 +229,11 @@ class Simulator {
         rows.add(*loop_, integ.motion(), tau, watch.at_row(integ));
         if (PyErr_CheckSignals() != 0) throw py::error_already_set();  // Ctrl-C
         {
+          const CtrlC hook(integ.motion());
           py::gil_scoped_release release;
           st = hold ? loop_->step(tau) : loop_->step();
         }
+        if (st.interrupted) throw py::error_already_set();
         if (!st.ok) break;
         watch.after_step(integ);
       }

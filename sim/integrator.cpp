@@ -115,7 +115,7 @@ void Integrator::restart(double t_stop) {
 Status Integrator::advance_to(double t_out) {
   const auto begin = std::chrono::steady_clock::now();
   Status st = t_out > t_ ? advance(t_out) : Status{};
-  st = st.ok ? watch() : explain(std::move(st));
+  st = st.ok ? watch() : st.interrupted ? st : explain(std::move(st));
   stats_.wall_time +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   return st;
@@ -125,7 +125,7 @@ Status Integrator::step() {
   if (t_ >= t_stop_) return {};
   const auto begin = std::chrono::steady_clock::now();
   Status st = one_step();
-  st = st.ok ? watch() : explain(std::move(st));
+  st = st.ok ? watch() : st.interrupted ? st : explain(std::move(st));
   stats_.wall_time +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   return st;

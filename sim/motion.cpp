@@ -102,7 +102,19 @@ Status Motion::check_state(double t, const double* y) const {
   return {};
 }
 
+bool Motion::interrupt_requested() {
+  const auto now = std::chrono::steady_clock::now();
+  if (now < next_interrupt_look_) return false;
+  next_interrupt_look_ = now + std::chrono::milliseconds(20);
+  return interrupt_();
+}
+
 Status Motion::rhs(double t, const double* y, double* ydot) {
+  if (interrupt_ && interrupt_requested()) {
+    Status st{false, at_time(t) + "interrupted"};
+    st.interrupted = true;
+    return st;
+  }
   ++evaluations_;
   const int n = model_.n();
   configuration(y, q_);

@@ -21,6 +21,7 @@
 // checked: a singular or indefinite M^s, or a NaN/Inf in q̈, is a failed Status naming the time,
 // the quantity and the coordinate, never a NaN handed on.
 #pragma once
+#include <chrono>
 #include <exception>
 #include <functional>
 #include <memory>
@@ -45,6 +46,13 @@ class Motion {
   // τ = u(t, q, v) from now on (an empty u: back to the Actuation).
   void set_control(Control u) { control_ = std::move(u); }
   bool controlled() const { return static_cast<bool>(control_); }
+  // Asked at most every 20 ms of wall time, before an evaluation of f: true stops the run there
+  // (a Status with `interrupted`), so that Ctrl-C ends even one long adaptive step or Newton
+  // iteration at once. Empty: never asked.
+  void set_interrupt(std::function<bool()> requested) {
+    interrupt_ = std::move(requested);
+    next_interrupt_look_ = {};
+  }
 
   const Model& model() const { return model_; }
   int n() const { return model_.n(); }
@@ -111,6 +119,9 @@ class Motion {
   Actuation tau_;
   Control control_;
   std::exception_ptr control_error_;
+  std::function<bool()> interrupt_;
+  std::chrono::steady_clock::time_point next_interrupt_look_;
+  bool interrupt_requested();
   Workspace ws_;
   std::unique_ptr<LoopWorkspace> loops_;  // with constraints only
   double baumgarte_ = kDefaultBaumgarte;

@@ -115,11 +115,23 @@ RecordedRun run_recorded(Integrator& integ, double t_end, long every,
     return r;
   }
   const auto output = [&] { row(integ, watch.at_row(integ)); };
+  // `stop` is also asked inside the steps (at most every 20 ms: Motion::set_interrupt), so that a
+  // long adaptive step or a long span between outputs ends at once.
+  struct Hook {
+    Motion& motion;
+    ~Hook() { motion.set_interrupt({}); }
+  } hook{integ.motion()};
+  integ.motion().set_interrupt([&] { return stop(integ.t()); });
+  const auto interrupted = [&] {
+    if (!r.status.interrupted) return false;
+    r.status = {};
+    return r.interrupted = true;
+  };
   const auto begin = std::chrono::steady_clock::now();
   if (times) {
     for (double t : *times) {
       if (t > integ.t()) r.status = integ.advance_to(t);
-      if (!r.status.ok) break;
+      if (interrupted() || !r.status.ok) break;
       watch.after_step(integ);
       output();
       if ((r.interrupted = stop(integ.t()))) break;
@@ -128,7 +140,7 @@ RecordedRun run_recorded(Integrator& integ, double t_end, long every,
     output();
     for (long step = 1; integ.t() < t_end; ++step) {
       r.status = integ.step();
-      if (!r.status.ok) break;
+      if (interrupted() || !r.status.ok) break;
       watch.after_step(integ);
       if (step % every == 0 || integ.t() >= t_end) output();
       if ((r.interrupted = stop(integ.t()))) break;

@@ -344,6 +344,25 @@ TEST_CASE("an interrupted simulate leaves the old output file intact", "[hardeni
   fs::remove_all(dir);
 }
 
+TEST_CASE("SIGINT ends an adaptive simulate inside a long span between outputs at once",
+          "[hardening]") {
+  // One output every 1e6 s: the old check between outputs answered only after minutes of work.
+  // The stop is now asked inside the steps (every 20 ms at most): exit 130 within a second.
+  for (const char* integrator : {"dopri", "bdf"}) {
+    INFO(integrator);
+    const Run r = run_shell(
+        "sh -c '" + std::string(FEMDYN_BINARY) + " simulate " + model_path("finger.json") +
+        " --t-end 1e9 --integrator " + integrator +
+        " --qd0 1,1,1,1 --sample-dt 1e6 & pid=$!; sleep 1; s=$(date +%s%N); kill -INT $pid; "
+        "wait $pid; echo exit=$? ms=$(( ($(date +%s%N) - s) / 1000000 ))'");
+    INFO(r.out);
+    CHECK(r.out.find("exit=130") != std::string::npos);
+    const std::size_t at = r.out.find("ms=");
+    REQUIRE(at != std::string::npos);
+    CHECK(std::stol(r.out.substr(at + 3)) < 1000);
+  }
+}
+
 // Issue 22: readers and compile linear in n. The inputs are generated here; their times are
 // measured in femdyn_bench (docs/performance.md), never asserted.
 TEST_CASE("a JSON array of 1,000,000 objects is read, and as bodies refused by count",

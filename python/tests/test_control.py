@@ -180,6 +180,27 @@ def test_ctrl_c_stops_a_run(finger):
         timer.cancel()
 
 
+@pytest.mark.parametrize("integrator", ["dopri", "bdf"])
+def test_ctrl_c_stops_one_long_step(finger, integrator):
+    """One step of a billion seconds on a moving model: Ctrl-C is honoured inside it (the motion
+    asks Python's signal check every 20 ms), raising KeyboardInterrupt within a second, and the
+    Simulator is usable after."""
+    import time
+    sim = femdyn.Simulator(finger, integrator=integrator, dt=1e9, q0=Q0, qd0=np.ones(4))
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    start = time.monotonic()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            sim.step(TAU)
+    finally:
+        timer.cancel()
+    assert time.monotonic() - start < 1.3
+    assert sim.state["t"] < 1e9  # stopped inside the step, at a good state
+    sim.reset(Q0)
+    assert sim.state["t"] == 0 and np.array_equal(sim.state["q"], Q0)
+
+
 # ---- the examples converge (short horizons) --------------------------------------------------
 
 def test_computed_torque_tracks_the_fingertip_path():
