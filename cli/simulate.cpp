@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "cli/commands.hpp"
+#include "cli/interrupt.hpp"
 #include "cli/progress.hpp"
 #include "core/memory.hpp"
 #include "core/names.hpp"
@@ -97,30 +98,6 @@ Status output_fits(const AtomicFile& out, const Model& m, const SimulationReques
                      format_short(static_cast<double>(space.available) / 1e9) +
                      " GB free: write fewer rows (--every k or --sample-dt s)"};
 }
-
-volatile std::sig_atomic_t g_interrupted = 0;
-extern "C" void on_interrupt(int) { g_interrupted = 1; }
-
-// SIGINT and SIGTERM set a flag the run checks after every step; restored on exit.
-class InterruptGuard {
- public:
-  InterruptGuard() {
-    g_interrupted = 0;
-    struct sigaction sa {};
-    sa.sa_handler = on_interrupt;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &old_int_);
-    sigaction(SIGTERM, &sa, &old_term_);
-  }
-  ~InterruptGuard() {
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-  }
-
- private:
-  struct sigaction old_int_ {
-  }, old_term_{};
-};
 
 // The command line's spelling of the request's options: --t-end, --tau-csv FILE, --max-memory.
 Door command_line(const Args& a) {

@@ -4,9 +4,10 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
-#include <sstream>
+#include <optional>
 
 #include "cli/commands.hpp"
+#include "cli/interrupt.hpp"
 #include "compile/actuators.hpp"
 #include "io/atomic_file.hpp"
 #include "io/csv.hpp"
@@ -29,8 +30,10 @@ for a ball or free joint) to --to in T seconds (default 1), along each joint's g
 (q_ref = q_from ⊕ s(t/T)(q_to ⊖ q_from); n_q values each, quaternions (w, x, y, z)), computes the joint torques τ(t) = M^s q̈_ref + h − Q(τ = 0) by inverse dynamics,
 then simulates the model under τ(t) alone (RK4, N steps, default 1000) and reports how closely
 the simulated motion follows q_ref (max |q_sim ⊖ q_ref|: rad or m; a rotation by the rotation
-vector between the two quaternions). --csv writes t, q_ref, τ and q_sim per step (atomically; an
-existing FILE is replaced only with --force, and never when it is MODEL). --json prints
+vector between the two quaternions). --csv writes t, q_ref, τ and q_sim per step (streamed to a
+temporary file renamed into place at the end, so that it appears whole or not at all, its size
+checked against the disk first; an existing FILE is replaced only with --force, and never when it
+is MODEL). Ctrl-C stops the run: exit 130, FILE not written. --json prints
 {"model", "n", "coordinates", "duration", "steps", "max_tracking_error", "max_abs_tau",
 "final_tracking_error", "feedback"}. τ acts on every coordinate, so a model with closed loops is
 refused (exit 1), and so is one with a coordinate no actuator drives (docs/control.md#actuation:
@@ -96,6 +99,58 @@ void require_fully_actuated(const std::string& file, const Model& m) {
                                "' is not actuated (\"actuated\": false): "
                                "computed torque would push on it (underactuated tracking is not "
                                "supported)");
+  }
+}
+
+// --csv: rows streamed to a file that appears whole or not at all (io/atomic_file.hpp), its size
+// checked against the disk first: (N + 1) rows of 2 n_q + n + 1 numbers, at most 24 bytes each.
+class TrackCsv {
+ public:
+  TrackCsv(const std::string& path, bool force, const Model& m, int steps) : out_(path, force) {
+    const double bytes = (steps + 1.0) * (2.0 * m.n_q() + m.n() + 1) * 24;
+    std::error_code ec;
+    const auto space =
+        std::filesystem::space(std::filesystem::absolute(out_.temporary(), ec).parent_path(), ec);
+    if (!ec && bytes > static_cast<double>(space.available))
+      throw CliError("--csv " + path + ": the table would take up to " + format_short(bytes / 1e9) +
+                     " GB and the disk has " +
+                     format_short(static_cast<double>(space.available) / 1e9) +
+                     " GB free: fewer --steps");
+    std::ostream& o = out_.stream();
+    o.precision(12);
+    o << "t";  // names quoted where they need it (RFC 4180): a coordinate "a,b" stays one column
+    for (const auto& c : m.configuration_names) o << ',' << csv_field("q_ref_" + c);
+    for (const auto& c : m.coordinate_names) o << ',' << csv_field("tau_" + c);
+    for (const auto& c : m.configuration_names) o << ',' << csv_field("q_sim_" + c);
+    o << "\n";
+  }
+  void row(double t, const VecX& q_ref, const VecX& tau, const VecX& q_sim) {
+    std::ostream& o = out_.stream();
+    o << t;
+    for (const VecX* v : {&q_ref, &tau, &q_sim})
+      for (Eigen::Index i = 0; i < v->size(); ++i) o << ',' << (*v)[i];
+    o << "\n";
+  }
+  void commit() {
+    try {
+      out_.commit();
+    } catch (const std::runtime_error& e) {
+      throw CliError(std::string("--csv ") + e.what());
+    }
+  }
+  const std::string& path() const { return out_.path(); }
+
+ private:
+  AtomicFile out_;
+};
+
+// The --csv file, opened before any work (a file it may not replace is refused then).
+std::optional<TrackCsv> open_csv(const Args& a, const Model& m, int steps) {
+  if (!a.has("csv")) return std::nullopt;
+  try {
+    return std::make_optional<TrackCsv>(a.options.at("csv"), a.has("force"), m, steps);
+  } catch (const std::runtime_error& e) {
+    throw CliError(std::string("--csv ") + e.what());
   }
 }
 
@@ -167,14 +222,8 @@ int cmd_track(int argc, char** argv) {
   else
     rk4.reset(0, q0, VecX::Zero(n), T);
   double max_err = 0, max_tau = 0, final_err = 0;
-  std::ostringstream csv;
-  csv.precision(12);
-  csv << "t";
-  // Names quoted where they need it (RFC 4180): a coordinate "a,b" stays one column.
-  for (const auto& c : m.configuration_names) csv << ',' << csv_field("q_ref_" + c);
-  for (const auto& c : m.coordinate_names) csv << ',' << csv_field("tau_" + c);
-  for (const auto& c : m.configuration_names) csv << ',' << csv_field("q_sim_" + c);
-  csv << "\n";
+  std::optional<TrackCsv> csv = open_csv(a, m, N);
+  const InterruptGuard interrupt;
   for (int k = 0; k <= N; ++k) {
     const double t = k * dt;
     tau(t, u);                                       // (and q_ref at t into qr)
@@ -183,24 +232,19 @@ int cmd_track(int argc, char** argv) {
     final_err = configuration_difference(m, qr, integ.q()).cwiseAbs().maxCoeff();
     max_err = std::max(max_err, final_err);
     max_tau = std::max(max_tau, u.cwiseAbs().maxCoeff());
-    csv << t;
-    for (int i = 0; i < m.n_q(); ++i) csv << "," << qr[i];
-    for (int i = 0; i < n; ++i) csv << "," << u[i];
-    for (int i = 0; i < m.n_q(); ++i) csv << "," << integ.q()[i];
-    csv << "\n";
+    if (csv) csv->row(t, qr, u, integ.q());
     if (k == N) break;
+    if (g_interrupted) {
+      std::cerr << "femdyn track: interrupted at t = " << t << " s"
+                << (csv ? "; " + escaped(csv->path()) + " was not written" : std::string()) << "\n";
+      return 130;  // (the temporary file goes with `csv`)
+    }
     const Status st = feedback ? loop.step() : rk4.advance_to((k + 1) * dt);
     if (!st.ok)
       throw StateError(a.positional[0] + ": " +
                        failure_text(st, loop, law, q_start, feedback, mode));
   }
-  if (a.has("csv")) {
-    try {
-      write_file_atomic(a.options.at("csv"), csv.str(), a.has("force"));
-    } catch (const std::runtime_error& e) {
-      throw CliError(std::string("--csv ") + e.what());
-    }
-  }
+  if (csv) csv->commit();
   if (a.has("json")) {
     std::cout << json_text(Json{
                      {"model", m.name},

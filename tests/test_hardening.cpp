@@ -363,6 +363,28 @@ TEST_CASE("SIGINT ends an adaptive simulate inside a long span between outputs a
   }
 }
 
+TEST_CASE("track streams its --csv table and an interrupted track leaves no file", "[hardening]") {
+  // The table grows on disk while the run lasts (it was built in memory: 1 GB and growing at
+  // 10 million steps); SIGINT ends it with exit 130, the file not written, no temporary left.
+  const fs::path dir = scratch() / "track_stream";
+  fs::create_directories(dir);
+  const fs::path out = dir / "table.csv";
+  const Run r =
+      run_shell("sh -c '" + std::string(FEMDYN_BINARY) + " track " + model_path("finger.json") +
+                " --to 0.3,0.5,0.4,0.3 --steps 10000000 --csv " + out.string() +
+                " & pid=$!; sleep 1.5; echo bytes=$(find " + dir.string() +
+                " -type f -exec cat {} + | wc -c); kill -INT $pid; wait $pid; echo exit=$?' 2>&1");
+  INFO(r.out);
+  CHECK(r.out.find("exit=130") != std::string::npos);
+  CHECK_THAT(r.out, Catch::Contains("femdyn track: interrupted at t = ") &&
+                        Catch::Contains("was not written"));
+  const std::size_t at = r.out.find("bytes=");
+  REQUIRE(at != std::string::npos);
+  CHECK(std::stol(r.out.substr(at + 6)) > 100000);  // rows already on disk, before the end
+  CHECK(fs::is_empty(dir));
+  fs::remove_all(dir);
+}
+
 // Issue 22: readers and compile linear in n. The inputs are generated here; their times are
 // measured in femdyn_bench (docs/performance.md), never asserted.
 TEST_CASE("a JSON array of 1,000,000 objects is read, and as bodies refused by count",
