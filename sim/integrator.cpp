@@ -182,7 +182,7 @@ Status Integrator::diverged() {
             at_time(t_) + "the solution diverges (" + held + format_short(watch_.supplied()) +
                 " J it started with and was given): " +
                 divergence_cause(motion_.model(), kind(), fixed_dt(), setting(), q0_,
-                                 y0_.segment(n, n), tau0),
+                                 y0_.segment(n, n), tau0, motion_.baumgarte()),
             -1};
   st.diverged = true;
   return st;

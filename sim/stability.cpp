@@ -332,9 +332,17 @@ double error_per_period(IntegratorKind kind, double omega, double dt) {
   return NAN;
 }
 
+std::optional<double> baumgarte_stable_step(double omega, IntegratorKind kind) {
+  Linearization lin;
+  lin.A.resize(2, 2);
+  lin.A << 0, 1, -omega * omega, -2 * omega;
+  analyse(lin);
+  return largest_stable_step(lin, kind);
+}
+
 std::string divergence_cause(const Model& m, IntegratorKind kind, double dt,
                              const std::string& setting, const VecX& q0, const VecX& qd0,
-                             const VecX& tau0) {
+                             const VecX& tau0, double baumgarte) {
   const std::string method = std::string(integrator_name(kind)) + " at " + setting;
   if (dt <= 0)
     return method + ": the error control did not hold the solution; tighten rtol and atol" +
@@ -346,8 +354,7 @@ std::string divergence_cause(const Model& m, IntegratorKind kind, double dt,
            std::to_string(m.n()) + " is too large to find it here; femdyn check --states 1 " +
            "estimates it); use a smaller dt or dopri";
   Workspace ws(m);
-  // Closed loops at Baumgarte rate 0: the fixed-step run projected after every step.
-  const Linearization lin = linearize(m, ws, q0, qd0, tau0, 0);
+  const Linearization lin = linearize(m, ws, q0, qd0, tau0, baumgarte);
   if (!lin.status.ok)
     return method + " diverged from a start state whose dynamics cannot be linearised (" +
            lin.status.message + "); use a smaller dt or dopri";

@@ -111,9 +111,15 @@ double error_per_period(IntegratorKind kind, double omega, double dt);
 // state and the step limit and step it gives, e.g. "rk4 at dt = 1.5 s is beyond the stability
 // limit of the stiffest mode (10 rad/s, oscillatory, undamped; limit ≈ 0.283 s); use dt ≤
 // 0.037 s or dopri".
+// Closed loops are linearised at the run's Baumgarte rate, whose modes −ω are among the stiffest.
 std::string divergence_cause(const Model& model, IntegratorKind kind, double dt,
                              const std::string& setting, const VecX& q0, const VecX& qd0,
-                             const VecX& tau0);
+                             const VecX& tau0, double baumgarte = Motion::kDefaultBaumgarte);
+
+// The largest stable step of `kind` on a closed loop's residual at Baumgarte's rate ω, the mode
+// ë + 2ω ė + ω² e = 0 (a double eigenvalue −ω) by the same test as the model's modes: rk4 about
+// 2.785/ω, symplectic Euler (2√2 − 2)/ω, dopri about 3.3/ω, bdf unbounded.
+std::optional<double> baumgarte_stable_step(double omega, IntegratorKind kind);
 
 // A body whose mass properties make the equations ill-conditioned or unphysical-looking.
 struct SuspiciousBody {

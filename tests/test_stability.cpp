@@ -56,6 +56,38 @@ TEST_CASE("linearisation and stable steps match the closed forms of an oscillato
   CHECK(p.A(1, 0) == Approx(-9.81 * std::sin(0.4)).epsilon(1e-6));
 }
 
+TEST_CASE("a Baumgarte rate's stable step is each method's real-axis bound over ω",
+          "[stability][loops]") {
+  // The residual's mode ë + 2ωė + ω²e = 0, a double eigenvalue −ω: RK4's boundary on the negative
+  // real axis is the root of |1 + z + z²/2 + z³/6 + z⁴/24| = 1, z = −2.7852935; symplectic
+  // Euler's on this damped pair 2√2 − 2 (det = 1 − 2x, tr² conditions: x² + 4x − 4 ≤ 0);
+  // Dormand–Prince 5(4)'s about −3.3066; BDF none. The same at any scale of ω.
+  for (const double w : {20.0, 1e4, 1e10}) {
+    INFO("ω = " << w);
+    CHECK(*baumgarte_stable_step(w, IntegratorKind::Rk4) * w == Approx(2.7852935).epsilon(1e-5));
+    CHECK(*baumgarte_stable_step(w, IntegratorKind::Euler) * w ==
+          Approx(2 * std::sqrt(2.0) - 2).epsilon(1e-5));
+    CHECK(*baumgarte_stable_step(w, IntegratorKind::Dopri) * w == Approx(3.3066).epsilon(1e-3));
+    CHECK(std::isinf(*baumgarte_stable_step(w, IntegratorKind::Bdf)));
+  }
+  // simulate refuses a rate its method cannot follow, in one line, before any work (it ran for
+  // minutes); just inside the bound the run is made.
+  const std::string five_bar = model_path("five_bar.json");
+  for (const char* integrator : {"rk4", "euler", "dopri"}) {
+    const Run r = run("simulate " + five_bar + " --t-end 1 --integrator " +
+                      std::string(integrator) + " --baumgarte 1e10");
+    INFO(integrator << ": " << r.out);
+    CHECK(r.code == 2);
+    CHECK_THAT(r.out,
+               Catch::Contains("--baumgarte 1e+10: the loops' residual decays at -1e+10") ||
+                   Catch::Contains("--baumgarte 1e+10: the loops' residual decays at −1e+10"));
+  }
+  CHECK(run("simulate " + five_bar + " --t-end 0.2 --integrator rk4 --dt 0.001 --baumgarte 2700")
+            .code == 0);
+  CHECK(run("simulate " + five_bar + " --t-end 0.2 --integrator rk4 --dt 0.001 --baumgarte 2900")
+            .code == 2);
+}
+
 TEST_CASE("at cond(M^s) = 1e10 the backward error of q̈ is below 1e-14", "[stability]") {
   // Two links whose masses differ by the ratio that makes cond(M^s) ≈ 1e10.
   for (double ratio : {1e9, 1e10}) {

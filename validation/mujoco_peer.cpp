@@ -385,11 +385,10 @@ std::string prepared_mjcf(const std::string& path) {
       }
       // An actuator's defaults go with the actuators (MuJoCo 3's kv or inheritrange on them stop
       // MuJoCo 2.2 reading the file).
-      const bool actuator_default =
-          std::string(e->Name()) == "default" &&
-          (tag == "general" || tag == "motor" || tag == "position" || tag == "velocity" ||
-           tag == "intvelocity" || tag == "damper" || tag == "cylinder" || tag == "muscle" ||
-           tag == "adhesion");
+      const bool actuator_default = std::string(e->Name()) == "default" &&
+                                    (tag == "general" || tag == "motor" || tag == "position" ||
+                                     tag == "velocity" || tag == "intvelocity" || tag == "damper" ||
+                                     tag == "cylinder" || tag == "muscle" || tag == "adhesion");
       const bool unused = tag == "contact" || tag == "skin" || tag == "flag" || tag == "actuator" ||
                           tag == "sensor" || tag == "keyframe" || tag == "tendon" ||
                           actuator_default;
