@@ -52,7 +52,12 @@ int cmd_view(int argc, char** argv) {
                                             : view::posture(m, configuration_vector(a, "q", m));
   view::write_model_page(out, m, a.positional[0], motion, a.has("force"));
   std::cerr << "femdyn view: wrote " << escaped(out) << " (" << m.bodies.size() << " bodies, "
-            << m.elements.size() << " elements, " << motion.frames.size() << " frames)\n";
+            << m.elements.size() << " elements, " << motion.frames.size() << " frames";
+  if (motion.frames.size() < motion.rows)
+    std::cerr << " of the trajectory's " << motion.rows
+              << " rows, evenly spaced: a page holds at most " << view::frame_limit(m.bodies.size())
+              << " frames of " << m.bodies.size() << " bodies";
+  std::cerr << ")\n";
   return 0;
 }
 

@@ -151,6 +151,39 @@ TEST_CASE("view: a long trajectory keeps at most kMaxFrames, its first and last 
   CHECK(motion.energy_source == "computed");  // no energy columns: femdyn computes them
 }
 
+TEST_CASE("view: a page holds at most a million body poses, the frames thinned evenly",
+          "[view][hardening]") {
+  // 10,000 bodies × 1,500 frames (15 M poses) took 2.7 GB and aborted with bad_alloc: a model of
+  // many bodies keeps fewer frames, kMaxPoses / bodies, the first and last rows among them.
+  CHECK(view::frame_limit(1) == view::kMaxFrames);
+  CHECK(view::frame_limit(10'000) == 100);
+  CHECK(view::frame_limit(100'000'000) == 2);
+  Scratch dir("view_thinned");
+  const std::string model = (dir.dir / "tree.json").string(),
+                    traj = (dir.dir / "traj.csv").string();
+  std::ofstream(model) << R"({"model": "random_tree", "params": {"seed": 3, "bodies": 2000}})";
+  const Model m = load_model(model);
+  std::ofstream csv(traj);
+  csv << "t";
+  for (const std::string& c : m.configuration_names) csv << ",q_" << c;
+  csv << "\n";
+  for (int r = 0; r < 1500; ++r) {
+    csv << 0.001 * r;
+    for (int i = 0; i < m.n_q(); ++i) csv << "," << (i % 7 == 0 ? 0.001 * r : 0.0);
+    csv << "\n";
+  }
+  csv.close();
+  const view::Motion motion = view::read_trajectory(m, traj);
+  CHECK(motion.rows == 1500);
+  REQUIRE(motion.frames.size() == 500);
+  CHECK(motion.frames.front().t == 0);
+  CHECK(motion.frames.back().t == Approx(1.499));
+  const Run r =
+      run("view " + model + " --traj " + traj + " --out " + (dir.dir / "page.html").string());
+  CHECK(r.code == 0);
+  CHECK_THAT(r.out, Catch::Contains("500 frames of the trajectory's 1500 rows, evenly spaced"));
+}
+
 TEST_CASE("view: a URDF's visual primitives and their colours are read", "[view]") {
   const std::string path = model_path("urdf/arm7.urdf");
   const std::string text = read_file(path);

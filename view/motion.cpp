@@ -39,16 +39,16 @@ std::vector<std::size_t> columns(const TrajectoryTable& table, const std::string
   return out;
 }
 
-// Rows kept: all, or kMaxFrames evenly spaced with the first and the last.
-std::vector<std::size_t> kept_rows(std::size_t rows) {
+// Rows kept: all, or `limit` (≥ 2) evenly spaced with the first and the last.
+std::vector<std::size_t> kept_rows(std::size_t rows, std::size_t limit) {
   std::vector<std::size_t> out;
-  if (rows <= kMaxFrames) {
+  if (rows <= limit) {
     for (std::size_t r = 0; r < rows; ++r) out.push_back(r);
     return out;
   }
-  for (std::size_t k = 0; k < kMaxFrames; ++k)
-    out.push_back(static_cast<std::size_t>(
-        std::llround(static_cast<double>(k) * (rows - 1) / (kMaxFrames - 1))));
+  for (std::size_t k = 0; k < limit; ++k)
+    out.push_back(
+        static_cast<std::size_t>(std::llround(static_cast<double>(k) * (rows - 1) / (limit - 1))));
   return out;
 }
 
@@ -84,7 +84,8 @@ Motion trajectory(const Model& model, const TrajectoryTable& table, const std::s
   m.energy_source = energy_cols.empty() ? "computed" : "trajectory";
   Workspace ws(model);
   double t_before = -INFINITY;
-  for (const std::size_t r : kept_rows(table.rows.size())) {
+  m.rows = table.rows.size();
+  for (const std::size_t r : kept_rows(table.rows.size(), frame_limit(model.bodies.size()))) {
     const std::vector<double>& row = table.rows[r];
     const std::string where = source + ": row " + std::to_string(r + 1);
     for (std::size_t c = 0; c < row.size(); ++c)

@@ -1,7 +1,10 @@
 // The motion a page shows: the model's configuration q at a list of times, from a trajectory
 // CSV of `femdyn simulate` (io/trajectory_csv.hpp) or one posture, with the energy balance at
-// each time. At most kMaxFrames frames are kept (evenly spaced rows, the last row always).
+// each time. At most frame_limit(bodies) frames are kept (evenly spaced rows, the first and the
+// last always): kMaxFrames, fewer for a model of many bodies so that a page holds at most
+// kMaxPoses body poses (10,000 bodies × 1,500 frames, 15 M poses, took 2.7 GB and aborted).
 #pragma once
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -11,6 +14,10 @@
 namespace femdyn::view {
 
 inline constexpr std::size_t kMaxFrames = 1500;
+inline constexpr std::size_t kMaxPoses = 1'000'000;
+inline std::size_t frame_limit(std::size_t bodies) {
+  return std::clamp<std::size_t>(kMaxPoses / std::max<std::size_t>(bodies, 1), 2, kMaxFrames);
+}
 
 struct MotionFrame {
   double t = 0;
@@ -20,6 +27,7 @@ struct MotionFrame {
 
 struct Motion {
   std::vector<MotionFrame> frames;
+  std::size_t rows = 1;       // the trajectory's rows, of which `frames` keeps some
   bool trajectory = false;    // from a trajectory (else one posture)
   std::string energy_source;  // "trajectory" (its columns) or "computed" (core energy())
 };
