@@ -17,7 +17,9 @@ page of the trajectory, and in one headless Chromium (driven over the DevTools p
     one on a welded link): the visuals and distinct meshes drawn equal those the file holds,
     counted here from the XML;
   - loop (a five-bar closed by a ball constraint): every constraint of `femdyn info` is drawn,
-    its two places together (within 1e-4 of the model's size) at every screenshot;
+    its two places together (within 1e-4 of the model's size) at every screenshot; the model is
+    renamed with quotes, a backslash, markup and a script end tag, which the page's title and
+    model line show exactly as `femdyn info` names it;
   - finger, again in a Chromium without WebGL (--disable-3d-apis): the page says so, holds the
     same counts and draws its plots.
 Exit 77 (ctest's SKIP_RETURN_CODE) when Chromium is absent; tools/setup.sh --all installs it.
@@ -35,6 +37,8 @@ import xml.etree.ElementTree as ET
 import zlib
 
 SKIP = 77
+HOSTILE_NAME = 'q"uote\'s \\ back <b>&amp;</b> </script><!-- ${x}'
+
 WIDTH, HEIGHT = 960, 600  # the browser's view
 VIEW3D = 960 - 340  # the 3-D view's width: left of the side panel (web/view.html #side, 340 px)
 BACKGROUND = (0xF4, 0xF6, 0xF8)  # the 3-D view's clear colour (web/view.js)
@@ -258,6 +262,14 @@ def check_status(status, counts, frames_min, page, webgl=True):
     assert int(data["motionFrames"]) >= frames_min, f"{where}: {data['motionFrames']} frames"
 
 
+def check_name(browser, name, page):
+    assert name == HOSTILE_NAME, f"femdyn info names the model {name!r}"
+    title = browser.evaluate("document.title")
+    line = browser.evaluate("document.getElementById('model-name').textContent")
+    assert title == "femdyn view: " + name, f"{page}: the title is {title!r}"
+    assert line.startswith(name + " ("), f"{page}: the model line is {line!r}"
+
+
 def check_screenshots(case, shots, times):
     for t, shot in zip(times, shots):
         pixels = [p for row in shot for p in row]
@@ -319,6 +331,13 @@ def main():
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
     model, simulate = CASES[case]
+    if case == "loop":  # a name that HTML, the script block and JSON must each escape
+        doc = json.load(open(os.path.join(source_dir, model)))
+        doc["name"] = HOSTILE_NAME
+        doc.pop("$schema", None)
+        model = os.path.join(work, "renamed.json")
+        with open(model, "w") as f:
+            json.dump(doc, f)
     info, counts = expected_counts(femdyn, model, source_dir)
     if "--tau-each" in simulate:  # the same actuation on every coordinate
         k = simulate.index("--tau-each")
@@ -337,6 +356,8 @@ def main():
         for page, frames_min in ((posture, 1), (moving, 2)):
             browser.open(f"file://{page}")
             check_status(browser.status(), counts, frames_min, page)
+            if case == "loop":
+                check_name(browser, info["model"], page)
         closures = 0
         for t in times:
             png = os.path.join(work, f"t{t:g}.png")
