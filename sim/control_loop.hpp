@@ -87,6 +87,7 @@ class ControlLoop {
  private:
   // Integrates [t_k, t_{k+1}]: with held_ unless per_evaluation_.
   Status advance_period();
+  bool stable_in_f();  // theory's word on the energy watch's verdict (control_loop.cpp)
   const Model& model_;
   ControlLoopOptions options_;
   Control u_;

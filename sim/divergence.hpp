@@ -43,6 +43,14 @@ class DivergenceWatch {
   // The energy needs a look when ‖q̇‖∞ has doubled since the last look: a diverging explicit
   // step grows the rates geometrically, and a look costs one evaluation of M^s.
   bool due(double qd_norm) const { return !(qd_norm <= 2 * qd_looked_); }
+  // The energy at this state (E, W) counted as supplied from now on: a look that exceeded the
+  // bounds but that theory does not call unstable (a controller inside f, whose supply W cannot
+  // show: ControlLoop) raises S₀ to it, so that only a further tenfold growth looks again.
+  void accept(const Energy& E, double W) {
+    S0_ = std::max({S0_, std::abs(E.total()), E.kinetic, std::abs(E.potential), std::abs(W)});
+    first_exceeding_ = 0;
+    confirmed_ = false;
+  }
   // Looks at the energy E and the work W at a state: true when the gain exceeds its bounds
   // there (above). A transient that then decays — a step near a stability limit that swings
   // the energy up once, as RK4 does on a critically damped mode — is not a divergence, so

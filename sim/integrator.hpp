@@ -126,6 +126,9 @@ class Integrator {
   const IntegratorStats& stats() const { return stats_; }
   Motion& motion() { return motion_; }
   const DivergenceWatch& divergence() const { return watch_; }
+  // The state's energy counted as supplied (DivergenceWatch::accept): after a divergence verdict
+  // that the caller's theory overrules, the run goes on from the state it reached.
+  void accept_energy() { watch_.accept(motion_.energy_at(y_.data()), work()); }
 
  protected:
   Integrator(const Model& model, Actuation tau);

@@ -302,3 +302,23 @@ TEST_CASE("a controller whose sampled loop grows is named as the cause of the fa
   g.reset(0, VecX::Constant(1, 0.1), VecX::Zero(1));
   CHECK(g.run(1.0).ok);
 }
+
+TEST_CASE("a stiff PD law inside f is called diverged only beyond rk4's limit on its loop",
+          "[control][divergence]") {
+  // track's computed torque on the finger, ë + K_d ė + K_p e = 0 critically damped at ω =
+  // √K_p: a double eigenvalue −ω, rk4 stable for ω dt ≤ 2.785. At ω dt = 2.5 (1 ms) it tracks
+  // to 1e-5 rad, though the controller's work inside the steps leaves W's quadrature far from
+  // E (W = −2e-4 J, E = 3e-5 J: the energy watch alone called it diverged at t = 2 ms); at
+  // ω dt = 3 it diverges, and the controller is named.
+  const std::string track =
+      "track " + model_path("finger.json") + " --to 0.3,0.5,0.4,0.3 --control evaluation";
+  const Run inside = run(track + " --kp 6.25e6 --kd 5000 --json");
+  INFO(inside.out);
+  REQUIRE(inside.code == 0);
+  CHECK(nlohmann::json::parse(inside.out)["max_tracking_error"].get<double>() < 1e-4);
+  const Run beyond = run(track + " --kp 9e6 --kd 6000");
+  INFO(beyond.out);
+  CHECK(beyond.code == 1);
+  CHECK_THAT(beyond.out, Catch::Contains("the solution diverges") &&
+                             Catch::Contains("the controller is the likely cause"));
+}
