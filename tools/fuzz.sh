@@ -34,7 +34,7 @@ echo "fuzz: built $build in $(($(date +%s) - t0)) s (log: $log)"
 
 # target  max_len  dictionary  seed corpora (read only; new inputs go to build-fuzz/corpus/TARGET)
 targets=(
-  "json_model 8192 tests/fuzz/json_model.dict models"
+  "json_model 8192 tests/fuzz/json_model.dict models tests/fuzz/corpus/json_model"
   "urdf 20480 tests/fuzz/urdf.dict models/urdf tests/robots"
   "vector 256 - tests/fuzz/corpus/vector"
   "csv 4096 tests/fuzz/csv.dict tests/fuzz/corpus/csv"
