@@ -94,10 +94,10 @@ double seconds_per_state(const Model& m) {
     return std::chrono::duration<double>(Clock::now() - t).count();
   };
   Workspace ws(m);
-  const VecX z = VecX::Zero(m.n());
+  const VecX q = neutral_posture(m), z = VecX::Zero(m.n());  // (q has n_q entries: quaternions)
   auto begin = Clock::now();
   constexpr int kProbe = 4;
-  for (int i = 0; i < kProbe; ++i) (void)tree_forward_dynamics(m, ws, z, z, z);
+  for (int i = 0; i < kProbe; ++i) (void)tree_forward_dynamics(m, ws, q, z, z);
   const double eval = since(begin) / kProbe;
   const double n = m.n(), N0 = std::min(2 * n, 200.0);
   std::mt19937 rng(7);

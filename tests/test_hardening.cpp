@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cstdio>
 #include <filesystem>
@@ -506,6 +507,74 @@ TEST_CASE("every command given options but no MODEL says so in one line, exit 2"
   }
 }
 
+TEST_CASE("hostile option values on the newer surfaces: one line, exit 2, never NaN or a crash",
+          "[hardening]") {
+  // Each command of issue 45's surfaces (loops, multi-DOF joints, frames, track, linearize,
+  // kinematics, view, a JSON model referring to a URDF) given, option by option, NaN, a huge
+  // value, a negative or zero one where it must be positive, the wrong count, an unknown name
+  // and a control character.
+  Scratch s("hostile_options");
+  const std::string urdf_ref = (s.dir / "arm.json").string();
+  std::ofstream(urdf_ref) << R"({"model": "urdf", "params": {"file": ")"
+                          << model_path("urdf/arm7.urdf") << R"(", "root_joint": "free"}})";
+  const std::string loop = model_path("five_bar.json"), space = model_path("space_robot.json"),
+                    delta = model_path("delta.json"), out = (s.dir / "o.html").string();
+  const std::vector<std::string> cases = {
+      "linearize " + loop + " --q nan,0,0,0,0",
+      "linearize " + loop + " --qd 1e300,0,0,0,0",
+      "linearize " + loop + " --q 0,0",
+      "linearize " + loop + " --baumgarte -1",
+      "linearize " + urdf_ref + " --tau 1,2,3",
+      "linearize " + space + " --q 1e300",
+      "kinematics " + delta + " --frame nope",
+      "kinematics " + delta + " --frame \x1b[31m",
+      "kinematics " + delta + " --axes sideways",
+      "kinematics " + urdf_ref + " --qd nan",
+      "kinematics " + space + " --max-memory -4",
+      "track " + model_path("finger.json") + " --to nan,0,0,0",
+      "track " + model_path("finger.json") + " --to 0,0",
+      "track " + model_path("finger.json") + " --to 0.1,0,0,0 --duration -1",
+      "track " + model_path("finger.json") + " --to 0.1,0,0,0 --steps 0",
+      "track " + model_path("finger.json") + " --to 0.1,0,0,0 --kp 1e300 --kd 1",
+      "track " + model_path("finger.json") + " --to 0.1,0,0,0 --kp 1 --kd 1 --control sometimes",
+      "view " + loop + " --q nan,0,0,0,0 --out " + out,
+      "view " + space + " --q 0,0 --out " + out,
+      "view " + urdf_ref + " --gravity 0,0,1e300 --out " + out,
+      "check " + loop + " --states -3",
+      "check " + loop + " --tol nan",
+      "check " + space + " --t-end 1e300",
+      "check " + space + " --states 0",
+      "simulate " + loop + " --t-end 1 --q0 0,nan,0,0,0",
+      "simulate " + urdf_ref + " --t-end 1 --qd0 1,2",
+  };
+  for (const std::string& c : cases) {
+    const Run r = run(c);
+    INFO(c << "\n" << r.out);
+    CHECK(r.code == 2);
+    CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);  // one line
+    // NaN only as the user's own text, quoted ('nan'), never as a number femdyn printed
+    std::size_t nans = 0, quoted = 0;
+    for (std::size_t at = r.out.find("nan"); at != std::string::npos;
+         at = r.out.find("nan", at + 1))
+      ++nans, quoted += at > 0 && r.out[at - 1] == '\'';
+    CHECK(nans == quoted);
+    CHECK(r.out.find('\x1b') == std::string::npos);  // a control character shown escaped
+  }
+}
+
+TEST_CASE("check runs on a floating base, whose q has more entries than q̇", "[hardening]") {
+  // Its time probe handed forward dynamics q̇'s size of zeros as q: every floating-base model
+  // failed with "tree_forward_dynamics: q has 33 entries; … n_q = 34".
+  for (const std::string& model :
+       {model_path("space_robot.json"),
+        std::string(FEMDYN_SOURCE_DIR) + "/tests/data/mjcf/floating.xml"}) {
+    const Run r = run("check " + model + " --states 2 --t-end 0.05");
+    INFO(model << "\n" << r.out);
+    CHECK(r.code == 0);
+    CHECK_THAT(r.out, Catch::Contains("largest stable step"));
+  }
+}
+
 TEST_CASE("check on loops that cannot close refuses as simulate does, no NaN report",
           "[hardening][loops]") {
   // The five-bar's tips held 10 m apart: they are at most about 1 m apart. check printed
@@ -525,7 +594,12 @@ TEST_CASE("check on loops that cannot close refuses as simulate does, no NaN rep
                                         ": the loops close at none of the 10 states tried: ") &&
                           Catch::Contains("'far'"));
     CHECK(std::count(r.out.begin(), r.out.end(), '\n') == 1);
-    CHECK(r.out.find("nan") == std::string::npos);
+    // NaN only as the user's own text, quoted ('nan'), never as a number femdyn printed
+    std::size_t nans = 0, quoted = 0;
+    for (std::size_t at = r.out.find("nan"); at != std::string::npos;
+         at = r.out.find("nan", at + 1))
+      ++nans, quoted += at > 0 && r.out[at - 1] == '\'';
+    CHECK(nans == quoted);
   }
   CHECK(run("simulate " + file + " --t-end 0.1").code == 1);
 }
