@@ -154,6 +154,72 @@ std::optional<TrackCsv> open_csv(const Args& a, const Model& m, int steps) {
   }
 }
 
+// --csv: refused before any work if it would clobber an input or, without --force, a file.
+void refuse_csv_target(const Args& a) {
+  if (!a.has("csv")) return;
+  const std::string& out = a.options.at("csv");
+  std::error_code ec;
+  if (const std::string input = input_at(out, model_inputs(a.positional[0])); !input.empty())
+    throw CliError("--csv " + out + " is " + input);
+  if (std::filesystem::exists(out, ec) && !a.has("force"))
+    throw CliError("--csv " + out + ": exists (use --force to replace it)");
+}
+
+// --kp, --kd and --control: the PD feedback, if any (--start needs it too).
+struct Feedback {
+  bool on = false;
+  double kp = 0, kd = 0;
+  ControlMode mode = ControlMode::ZeroOrderHold;
+};
+Feedback feedback_options(const Args& a) {
+  Feedback f;
+  f.on = a.has("kp") || a.has("kd");
+  if (f.on && !(a.has("kp") && a.has("kd"))) throw CliError("--kp and --kd go together");
+  f.kp = f.on ? number_option(a, "kp", 0) : 0;
+  f.kd = f.on ? number_option(a, "kd", 0) : 0;
+  if (!(f.kp >= 0) || !(f.kd >= 0)) throw CliError("--kp and --kd expect numbers ≥ 0");
+  if (a.has("control")) {
+    const std::string& c = a.options.at("control");
+    if (c == "evaluation")
+      f.mode = ControlMode::PerEvaluation;
+    else if (c != "hold")
+      throw CliError("--control expects evaluation or hold");
+    if (!f.on) throw CliError("--control needs --kp and --kd");
+  }
+  if (a.has("start") && !f.on) throw CliError("--start needs --kp and --kd");
+  return f;
+}
+
+struct TrackResult {
+  double max_err = 0, max_tau = 0, final_err = 0;
+};
+
+void print_track(const Args& a, const Model& m, double T, int N, const Feedback& f,
+                 const TrackResult& r) {
+  if (a.has("json")) {
+    const char* control = f.mode == ControlMode::PerEvaluation ? "evaluation" : "hold";
+    std::cout << json_text(
+                     Json{{"model", m.name},
+                          {"n", m.n()},
+                          {"coordinates", m.coordinate_names},
+                          {"duration", T},
+                          {"steps", N},
+                          {"max_tracking_error", r.max_err},
+                          {"final_tracking_error", r.final_err},
+                          {"max_abs_tau", r.max_tau},
+                          {"feedback", f.on ? Json{{"kp", f.kp}, {"kd", f.kd}, {"control", control}}
+                                            : Json(nullptr)}})
+              << "\n";
+    return;
+  }
+  std::cout << "model: " << m.name << "\nquintic motion over " << T << " s, " << N << " RK4 steps, "
+            << (f.on ? "computed torque with PD feedback (kp " + format_number(f.kp) + ", kd " +
+                           format_number(f.kd) + ")\n"
+                     : std::string("feed-forward torques by inverse dynamics\n"))
+            << "max |tau|: " << r.max_tau << "\nmax |q_sim - q_ref|: " << r.max_err
+            << "\nfinal |q_sim - q_ref|: " << r.final_err << "\n";
+}
+
 }  // namespace
 
 int cmd_track(int argc, char** argv) {
@@ -165,14 +231,7 @@ int cmd_track(int argc, char** argv) {
     return 0;
   }
   if (a.positional.size() != 1) throw CliError("expected one MODEL file (try --help)");
-  if (a.has("csv")) {  // refused before any work if it would clobber a file
-    const std::string& out = a.options.at("csv");
-    std::error_code ec;
-    if (const std::string input = input_at(out, model_inputs(a.positional[0])); !input.empty())
-      throw CliError("--csv " + out + " is " + input);
-    if (std::filesystem::exists(out, ec) && !a.has("force"))
-      throw CliError("--csv " + out + ": exists (use --force to replace it)");
-  }
+  refuse_csv_target(a);
   Model m = load(a);
   if (a.has("actuated-base")) actuate_free_joints(m);
   require_fully_actuated(a.positional[0], m);
@@ -194,21 +253,10 @@ int cmd_track(int argc, char** argv) {
   };
   VecX u(n);
   const double dt = T / N;
-  const bool feedback = a.has("kp") || a.has("kd");
-  if (feedback && !(a.has("kp") && a.has("kd"))) throw CliError("--kp and --kd go together");
-  const double kp = feedback ? number_option(a, "kp", 0) : 0,
-               kd = feedback ? number_option(a, "kd", 0) : 0;
-  if (!(kp >= 0) || !(kd >= 0)) throw CliError("--kp and --kd expect numbers ≥ 0");
-  ControlMode mode = ControlMode::ZeroOrderHold;
-  if (a.has("control")) {
-    const std::string& c = a.options.at("control");
-    if (c == "evaluation")
-      mode = ControlMode::PerEvaluation;
-    else if (c != "hold")
-      throw CliError("--control expects evaluation or hold");
-    if (!feedback) throw CliError("--control needs --kp and --kd");
-  }
-  if (a.has("start") && !feedback) throw CliError("--start needs --kp and --kd");
+  const Feedback fb = feedback_options(a);
+  const bool feedback = fb.on;
+  const double kp = fb.kp, kd = fb.kd;
+  const ControlMode mode = fb.mode;
   const VecX q_start = a.has("start") ? configuration_vector(a, "start", m) : q0;
   // Open loop: τ(t) alone, by RK4. Closed: the same RK4 step under computed torque with PD.
   Rk4 rk4(m, {.dt = dt}, tau);
@@ -221,7 +269,8 @@ int cmd_track(int argc, char** argv) {
     loop.reset(0, q_start, VecX::Zero(n));
   else
     rk4.reset(0, q0, VecX::Zero(n), T);
-  double max_err = 0, max_tau = 0, final_err = 0;
+  TrackResult r;
+  double &max_err = r.max_err, &max_tau = r.max_tau, &final_err = r.final_err;
   std::optional<TrackCsv> csv = open_csv(a, m, N);
   const InterruptGuard interrupt;
   for (int k = 0; k <= N; ++k) {
@@ -245,32 +294,7 @@ int cmd_track(int argc, char** argv) {
                        failure_text(st, loop, law, q_start, feedback, mode));
   }
   if (csv) csv->commit();
-  if (a.has("json")) {
-    std::cout << json_text(Json{
-                     {"model", m.name},
-                     {"n", m.n()},
-                     {"coordinates", m.coordinate_names},
-                     {"duration", T},
-                     {"steps", N},
-                     {"max_tracking_error", max_err},
-                     {"final_tracking_error", final_err},
-                     {"max_abs_tau", max_tau},
-                     {"feedback",
-                      feedback ? Json{{"kp", kp},
-                                      {"kd", kd},
-                                      {"control",
-                                       mode == ControlMode::PerEvaluation ? "evaluation" : "hold"}}
-                               : Json(nullptr)}})
-              << "\n";
-  } else {
-    std::cout << "model: " << m.name << "\nquintic motion over " << T << " s, " << N
-              << " RK4 steps, "
-              << (feedback ? "computed torque with PD feedback (kp " + format_number(kp) + ", kd " +
-                                 format_number(kd) + ")\n"
-                           : std::string("feed-forward torques by inverse dynamics\n"))
-              << "max |tau|: " << max_tau << "\nmax |q_sim - q_ref|: " << max_err
-              << "\nfinal |q_sim - q_ref|: " << final_err << "\n";
-  }
+  print_track(a, m, T, N, fb, r);
   return 0;
 }
 
