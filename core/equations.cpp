@@ -279,6 +279,16 @@ Energy energy_levels(const Model& model, Workspace& ws, const VecX& q, const Vec
   return E;
 }
 
+// The spherical and free joints' velocity terms, out of the hot path of every other model: the
+// free rotors' h_a (core/joints/rotor.hpp) into `h`, times `sign_h`, and the dampers' −c θ̇
+// (core/joints/passive.hpp) into `Q`, times `sign_Q`.
+bool has_rate_terms(const Model& m) { return !m.free_rotors.empty() || !m.rate_dampers.empty(); }
+[[gnu::noinline]] void add_rate_terms(const Model& m, const VecX& qd, VecX& h, VecX& Q,
+                                      double sign_h = 1.0, double sign_Q = 1.0) {
+  add_rotor_bias(m, qd, sign_h, h);
+  add_rate_dampers(m, qd, sign_Q, Q);
+}
+
 }  // namespace
 
 EquationRoutes choose_equation_routes(const Model& model) {
@@ -346,8 +356,7 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
   require_state(model, "evaluate", q, &qd, "qd");
   require_size(model, "evaluate", "tau", tau, ArgumentKind::Actuation);
   model.routes.evaluate(model, ws, q, qd, tau);
-  add_rotor_bias(model, qd, 1.0, ws.h);
-  add_rate_dampers(model, qd, 1.0, ws.Q);
+  if (has_rate_terms(model)) add_rate_terms(model, qd, ws.h, ws.Q);
   if (model.springs.empty()) return;
   spring_forces(model, ws, q, qd);
   ws.Q += ws.Q_springs;
@@ -356,7 +365,7 @@ void evaluate(const Model& model, Workspace& ws, const VecX& q, const VecX& qd, 
 void evaluate_bias(const Model& model, Workspace& ws, const VecX& q, const VecX& qd) {
   require_state(model, "evaluate_bias", q, &qd, "qd");
   model.routes.evaluate_bias(model, ws, q, qd);
-  add_rotor_bias(model, qd, 1.0, ws.h);
+  if (!model.free_rotors.empty()) add_rotor_bias(model, qd, 1.0, ws.h);
 }
 
 namespace {
@@ -375,8 +384,7 @@ Status tree_accelerations(const Model& model, Workspace& ws, const VecX& q, cons
       ws.tau_applied.setZero(model.n());
     }
     if (tau.size()) ws.tau_applied += tau;  // (none: no actuation)
-    add_rotor_bias(model, qd, -1.0, ws.tau_applied);
-    add_rate_dampers(model, qd, 1.0, ws.tau_applied);
+    if (has_rate_terms(model)) add_rate_terms(model, qd, ws.tau_applied, ws.tau_applied, -1.0);
     applied = &ws.tau_applied;
   }
   const Status st = model.routes.forward_dynamics(model, ws, q, qd, *applied);
@@ -421,8 +429,7 @@ void inverse_dynamics(const Model& model, Workspace& ws, const VecX& q, const Ve
   require_state(model, "inverse_dynamics", q, &qd, "qd");
   require_size(model, "inverse_dynamics", "qdd", qdd, ArgumentKind::Rate);
   model.routes.inverse_dynamics(model, ws, q, qd, qdd);
-  add_rotor_bias(model, qd, 1.0, ws.tau);
-  add_rate_dampers(model, qd, -1.0, ws.tau);
+  if (has_rate_terms(model)) add_rate_terms(model, qd, ws.tau, ws.tau, 1.0, -1.0);
   if (model.springs.empty()) return;
   spring_forces(model, ws, q, qd);
   ws.tau -= ws.Q_springs;
