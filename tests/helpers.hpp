@@ -37,6 +37,18 @@ std::string arm_json(double k, double c = 0, double g = 0);
 std::string random_tree_json(unsigned seed, int bodies, double branching, bool prismatic,
                              double gravity = 9.81);
 
+// The model's own routes and the two whole alternatives (the transform T with node sweeps, and
+// composite inertias with Newton–Euler, both solved by Cholesky): what a relation is checked on.
+inline std::vector<RouteChoice> main_routes() {
+  return {{},
+          {.mass = MassRoute::Transform,
+           .force = ForceRoute::Nodes,
+           .dynamics = DynamicsRoute::Cholesky},
+          {.mass = MassRoute::Composite,
+           .force = ForceRoute::Bodies,
+           .dynamics = DynamicsRoute::Cholesky}};
+}
+
 // A random tree with every element type, fixed joints, springs, dampers, point loads and
 // torques, and (with `couplings`) joints that follow others linearly; with `several_rates`,
 // universal, planar, spherical and free joints in place of half the plain revolute ones, and a

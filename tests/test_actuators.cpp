@@ -271,13 +271,7 @@ VecX free_rotor_bias(const Model& a, const VecX& qd) {
 
 TEST_CASE("armature on a free joint: I_a on its six rates and I_a ω × v in h, on every route",
           "[actuators]") {
-  const RouteChoice routes[] = {{},
-                                {.mass = MassRoute::Transform,
-                                 .force = ForceRoute::Nodes,
-                                 .dynamics = DynamicsRoute::Cholesky},
-                                {.mass = MassRoute::Composite,
-                                 .force = ForceRoute::Bodies,
-                                 .dynamics = DynamicsRoute::Cholesky}};
+  const std::vector<RouteChoice> routes = main_routes();
   // `b` has no rotor; `c` only the free joints' removed (a law's coupled rotors add to h too).
   const auto check = [](const Model& a, const Model& b, const Model& c, unsigned seed) {
     check_rotors(a, b, seed);

@@ -263,14 +263,8 @@ void check_placements(const Case& c, std::mt19937& rng, const RouteChoice& route
 TEST_CASE("moving the whole mechanism (1e3 m, 1e6 m, turned) changes no answer, on every route",
           "[one-truth][placement]") {
   std::mt19937 rng(43);
-  std::srand(43);                               // (Eigen's random rotations)
-  const std::vector<RouteChoice> routes = {{},  // the model's own
-                                           {.mass = MassRoute::Transform,
-                                            .force = ForceRoute::Nodes,
-                                            .dynamics = DynamicsRoute::Cholesky},
-                                           {.mass = MassRoute::Composite,
-                                            .force = ForceRoute::Bodies,
-                                            .dynamics = DynamicsRoute::Cholesky}};
+  std::srand(43);  // (Eigen's random rotations)
+  const std::vector<RouteChoice> routes = main_routes();
   int checked = 0;
   for (const Case& c : mechanisms_of_every_kind(relation_count(6)))
     for (const RouteChoice& r : routes) {
