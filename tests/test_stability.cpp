@@ -73,14 +73,14 @@ TEST_CASE("a Baumgarte rate's stable step is each method's real-axis bound over 
   // simulate refuses a rate its method cannot follow, in one line, before any work (it ran for
   // minutes); just inside the bound the run is made.
   const std::string five_bar = model_path("five_bar.json");
-  for (const char* integrator : {"rk4", "euler", "dopri"}) {
+  for (const char* integrator : {"rk4", "euler", "dopri", "bdf"}) {
     const Run r = run("simulate " + five_bar + " --t-end 1 --integrator " +
                       std::string(integrator) + " --baumgarte 1e10");
     INFO(integrator << ": " << r.out);
     CHECK(r.code == 2);
-    CHECK_THAT(r.out,
-               Catch::Contains("--baumgarte 1e+10: the loops' residual decays at -1e+10") ||
-                   Catch::Contains("--baumgarte 1e+10: the loops' residual decays at −1e+10"));
+    CHECK_THAT(r.out, Catch::StartsWith("femdyn simulate: --baumgarte 1e+10: "));
+    const bool adaptive = std::string(integrator) == "dopri" || std::string(integrator) == "bdf";
+    CHECK((r.out.find("--max-steps (1e+07)") != std::string::npos) == adaptive);
   }
   CHECK(run("simulate " + five_bar + " --t-end 0.2 --integrator rk4 --dt 0.001 --baumgarte 2700")
             .code == 0);
