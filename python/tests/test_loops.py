@@ -5,6 +5,7 @@ mechanism reproduces the Test Set's reference at t = 0.03 through femdyn.simulat
 file validates against docs/model.schema.json."""
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -190,3 +191,13 @@ def test_every_model_file_follows_the_schema():
     bad["constraints"][0]["length"] = 1.0  # a ball has no length
     with pytest.raises(jsonschema.ValidationError):
         jsonschema.validate(bad, schema)
+
+
+@pytest.mark.parametrize("integrator, bound", [("rk4", "2.79e-10 s"), ("euler", "8.28e-11 s"),
+                                               ("dopri", "max_steps"), ("bdf", "max_steps")])
+def test_a_baumgarte_rate_the_method_cannot_follow_is_refused_as_on_the_command_line(integrator,
+                                                                                     bound):
+    """The same request rule as `femdyn simulate --baumgarte`: one ValueError naming the bound."""
+    m = femdyn.load(model_path("models/five_bar.json"))
+    with pytest.raises(ValueError, match=r"^baumgarte 1e\+10: .*" + re.escape(bound)):
+        femdyn.simulate(m, t_end=1.0, integrator=integrator, baumgarte=1e10)
