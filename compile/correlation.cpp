@@ -17,8 +17,6 @@
 namespace femdyn {
 namespace {
 
-constexpr const char* kAxis[] = {"x", "y", "z"};
-
 // The shallowest body on which a point of body b stays fixed: a point on a revolute axis, or
 // behind a fixed joint, moves with the parent too. Coincident element nodes thus share one
 // system node, as at the paper's hinges.
@@ -481,11 +479,6 @@ std::optional<MassMatrixProblem> mass_matrix_problem(const Model& m, bool list_i
 
 void check_mass_matrix(const Model& m) {
   if (const auto p = mass_matrix_problem(m)) throw ModelError(p->where, p->message);
-}
-
-std::string Model::dof_name_of(const SystemDof& d) const {
-  if (d.kind == DofKind::Translation) return nodes[d.carrier].label + "." + kAxis[d.axis];
-  return bodies[d.carrier].name + ".r" + kAxis[d.axis];
 }
 
 }  // namespace femdyn

@@ -277,4 +277,11 @@ struct Model {
   std::string dof_name_of(const SystemDof& d) const;  // e.g. "link2/tip.x" or "link2.rz"
 };
 
+// (Defined here, with the Model it names, not in compile/: core keeps its own symbols.)
+inline std::string Model::dof_name_of(const SystemDof& d) const {
+  static constexpr const char* kAxes[] = {"x", "y", "z"};
+  if (d.kind == DofKind::Translation) return nodes[d.carrier].label + "." + kAxes[d.axis];
+  return bodies[d.carrier].name + ".r" + kAxes[d.axis];
+}
+
 }  // namespace femdyn
