@@ -89,13 +89,10 @@ Status output_fits(const AtomicFile& out, const Model& m, const SimulationReques
   else
     return {};
   const double bytes = rows * (2.0 * m.n() + 5) * 24;
-  std::error_code ec;
-  const auto space =
-      std::filesystem::space(std::filesystem::absolute(out.temporary(), ec).parent_path(), ec);
-  if (ec || bytes <= static_cast<double>(space.available)) return {};
+  const double free = out.shortfall(bytes);
+  if (free == 0) return {};
   return {false, "the trajectory would take up to " + format_short(bytes / 1e9) + " GB (" +
-                     format_short(rows) + " rows) and the disk has " +
-                     format_short(static_cast<double>(space.available) / 1e9) +
+                     format_short(rows) + " rows) and the disk has " + format_short(free / 1e9) +
                      " GB free: write fewer rows (--every k or --sample-dt s)"};
 }
 

@@ -108,13 +108,9 @@ class TrackCsv {
  public:
   TrackCsv(const std::string& path, bool force, const Model& m, int steps) : out_(path, force) {
     const double bytes = (steps + 1.0) * (2.0 * m.n_q() + m.n() + 1) * 24;
-    std::error_code ec;
-    const auto space =
-        std::filesystem::space(std::filesystem::absolute(out_.temporary(), ec).parent_path(), ec);
-    if (!ec && bytes > static_cast<double>(space.available))
+    if (const double free = out_.shortfall(bytes); free > 0)
       throw CliError("--csv " + path + ": the table would take up to " + format_short(bytes / 1e9) +
-                     " GB and the disk has " +
-                     format_short(static_cast<double>(space.available) / 1e9) +
+                     " GB and the disk has " + format_short(free / 1e9) +
                      " GB free: fewer --steps");
     std::ostream& o = out_.stream();
     o.precision(12);
@@ -270,7 +266,6 @@ int cmd_track(int argc, char** argv) {
   else
     rk4.reset(0, q0, VecX::Zero(n), T);
   TrackResult r;
-  double &max_err = r.max_err, &max_tau = r.max_tau, &final_err = r.final_err;
   std::optional<TrackCsv> csv = open_csv(a, m, N);
   const InterruptGuard interrupt;
   for (int k = 0; k <= N; ++k) {
@@ -278,9 +273,9 @@ int cmd_track(int argc, char** argv) {
     tau(t, u);                                       // (and q_ref at t into qr)
     if (feedback) law(t, integ.q(), integ.qd(), u);  // the torque applied from t
     // |q_sim ⊖ q_ref|: rad or m (a ball's rotation: the angle of the rotation vector's entries)
-    final_err = configuration_difference(m, qr, integ.q()).cwiseAbs().maxCoeff();
-    max_err = std::max(max_err, final_err);
-    max_tau = std::max(max_tau, u.cwiseAbs().maxCoeff());
+    r.final_err = configuration_difference(m, qr, integ.q()).cwiseAbs().maxCoeff();
+    r.max_err = std::max(r.max_err, r.final_err);
+    r.max_tau = std::max(r.max_tau, u.cwiseAbs().maxCoeff());
     if (csv) csv->row(t, qr, u, integ.q());
     if (k == N) break;
     if (g_interrupted) {

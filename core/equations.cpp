@@ -376,7 +376,7 @@ namespace {
 Status tree_accelerations(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                           const VecX& tau) {
   const VecX* applied = &tau;
-  if (!model.springs.empty() || !model.free_rotors.empty() || !model.rate_dampers.empty()) {
+  if (!model.springs.empty() || has_rate_terms(model)) {
     if (!model.springs.empty()) {
       spring_forces(model, ws, q, qd);
       ws.tau_applied = ws.Q_springs;

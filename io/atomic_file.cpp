@@ -10,6 +10,14 @@
 
 namespace femdyn {
 
+double AtomicFile::shortfall(double bytes) const {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::space_info space = fs::space(fs::absolute(tmp_, ec).parent_path(), ec);
+  if (ec || bytes <= static_cast<double>(space.available)) return 0;
+  return static_cast<double>(space.available);
+}
+
 AtomicFile::AtomicFile(std::string path, bool replace) : path_(std::move(path)) {
   namespace fs = std::filesystem;
   std::error_code ec;

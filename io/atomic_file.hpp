@@ -27,6 +27,9 @@ class AtomicFile {
   void discard();  // removes the temporary file now
   const std::string& path() const { return path_; }
   const std::string& temporary() const { return tmp_; }
+  // The bytes free on the output's disk when `bytes` would not fit there, else 0 (also when the
+  // free space cannot be read): the one check of every writer that knows its size up front.
+  double shortfall(double bytes) const;
 
  private:
   std::string path_, tmp_;

@@ -98,17 +98,12 @@ py::array_t<double> table(const std::vector<double>& x, py::ssize_t cols) {
 // Ctrl-C inside a step (a long adaptive step, a Newton iteration): while it lives, the motion
 // asks Python's signal check every 20 ms of wall time, the GIL taken briefly; a pending signal
 // stops the step with Status::interrupted, its KeyboardInterrupt left set for the caller.
-struct CtrlC {
-  Motion& motion;
-  explicit CtrlC(Motion& m) : motion(m) {
-    motion.set_interrupt([] {
-      py::gil_scoped_acquire acquire;
-      return PyErr_CheckSignals() != 0;
-    });
-  }
-  ~CtrlC() { motion.set_interrupt({}); }
-  CtrlC(const CtrlC&) = delete;
-  CtrlC& operator=(const CtrlC&) = delete;
+struct CtrlC : Motion::InterruptScope {
+  explicit CtrlC(Motion& m)
+      : Motion::InterruptScope(m, [] {
+          py::gil_scoped_acquire acquire;
+          return PyErr_CheckSignals() != 0;
+        }) {}
 };
 
 class Simulator {

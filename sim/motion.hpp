@@ -53,6 +53,19 @@ class Motion {
     interrupt_ = std::move(requested);
     next_interrupt_look_ = {};
   }
+  // set_interrupt for a scope: the request asked while it lives, none after, however it ends.
+  class InterruptScope {
+   public:
+    InterruptScope(Motion& motion, std::function<bool()> requested) : motion_(motion) {
+      motion_.set_interrupt(std::move(requested));
+    }
+    ~InterruptScope() { motion_.set_interrupt({}); }
+    InterruptScope(const InterruptScope&) = delete;
+    InterruptScope& operator=(const InterruptScope&) = delete;
+
+   private:
+    Motion& motion_;
+  };
 
   const Model& model() const { return model_; }
   int n() const { return model_.n(); }

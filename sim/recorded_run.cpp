@@ -117,11 +117,7 @@ RecordedRun run_recorded(Integrator& integ, double t_end, long every,
   const auto output = [&] { row(integ, watch.at_row(integ)); };
   // `stop` is also asked inside the steps (at most every 20 ms: Motion::set_interrupt), so that a
   // long adaptive step or a long span between outputs ends at once.
-  struct Hook {
-    Motion& motion;
-    ~Hook() { motion.set_interrupt({}); }
-  } hook{integ.motion()};
-  integ.motion().set_interrupt([&] { return stop(integ.t()); });
+  const Motion::InterruptScope inside_steps(integ.motion(), [&] { return stop(integ.t()); });
   const auto interrupted = [&] {
     if (!r.status.interrupted) return false;
     r.status = {};
