@@ -12,6 +12,7 @@
 #include "python/run_stats.hpp"
 #include "sim/control_loop.hpp"
 #include "sim/run_report.hpp"
+#include "sim/simulation_request.hpp"
 
 namespace femdyn::python {
 namespace {
@@ -106,15 +107,30 @@ struct CtrlC : Motion::InterruptScope {
         }) {}
 };
 
+// Closed loops' Baumgarte rate against the stepper, as femdyn.simulate asks it
+// (sim/simulation_request.hpp): a ValueError where the method cannot follow it over `t_end`
+// (0 at construction: the fixed step's bound alone).
+void check_baumgarte_rate(const Model& m, const IntegratorOptions& o, double t_end) {
+  static const Door python{[](std::string_view name) { return std::string(name); },
+                           [](double bytes) { return set_max_memory_text(bytes); }};
+  try {
+    check_baumgarte(m, o, std::nullopt, t_end, python);
+  } catch (const RequestError& e) {
+    throw py::value_error(e.what());
+  }
+}
+
 class Simulator {
  public:
   Simulator(const PyModel& model, const std::string& integrator, double dt,
             std::optional<long> substeps, std::optional<double> rtol, std::optional<double> atol,
             const OptArray& q0, const OptArray& qd0)
       : model_(model.model),
+        options_(stepper_options(integrator, dt, substeps, rtol, atol)),
         loop_(std::make_unique<ControlLoop>(
-            *model_, stepper_options(integrator, dt, substeps, rtol, atol),
+            *model_, options_,
             ControlLoopOptions{.mode = ControlMode::PerEvaluation, .period = dt})) {
+    check_baumgarte_rate(*model_, options_, 0);
     reset(q0, qd0, 0);
   }
 
@@ -161,6 +177,7 @@ class Simulator {
     if (!(t_end >= integ.t()) || t_end > 1e9)
       throw py::value_error("t_end: expected a time in [t, 1e9] s, t = " + format_short(integ.t()));
     if (Status plan = integ.plan(t_end); !plan.ok) throw py::value_error(plan.message);
+    check_baumgarte_rate(*model_, options_, t_end - integ.t());
     const Model& m = *model_;
     // Memory, before any is allocated: a row a period, n_q + 3n + 2 numbers, held in growing
     // vectors and then copied into arrays (twice that at the end).
@@ -294,6 +311,7 @@ class Simulator {
   }
 
   std::shared_ptr<const Model> model_;
+  IntegratorOptions options_;
   std::unique_ptr<ControlLoop> loop_;
   bool running_ = false;
 };

@@ -61,48 +61,6 @@ void check_tau(const Model& model, const SimulationRequest& r, const Door& door)
       throw RequestError(option + ": " + bad);
 }
 
-// A Baumgarte rate ω the method cannot follow, refused before any work: the closed loops'
-// residual decays as ë + 2ω ė + ω² e = 0 (a double eigenvalue −ω), so a fixed step beyond that
-// mode's stable step diverges at once, and an explicit adaptive method takes steps no longer
-// than it (dopri: about 3.3/ω): a run needing more than max_steps of them. BDF is stable at any
-// ω but, its error test and the projection's restarts following the residual, was measured to
-// take about ω t / 10 steps from ω = 1e4 on (the five-bar: 1,669 steps a second at 1e4, 380,941
-// at 1e6, 933,607 at 1e7; Andrews' mechanism 1.5e5 a second at 1e6): refused beyond max_steps.
-void check_baumgarte(const Model& model, const SimulationRequest& r, const Door& door) {
-  const double w = r.baumgarte.value_or(Motion::kDefaultBaumgarte);
-  if (model.constraints.empty() || !(w > 0)) return;
-  const IntegratorOptions& o = r.options;
-  const std::string rate = r.baumgarte ? door.option("baumgarte") + " " + format_short(w)
-                                       : "the Baumgarte rate " + format_short(w) + " 1/s";
-  if (o.kind == IntegratorKind::Bdf) {
-    if (const double steps = r.t_end * w / 10; steps > static_cast<double>(o.adaptive.max_steps))
-      throw RequestError(rate + ": bdf, stable at any rate, still follows the loops' residual " +
-                         "with about ω t / 10 steps (measured): " + format_short(steps) +
-                         " steps, beyond " + door.option("max_steps") + " (" +
-                         format_short(static_cast<double>(o.adaptive.max_steps)) +
-                         "); lower the rate (20 to 1000 1/s hold most loops)");
-    return;
-  }
-  const std::optional<double> h = baumgarte_stable_step(w, o.kind);
-  if (!h || !std::isfinite(*h)) return;
-  const std::string mode = ": the loops' residual decays at −" + format_short(w) + " 1/s, which " +
-                           integrator_name(o.kind) + " follows only at steps ≤ " +
-                           format_short(*h) + " s";
-  if (!is_adaptive(o.kind)) {
-    if (o.fixed.dt > *h)
-      throw RequestError(rate + mode + ", and " + door.option("dt") + " is " +
-                         format_short(o.fixed.dt) + " s: lower the rate to ≤ " +
-                         format_short(w * *h / o.fixed.dt) + " 1/s or the step");
-    return;
-  }
-  const double steps = r.t_end / *h;
-  if (steps > static_cast<double>(o.adaptive.max_steps))
-    throw RequestError(rate + mode + ": at least " + format_short(steps) + " steps, beyond " +
-                       door.option("max_steps") + " (" +
-                       format_short(static_cast<double>(o.adaptive.max_steps)) +
-                       "); lower the rate (20 to 1000 1/s hold most loops) or use bdf");
-}
-
 // The run's matrices, the sample times and the rows a door holds, before any is allocated.
 void check_memory(const Model& model, const SimulationRequest& r, const Door& door) {
   const IntegratorOptions& o = r.options;
@@ -168,6 +126,48 @@ IntegratorOptions integrator_options(const IntegratorChoice& c, const Door& door
   return o;
 }
 
+// A Baumgarte rate ω the method cannot follow, refused before any work: the closed loops'
+// residual decays as ë + 2ω ė + ω² e = 0 (a double eigenvalue −ω), so a fixed step beyond that
+// mode's stable step diverges at once, and an explicit adaptive method takes steps no longer
+// than it (dopri: about 3.3/ω): a run needing more than max_steps of them. BDF is stable at any
+// ω but, its error test and the projection's restarts following the residual, was measured to
+// take about ω t / 10 steps from ω = 1e4 on (the five-bar: 1,669 steps a second at 1e4, 380,941
+// at 1e6, 933,607 at 1e7; Andrews' mechanism 1.5e5 a second at 1e6): refused beyond max_steps.
+void check_baumgarte(const Model& model, const IntegratorOptions& o, std::optional<double> given,
+                     double t_end, const Door& door) {
+  const double w = given.value_or(Motion::kDefaultBaumgarte);
+  if (model.constraints.empty() || !(w > 0)) return;
+  const std::string rate = given ? door.option("baumgarte") + " " + format_short(w)
+                                 : "the Baumgarte rate " + format_short(w) + " 1/s";
+  if (o.kind == IntegratorKind::Bdf) {
+    if (const double steps = t_end * w / 10; steps > static_cast<double>(o.adaptive.max_steps))
+      throw RequestError(rate + ": bdf, stable at any rate, still follows the loops' residual " +
+                         "with about ω t / 10 steps (measured): " + format_short(steps) +
+                         " steps, beyond " + door.option("max_steps") + " (" +
+                         format_short(static_cast<double>(o.adaptive.max_steps)) +
+                         "); lower the rate (20 to 1000 1/s hold most loops)");
+    return;
+  }
+  const std::optional<double> h = baumgarte_stable_step(w, o.kind);
+  if (!h || !std::isfinite(*h)) return;
+  const std::string mode = ": the loops' residual decays at −" + format_short(w) + " 1/s, which " +
+                           integrator_name(o.kind) + " follows only at steps ≤ " +
+                           format_short(*h) + " s";
+  if (!is_adaptive(o.kind)) {
+    if (o.fixed.dt > *h)
+      throw RequestError(rate + mode + ", and " + door.option("dt") + " is " +
+                         format_short(o.fixed.dt) + " s: lower the rate to ≤ " +
+                         format_short(w * *h / o.fixed.dt) + " 1/s or the step");
+    return;
+  }
+  const double steps = t_end / *h;
+  if (steps > static_cast<double>(o.adaptive.max_steps))
+    throw RequestError(rate + mode + ": at least " + format_short(steps) + " steps, beyond " +
+                       door.option("max_steps") + " (" +
+                       format_short(static_cast<double>(o.adaptive.max_steps)) +
+                       "); lower the rate (20 to 1000 1/s hold most loops) or use bdf");
+}
+
 StateAssembly check_request(const Model& model, SimulationRequest& r, const Door& door) {
   if (!(r.t_end > 0) || r.t_end > 1e9)
     throw RequestError(door.option("t_end") + " expects a time in (0, 1e9] s");
@@ -178,7 +178,7 @@ StateAssembly check_request(const Model& model, SimulationRequest& r, const Door
     if (!(*r.baumgarte >= 0) || !std::isfinite(*r.baumgarte))
       throw RequestError(door.option("baumgarte") + " expects a rate >= 0 (1/s; 0: off)");
   }
-  check_baumgarte(model, r, door);
+  check_baumgarte(model, r.options, r.baumgarte, r.t_end, door);
   check_tau(model, r, door);
   check_memory(model, r, door);
   if (r.sample_dt) r.times = sample_times(r.t_end, *r.sample_dt);

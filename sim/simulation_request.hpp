@@ -68,6 +68,12 @@ struct SimulationRequest {
   bool driven() const { return static_cast<bool>(tau); }
 };
 
+// Closed loops' Baumgarte rate ω (nullopt: the default) against the method that must follow it
+// over a run of t_end (0: a stepper whose end is not known yet: the fixed step's bound alone):
+// RequestError where it cannot (simulation_request.cpp); every door that runs a model asks it.
+void check_baumgarte(const Model& model, const IntegratorOptions& options,
+                     std::optional<double> rate, double t_end, const Door& door);
+
 // The request's rules, before any work (RequestError, or MemoryRefused for the memory). With
 // closed loops, q0 and qd0 are then assembled onto the constraints (StateError where they
 // cannot be) and the assembly is returned; `times` is filled from sample_dt.

@@ -201,3 +201,17 @@ def test_a_baumgarte_rate_the_method_cannot_follow_is_refused_as_on_the_command_
     m = femdyn.load(model_path("models/five_bar.json"))
     with pytest.raises(ValueError, match=r"^baumgarte 1e\+10: .*" + re.escape(bound)):
         femdyn.simulate(m, t_end=1.0, integrator=integrator, baumgarte=1e10)
+
+
+def test_the_simulator_refuses_the_same_baumgarte_rate_as_simulate():
+    """One truth: the Simulator's fixed step answers as femdyn.simulate for the same loop model
+    (the default rate 20 1/s under rk4 needs a step ≤ 0.139 s), and a short step runs."""
+    m = femdyn.load(model_path("models/five_bar.json"))
+    with pytest.raises(ValueError) as run_error:
+        femdyn.simulate(m, t_end=1.0, integrator="rk4", dt=0.5)
+    with pytest.raises(ValueError) as sim_error:
+        femdyn.Simulator(m, integrator="rk4", dt=0.5)
+    assert str(sim_error.value) == str(run_error.value)
+    assert "the Baumgarte rate 20 1/s" in str(sim_error.value)
+    sim = femdyn.Simulator(m, integrator="rk4", dt=0.01)
+    sim.step(np.zeros(m.n))
