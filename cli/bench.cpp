@@ -22,11 +22,11 @@
 
 #include "cli/commands.hpp"
 #include "core/derivatives/derivatives.hpp"
-#include "core/equations.hpp"
+#include "core/dynamics/equations.hpp"
 #include "core/joints/passive.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/loops/constrained_dynamics.hpp"
-#include "core/math.hpp"
-#include "core/sampling.hpp"
+#include "core/spatial/math.hpp"
 #include "io/output.hpp"
 #include "io/urdf_loader.hpp"
 #ifdef FEMDYN_WITH_MUJOCO
@@ -61,7 +61,7 @@ engines and the ratio Simbody / femdyn (above 1: femdyn is faster):
        the residual with the applied forces and q̈ = 0
   Q    femdyn: evaluate(), M^s, h and Q together (its entry point that assembles Q); Simbody:
        realize Dynamics, calcM and the residual with the applied forces (h − Q)
-  qdd  femdyn forward_dynamics(), by the model's route (core/equations.hpp); Simbody: realize
+  qdd  femdyn forward_dynamics(), by the model's route (core/dynamics/equations.hpp); Simbody: realize
        Dynamics, calcAccelerationIgnoringConstraints (calcAcceleration on a coupled model)
   tau  femdyn inverse_dynamics(); Simbody: the residual with the applied forces and q̈
   qdd_c  (a model with loop constraints) the constrained q̈: femdyn

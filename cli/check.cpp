@@ -14,9 +14,9 @@
 
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/loops/assembly.hpp"
-#include "core/memory.hpp"
-#include "core/sampling.hpp"
+#include "core/workspace/memory.hpp"
 #include "io/output.hpp"
 #include "sim/stability.hpp"
 #include "sim/step_trial.hpp"

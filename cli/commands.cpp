@@ -7,12 +7,12 @@
 #include <iostream>
 
 #include "compile/correlation.hpp"
-#include "core/equations.hpp"
-#include "core/limits.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/loops/assembly.hpp"
-#include "core/memory.hpp"
-#include "core/names.hpp"
-#include "core/sampling.hpp"
+#include "core/model/limits.hpp"
+#include "core/model/names.hpp"
+#include "core/workspace/memory.hpp"
 #include "io/model_loader.hpp"
 #include "io/output.hpp"
 

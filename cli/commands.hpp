@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "core/errors.hpp"
+#include "core/model/errors.hpp"
 #include "io/model_loader.hpp"
 
 namespace femdyn::cli {
@@ -50,13 +50,13 @@ Model load(const Args& a, std::size_t count = 1);  // the first positional; expe
 // inertia, in one line ("" when M^s is regular).
 Model load_description(const Args& a, std::string& singular);
 // --max-memory GB (a number > 0, below 1e9) as bytes, or 0 when absent: the memory limit's
-// default, half the available memory (core/memory.hpp).
+// default, half the available memory (core/workspace/memory.hpp).
 double max_memory(const Args& a);
 // The memory `numbers` printed numbers take at most on the way out (as text: 18 bytes each in a
 // stream of up to twice its text, copied out; --json: a JSON value each, then its text).
 double printed_bytes(double numbers, bool json);
 // Refuses, before any work, a command whose estimate `bytes` exceeds the memory limit
-// (--max-memory, core/memory.hpp), naming the model file and `what`.
+// (--max-memory, core/workspace/memory.hpp), naming the model file and `what`.
 void require_command_memory(const Args& a, const std::string& what, double bytes);
 
 int cmd_info(int argc, char** argv);

@@ -10,8 +10,8 @@
 #include <sstream>
 
 #include "cli/commands.hpp"
-#include "core/equations.hpp"
-#include "core/sampling.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "io/output.hpp"
 
 namespace femdyn::cli {

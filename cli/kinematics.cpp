@@ -1,17 +1,18 @@
 // femdyn kinematics: the pose, Jacobian, velocity and J̇v of named frames at a state
-// (core/frames.hpp), the centre of mass and the centroidal momentum (core/momentum.hpp), and on
-// a free-floating tree each frame's generalized Jacobian — what a controller asks of the model.
-#include "core/kinematics.hpp"
+// (core/kinematics/frames.hpp), the centre of mass and the centroidal momentum
+// (core/kinematics/momentum.hpp), and on a free-floating tree each frame's generalized Jacobian —
+// what a controller asks of the model.
+#include "core/kinematics/kinematics.hpp"
 
 #include <iostream>
 #include <sstream>
 
 #include "cli/commands.hpp"
-#include "core/errors.hpp"
-#include "core/frames.hpp"
-#include "core/memory.hpp"
-#include "core/momentum.hpp"
-#include "core/names.hpp"
+#include "core/kinematics/frames.hpp"
+#include "core/kinematics/momentum.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/names.hpp"
+#include "core/workspace/memory.hpp"
 #include "io/output.hpp"
 
 namespace femdyn::cli {
@@ -73,7 +74,7 @@ std::vector<int> chosen_frames(const Args& a, const Model& m) {
   return out;
 }
 
-// Whether the model is one tree on a free joint (core/momentum.hpp): then J* is printed.
+// Whether the model is one tree on a free joint (core/kinematics/momentum.hpp): then J* is printed.
 bool floating_tree(const Model& m) {
   try {
     floating_base_rate(m);

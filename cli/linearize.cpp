@@ -8,9 +8,9 @@
 
 #include "cli/commands.hpp"
 #include "core/derivatives/derivatives.hpp"
-#include "core/equations.hpp"
-#include "core/memory.hpp"
-#include "core/names.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/model/names.hpp"
+#include "core/workspace/memory.hpp"
 #include "io/output.hpp"
 
 namespace femdyn::cli {

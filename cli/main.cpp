@@ -4,9 +4,9 @@
 #include <string>
 
 #include "cli/commands.hpp"
-#include "core/errors.hpp"
-#include "core/memory.hpp"
-#include "core/names.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/names.hpp"
+#include "core/workspace/memory.hpp"
 
 namespace {
 
@@ -101,7 +101,7 @@ int main(int argc, char** argv) {
     return 1;
   } catch (const std::bad_alloc&) {
     // The last line of defence: work that allocates by input size is estimated and refused up
-    // front (core/memory.hpp); what no estimate foresaw is still one line of femdyn's.
+    // front (core/workspace/memory.hpp); what no estimate foresaw is still one line of femdyn's.
     std::cerr << "femdyn " << cmd << ": " << femdyn::out_of_memory_text("running " + cmd) << "\n";
     return 1;
   } catch (const std::exception& e) {

@@ -19,7 +19,7 @@
 #include <thread>
 
 #include "cli/commands.hpp"
-#include "core/sampling.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "io/atomic_file.hpp"
 #include "io/csv.hpp"
 #include "io/output.hpp"

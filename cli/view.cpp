@@ -3,7 +3,7 @@
 #include <iostream>
 
 #include "cli/commands.hpp"
-#include "core/names.hpp"
+#include "core/model/names.hpp"
 #include "io/atomic_file.hpp"
 #include "io/model_loader.hpp"
 #include "view/page.hpp"

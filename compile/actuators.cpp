@@ -3,10 +3,10 @@
 #include <cmath>
 #include <vector>
 
-#include "core/errors.hpp"
 #include "core/joints/kernel.hpp"
-#include "core/limits.hpp"
-#include "core/names.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/limits.hpp"
+#include "core/model/names.hpp"
 
 namespace femdyn {
 namespace {

@@ -1,10 +1,10 @@
 // A joint's actuator, friction and stop (JointSpec -> Joint, checked), and what the model
-// derives from them once (core/model.hpp: the rotors' M_a, the effort limits on q).
+// derives from them once (core/model/model.hpp: the rotors' M_a, the effort limits on q).
 #pragma once
 #include <string>
 
 #include "compile/spec.hpp"
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 
 namespace femdyn {
 

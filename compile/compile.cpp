@@ -10,14 +10,14 @@
 #include "compile/compile_level.hpp"
 #include "compile/correlation.hpp"
 #include "compile/loops.hpp"
-#include "core/body_inertia.hpp"
-#include "core/errors.hpp"
+#include "core/dynamics/body_inertia.hpp"
 #include "core/joints/kernel.hpp"
 #include "core/joints/rotation.hpp"
-#include "core/limits.hpp"
-#include "core/mass_solver.hpp"
-#include "core/model.hpp"
-#include "core/names.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/limits.hpp"
+#include "core/model/model.hpp"
+#include "core/model/names.hpp"
+#include "core/workspace/mass_solver.hpp"
 
 namespace femdyn {
 namespace {
@@ -256,7 +256,7 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
       ++stack.back().second;
     }
   }
-  // The hot path's form of C (core/coupling.hpp).
+  // The hot path's form of C (core/kinematics/coupling.hpp).
   std::vector<Eigen::Triplet<double>> entries;
   bool identity = nt == n && m.theta0.isZero(0);
   for (int t = 0; t < nt; ++t)

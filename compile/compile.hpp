@@ -1,8 +1,8 @@
 // compile(): a mechanism as described (compile/spec.hpp) into an immutable Model
-// (core/model.hpp), by the passes of compile/compile.cpp.
+// (core/model/model.hpp), by the passes of compile/compile.cpp.
 #pragma once
 #include "compile/spec.hpp"
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 
 namespace femdyn {
 

@@ -6,12 +6,12 @@
 #include <numbers>
 
 #include "compile/actuators.hpp"
-#include "core/errors.hpp"
 #include "core/joints/kernel.hpp"
-#include "core/kinematics.hpp"
-#include "core/names.hpp"
-#include "core/sampling.hpp"
-#include "core/workspace.hpp"
+#include "core/kinematics/kinematics.hpp"
+#include "core/kinematics/sampling.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/names.hpp"
+#include "core/workspace/workspace.hpp"
 
 namespace femdyn {
 

@@ -1,11 +1,11 @@
-// compile() for a mechanism with a nonlinear coupling law (core/coupling_level.hpp): the tree
+// compile() for a mechanism with a nonlinear coupling law (core/model/coupling_level.hpp): the tree
 // of every joint is compiled twice from the spec (once as Model::tree, once as the model
 // itself), and the model's coordinates become the joints that no coupling sets.
 #pragma once
 #include "compile/compile.hpp"
 #include "compile/spec.hpp"
-#include "core/model.hpp"
-#include "core/workspace.hpp"
+#include "core/model/model.hpp"
+#include "core/workspace/workspace.hpp"
 
 namespace femdyn {
 

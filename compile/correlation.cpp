@@ -6,13 +6,13 @@
 #include <random>
 #include <tuple>
 
-#include "core/equations.hpp"
-#include "core/errors.hpp"
+#include "core/dynamics/equations.hpp"
 #include "core/joints/kernel.hpp"
-#include "core/kinematics.hpp"
-#include "core/limits.hpp"
-#include "core/names.hpp"
-#include "core/sampling.hpp"
+#include "core/kinematics/kinematics.hpp"
+#include "core/kinematics/sampling.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/limits.hpp"
+#include "core/model/names.hpp"
 
 namespace femdyn {
 namespace {

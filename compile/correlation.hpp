@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "compile/spec.hpp"
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 
 namespace femdyn {
 

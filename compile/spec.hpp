@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "core/coupling_function.hpp"
-#include "core/element.hpp"
-#include "core/joints/joint_type.hpp"
+#include "core/model/coupling_function.hpp"
+#include "core/model/element.hpp"
+#include "core/model/joint_type.hpp"
 
 namespace femdyn {
 
@@ -103,7 +103,7 @@ struct AttachmentSpec {
   std::string where;
 };
 
-// A loop-closure constraint (core/loops/constraint.hpp; docs/model-format.md#constraints).
+// A loop-closure constraint (core/model/loop_constraint.hpp; docs/model-format.md#constraints).
 struct ConstraintSpec {
   std::string name;
   std::string type;          // ball, weld, distance, point_on_line, point_on_plane, gear
@@ -117,7 +117,7 @@ struct ConstraintSpec {
   std::string where;
 };
 
-// A linear spring-damper between two places (core/springs.hpp).
+// A linear spring-damper between two places (core/dynamics/springs.hpp).
 struct SpringSpec {
   std::string name;
   AttachmentSpec a, b;

@@ -1,6 +1,6 @@
 #include "elements/rigid_body.hpp"
 
-#include "core/inertia.hpp"
+#include "core/spatial/inertia.hpp"
 #include "elements/lumped_point.hpp"
 #include "elements/rotary_node.hpp"
 

@@ -2,7 +2,7 @@
 // (body frame), as in URDF. Loading turns it into equivalent elements with the same
 // pseudo-inertia P:
 //   "equivalent": "point_rotary" (default)  lumped_point m at c + rotary_node I_c at c
-//   "equivalent": "four_points"             four lumped points m/4 (core/inertia.hpp)
+//   "equivalent": "four_points"             four lumped points m/4 (core/spatial/inertia.hpp)
 #pragma once
 #include "elements/registry.hpp"
 

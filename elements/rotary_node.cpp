@@ -1,6 +1,6 @@
 #include "elements/rotary_node.hpp"
 
-#include "core/inertia.hpp"
+#include "core/spatial/inertia.hpp"
 
 namespace femdyn {
 

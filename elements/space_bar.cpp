@@ -1,6 +1,6 @@
 #include "elements/space_bar.hpp"
 
-#include "core/inertia.hpp"
+#include "core/spatial/inertia.hpp"
 
 namespace femdyn {
 

@@ -5,10 +5,10 @@
 #include <fstream>
 #include <string_view>
 
-#include "core/errors.hpp"
-#include "core/limits.hpp"
-#include "core/memory.hpp"
-#include "core/names.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/limits.hpp"
+#include "core/model/names.hpp"
+#include "core/workspace/memory.hpp"
 #include "io/csv.hpp"
 #include "io/input_file.hpp"
 

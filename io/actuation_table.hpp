@@ -7,14 +7,15 @@
 #include <string>
 #include <vector>
 
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 
 namespace femdyn {
 
 class ActuationTable {
  public:
-  // Throws ModelError ("FILE:LINE: …") on a malformed file, MemoryRefused (core/memory.hpp)
-  // when its rows would need more memory than the limit (`memory_given` bytes, 0: the default).
+  // Throws ModelError ("FILE:LINE: …") on a malformed file, MemoryRefused
+  // (core/workspace/memory.hpp) when its rows would need more memory than the limit (`memory_given`
+  // bytes, 0: the default).
   ActuationTable(const std::string& path, const Model& model, double memory_given = 0);
   // The same from the file's text; `path` names it in errors (the CSV fuzz target).
   struct FromText {};

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "core/errors.hpp"
+#include "core/model/errors.hpp"
 
 namespace femdyn {
 

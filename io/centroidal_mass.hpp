@@ -4,7 +4,7 @@
 #pragma once
 #include <string>
 
-#include "core/math.hpp"
+#include "core/spatial/math.hpp"
 
 namespace femdyn {
 

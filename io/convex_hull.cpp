@@ -8,7 +8,7 @@ extern "C" {
 #include <libqhull_r/qhull_ra.h>
 }
 
-#include "core/errors.hpp"
+#include "core/model/errors.hpp"
 
 namespace femdyn {
 namespace {

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/names.hpp"
+#include "core/model/names.hpp"
 
 namespace femdyn {
 namespace {

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "core/errors.hpp"
+#include "core/model/errors.hpp"
 
 namespace femdyn {
 namespace {

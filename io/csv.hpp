@@ -3,7 +3,7 @@
 // with each double quote in it doubled; every other field as it is. So a coordinate named "a,b"
 // stays one column: `t,"q_a,b",…`. The readers (--tau-csv, io/actuation_table; the trajectory,
 // io/trajectory_csv) take quoted and unquoted fields. A line break inside quotes is not read:
-// femdyn's names cannot hold one (core/names.hpp).
+// femdyn's names cannot hold one (core/model/names.hpp).
 #pragma once
 #include <string>
 #include <string_view>

@@ -7,7 +7,7 @@
 #include <cerrno>
 #include <cstring>
 
-#include "core/limits.hpp"
+#include "core/model/limits.hpp"
 
 namespace femdyn {
 

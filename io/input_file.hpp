@@ -1,6 +1,6 @@
 // Reading an input file (model, URDF, actuation table) safely: only a regular file is read (a
 // FIFO, device, socket or directory is refused before anything blocks), and at most
-// kMaxFileBytes (core/limits.hpp). Errors are ModelError naming the path.
+// kMaxFileBytes (core/model/limits.hpp). Errors are ModelError naming the path.
 #pragma once
 #include <string>
 

@@ -3,8 +3,8 @@
 
 #include <cctype>
 
-#include "core/errors.hpp"
-#include "core/limits.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/limits.hpp"
 
 namespace femdyn {
 namespace {
@@ -85,7 +85,7 @@ JsonOutline outline(const std::string& text) {
 // The text as JSON, its nesting and body count bounded first; malformed JSON named by line and
 // column.
 Json parse_json(const std::string& text, const std::string& source) {
-  // The nesting depth and the number of bodies are bounded (core/limits.hpp) by one pass over
+  // The nesting depth and the number of bodies are bounded (core/model/limits.hpp) by one pass over
   // the text, before a deep or huge document can cost anything.
   const JsonOutline shape = outline(text);
   if (shape.too_deep)

@@ -1,5 +1,5 @@
 // A model file's JSON text read safely: its nesting depth and number of bodies bounded by one
-// linear pass before it is parsed (core/limits.hpp), malformed JSON named by line and column.
+// linear pass before it is parsed (core/model/limits.hpp), malformed JSON named by line and column.
 #pragma once
 #include <string>
 

@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <sstream>
 
-#include "core/errors.hpp"
+#include "core/model/errors.hpp"
 #include "io/input_file.hpp"
 
 namespace femdyn {

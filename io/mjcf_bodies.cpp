@@ -2,8 +2,8 @@
 #include <Eigen/Eigenvalues>
 #include <cstring>
 
-#include "core/inertia.hpp"
-#include "core/names.hpp"
+#include "core/model/names.hpp"
+#include "core/spatial/inertia.hpp"
 #include "io/mjcf_reading.hpp"
 
 namespace femdyn::mjcf {

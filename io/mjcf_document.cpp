@@ -5,9 +5,9 @@
 #include <cstring>
 #include <filesystem>
 
-#include "core/errors.hpp"
-#include "core/limits.hpp"
-#include "core/names.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/limits.hpp"
+#include "core/model/names.hpp"
 #include "io/input_file.hpp"
 #include "io/xml_error.hpp"
 

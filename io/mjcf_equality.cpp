@@ -11,7 +11,7 @@
 #include <algorithm>
 #include <cstring>
 
-#include "core/names.hpp"
+#include "core/model/names.hpp"
 #include "io/mjcf_reading.hpp"
 
 namespace femdyn::mjcf {

@@ -4,7 +4,7 @@
 #include <numbers>
 #include <vector>
 
-#include "core/names.hpp"
+#include "core/model/names.hpp"
 
 namespace femdyn::mjcf {
 

@@ -16,7 +16,7 @@
 #include <optional>
 #include <string>
 
-#include "core/math.hpp"
+#include "core/spatial/math.hpp"
 #include "io/mjcf_document.hpp"
 
 namespace femdyn::mjcf {

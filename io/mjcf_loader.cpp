@@ -7,8 +7,8 @@
 #include <numbers>
 #include <set>
 
-#include "core/limits.hpp"
-#include "core/names.hpp"
+#include "core/model/limits.hpp"
+#include "core/model/names.hpp"
 #include "io/mjcf_reading.hpp"
 
 namespace femdyn {

@@ -4,8 +4,8 @@
 #include <cstring>
 #include <filesystem>
 
-#include "core/errors.hpp"
-#include "core/names.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/names.hpp"
 #include "io/convex_hull.hpp"
 #include "io/mjcf_reading.hpp"
 

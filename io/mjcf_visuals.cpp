@@ -2,7 +2,7 @@
 #include <cstring>
 #include <filesystem>
 
-#include "core/errors.hpp"
+#include "core/model/errors.hpp"
 #include "io/mjcf_reading.hpp"
 
 namespace femdyn::mjcf {

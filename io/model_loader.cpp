@@ -8,8 +8,8 @@
 #include <sstream>
 
 #include "compile/compile.hpp"
-#include "core/limits.hpp"
-#include "core/names.hpp"
+#include "core/model/limits.hpp"
+#include "core/model/names.hpp"
 #include "io/catalog.hpp"
 #include "io/coupling_json.hpp"
 #include "io/input_file.hpp"

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "compile/compile.hpp"
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 #include "io/catalog.hpp"
 #include "io/params.hpp"
 

@@ -8,7 +8,7 @@
 #include <sstream>
 #include <system_error>
 
-#include "core/equations.hpp"
+#include "core/dynamics/equations.hpp"
 #include "core/joints/kernel.hpp"
 #include "io/atomic_file.hpp"
 

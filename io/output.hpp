@@ -5,8 +5,8 @@
 #include <vector>
 
 #include "core/loops/constrained_dynamics.hpp"
-#include "core/status.hpp"
-#include "core/workspace.hpp"
+#include "core/workspace/status.hpp"
+#include "core/workspace/workspace.hpp"
 #include "io/params.hpp"
 
 namespace femdyn {

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "core/names.hpp"
+#include "core/model/names.hpp"
 
 namespace femdyn {
 

@@ -6,8 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "core/errors.hpp"
-#include "core/math.hpp"
+#include "core/model/errors.hpp"
+#include "core/spatial/math.hpp"
 
 namespace femdyn {
 

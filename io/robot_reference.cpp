@@ -5,8 +5,8 @@
 #include <cctype>
 #include <filesystem>
 
-#include "core/errors.hpp"
-#include "core/names.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/names.hpp"
 #include "io/input_file.hpp"
 #include "io/json_text.hpp"
 #include "io/mjcf_loader.hpp"

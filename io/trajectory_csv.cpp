@@ -3,8 +3,8 @@
 #include <charconv>
 #include <sstream>
 
-#include "core/errors.hpp"
-#include "core/names.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/names.hpp"
 #include "io/csv.hpp"
 
 namespace femdyn {

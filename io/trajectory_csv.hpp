@@ -1,16 +1,16 @@
 // The trajectory CSV every command writes (femdyn simulate, study): one row per output time,
 //   t, q_<c>…, qd_<c>…, kinetic, potential, total, work
-// with the coordinate names from the model, energies in J (core/equations.hpp energy()) and
-// work = W, the work done by the non-conservative forces since t = 0 (sim/motion.hpp), so
-// that total(t) − total(0) = work(t) up to the integration error. Full double precision. The
-// header's fields are quoted where a name needs it (RFC 4180, io/csv.hpp): a coordinate "a,b"
-// is the one column "q_a,b".
+// with the coordinate names from the model, energies in J (core/dynamics/equations.hpp energy())
+// and work = W, the work done by the non-conservative forces since t = 0 (sim/motion.hpp), so that
+// total(t) − total(0) = work(t) up to the integration error. Full double precision. The header's
+// fields are quoted where a name needs it (RFC 4180, io/csv.hpp): a coordinate "a,b" is the one
+// column "q_a,b".
 #pragma once
 #include <ostream>
 #include <string>
 #include <vector>
 
-#include "core/equations.hpp"
+#include "core/dynamics/equations.hpp"
 
 namespace femdyn {
 

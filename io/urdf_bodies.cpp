@@ -2,8 +2,8 @@
 #include <algorithm>
 #include <optional>
 
-#include "core/inertia.hpp"
-#include "core/names.hpp"
+#include "core/model/names.hpp"
+#include "core/spatial/inertia.hpp"
 #include "io/centroidal_mass.hpp"
 #include "io/urdf_reading.hpp"
 

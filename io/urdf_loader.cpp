@@ -13,8 +13,8 @@
 #include <set>
 #include <sstream>
 
-#include "core/limits.hpp"
-#include "core/names.hpp"
+#include "core/model/limits.hpp"
+#include "core/model/names.hpp"
 #include "io/input_file.hpp"
 #include "io/urdf_reading.hpp"
 #include "io/xml_error.hpp"

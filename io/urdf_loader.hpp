@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "core/math.hpp"
+#include "core/spatial/math.hpp"
 #include "io/model_format.hpp"
 #include "io/params.hpp"
 #include "io/visual.hpp"

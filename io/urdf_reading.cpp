@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "core/names.hpp"
+#include "core/model/names.hpp"
 
 namespace femdyn::urdf_reading {
 

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "core/math.hpp"
+#include "core/model/errors.hpp"
+#include "core/spatial/math.hpp"
 #include "io/params.hpp"
 #include "io/urdf_loader.hpp"
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "core/math.hpp"
+#include "core/spatial/math.hpp"
 
 namespace femdyn {
 

@@ -3,10 +3,10 @@
 #include <cstdio>
 
 #include "compile/compile.hpp"
-#include "core/errors.hpp"
-#include "core/inertia.hpp"
-#include "core/limits.hpp"
-#include "core/names.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/limits.hpp"
+#include "core/model/names.hpp"
+#include "core/spatial/inertia.hpp"
 #include "elements/lumped_point.hpp"
 #include "elements/rigid_body.hpp"
 #include "elements/rod.hpp"

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "compile/spec.hpp"
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 
 namespace femdyn {
 
@@ -51,7 +51,7 @@ class MechanismBuilder {
   // θ_joint = Σ ratio_i θ_{follows_i} + offset.
   void coupling(const std::string& joint, const std::vector<std::pair<std::string, double>>& terms,
                 double offset = 0);
-  // θ_joint = law(θ_{follows_1}, …) (core/coupling_function.hpp).
+  // θ_joint = law(θ_{follows_1}, …) (core/model/coupling_function.hpp).
   void coupling(const std::string& joint, const std::vector<std::string>& follows,
                 std::shared_ptr<const CouplingFunction> law);
   // A coupling made elsewhere (e.g. read from its JSON form: io parse_coupling); its `where`

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "core/coupling_function.hpp"
+#include "core/model/coupling_function.hpp"
 
 namespace femdyn {
 namespace {

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <random>
 
-#include "core/math.hpp"
+#include "core/spatial/math.hpp"
 
 namespace femdyn {
 

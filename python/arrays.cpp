@@ -2,9 +2,9 @@
 
 #include <cmath>
 
-#include "core/limits.hpp"
-#include "core/names.hpp"
-#include "core/sampling.hpp"
+#include "core/kinematics/sampling.hpp"
+#include "core/model/limits.hpp"
+#include "core/model/names.hpp"
 
 namespace femdyn::python {
 

@@ -8,9 +8,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "core/errors.hpp"
-#include "core/frames.hpp"
-#include "core/model.hpp"
+#include "core/kinematics/frames.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/model.hpp"
 
 namespace femdyn::python {
 
@@ -30,7 +30,7 @@ std::string shape_text(const py::array& a);
 
 // What the entries of an argument may be. Bounded: a physical input (a state q, q̇, q̈, an
 // actuation τ), like the model's numbers and the CLI's --q, --qd, --tau and --tau-csv: finite
-// and |x| ≤ kMaxMagnitude (core/limits.hpp), one limit everywhere. Finite: any finite number.
+// and |x| ≤ kMaxMagnitude (core/model/limits.hpp), one limit everywhere. Finite: any finite number.
 enum class Entries { Finite, Bounded };
 
 // A state vector: shape (n,), every entry bounded (or finite if asked). Absent (None, where
@@ -58,7 +58,7 @@ RowMatX configuration_batch_arg(const Array& a, const char* name, const Model& m
 // as Python's open() refuses it: the system, and C++ code that takes C strings, would see only
 // the part before it ("a\0b.json" would open "a").
 const std::string& text_arg(const std::string& s, const char* name);
-// A frame by name (ValueError naming it), and a set of axes by name (core/frames.hpp).
+// A frame by name (ValueError naming it), and a set of axes by name (core/kinematics/frames.hpp).
 int frame_arg(const Model& model, const std::string& name);
 FrameAxes axes_arg(const std::string& text);
 const std::optional<std::string>& text_arg(const std::optional<std::string>& s, const char* name);

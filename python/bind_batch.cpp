@@ -6,13 +6,13 @@
 #include <limits>
 #include <optional>
 
-#include "core/equations.hpp"
-#include "core/frames.hpp"
-#include "core/kinematics.hpp"
-#include "core/memory.hpp"
-#include "core/momentum.hpp"
-#include "core/names.hpp"
-#include "core/sampling.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/frames.hpp"
+#include "core/kinematics/kinematics.hpp"
+#include "core/kinematics/momentum.hpp"
+#include "core/kinematics/sampling.hpp"
+#include "core/model/names.hpp"
+#include "core/workspace/memory.hpp"
 #include "python/derivative_rows.hpp"
 #include "python/parallel.hpp"
 #include "python/py_model.hpp"
@@ -63,7 +63,7 @@ struct RowState {
 };
 
 // Refuses a batch whose results (`per_row` bytes a row) and per-thread workspaces
-// (`per_thread`) exceed the memory limit (core/memory.hpp), before they are allocated.
+// (`per_thread`) exceed the memory limit (core/workspace/memory.hpp), before they are allocated.
 void require_batch_memory(const char* what, const Model& m, Eigen::Index k, int threads,
                           double per_row, double per_thread) {
   const double bytes = static_cast<double>(k) * per_row + threads * per_thread;
@@ -300,7 +300,7 @@ py::dict frame_kinematics_batch(const PyModel& self, const std::string& name, co
   return d;
 }
 
-// The centroidal quantities at k states (core/momentum.hpp), each with a leading k axis.
+// The centroidal quantities at k states (core/kinematics/momentum.hpp), each with a leading k axis.
 py::dict centroidal_batch(const PyModel& self, const Array& q, const OptArray& qd, int threads) {
   const Model& m = *self.model;
   const Batch b(m, q, qd, std::nullopt, "", Entries::Bounded);

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <variant>
 
-#include "core/names.hpp"
+#include "core/model/names.hpp"
 #include "io/model_loader.hpp"
 #include "models/builder.hpp"
 #include "python/py_model.hpp"

@@ -7,7 +7,7 @@
 #include <optional>
 
 #include "core/derivatives/derivatives.hpp"
-#include "core/equations.hpp"
+#include "core/dynamics/equations.hpp"
 #include "python/derivative_rows.hpp"
 #include "python/py_model.hpp"
 

@@ -8,7 +8,7 @@
 #include <optional>
 
 #include "core/loops/assembly.hpp"
-#include "core/names.hpp"
+#include "core/model/names.hpp"
 #include "python/py_model.hpp"
 
 namespace femdyn::python {

@@ -4,14 +4,14 @@
 
 #include <cmath>
 
-#include "core/equations.hpp"
-#include "core/frames.hpp"
-#include "core/kinematics.hpp"
-#include "core/limits.hpp"
-#include "core/memory.hpp"
-#include "core/momentum.hpp"
-#include "core/names.hpp"
-#include "core/sampling.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/frames.hpp"
+#include "core/kinematics/kinematics.hpp"
+#include "core/kinematics/momentum.hpp"
+#include "core/kinematics/sampling.hpp"
+#include "core/model/limits.hpp"
+#include "core/model/names.hpp"
+#include "core/workspace/memory.hpp"
 #include "io/model_loader.hpp"
 #include "io/output.hpp"
 #include "python/py_model.hpp"
@@ -97,7 +97,7 @@ VecX inverse(PyModel& self, const Array& q, const OptArray& qd, const OptArray& 
   return self.ws.tau;
 }
 
-// A frame's kinematics (core/frames.hpp) as a dict of numpy arrays.
+// A frame's kinematics (core/kinematics/frames.hpp) as a dict of numpy arrays.
 py::dict frame_of(PyModel& self, const std::string& name, const Array& q, const OptArray& qd,
                   const std::string& axes_text) {
   const Model& m = *self.model;
@@ -117,7 +117,7 @@ py::dict frame_of(PyModel& self, const std::string& name, const Array& q, const 
   return out;
 }
 
-// The mechanism's centre of mass and centroidal momentum (core/momentum.hpp) as a dict.
+// The mechanism's centre of mass and centroidal momentum (core/kinematics/momentum.hpp) as a dict.
 py::dict centroidal_dict(const MomentumKinematics& c) {
   py::dict out;
   out["mass"] = c.mass;

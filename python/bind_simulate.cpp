@@ -6,10 +6,10 @@
 #include <chrono>
 #include <cmath>
 
-#include "core/errors.hpp"
-#include "core/limits.hpp"
-#include "core/memory.hpp"
-#include "core/names.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/limits.hpp"
+#include "core/model/names.hpp"
+#include "core/workspace/memory.hpp"
 #include "io/actuation_table.hpp"
 #include "python/py_model.hpp"
 #include "python/run_stats.hpp"

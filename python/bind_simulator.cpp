@@ -7,7 +7,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "core/memory.hpp"
+#include "core/workspace/memory.hpp"
 #include "python/py_model.hpp"
 #include "python/run_stats.hpp"
 #include "sim/control_loop.hpp"

@@ -8,9 +8,9 @@
 #include <optional>
 #include <stdexcept>
 
-#include "core/errors.hpp"
-#include "core/memory.hpp"
-#include "core/message.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/message.hpp"
+#include "core/workspace/memory.hpp"
 #include "python/py_model.hpp"
 
 namespace {
@@ -32,8 +32,8 @@ void raise(PyObject* type, const char* what) {
 }
 
 // The last line of defence, as the command line's main() is: every C++ exception that reaches
-// Python gets a message made safe (core/message.hpp), with the Python type pybind11 would give
-// it. femdyn's own errors are safe already (femdyn::Error); ModelError and NumericalError have
+// Python gets a message made safe (core/model/message.hpp), with the Python type pybind11 would
+// give it. femdyn's own errors are safe already (femdyn::Error); ModelError and NumericalError have
 // their own translators, registered after this one and so tried first.
 void translate(std::exception_ptr p) {
   try {

@@ -7,7 +7,7 @@
 #include <thread>
 #include <vector>
 
-#include "core/workspace.hpp"
+#include "core/workspace/workspace.hpp"
 #include "python/arrays.hpp"
 
 namespace femdyn::python {

@@ -7,8 +7,8 @@
 
 #include "core/derivatives/derivatives.hpp"
 #include "core/loops/constrained_dynamics.hpp"
-#include "core/memory.hpp"
-#include "core/workspace.hpp"
+#include "core/workspace/memory.hpp"
+#include "core/workspace/workspace.hpp"
 #include "io/model_loader.hpp"
 #include "python/arrays.hpp"
 
@@ -50,7 +50,7 @@ void equations_at(const Model& model, Workspace& ws, LoopWorkspace* loops, const
 // naming `what`).
 void require_open_tree(const Model& model, const char* what);
 
-// How to raise the memory limit (core/memory.hpp) from Python far enough for `bytes`:
+// How to raise the memory limit (core/workspace/memory.hpp) from Python far enough for `bytes`:
 // "femdyn.set_max_memory(4.9) if that much memory is free".
 inline std::string set_max_memory_text(double bytes) {
   return "femdyn.set_max_memory(" + max_memory_gb(bytes) + ") if that much memory is free";

@@ -4,7 +4,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "core/limits.hpp"
+#include "core/model/limits.hpp"
 #include "sim/controller_diagnosis.hpp"
 
 namespace femdyn {
@@ -22,7 +22,8 @@ std::string tau_problem(const Model& model, const VecX& tau) {
     return "tau has " + std::to_string(tau.size()) + " entries, expected " + std::to_string(n);
   for (int i = 0; i < n; ++i) {
     if (!std::isfinite(tau[i])) return "tau is NaN or Inf (" + model.coordinate_names[i] + ")";
-    if (std::abs(tau[i]) > kMaxMagnitude)  // as --tau and every physical input (core/limits.hpp)
+    if (std::abs(tau[i]) >
+        kMaxMagnitude)  // as --tau and every physical input (core/model/limits.hpp)
       return "tau of '" + model.coordinate_names[i] + "' " + out_of_range_text(tau[i]);
   }
   return unactuated_problem(model, tau);

@@ -2,7 +2,7 @@
 
 #include <unsupported/Eigen/MatrixFunctions>
 
-#include "core/names.hpp"
+#include "core/model/names.hpp"
 #include "sim/stability.hpp"
 
 namespace femdyn {

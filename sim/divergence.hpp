@@ -25,7 +25,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/equations.hpp"
+#include "core/dynamics/equations.hpp"
 
 namespace femdyn {
 

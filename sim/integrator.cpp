@@ -4,8 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "core/errors.hpp"
-#include "core/memory.hpp"
+#include "core/model/errors.hpp"
+#include "core/workspace/memory.hpp"
 #include "sim/fixed_step.hpp"
 #include "sim/stability.hpp"
 #include "sim/sundials_integrators.hpp"

@@ -159,9 +159,9 @@ struct IntegratorOptions {  // what make_integrator reads: the one that applies 
   std::string check() const;
 };
 
-// The memory a run of `kind` holds besides its output rows (core/memory.hpp): the workspace
-// (evaluation_bytes where forward dynamics or the energy forms M^s), and bdf's dense
-// (2n + 1) x (2n + 1) Jacobian and its factor. For the estimate made before make_integrator.
+// The memory a run of `kind` holds besides its output rows (core/workspace/memory.hpp): the
+// workspace (evaluation_bytes where forward dynamics or the energy forms M^s), and bdf's dense (2n
+// + 1) x (2n + 1) Jacobian and its factor. For the estimate made before make_integrator.
 double integrator_bytes(const Model& model, IntegratorKind kind);
 
 // The integrator of options.kind for the model under τ(t). Throws std::invalid_argument with

@@ -6,8 +6,8 @@
 
 #include "core/joints/kernel.hpp"
 #include "core/joints/passive.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/loops/assembly.hpp"
-#include "core/sampling.hpp"
 
 namespace femdyn {
 

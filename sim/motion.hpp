@@ -17,9 +17,9 @@
 // with W the work done by the non-conservative forces (actuation τ saturated at the joints'
 // effort limits, joint dampers, Coulomb friction and stop dissipation, body torques)
 // and P_nc its power, so that E(t) − E(0) = W(t) for the mechanical energy E of
-// core/equations.hpp (docs/simulation.md). Every evaluation goes through forward_dynamics and is
-// checked: a singular or indefinite M^s, or a NaN/Inf in q̈, is a failed Status naming the time,
-// the quantity and the coordinate, never a NaN handed on.
+// core/dynamics/equations.hpp (docs/simulation.md). Every evaluation goes through forward_dynamics
+// and is checked: a singular or indefinite M^s, or a NaN/Inf in q̈, is a failed Status naming the
+// time, the quantity and the coordinate, never a NaN handed on.
 #pragma once
 #include <chrono>
 #include <exception>
@@ -27,7 +27,7 @@
 #include <memory>
 #include <vector>
 
-#include "core/equations.hpp"
+#include "core/dynamics/equations.hpp"
 #include "core/loops/constrained_dynamics.hpp"
 
 namespace femdyn {

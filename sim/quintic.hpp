@@ -1,8 +1,8 @@
 // The quintic (minimum-jerk) point-to-point reference used for computed-torque trajectories
 // (femdyn track). Time integration is in sim/integrator.hpp.
 #pragma once
-#include "core/math.hpp"
-#include "core/model.hpp"
+#include "core/model/model.hpp"
+#include "core/spatial/math.hpp"
 
 namespace femdyn {
 

@@ -14,7 +14,7 @@
 #include <memory>
 #include <vector>
 
-#include "core/equations.hpp"
+#include "core/dynamics/equations.hpp"
 #include "sim/integrator.hpp"
 
 namespace femdyn {

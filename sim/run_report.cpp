@@ -1,6 +1,6 @@
 #include "sim/run_report.hpp"
 
-#include "core/equations.hpp"
+#include "core/dynamics/equations.hpp"
 
 namespace femdyn {
 
@@ -57,7 +57,7 @@ Json simulation_json(const Model& model, const SimulationRequest& request,
             {"ok", st.ok},
             {"diverged", st.diverged},
             {"failure", st.ok ? std::string() : st.message}});
-  Json routes = Json::object();  // which algorithms ran (core/equations.hpp, route_report)
+  Json routes = Json::object();  // which algorithms ran (core/dynamics/equations.hpp, route_report)
   for (const auto& [key, name] : route_report(model).fields()) routes[key] = name;
   j["routes"] = routes;
   const IntegratorOptions& o = request.options;

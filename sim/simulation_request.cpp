@@ -3,8 +3,8 @@
 #include <chrono>
 #include <cmath>
 
-#include "core/memory.hpp"
-#include "core/names.hpp"
+#include "core/model/names.hpp"
+#include "core/workspace/memory.hpp"
 #include "sim/control_loop.hpp"
 #include "sim/stability.hpp"
 

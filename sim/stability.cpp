@@ -10,23 +10,13 @@
 
 #include "core/derivatives/derivatives.hpp"
 #include "core/joints/passive.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/loops/constraint_kinematics.hpp"
-#include "core/sampling.hpp"
 #include "sim/motion.hpp"
+#include "sim/step_stability.hpp"
 
 namespace femdyn {
 namespace {
-
-// R(z) of the Runge–Kutta methods, as the polynomial Σ c_k z^k.
-std::complex<double> stability_function(IntegratorKind kind, std::complex<double> z) {
-  const double rk4[] = {1, 1, 1.0 / 2, 1.0 / 6, 1.0 / 24};
-  const double dopri[] = {1, 1, 1.0 / 2, 1.0 / 6, 1.0 / 24, 1.0 / 120, 1.0 / 600};
-  const double* c = kind == IntegratorKind::Rk4 ? rk4 : dopri;
-  const int degree = kind == IntegratorKind::Rk4 ? 4 : 6;
-  std::complex<double> r = c[degree];
-  for (int k = degree - 1; k >= 0; --k) r = r * z + c[k];  // Horner
-  return r;
-}
 
 // The oscillators x″ = k x + d ẋ that semi-implicit Euler sees (its step is not a map of the
 // first-order modes one by one): one per pair of modes of A, k = −λ1 λ2 and d = λ1 + λ2 —
@@ -34,10 +24,6 @@ std::complex<double> stability_function(IntegratorKind kind, std::complex<double
 // parallel: the overdamped pair of a spring with ζ > 1, a saddle ±a). Mirrored as the modes
 // are: k = −|λ1 λ2|, d = −|Re(λ1 + λ2)|. A real mode with no partner is first order: k = 0,
 // d = −|λ|.
-struct Oscillator {
-  double k = 0, d = 0;
-};
-
 std::vector<Oscillator> euler_oscillators(const Linearization& lin) {
   const Eigen::EigenSolver<MatX> eig(lin.A, true);
   const Eigen::VectorXcd& ev = eig.eigenvalues();
@@ -82,31 +68,6 @@ std::vector<Oscillator> euler_oscillators(const Linearization& lin) {
     }
   }
   return out;
-}
-
-// Each mode λ of A, mirrored into the left half-plane (a physically growing mode, such as a
-// fall, sets the same step limit as its decaying mirror), must not be amplified:
-//   RK4, dopri:  |R(h λ̃)| ≤ 1,  λ̃ = −|Re λ| + i Im λ;
-//   semi-implicit Euler on each oscillator x″ = k x + d ẋ above: the spectral radius of its
-//   step [[1 + h²k, h(1 + hd)], [hk, 1 + hd]] ≤ 1.
-bool stable(const Linearization& lin, const std::vector<Oscillator>& oscillators,
-            IntegratorKind kind, double h) {
-  constexpr double slack = 1 + 1e-12;
-  if (kind == IntegratorKind::Euler) {
-    for (const Oscillator& o : oscillators) {
-      Eigen::Matrix2d G;
-      G << 1 + h * h * o.k, h * (1 + h * o.d), h * o.k, 1 + h * o.d;
-      if (Eigen::EigenSolver<Eigen::Matrix2d>(G, false).eigenvalues().cwiseAbs().maxCoeff() > slack)
-        return false;
-    }
-    return true;
-  }
-  for (Eigen::Index i = 0; i < lin.eigenvalues.size(); ++i) {
-    const std::complex<double> lambda(-std::abs(lin.eigenvalues[i].real()),
-                                      lin.eigenvalues[i].imag());
-    if (std::abs(stability_function(kind, h * lambda)) > slack) return false;
-  }
-  return true;
 }
 
 }  // namespace
@@ -187,7 +148,7 @@ Linearization difference_linearization(const Model& m, Workspace& ws, const VecX
   std::unique_ptr<LoopWorkspace> loops;
   if (!m.constraints.empty()) loops = std::make_unique<LoopWorkspace>(m);
   // Column j of [K D] by central differences: (q̈(y + δ e_j) − q̈(y − δ e_j)) / 2δ. With a
-  // spherical or free joint y = (ξ, v) in the chart around q (core/motion.hpp): q moves by
+  // spherical or free joint y = (ξ, v) in the chart around q (sim/motion.hpp): q moves by
   // q ⊕ δ e_j, and the top rows are ∂ξ̇/∂(ξ, v) = [∂ξ̇/∂ξ, 1] at ξ = 0.
   const bool flat = flat_model(m);
   for (int j = 0; j < 2 * n; ++j) {
@@ -222,23 +183,26 @@ Linearization difference_linearization(const Model& m, Workspace& ws, const VecX
 }
 
 std::optional<double> largest_stable_step(const Linearization& lin, IntegratorKind kind) {
-  if (kind == IntegratorKind::Bdf) return std::numeric_limits<double>::infinity();
-  const double rate = std::abs(lin.stiffest);
-  if (!std::isfinite(rate) || !lin.status.ok) return std::nullopt;
-  if (rate == 0) return std::numeric_limits<double>::infinity();
-  // Every explicit method here is unstable beyond h |λ| = 10; bisect on log h below that.
-  double lo = 1e-6 / rate, hi = 10 / rate;
-  const std::vector<Oscillator> oscillators =
-      kind == IntegratorKind::Euler ? euler_oscillators(lin) : std::vector<Oscillator>{};
-  if (!stable(lin, oscillators, kind, lo)) return 0.0;
-  if (stable(lin, oscillators, kind, hi)) return hi;
-  // (lo √(hi/lo), not √(lo hi): the product underflows for rates beyond 1e150; at most 60
-  // halvings of log(hi/lo) = log 1e7 reach 1e-6)
-  for (int i = 0; i < 60 && hi / lo > 1 + 1e-6; ++i) {
-    const double mid = lo * std::sqrt(hi / lo);
-    (stable(lin, oscillators, kind, mid) ? lo : hi) = mid;
-  }
-  return lo;
+  return with_step_stability(kind, [&]<class S>(S) -> std::optional<double> {
+    if (!S::bounded) return std::numeric_limits<double>::infinity();
+    const double rate = std::abs(lin.stiffest);
+    if (!std::isfinite(rate) || !lin.status.ok) return std::nullopt;
+    if (rate == 0) return std::numeric_limits<double>::infinity();
+    const std::vector<Oscillator> oscillators =
+        S::needs_oscillators ? euler_oscillators(lin) : std::vector<Oscillator>{};
+    const ModeSet modes{lin.eigenvalues, oscillators};
+    // Every explicit method here is unstable beyond h |λ| = 10; bisect on log h below that.
+    double lo = 1e-6 / rate, hi = 10 / rate;
+    if (!S::stable(modes, lo)) return 0.0;
+    if (S::stable(modes, hi)) return hi;
+    // (lo √(hi/lo), not √(lo hi): the product underflows for rates beyond 1e150; at most 60
+    // halvings of log(hi/lo) = log 1e7 reach 1e-6)
+    for (int i = 0; i < 60 && hi / lo > 1 + 1e-6; ++i) {
+      const double mid = lo * std::sqrt(hi / lo);
+      (S::stable(modes, mid) ? lo : hi) = mid;
+    }
+    return lo;
+  });
 }
 
 bool has_dampers(const Model& m) {

@@ -23,8 +23,8 @@
 #include <string>
 #include <vector>
 
-#include "core/body_inertia.hpp"
-#include "core/equations.hpp"
+#include "core/dynamics/body_inertia.hpp"
+#include "core/dynamics/equations.hpp"
 #include "sim/integrator.hpp"
 
 namespace femdyn {

@@ -25,7 +25,7 @@ struct DerivativeWorkspace;
 
 // The shortest run an adaptive integrator takes (s): SUNDIALS' first-step estimate divides by
 // the span squared, which overflows double precision below about 1e-154 s; the bound mirrors
-// kMaxMagnitude (core/limits.hpp) as its reciprocal.
+// kMaxMagnitude (core/model/limits.hpp) as its reciprocal.
 inline constexpr double kMinAdaptiveSpan = 1e-100;
 
 class Adaptive : public Integrator {

@@ -1,11 +1,12 @@
 // Numerical derivatives for the analytic derivatives' tests (tests/test_derivatives.cpp,
 // tests/test_loop_derivatives.cpp): central differences along the tangent q ⊕ ε e_m of
-// integrate_posture (core/sampling.hpp) or along v + ε e_m, and their Richardson extrapolation.
+// integrate_posture (core/kinematics/sampling.hpp) or along v + ε e_m, and their Richardson
+// extrapolation.
 #pragma once
 #include <functional>
 
-#include "core/model.hpp"
-#include "core/sampling.hpp"
+#include "core/kinematics/sampling.hpp"
+#include "core/model/model.hpp"
 
 namespace femdyn::test {
 

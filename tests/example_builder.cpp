@@ -3,7 +3,7 @@
 // and run by the test suite (docs/tutorial.md shows this file).
 #include <iostream>
 
-#include "core/equations.hpp"
+#include "core/dynamics/equations.hpp"
 #include "models/builder.hpp"
 
 int main() {

@@ -2,7 +2,7 @@
 // dynamics. Built and run by the test suite (docs/tutorial.md shows this file).
 #include <iostream>
 
-#include "core/equations.hpp"
+#include "core/dynamics/equations.hpp"
 #include "io/model_loader.hpp"
 
 int main(int argc, char** argv) {

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "core/equations.hpp"
-#include "core/kinematics.hpp"
-#include "core/sampling.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/kinematics.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "io/model_loader.hpp"
 
 namespace femdyn::test {

@@ -8,10 +8,10 @@
 #include <random>
 #include <string>
 
-#include "core/equations.hpp"
-#include "core/kinematics.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/kinematics.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/loops/constrained_dynamics.hpp"
-#include "core/sampling.hpp"
 #include "tests/helpers.hpp"
 
 namespace femdyn::test {

@@ -1,9 +1,9 @@
 // The spatial momentum of a condensable model, for the tests of free-floating mechanisms.
 #pragma once
-#include "core/kinematics.hpp"
-#include "core/model.hpp"
-#include "core/spatial.hpp"
-#include "core/workspace.hpp"
+#include "core/kinematics/kinematics.hpp"
+#include "core/model/model.hpp"
+#include "core/spatial/spatial.hpp"
+#include "core/workspace/workspace.hpp"
 
 namespace femdyn::test {
 

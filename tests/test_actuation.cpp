@@ -10,7 +10,7 @@
 
 #include "compile/actuators.hpp"
 #include "core/derivatives/derivatives.hpp"
-#include "core/equations.hpp"
+#include "core/dynamics/equations.hpp"
 #include "sim/control_loop.hpp"
 #include "tests/helpers.hpp"
 

@@ -10,7 +10,7 @@
 #include <numbers>
 #include <random>
 
-#include "core/momentum.hpp"
+#include "core/kinematics/momentum.hpp"
 #include "io/params.hpp"
 #include "models/builder.hpp"
 #include "models/random_tree.hpp"

@@ -1,5 +1,5 @@
-// Nonlinear coupling laws θ_out = f(θ_in) (core/coupling_function.hpp) and the coupling level
-// θ = g(q) they make (core/coupling_level.hpp, core/coupling_chain.hpp).
+// Nonlinear coupling laws θ_out = f(θ_in) (core/model/coupling_function.hpp) and the coupling level
+// θ = g(q) they make (core/model/coupling_level.hpp, core/dynamics/coupling_chain.hpp).
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
@@ -8,8 +8,8 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 
-#include "core/coupling_function.hpp"
-#include "core/errors.hpp"
+#include "core/model/coupling_function.hpp"
+#include "core/model/errors.hpp"
 #include "models/random_tree.hpp"
 #include "tests/helpers.hpp"
 

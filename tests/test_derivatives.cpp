@@ -37,7 +37,7 @@ std::string with_actuators(const std::string& text, unsigned seed) {
 }
 
 // `count` two-point springs between random bodies (or the world) at random points, with seeded
-// stiffness, rest length and damping (core/springs.hpp).
+// stiffness, rest length and damping (core/dynamics/springs.hpp).
 std::string with_springs(const std::string& text, unsigned seed, int count) {
   Json j = Json::parse(text);
   std::mt19937 rng(seed);

@@ -6,9 +6,9 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "core/errors.hpp"
-#include "core/message.hpp"
-#include "core/names.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/message.hpp"
+#include "core/model/names.hpp"
 #include "io/actuation_table.hpp"
 #include "io/csv.hpp"
 #include "io/output.hpp"

@@ -5,8 +5,8 @@
 #include <sstream>
 
 #include "compile/compile.hpp"
-#include "core/equations.hpp"
-#include "core/inertia.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/spatial/inertia.hpp"
 #include "elements/lumped_point.hpp"
 #include "elements/registry.hpp"
 #include "elements/space_bar.hpp"

@@ -2,7 +2,7 @@
 #include <catch2/catch.hpp>
 
 #include "compile/compile.hpp"
-#include "core/errors.hpp"
+#include "core/model/errors.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;

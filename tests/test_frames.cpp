@@ -1,15 +1,15 @@
-// Frames and their kinematics (core/frames.hpp) against finite differences of the poses: J's
-// columns are the frame's velocity along each rate, J̇v the derivative of J v along v, in each of
-// the three sets of axes; on trees of every joint type, a floating base, linear couplings and a
+// Frames and their kinematics (core/kinematics/frames.hpp) against finite differences of the poses:
+// J's columns are the frame's velocity along each rate, J̇v the derivative of J v along v, in each
+// of the three sets of axes; on trees of every joint type, a floating base, linear couplings and a
 // coupling law (whose bias needs θ̈ = γ at q̈ = 0). And frames from JSON: xyz, node, rpy, errors.
 #include <catch2/catch.hpp>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "core/frames.hpp"
 #include "core/joints/rotation.hpp"
-#include "core/sampling.hpp"
+#include "core/kinematics/frames.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;

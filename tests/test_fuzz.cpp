@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "compile/compile.hpp"
-#include "core/errors.hpp"
+#include "core/model/errors.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;

@@ -11,8 +11,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "core/errors.hpp"
-#include "core/sampling.hpp"
+#include "core/kinematics/sampling.hpp"
+#include "core/model/errors.hpp"
 #include "io/urdf_loader.hpp"
 #include "tests/helpers.hpp"
 #include "validation/scaling_models.hpp"

@@ -6,8 +6,8 @@
 #include <cstdlib>
 
 #include "core/derivatives/derivatives.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/loops/assembly.hpp"
-#include "core/sampling.hpp"
 #include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
 #include "tests/loop_checks.hpp"

@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "core/equations.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/loops/assembly.hpp"
-#include "core/sampling.hpp"
 #include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
 

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "core/derivatives/derivatives.hpp"
-#include "core/sampling.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "sim/integrator.hpp"
 #include "sim/sundials_integrators.hpp"
 #include "tests/helpers.hpp"

@@ -6,10 +6,10 @@
 #include <catch2/catch.hpp>
 #include <random>
 
-#include "core/equations.hpp"
+#include "core/dynamics/equations.hpp"
 #include "core/joints/kernel.hpp"
-#include "core/kinematics.hpp"
-#include "core/sampling.hpp"
+#include "core/kinematics/kinematics.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "sim/integrator.hpp"
 #include "sim/quintic.hpp"
 #include "tests/helpers.hpp"

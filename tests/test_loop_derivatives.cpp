@@ -10,8 +10,8 @@
 #include <random>
 
 #include "core/derivatives/derivatives.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/loops/assembly.hpp"
-#include "core/sampling.hpp"
 #include "tests/differences.hpp"
 #include "tests/helpers.hpp"
 #include "tests/loop_checks.hpp"

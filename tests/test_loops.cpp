@@ -1,9 +1,9 @@
-// Closed loops (core/loops/) and two-point springs (core/springs.hpp): the constraint Jacobian
-// and its bias against finite differences of Φ, the constrained q̈ and λ against the equations
-// they must satisfy (Φ_q q̈ = −Φ̇_q v, and inverse dynamics giving back τ + Φ_qᵀλ), assembly and
-// projection, redundancy and dead points, springs against their potential, and Andrews'
-// squeezing mechanism against the Test Set for IVP Solvers (its consistent initial values at
-// t = 0 and its reference solution at t = 0.03, computed there with PSIDE at tolerances 1e-14).
+// Closed loops (core/loops/) and two-point springs (core/dynamics/springs.hpp): the constraint
+// Jacobian and its bias against finite differences of Φ, the constrained q̈ and λ against the
+// equations they must satisfy (Φ_q q̈ = −Φ̇_q v, and inverse dynamics giving back τ + Φ_qᵀλ),
+// assembly and projection, redundancy and dead points, springs against their potential, and
+// Andrews' squeezing mechanism against the Test Set for IVP Solvers (its consistent initial values
+// at t = 0 and its reference solution at t = 0.03, computed there with PSIDE at tolerances 1e-14).
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <fstream>
@@ -11,10 +11,11 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "core/equations.hpp"
-#include "core/kinematics.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/dynamics/springs.hpp"
+#include "core/kinematics/kinematics.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/loops/assembly.hpp"
-#include "core/sampling.hpp"
 #include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
 #include "tests/loop_checks.hpp"

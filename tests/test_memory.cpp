@@ -1,7 +1,7 @@
-// Memory refused up front, one convention (core/memory.hpp, issue 22): work that allocates by
-// input size is estimated first and refused beyond the memory limit with one line, the size it
-// needs and how to proceed. The tests set a small --max-memory, so that nothing depends on the
-// machine's memory; and the smaller items of the same round (a compact τ table, the condition
+// Memory refused up front, one convention (core/workspace/memory.hpp, issue 22): work that
+// allocates by input size is estimated first and refused beyond the memory limit with one line, the
+// size it needs and how to proceed. The tests set a small --max-memory, so that nothing depends on
+// the machine's memory; and the smaller items of the same round (a compact τ table, the condition
 // number that overflows, a run too short for SUNDIALS).
 #include <sys/resource.h>
 
@@ -10,7 +10,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "core/memory.hpp"
+#include "core/workspace/memory.hpp"
 #include "io/actuation_table.hpp"
 #include "sim/integrator.hpp"
 #include "tests/helpers.hpp"

@@ -7,7 +7,7 @@
 #include <numbers>
 #include <random>
 
-#include "core/errors.hpp"
+#include "core/model/errors.hpp"
 #include "io/convex_hull.hpp"
 #include "io/mesh.hpp"
 #include "tests/helpers.hpp"

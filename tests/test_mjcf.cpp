@@ -8,9 +8,9 @@
 #include <random>
 #include <stdexcept>
 
-#include "core/equations.hpp"
+#include "core/dynamics/equations.hpp"
 #include "core/joints/passive.hpp"
-#include "core/sampling.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "io/model_loader.hpp"
 #include "tests/helpers.hpp"
 #include "validation/mujoco_peer.hpp"

@@ -7,11 +7,11 @@
 #include <numbers>
 #include <random>
 
-#include "core/equations.hpp"
-#include "core/frames.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/frames.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/loops/assembly.hpp"
 #include "core/loops/constraint_kinematics.hpp"
-#include "core/sampling.hpp"
 #include "io/model_loader.hpp"
 #include "tests/helpers.hpp"
 

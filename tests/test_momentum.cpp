@@ -1,6 +1,6 @@
-// The mechanism as a whole (core/momentum.hpp): centre of mass, its Jacobian, the centroidal
-// momentum matrix A_G and their biases, against finite differences of the poses, against the
-// body-level sums of tests/momentum.hpp (independent code: the condensed body inertias), and
+// The mechanism as a whole (core/kinematics/momentum.hpp): centre of mass, its Jacobian, the
+// centroidal momentum matrix A_G and their biases, against finite differences of the poses, against
+// the body-level sums of tests/momentum.hpp (independent code: the condensed body inertias), and
 // against Newton and Euler: the momentum changes only by the external wrench, so
 // A_G q̈ + Ȧ_G v = (m g, 0) with q̈ from forward dynamics. The generalized Jacobian against a
 // free-floating simulation, whose momentum the dynamics alone conserves.
@@ -8,9 +8,9 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "core/equations.hpp"
-#include "core/momentum.hpp"
-#include "core/sampling.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/momentum.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
 #include "tests/momentum.hpp"

@@ -7,8 +7,8 @@
 #include <random>
 #include <stdexcept>
 
-#include "core/equations.hpp"
-#include "core/sampling.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "io/model_loader.hpp"
 #include "io/urdf_loader.hpp"
 #include "tests/helpers.hpp"

@@ -22,11 +22,11 @@
 #include <map>
 #include <random>
 
-#include "core/arguments.hpp"
 #include "core/derivatives/derivatives.hpp"
-#include "core/frames.hpp"
 #include "core/joints/kernel.hpp"
+#include "core/kinematics/frames.hpp"
 #include "core/loops/assembly.hpp"
+#include "core/model/arguments.hpp"
 #include "io/model_loader.hpp"
 #include "io/params.hpp"
 #include "models/random_tree.hpp"
@@ -585,8 +585,8 @@ TEST_CASE("the C++ entry points refuse a state of the wrong size in one line nam
   DerivativeWorkspace d(m);
   CHECK_THAT(message([&] { (void)forward_dynamics_derivatives(m, ws, d, v, v, VecX()); }),
              Catch::StartsWith("forward_dynamics_derivatives: q has 33"));
-  // No actuation at all is τ = 0, as before, with springs too (core/springs.hpp; the model has
-  // loops: its spanning tree).
+  // No actuation at all is τ = 0, as before, with springs too (core/dynamics/springs.hpp; the model
+  // has loops: its spanning tree).
   CHECK(message([&] { (void)forward_dynamics(m, ws, q, v, VecX()); }) == "(accepted)");
   const Model sprung = load_text(every_constraint_tree(5));
   REQUIRE(!sprung.springs.empty());

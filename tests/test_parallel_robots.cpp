@@ -12,10 +12,10 @@
 #include <numbers>
 #include <random>
 
-#include "core/equations.hpp"
-#include "core/frames.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/frames.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/loops/assembly.hpp"
-#include "core/sampling.hpp"
 #include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
 #include "tests/loop_checks.hpp"

@@ -6,8 +6,8 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
-#include "core/articulated.hpp"
-#include "core/mass_solver.hpp"
+#include "core/dynamics/articulated.hpp"
+#include "core/workspace/mass_solver.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;
@@ -322,7 +322,7 @@ TEST_CASE("energy on the composite route is ½ q̇ᵀ M^s q̇ body by body, M^s 
 TEST_CASE("spanning rods on the body-level routes equal the node-level routes", "[routes]") {
   // Rods across the fixed joints of random trees of every joint type, and the four-bar fingers'
   // trees (every joint a coordinate: their coupler rods join two moving bodies): the composite
-  // M^s and Newton–Euler carry the rods as their own terms (core/span_inertia.hpp), the
+  // M^s and Newton–Euler carry the rods as their own terms (core/dynamics/span_inertia.hpp), the
   // reference routes as elements of Tᵀ M T.
   std::vector<std::pair<std::string, std::shared_ptr<const Model>>> cases;
   for (unsigned seed = 31; seed <= 36; ++seed) {
@@ -364,9 +364,9 @@ TEST_CASE("spanning rods on the body-level routes equal the node-level routes", 
 }
 
 TEST_CASE("coupling laws on the tree's body-level sweeps equal the reference routes", "[routes]") {
-  // Random trees with a four-bar, a polynomial and a spline law (core/coupling_chain.hpp), joint
-  // springs, dampers, friction and rotors on some joints, and rods where a fixed joint allows:
-  // forward dynamics by one pair of sweeps with θ̈ = γ as the bias acceleration against the
+  // Random trees with a four-bar, a polynomial and a spline law (core/dynamics/coupling_chain.hpp),
+  // joint springs, dampers, friction and rotors on some joints, and rods where a fixed joint
+  // allows: forward dynamics by one pair of sweeps with θ̈ = γ as the bias acceleration against the
   // tree's equations formed on the node-level routes and reduced through G.
   const RouteChoice reference_routes{.mass = MassRoute::Transform,
                                      .force = ForceRoute::Nodes,

@@ -2,7 +2,7 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 
-#include "core/mass_solver.hpp"
+#include "core/workspace/mass_solver.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;
@@ -148,7 +148,7 @@ TEST_CASE("M^s by composite inertias (composite route) equals Tᵀ M T", "[solve
                                    [](const ElementEntry& e) { return e.spans; });
     CHECK(m.condensable == (!m.explicit_table && !spans));
     // The composite route wherever it is exact (compile's choice), or exact but for spanning
-    // rods that it then carries as their own terms (core/span_inertia.hpp).
+    // rods that it then carries as their own terms (core/dynamics/span_inertia.hpp).
     CHECK((m.mass_route == MassRoute::Composite) == (m.condensable || !m.spanning_masses.empty()));
     CHECK(m.spanning_masses.empty() == !spans);
     condensed += m.mass_route == MassRoute::Composite;

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <random>
 
-#include "core/equations.hpp"
-#include "core/sampling.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
 #include "tests/momentum.hpp"

@@ -9,8 +9,8 @@
 #include <random>
 
 #include "core/derivatives/derivatives.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/loops/assembly.hpp"
-#include "core/sampling.hpp"
 #include "sim/stability.hpp"
 #include "tests/helpers.hpp"
 

@@ -10,9 +10,9 @@
 #include <numbers>
 #include <random>
 
-#include "core/equations.hpp"
-#include "core/errors.hpp"
-#include "core/sampling.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/sampling.hpp"
+#include "core/model/errors.hpp"
 #include "io/model_loader.hpp"
 #include "io/urdf_loader.hpp"
 #include "tests/helpers.hpp"

@@ -8,10 +8,10 @@
 #include <fstream>
 #include <random>
 
-#include "core/equations.hpp"
-#include "core/errors.hpp"
-#include "core/inertia.hpp"
-#include "core/sampling.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/sampling.hpp"
+#include "core/model/errors.hpp"
+#include "core/spatial/inertia.hpp"
 #include "io/centroidal_mass.hpp"
 #include "io/model_loader.hpp"
 #include "tests/helpers.hpp"

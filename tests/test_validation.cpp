@@ -8,8 +8,8 @@
 #include <sstream>
 
 #include "compile/compile.hpp"
-#include "core/body_inertia.hpp"
-#include "core/inertia.hpp"
+#include "core/dynamics/body_inertia.hpp"
+#include "core/spatial/inertia.hpp"
 #include "elements/rotary_node.hpp"
 #include "io/params.hpp"
 #include "models/random_tree.hpp"

@@ -6,10 +6,10 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "core/kinematics.hpp"
+#include "core/kinematics/kinematics.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/loops/assembly.hpp"
 #include "core/loops/constrained_dynamics.hpp"
-#include "core/sampling.hpp"
 #include "io/model_loader.hpp"
 #include "io/params.hpp"
 #include "models/random_tree.hpp"

@@ -11,8 +11,8 @@
 #include <set>
 #include <sstream>
 
-#include "core/body_inertia.hpp"
-#include "core/frames.hpp"
+#include "core/dynamics/body_inertia.hpp"
+#include "core/kinematics/frames.hpp"
 #include "io/mesh.hpp"
 #include "io/mjcf_loader.hpp"
 #include "io/urdf_loader.hpp"

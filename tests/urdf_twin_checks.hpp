@@ -5,8 +5,8 @@
 #include <catch2/catch.hpp>
 #include <random>
 
-#include "core/equations.hpp"
-#include "core/sampling.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "tests/helpers.hpp"
 #include "validation/urdf_twin.hpp"
 

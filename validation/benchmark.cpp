@@ -60,11 +60,11 @@
 
 #include "compile/compile.hpp"
 #include "core/derivatives/derivatives.hpp"
-#include "core/equations.hpp"
-#include "core/kinematics.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/kinematics.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/loops/assembly.hpp"
-#include "core/math.hpp"
-#include "core/sampling.hpp"
+#include "core/spatial/math.hpp"
 #include "io/model_loader.hpp"
 #include "validation/alloc_counter.hpp"
 #ifdef FEMDYN_WITH_MUJOCO

@@ -6,7 +6,7 @@
 #pragma once
 #include <string>
 
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 #include "io/model_loader.hpp"
 #include "validation/validate.hpp"
 

@@ -10,8 +10,8 @@
 #include <stdexcept>
 #include <thread>
 
-#include "core/errors.hpp"
 #include "core/joints/kernel.hpp"
+#include "core/model/errors.hpp"
 #include "sim/integrator.hpp"
 #include "validation/twin.hpp"
 #include "validation/validate.hpp"

@@ -11,7 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "core/names.hpp"
+#include "core/model/names.hpp"
 #include "validation/twin_impl.hpp"
 
 namespace femdyn::validation {

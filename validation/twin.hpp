@@ -103,8 +103,9 @@ struct TwinRod {
   std::string name;  // the element's place in the file, for messages
 };
 
-// A loop constraint of the model (core/loops/constraint.hpp) as Simbody's (twin_constraints.hpp):
-// places A and B fixed on bodies (body frames; −1 the ground) with axes R and origin p.
+// A loop constraint of the model (core/model/loop_constraint.hpp) as Simbody's
+// (twin_constraints.hpp): places A and B fixed on bodies (body frames; −1 the ground) with axes R
+// and origin p.
 struct TwinConstraint {
   enum class Type { Ball, PointOnLine, PointInPlane, Weld, Rod, Gear } type = Type::Ball;
   std::string name;  // for messages
@@ -119,7 +120,7 @@ struct TwinConstraint {
   double offset = 0;
 };
 
-// A two-point linear spring-damper (core/springs.hpp): Force::TwoPointLinearSpring and
+// A two-point linear spring-damper (core/dynamics/springs.hpp): Force::TwoPointLinearSpring and
 // Force::TwoPointLinearDamper between p_a on body_a and p_b on body_b (body frames; −1 the ground).
 struct TwinSpring {
   int body_a = -1, body_b = -1;

@@ -7,8 +7,8 @@
 #include <memory>
 #include <utility>
 
-#include "core/errors.hpp"
-#include "core/names.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/names.hpp"
 #include "validation/twin_impl.hpp"
 
 namespace femdyn::validation {

@@ -1,5 +1,5 @@
 // The model's loop constraints and two-point springs in the Simbody twin (twin.hpp), compiled
-// like twin.cpp. femdyn's constraints (core/loops/constraint.hpp) as Simbody's:
+// like twin.cpp. femdyn's constraints (core/model/loop_constraint.hpp) as Simbody's:
 //   ball                    Constraint::Ball (A's point on B's)
 //   ball in a plane (n),    Constraint::PointOnLine: A's point on the line through B's point
 //   point on line           along n (the line's direction), fixed in B

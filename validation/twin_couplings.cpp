@@ -6,7 +6,7 @@
 #include <memory>
 #include <vector>
 
-#include "core/errors.hpp"
+#include "core/model/errors.hpp"
 #include "validation/twin_impl.hpp"
 
 namespace femdyn::validation {

@@ -10,7 +10,7 @@
 
 #include <vector>
 
-#include "core/errors.hpp"
+#include "core/model/errors.hpp"
 #include "validation/twin_impl.hpp"
 #include "validation/twin_loops.hpp"
 

@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "core/names.hpp"
+#include "core/model/names.hpp"
 
 namespace femdyn::validation::loops {
 

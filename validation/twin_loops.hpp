@@ -19,7 +19,7 @@
 namespace femdyn::validation::loops {
 
 // θ = g(q) and θ̇ = G q̇ by the laws in their dependency order, each by its own chain rule
-// θ̇_t = Σ_k ∂f/∂x_k θ̇_{s_k} (the twin's own; femdyn's is core/coupling_level.hpp). Throws
+// θ̇_t = Σ_k ∂f/∂x_k θ̇_{s_k} (the twin's own; femdyn's is core/model/coupling_level.hpp). Throws
 // std::runtime_error naming the joint where a law is not defined.
 void joint_state(const TwinModel& m, const VecX& q, const VecX& qd, VecX& theta, VecX& theta_dot);
 

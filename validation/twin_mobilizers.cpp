@@ -3,7 +3,7 @@
 // twin.cpp (C++17, without NDEBUG).
 #include <Simbody.h>
 
-#include "core/names.hpp"
+#include "core/model/names.hpp"
 #include "validation/twin_constraints.hpp"
 #include "validation/twin_friction.hpp"
 #include "validation/twin_impl.hpp"

@@ -10,7 +10,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "core/names.hpp"
+#include "core/model/names.hpp"
 #include "validation/twin_impl.hpp"
 
 namespace femdyn::validation {

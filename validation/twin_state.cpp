@@ -5,7 +5,7 @@
 
 #include <algorithm>
 
-#include "core/errors.hpp"
+#include "core/model/errors.hpp"
 #include "validation/twin_impl.hpp"
 #include "validation/twin_loops.hpp"
 

@@ -10,14 +10,15 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "core/errors.hpp"
-#include "core/inertia.hpp"
+#include "core/model/errors.hpp"
+#include "core/spatial/inertia.hpp"
 #include "io/centroidal_mass.hpp"
 #include "validation/twin_friction.hpp"
 
 namespace femdyn::validation {
 
-// Simbody's small vectors here, not femdyn's Eigen ones (core/math.hpp, seen through inertia.hpp).
+// Simbody's small vectors here, not femdyn's Eigen ones (core/spatial/math.hpp, seen through
+// inertia.hpp).
 using Vec3 = SimTK::Vec3;
 using Mat33 = SimTK::Mat33;
 

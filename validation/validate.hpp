@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "core/memory.hpp"  // the memory limit, shared with every command
-#include "core/model.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/model.hpp"
+#include "core/workspace/memory.hpp"  // the memory limit, shared with every command
 #include "validation/twin.hpp"
 
 namespace femdyn::validation {

@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/errors.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/loops/assembly.hpp"
 #include "core/loops/constrained_dynamics.hpp"
-#include "core/sampling.hpp"
-#include "core/workspace.hpp"
+#include "core/model/errors.hpp"
+#include "core/workspace/workspace.hpp"
 
 namespace femdyn::validation {
 

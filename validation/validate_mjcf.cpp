@@ -8,12 +8,12 @@
 #include <algorithm>
 #include <random>
 
-#include "core/coupling_level.hpp"
-#include "core/equations.hpp"
-#include "core/errors.hpp"
+#include "core/dynamics/equations.hpp"
 #include "core/joints/passive.hpp"
-#include "core/sampling.hpp"
-#include "core/workspace.hpp"
+#include "core/kinematics/sampling.hpp"
+#include "core/model/coupling_level.hpp"
+#include "core/model/errors.hpp"
+#include "core/workspace/workspace.hpp"
 #include "validation/mujoco_peer.hpp"
 #include "validation/validate.hpp"
 

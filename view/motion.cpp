@@ -4,11 +4,11 @@
 #include <cmath>
 #include <optional>
 
-#include "core/equations.hpp"
-#include "core/errors.hpp"
-#include "core/names.hpp"
-#include "core/sampling.hpp"
-#include "core/workspace.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/sampling.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/names.hpp"
+#include "core/workspace/workspace.hpp"
 #include "io/input_file.hpp"
 
 namespace femdyn::view {

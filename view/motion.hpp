@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 #include "io/trajectory_csv.hpp"
 
 namespace femdyn::view {

@@ -3,7 +3,7 @@
 #pragma once
 #include <string>
 
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 #include "io/params.hpp"
 #include "view/motion.hpp"
 

@@ -7,12 +7,12 @@
 #include <map>
 #include <set>
 
-#include "core/body_inertia.hpp"
-#include "core/errors.hpp"
-#include "core/joints/joint_type.hpp"
-#include "core/kinematics.hpp"
-#include "core/loops/constraint.hpp"
-#include "core/workspace.hpp"
+#include "core/dynamics/body_inertia.hpp"
+#include "core/kinematics/kinematics.hpp"
+#include "core/model/errors.hpp"
+#include "core/model/joint_type.hpp"
+#include "core/model/loop_constraint.hpp"
+#include "core/workspace/workspace.hpp"
 #include "io/input_file.hpp"
 #include "io/mesh.hpp"
 

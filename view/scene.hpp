@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 #include "io/params.hpp"
 #include "io/visual.hpp"
 #include "view/motion.hpp"

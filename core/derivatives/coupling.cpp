@@ -1,7 +1,7 @@
 #include "core/derivatives/coupling.hpp"
 
 #include "core/derivatives/derivatives.hpp"
-#include "core/equations.hpp"
+#include "core/dynamics/equations.hpp"
 
 namespace femdyn {
 

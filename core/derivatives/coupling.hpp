@@ -1,6 +1,6 @@
 // The analytic derivatives (core/derivatives/derivatives.hpp) of a model with a nonlinear coupling
-// level θ = g(q) (core/coupling_level.hpp), chained from those of its tree (Model::tree, every
-// joint a coordinate) as its equations are (core/coupling_chain.hpp):
+// level θ = g(q) (core/model/coupling_level.hpp), chained from those of its tree (Model::tree,
+// every joint a coordinate) as its equations are (core/dynamics/coupling_chain.hpp):
 //   τ_q(q, q̇, q̈) = Gᵀ τ_θ(θ, θ̇, θ̈),   θ = g(q),   θ̇ = G q̇,   θ̈ = G q̈ + γ,   γ = g''[q̇, q̇].
 // With the tree's K_q = ∂τ_θ/∂θ, K_v = ∂τ_θ/∂θ̇ (the recursion) and M_θ = ∂τ_θ/∂θ̈ (its mass
 // matrix), and the nθ × n rows Θ = ∂θ̇/∂q, Ā = ∂(G q̈)/∂q, Γ = ∂γ/∂q:
@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "core/math.hpp"
-#include "core/status.hpp"
+#include "core/spatial/math.hpp"
+#include "core/workspace/status.hpp"
 
 namespace femdyn {
 

@@ -3,15 +3,15 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/arguments.hpp"
-#include "core/body_loads.hpp"
-#include "core/coupling.hpp"
-#include "core/equations.hpp"
-#include "core/errors.hpp"
+#include "core/dynamics/body_loads.hpp"
+#include "core/dynamics/equations.hpp"
 #include "core/joints/kernel.hpp"
 #include "core/joints/passive.hpp"
 #include "core/joints/rotor.hpp"
-#include "core/kinematics.hpp"
+#include "core/kinematics/coupling.hpp"
+#include "core/kinematics/kinematics.hpp"
+#include "core/model/arguments.hpp"
+#include "core/model/errors.hpp"
 
 namespace femdyn {
 namespace {

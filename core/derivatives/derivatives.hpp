@@ -1,13 +1,13 @@
 // Analytic derivatives of the dynamics (Carpentier and Mansard, "Analytical Derivatives of Rigid
 // Body Dynamics Algorithms", RSS 2018), over the element-assembled body inertias Λ_b in world
-// axes about the world origin (core/spatial.hpp), as the Newton–Euler recursion
-// (core/newton_euler.hpp) computes τ.
+// axes about the world origin (core/spatial/spatial.hpp), as the Newton–Euler recursion
+// (core/dynamics/newton_euler.hpp) computes τ.
 //
 // Convention. Every derivative is n × n over the rates v, one column per rate. A column with
 // respect to q is the derivative along the tangent: ∂f/∂q_m = d/dε f(q ⊕ ε e_m) at ε = 0, with
-// q ⊕ ξ of `integrate_posture` (core/sampling.hpp): q + ξ on a flat joint; on a spherical joint
-// q ⊗ exp(ξ), on a free joint (p + R ξ_p, q ⊗ exp(ξ_r)) — the body turns and moves in its own
-// axes. v, q̈ and τ are held fixed along it.
+// q ⊕ ξ of `integrate_posture` (core/kinematics/sampling.hpp): q + ξ on a flat joint; on a
+// spherical joint q ⊗ exp(ξ), on a free joint (p + R ξ_p, q ⊗ exp(ξ_r)) — the body turns and moves
+// in its own axes. v, q̈ and τ are held fixed along it.
 //
 // Inverse dynamics τ(q, v, q̈) = M^s q̈ + h − Q|_{τ=0}. For a rate m of body b(m), moving q_m
 // moves the subtree of b(m) rigidly by the twist S_m (its column, world axes about the origin).
@@ -59,8 +59,8 @@
 #include "core/derivatives/loops.hpp"
 #include "core/derivatives/spans.hpp"
 #include "core/derivatives/springs.hpp"
-#include "core/status.hpp"
-#include "core/workspace.hpp"
+#include "core/workspace/status.hpp"
+#include "core/workspace/workspace.hpp"
 
 namespace femdyn {
 

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <utility>
 
-#include "core/articulated.hpp"
 #include "core/derivatives/derivatives.hpp"
-#include "core/equations.hpp"
+#include "core/dynamics/articulated.hpp"
+#include "core/dynamics/equations.hpp"
 #include "core/joints/kernel.hpp"
 
 namespace femdyn {

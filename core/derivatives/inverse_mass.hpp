@@ -24,7 +24,7 @@
 #pragma once
 #include <vector>
 
-#include "core/math.hpp"
+#include "core/spatial/math.hpp"
 
 namespace femdyn {
 

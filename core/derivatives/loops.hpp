@@ -5,7 +5,7 @@
 // differentiated at the solution (q̈, λ), along the tangent convention of
 // core/derivatives/derivatives.hpp. With τ_ID(q, v, q̈) the inverse dynamics, g(q) = Φ_qᵀ λ at λ
 // fixed and c(q, v) = Φ_q q̈ + Φ̇_q v + 2ω Φ_q v + ω² Φ at q̈ fixed
-// (core/loops/constraint_derivatives.hpp):
+// (core/derivatives/constraint_derivatives.hpp):
 //
 //   M dq̈ − Φ_qᵀ dλ = dτ − ∂τ_ID/∂x dx + ∂g/∂x dx,     Φ_q dq̈ = −∂c/∂x dx,
 //
@@ -21,9 +21,9 @@
 //                            solution's inverse on the kept pivots).
 // Needs C = I (no coupled joints).
 #pragma once
+#include "core/derivatives/constraint_derivatives.hpp"
 #include "core/loops/constrained_dynamics.hpp"
-#include "core/loops/constraint_derivatives.hpp"
-#include "core/status.hpp"
+#include "core/workspace/status.hpp"
 
 namespace femdyn {
 

@@ -1,8 +1,9 @@
 // What the derivatives of forces at body points share (core/derivatives/springs.hpp, the
 // two-point springs; core/derivatives/spans.hpp, the elements spanning bodies): a point x fixed
-// on body b, moved by the rates on b's path. In world axes about the origin (core/spatial.hpp),
-// with S_m = (ω_m, v_m) a rate's column and J_m(x) = v_m + ω_m × x its velocity at x, along the
-// tangent θ ⊕ ε e_m (m on b's path; the subtree of m's body turns rigidly by S_m):
+// on body b, moved by the rates on b's path. In world axes about the origin
+// (core/spatial/spatial.hpp), with S_m = (ω_m, v_m) a rate's column and J_m(x) = v_m + ω_m × x its
+// velocity at x, along the tangent θ ⊕ ε e_m (m on b's path; the subtree of m's body turns rigidly
+// by S_m):
 //   ∂x/∂θ_m = J_m(x),
 //   ∂J_c(x)/∂θ_m = ω_m × J_c(x)  where S_c moves with θ_m (c below m, or c of m's joint and
 //                                fixed in its body),   ω_c × J_m(x) otherwise,
@@ -16,7 +17,7 @@
 #pragma once
 #include <vector>
 
-#include "core/spatial.hpp"
+#include "core/spatial/spatial.hpp"
 
 namespace femdyn {
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/derivatives/derivatives.hpp"
+#include "core/dynamics/span_inertia.hpp"
 
 namespace femdyn {
 

@@ -48,7 +48,7 @@ void add_spring(const Model& m, const Workspace& ws, const DerivativeWorkspace& 
   const PointMotion a = end_of(ws, d, spring.a), b = end_of(ws, d, spring.b);
   const Vec3 dist = a.x - b.x;
   const double l = dist.norm();
-  if (!(l > 0)) return;  // coincident ends: no force (core/springs.cpp), no derivative
+  if (!(l > 0)) return;  // coincident ends: no force (core/dynamics/springs.cpp), no derivative
   const Vec3 e = dist / l, u = a.x_dot - b.x_dot;
   const double k = spring.stiffness, c = spring.damping;
   const double l_dot = e.dot(u), s = k * (l - spring.rest_length) + c * l_dot;

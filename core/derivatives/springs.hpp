@@ -1,6 +1,7 @@
 // The two-point springs' terms of the analytic derivatives (core/derivatives/derivatives.hpp; the
-// springs are core/springs.hpp). A spring pulls its end A by f = −s ê, s = k (ℓ − ℓ₀) + c ℓ̇, with
-// d = x_A − x_B, ℓ = |d|, ê = d / ℓ, u = ẋ_A − ẋ_B, ℓ̇ = êᵀ u, and B by −f. On the joint rates
+// springs are core/dynamics/springs.hpp). A spring pulls its end A by f = −s ê, s = k (ℓ − ℓ₀) + c
+// ℓ̇, with d = x_A − x_B, ℓ = |d|, ê = d / ℓ, u = ẋ_A − ẋ_B, ℓ̇ = êᵀ u, and B by −f. On the joint
+// rates
 //   Q_c = Δ_cᵀ f,   Δ_c = J_c(x_A) − J_c(x_B) = ∂d/∂θ_c,
 // J_c(x) the velocity at x of the rate's column (0 off x's path), and τ_θ gains −Q. Along the
 // tangent θ ⊕ ε e_m (θ̇ fixed), with g_m = êᵀ Δ_m = ∂ℓ/∂θ_m:
@@ -12,7 +13,7 @@
 #pragma once
 #include <vector>
 
-#include "core/math.hpp"
+#include "core/spatial/math.hpp"
 
 namespace femdyn {
 

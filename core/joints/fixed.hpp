@@ -2,7 +2,7 @@
 // coordinate, S has no column.
 #pragma once
 #include "core/joints/flat.hpp"
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 
 namespace femdyn {
 

@@ -6,7 +6,7 @@
 // q ⊕ ξ = (p + R ξ_p, q ⊗ exp(ξ_r)); in the chart around q_c, ξ̇ = (exp(ξ_r) v, J_r(ξ_r)⁻¹ ω).
 #pragma once
 #include "core/joints/rotation.hpp"
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 
 namespace femdyn {
 

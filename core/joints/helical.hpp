@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "core/joints/flat.hpp"
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 
 namespace femdyn {
 

@@ -6,13 +6,14 @@
 // (R_pj, p_pj). Its nq coordinates θ_J (at Joint::idx_q in θ) place B:
 //   R_B = R_P R_pj R_J(θ_J),   p_B = p_P + R_P (p_pj + d_J),   d_J = R_pj p_J(θ_J)
 // (J::pose gives R_pj R_J and d_J, the displacement apart from p_pj, so that the roots' places
-// can be taken from the reference point without the world's large numbers: core/kinematics.cpp)
-// Its nv rates θ̇_J (at Joint::idx_v in θ̇) move B relative to P, about B's origin:
+// can be taken from the reference point without the world's large numbers:
+// core/kinematics/kinematics.cpp) Its nv rates θ̇_J (at Joint::idx_v in θ̇) move B relative to P,
+// about B's origin:
 //   (Δω, Δv) = S_J θ̇_J,   S_J = [S_ω; S_v] (6 × nv)              (J::S_angular, J::S_linear)
 // Each column of S_J is constant in one of two frames: in B (given in B's axes), or in the
 // parent's joint frame (J::in_parent(k); given in P's axes). In world axes a column is
-// s = R_B S or s = R_P S; as a spatial motion about the world origin (core/spatial.hpp) it is
-// (s_ω, s_v + p_B × s_ω). Its rate of change is then the frame's: ṡ = V_B × s or V_P × s, so
+// s = R_B S or s = R_P S; as a spatial motion about the world origin (core/spatial/spatial.hpp) it
+// is (s_ω, s_v + p_B × s_ω). Its rate of change is then the frame's: ṡ = V_B × s or V_P × s, so
 //   c_J = Ṡ_J θ̇_J = V_B × (S_B θ̇_B) + V_P × (S_P θ̇_P)     (the columns fixed in B, in P),
 // the whole bias a joint type needs, with no per-type derivative (Featherstone's c_J).
 // A type whose coordinates are not a vector space (spherical, free: nq ≠ nv) says how to move

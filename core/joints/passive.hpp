@@ -12,12 +12,12 @@
 //
 // The regularised Coulomb law is a smooth damper of slope F_c / v_s at θ̇ = 0: that slope, and
 // the stop's frequency sqrt(k_s / m_eff), are what limit an explicit integrator's step
-// (femdyn check). The rotor's reflected inertia I_a G² is in M^s, not here (core/model.hpp).
+// (femdyn check). The rotor's reflected inertia I_a G² is in M^s, not here (core/model/model.hpp).
 #pragma once
 #include <algorithm>
 #include <cmath>
 
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 
 namespace femdyn {
 

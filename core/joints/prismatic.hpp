@@ -3,7 +3,7 @@
 //   c_J = 0.
 #pragma once
 #include "core/joints/flat.hpp"
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 
 namespace femdyn {
 

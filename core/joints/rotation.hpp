@@ -7,7 +7,7 @@
 #pragma once
 #include <cmath>
 
-#include "core/math.hpp"
+#include "core/spatial/math.hpp"
 
 namespace femdyn {
 

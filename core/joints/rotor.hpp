@@ -14,7 +14,7 @@
 // joint's θ̇ give none. (MuJoCo's free joint takes the linear rate ṗ in world axes, where the same
 // rotor has no velocity term: validate's MuJoCo row compares the two through ṗ = R v.)
 #pragma once
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 
 namespace femdyn {
 

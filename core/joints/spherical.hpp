@@ -8,7 +8,7 @@
 #include <random>
 
 #include "core/joints/rotation.hpp"
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 
 namespace femdyn {
 

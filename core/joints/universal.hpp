@@ -6,7 +6,7 @@
 //      frame into account (kernel.hpp): c_J = ω_P × s₁ θ̇₁ + ω_B × s₂ θ̇₂ in world axes.
 #pragma once
 #include "core/joints/flat.hpp"
-#include "core/model.hpp"
+#include "core/model/model.hpp"
 
 namespace femdyn {
 

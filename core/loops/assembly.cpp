@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <limits>
 
-#include "core/equations.hpp"
-#include "core/sampling.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/sampling.hpp"
 
 namespace femdyn {
 

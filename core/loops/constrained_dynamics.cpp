@@ -5,10 +5,10 @@
 #include <cstdio>
 #include <string>
 
-#include "core/arguments.hpp"
-#include "core/articulated.hpp"
-#include "core/equations.hpp"
-#include "core/kinematics.hpp"
+#include "core/dynamics/articulated.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/kinematics.hpp"
+#include "core/model/arguments.hpp"
 
 namespace femdyn {
 
@@ -41,8 +41,8 @@ Status articulated_constraint_space(const Model& model, Workspace& ws, LoopWorks
   return {};
 }
 
-// The same on every other route: M^s formed and factorised (core/mass_solver.hpp), q̈₀ from one
-// inverse dynamics (Q − h = τ − τ_ID(q, v, 0)).
+// The same on every other route: M^s formed and factorised (core/workspace/mass_solver.hpp), q̈₀
+// from one inverse dynamics (Q − h = τ − τ_ID(q, v, 0)).
 Status cholesky_constraint_space(const Model& model, Workspace& ws, LoopWorkspace& lws,
                                  const VecX& q, const VecX& v, const VecX& tau) {
   inverse_dynamics(model, ws, q, v, lws.zero);  // τ_ID = h − Q(τ = 0)

@@ -4,7 +4,7 @@
 //
 // in the spanning tree's coordinates, with Baumgarte's stabilisation at rate ω (critically
 // damped: a residual decays as (1 + ωt) e^{−ωt}; ω = 0 leaves Φ̈ = 0 alone). Solved in the range
-// space of M^s, with the tree's own factorisation (core/mass_solver.hpp):
+// space of M^s, with the tree's own factorisation (core/workspace/mass_solver.hpp):
 //
 //   q̈₀ = M⁻¹ (Q − h)          (Q − h = τ − τ_ID(q, v, 0), one inverse dynamics)
 //   Y  = M⁻¹ Φ_qᵀ,   S = Φ_q Y  (m solves, m × m)
@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "core/loops/constraint_kinematics.hpp"
-#include "core/status.hpp"
+#include "core/workspace/status.hpp"
 
 namespace femdyn {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "core/joints/rotation.hpp"
-#include "core/kinematics.hpp"
+#include "core/kinematics/kinematics.hpp"
 
 namespace femdyn {
 

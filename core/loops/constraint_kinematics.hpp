@@ -1,4 +1,4 @@
-// The constraints' kinematics at a state (core/loops/constraint.hpp for the forms): the
+// The constraints' kinematics at a state (core/model/loop_constraint.hpp for the forms): the
 // residual Φ(q), the Jacobian Φ_q on the rates v (Φ̇ = Φ_q v) and the bias Φ̇_q v, the part of
 // Φ̈ = Φ_q q̈ + Φ̇_q v at q̈ = 0. With d = p_A − p_B, ḋ, its bias d̈₀ = a_A − a_B, Jd = Jv_A − Jv_B,
 // and for a row along an axis g = R_B e fixed in B (ġ = ω_B × g):
@@ -9,7 +9,7 @@
 //   distance      êᵀ Jd;                           bias êᵀ d̈₀ + (|ḋ|² − (êᵀ ḋ)²) / l
 //   gear          (e_j − Σ r_i e_i)ᵀ C (θ̇ = C v);  bias 0
 #pragma once
-#include "core/frames.hpp"
+#include "core/kinematics/frames.hpp"
 
 namespace femdyn {
 
@@ -26,8 +26,8 @@ struct ConstraintKinematics {
 void constraint_kinematics(const Model& model, const Workspace& ws, ConstraintKinematics& out);
 // The same with each attachment's Jacobian formed from the path of its body to the root over
 // the rates' spatial columns that articulated_forward_dynamics left in ws (C = I;
-// core/articulated.hpp), and its motion from the body states of the last propagate with the
-// bias: O(n + depth) per attachment, no body Jacobians (which cost O(Σ depth) to form).
+// core/dynamics/articulated.hpp), and its motion from the body states of the last propagate with
+// the bias: O(n + depth) per attachment, no body Jacobians (which cost O(Σ depth) to form).
 void constraint_kinematics_by_paths(const Model& model, const Workspace& ws,
                                     ConstraintKinematics& out);
 // The same as the first at (q, v), after its own propagate.

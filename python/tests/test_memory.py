@@ -1,4 +1,4 @@
-"""Memory refused up front (core/memory.hpp, issue 22): every call that allocates by its
+"""Memory refused up front (core/workspace/memory.hpp, issue 22): every call that allocates by its
 arguments' size estimates the memory first and, beyond the limit, raises a ValueError with one
 line: what needs how much, the limit, and how to proceed. The tests lower the limit with
 femdyn.set_max_memory, so nothing depends on the machine's memory."""

@@ -7,8 +7,8 @@
 #include <random>
 #include <typeinfo>
 
-#include "core/equations.hpp"
-#include "core/sampling.hpp"
+#include "core/dynamics/equations.hpp"
+#include "core/kinematics/sampling.hpp"
 
 #ifndef FEMDYN_FUZZ_NAN_CHECK
 #define FEMDYN_FUZZ_NAN_CHECK 1

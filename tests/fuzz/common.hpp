@@ -1,7 +1,7 @@
 // Shared by the fuzz targets (json_model.cpp, urdf.cpp, vector.cpp, csv.cpp): what counts as a
 // bug.
 //   Expected: femdyn::ModelError or another std::runtime_error whose message is one line of
-//   printable text (core/message.hpp printable_text), or a failed Status.
+//   printable text (core/model/message.hpp printable_text), or a failed Status.
 //   A bug (abort(), so libFuzzer keeps the input): a crash or sanitizer report, a hang (libFuzzer
 //   -timeout), an exception of any other type, an error message (what()) that holds a control
 //   character (C0 including a line break, DEL, C1) or a byte that is not UTF-8, and — with the
@@ -14,8 +14,8 @@
 #include <string>
 #include <typeinfo>
 
-#include "core/message.hpp"
-#include "core/model.hpp"
+#include "core/model/message.hpp"
+#include "core/model/model.hpp"
 #include "io/params.hpp"
 
 namespace femdyn::fuzz {

@@ -11,7 +11,7 @@
 #include <optional>
 
 #include "compile/compile.hpp"
-#include "core/limits.hpp"
+#include "core/model/limits.hpp"
 #include "io/actuation_table.hpp"
 #include "io/model_loader.hpp"
 #include "io/trajectory_csv.hpp"

@@ -3,7 +3,7 @@
 #include <optional>
 
 #include "compile/compile.hpp"
-#include "core/errors.hpp"
+#include "core/model/errors.hpp"
 #include "io/model_loader.hpp"
 #include "tests/fuzz/common.hpp"
 

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <optional>
 
-#include "core/errors.hpp"
+#include "core/model/errors.hpp"
 #include "io/model_loader.hpp"
 #include "io/urdf_loader.hpp"
 #include "tests/fuzz/common.hpp"
