@@ -205,118 +205,135 @@ int depth(const Model& m, int body) {
   return k;
 }
 
-}  // namespace
+// The node level of a compiled tree (Model::elements, nodes, dofs, M, F_constant), built in
+// passes: each element's nodes and their candidate transition coordinates, the loads' points,
+// the system DOFs numbered (those that move, or an explicit table's), then M = Σ_e scatter(m_e)
+// through N_m and F = M G + the loads.
+class NodeLevel {
+ public:
+  NodeLevel(MechanismSpec& spec, Model& m) : spec(spec), m(m), nodes_of(m.bodies.size()) {}
 
-std::vector<VecX> sample_states(const Model& m, int count) {
-  std::mt19937 rng(20261122u);
-  std::uniform_real_distribution<double> uni(-2.0, 2.0);
-  std::vector<VecX> qs;
-  for (int s = 0; s < count; ++s) {
-    VecX xi(m.n());
-    for (int a = 0; a < m.n(); ++a) xi[a] = uni(rng);
-    qs.push_back(integrate_posture(m, neutral_posture(m), xi));  // (q = ξ when flat)
+  void build(const std::vector<int>& body_of_spec) {
+    place_elements(body_of_spec);
+    place_loads();
+    set_dofs(m, cand.list);  // which candidates move at all
+    tol = 1e-10 * length_scale(m);
+    Ts = sample_T(m, spec.correlation.has_value(), tol);
+    set_dofs(m, spec.correlation ? number_by_table(*spec.correlation) : number_moving());
+    check_loads_kept();
+    assemble_mass();
+    constant_forces();
   }
-  return qs;
-}
 
-void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec, Model& m) {
-  // Elements in file order; each local DOF gets its candidate transition coordinate.
+ private:
+  // A load, with the node and body whose DOFs it pushes on.
+  struct LoadAt {
+    int node, body;
+    Vec3 force, torque;
+    std::string where;
+  };
+
+  MechanismSpec& spec;
+  Model& m;
   Candidates cand;
-  NodesOfBody nodes_of(m.bodies.size());
+  NodesOfBody nodes_of;
   std::vector<std::vector<int>> local_cand;  // per element: 6k, -1 where unused
   std::vector<std::vector<int>> all_cand;    // per element: 6k, also for unused local DOFs
-  // A node labelled "other_body/node" lies on that body (an element that spans bodies).
   std::map<std::string, int> body_named;
-  for (std::size_t k = 0; k < m.bodies.size(); ++k) body_named.emplace(m.bodies[k].name, k);
-  const auto body_of_label = [&](const std::string& label, int own) {
+  std::vector<LoadAt> loads;
+  double tol = 0;  // a row of T below it never moves
+  TSamples Ts;
+
+  // The body a node label "other_body/node" names (an element that spans bodies), else `own`.
+  int body_of_label(const std::string& label, int own) const {
     for (std::size_t cut = label.rfind('/'); cut != std::string::npos && cut > 0;
          cut = label.rfind('/', cut - 1)) {
       const auto it = body_named.find(label.substr(0, cut));
       if (it != body_named.end()) return it->second;
     }
     return own;
-  };
-  for (std::size_t s = 0; s < spec.bodies.size(); ++s) {
-    const int b = body_of_spec[s];
-    for (ElementSpec& es : spec.bodies[s].elements) {
-      ElementEntry e;
-      e.element = std::move(es.element);
-      e.body = b;
-      e.where = es.where;
-      e.node_labels = es.node_labels;
-      const auto nodes = e.element->nodes();
-      std::vector<int> used, all;
-      for (std::size_t l = 0; l < nodes.size(); ++l) {
-        std::string label = l < es.node_labels.size() ? es.node_labels[l] : "node";
-        check_name(label, es.where, "node label");
-        if (label.find('/') == std::string::npos) label = m.bodies[b].name + "/" + label;
-        check_magnitude(nodes[l].position, es.where, "element node position");
-        const int nb = body_of_label(label, b);
-        if (nb != b) {
-          e.spans = true;
-          for (int k = 3; k < kNodeDofs; ++k)
-            if (nodes[l].uses[k])
-              throw ModelError(es.where, "node '" + label +
-                                             "' is on another body: an element uses only its "
-                                             "translation there (no rotation)");
-        }
-        e.node_body.push_back(nb);
-        const int node = find_or_add_node(m, nodes_of, nb, nodes[l].position, label);
-        for (int k = 0; k < kNodeDofs; ++k) {
-          const bool use = nodes[l].uses[k];
-          const int c = k < 3 ? cand.add(DofKind::Translation, node, k, use)
-                              : cand.add(DofKind::Rotation, b, k - 3, use);
-          all.push_back(c);
-          used.push_back(nodes[l].uses[k] ? c : -1);
-        }
+  }
+
+  // Elements in file order; each local DOF gets its candidate transition coordinate.
+  void place_elements(const std::vector<int>& body_of_spec) {
+    for (std::size_t k = 0; k < m.bodies.size(); ++k)
+      body_named.emplace(m.bodies[k].name, static_cast<int>(k));
+    for (std::size_t s = 0; s < spec.bodies.size(); ++s)
+      for (ElementSpec& es : spec.bodies[s].elements) place_element(es, body_of_spec[s]);
+  }
+
+  void place_element(ElementSpec& es, int b) {
+    ElementEntry e;
+    e.element = std::move(es.element);
+    e.body = b;
+    e.where = es.where;
+    e.node_labels = es.node_labels;
+    const auto nodes = e.element->nodes();
+    std::vector<int> used, all;
+    for (std::size_t l = 0; l < nodes.size(); ++l) {
+      std::string label = l < es.node_labels.size() ? es.node_labels[l] : "node";
+      check_name(label, es.where, "node label");
+      if (label.find('/') == std::string::npos) label = m.bodies[b].name + "/" + label;
+      check_magnitude(nodes[l].position, es.where, "element node position");
+      const int nb = body_of_label(label, b);
+      if (nb != b) {
+        e.spans = true;
+        for (int k = 3; k < kNodeDofs; ++k)
+          if (nodes[l].uses[k])
+            throw ModelError(es.where, "node '" + label +
+                                           "' is on another body: an element uses only its "
+                                           "translation there (no rotation)");
       }
-      const MatX me = e.element->local_mass();
-      if (me.rows() != e.element->local_dof_count() || me.cols() != me.rows() || !me.allFinite() ||
-          (me - me.transpose()).norm() > 1e-12 * (1.0 + me.norm()))
-        throw ModelError(es.where, "element local mass is not a finite symmetric matrix");
-      local_cand.push_back(std::move(used));
-      all_cand.push_back(std::move(all));
-      m.elements.push_back(std::move(e));
+      e.node_body.push_back(nb);
+      const int node = find_or_add_node(m, nodes_of, nb, nodes[l].position, label);
+      for (int k = 0; k < kNodeDofs; ++k) {
+        const bool use = nodes[l].uses[k];
+        const int c = k < 3 ? cand.add(DofKind::Translation, node, k, use)
+                            : cand.add(DofKind::Rotation, b, k - 3, use);
+        all.push_back(c);
+        used.push_back(use ? c : -1);
+      }
+    }
+    check_local_mass(*e.element, es.where);
+    local_cand.push_back(std::move(used));
+    all_cand.push_back(std::move(all));
+    m.elements.push_back(std::move(e));
+  }
+
+  static void check_local_mass(const Element& element, const std::string& where) {
+    const MatX me = element.local_mass();
+    if (me.rows() != element.local_dof_count() || me.cols() != me.rows() || !me.allFinite() ||
+        (me - me.transpose()).norm() > 1e-12 * (1.0 + me.norm()))
+      throw ModelError(where, "element local mass is not a finite symmetric matrix");
+  }
+
+  // Loads need the DOFs they push on.
+  void place_loads() {
+    for (const LoadSpec& ls : spec.loads) {
+      const auto found = body_named.find(ls.body);
+      if (found == body_named.end())
+        throw ModelError(ls.where + "/body", "unknown body " + quoted_text(ls.body));
+      const int b = found->second;
+      check_magnitude(ls.point, ls.where + "/point", "load point");
+      check_magnitude(ls.force, ls.where + "/force", "load force");
+      check_magnitude(ls.torque, ls.where + "/torque", "load torque");
+      const int node = find_or_add_node(m, nodes_of, b, ls.point, ls.body + "/load");
+      if (!ls.force.isZero(0))
+        for (int k = 0; k < 3; ++k) cand.add(DofKind::Translation, node, k, true);
+      if (!ls.torque.isZero(0))
+        for (int k = 0; k < 3; ++k) cand.add(DofKind::Rotation, b, k, true);
+      loads.push_back({node, b, ls.force, ls.torque, ls.where});
+      if (!ls.force.isZero(0)) m.point_loads.push_back({b, ls.point, ls.force});
     }
   }
-  // Loads need the DOFs they push on.
-  struct LoadAt {
-    int node, body;
-    Vec3 force, torque;
-    std::string where;
-  };
-  std::vector<LoadAt> loads;
-  std::map<std::string, int> body_index;
-  if (!spec.loads.empty())
-    for (std::size_t k = 0; k < m.bodies.size(); ++k)
-      body_index.emplace(m.bodies[k].name, static_cast<int>(k));
-  for (const LoadSpec& ls : spec.loads) {
-    const auto found = body_index.find(ls.body);
-    const int b = found == body_index.end() ? -1 : found->second;
-    if (b < 0) throw ModelError(ls.where + "/body", "unknown body " + quoted_text(ls.body));
-    check_magnitude(ls.point, ls.where + "/point", "load point");
-    check_magnitude(ls.force, ls.where + "/force", "load force");
-    check_magnitude(ls.torque, ls.where + "/torque", "load torque");
-    const int node = find_or_add_node(m, nodes_of, b, ls.point, ls.body + "/load");
-    if (!ls.force.isZero(0))
-      for (int k = 0; k < 3; ++k) cand.add(DofKind::Translation, node, k, true);
-    if (!ls.torque.isZero(0))
-      for (int k = 0; k < 3; ++k) cand.add(DofKind::Rotation, b, k, true);
-    loads.push_back({node, b, ls.force, ls.torque, ls.where});
-    if (!ls.force.isZero(0)) m.point_loads.push_back({b, ls.point, ls.force});
-  }
 
-  // Which candidates move at all.
-  set_dofs(m, cand.list);
-  const double tol = 1e-10 * length_scale(m);
-  const TSamples Ts = sample_T(m, spec.correlation.has_value(), tol);
-  const int nc = static_cast<int>(cand.list.size());
-
-  std::vector<int> number(nc, 0);  // candidate -> 1-based system DOF, 0 left out
-  std::vector<SystemDof> dofs;
-  if (!spec.correlation) {
-    // A DOF that moves above round-off (1e-13 L) but below the cut-off is left out too: an
-    // approximation (an axis tilted by 3.5e-10 rad by rpy="3.141592654"), listed as one.
+  // The system DOFs without a table: every needed candidate that moves, in order. A DOF that
+  // moves above round-off (1e-13 L) but below the cut-off is left out too: an approximation
+  // (an axis tilted by 3.5e-10 rad by rpy="3.141592654"), listed as one.
+  std::vector<SystemDof> number_moving() {
+    const int nc = static_cast<int>(cand.list.size());
+    std::vector<int> number(nc, 0);  // candidate -> 1-based system DOF, 0 left out
+    std::vector<SystemDof> dofs;
     std::vector<std::string> barely;
     double barely_max = 0;
     for (int c = 0; c < nc; ++c) {
@@ -324,29 +341,51 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
       if (moves(Ts, c, tol)) {
         dofs.push_back(cand.list[c]);
         number[c] = static_cast<int>(dofs.size());
-      } else {
-        m.left_out.push_back(m.dof_name_of(cand.list[c]) + " (never moves)");
-        if (moves(Ts, c, 1e-3 * tol)) {
-          barely.push_back(m.dof_name_of(cand.list[c]));
-          barely_max = std::max(barely_max, Ts.row_max[c]);
-        }
+        continue;
+      }
+      m.left_out.push_back(m.dof_name_of(cand.list[c]) + " (never moves)");
+      if (moves(Ts, c, 1e-3 * tol)) {
+        barely.push_back(m.dof_name_of(cand.list[c]));
+        barely_max = std::max(barely_max, Ts.row_max[c]);
       }
     }
-    if (!barely.empty()) {
-      std::string list;
-      for (std::size_t k = 0; k < barely.size() && k < 5; ++k) list += (k ? ", " : "") + barely[k];
-      if (barely.size() > 5) list += ", … (" + std::to_string(barely.size()) + " in all)";
-      m.approximations.push_back(list + ": moves by at most " + format_sci(barely_max) +
-                                 " per unit rate, below the cut-off " + format_sci(tol) +
-                                 ", and is treated as never moving (its terms, gravity's "
-                                 "included, are dropped)");
-    }
+    if (!barely.empty()) note_barely_moving(barely, barely_max);
     for (std::size_t e = 0; e < m.elements.size(); ++e)
       for (int c : local_cand[e]) m.elements[e].table_row.push_back(c >= 0 ? number[c] : 0);
-  } else {
-    // Explicit N_m, checked: each number must name one physical motion.
+    return dofs;
+  }
+
+  void note_barely_moving(const std::vector<std::string>& barely, double barely_max) {
+    std::string list;
+    for (std::size_t k = 0; k < barely.size() && k < 5; ++k) list += (k ? ", " : "") + barely[k];
+    if (barely.size() > 5) list += ", … (" + std::to_string(barely.size()) + " in all)";
+    m.approximations.push_back(list + ": moves by at most " + format_sci(barely_max) +
+                               " per unit rate, below the cut-off " + format_sci(tol) +
+                               ", and is treated as never moving (its terms, gravity's "
+                               "included, are dropped)");
+  }
+
+  // Explicit N_m, checked: each number must name one physical motion.
+  std::vector<SystemDof> number_by_table(const CorrelationSpec& cs) {
     m.explicit_table = true;
-    const CorrelationSpec& cs = *spec.correlation;
+    const int N = table_size(cs);
+    std::vector<int> def(N + 1, -1);                  // system DOF -> defining candidate
+    std::vector<std::pair<int, std::string>> joined;  // approximate joins (join_deepest)
+    for (std::size_t e = 0; e < cs.rows.size(); ++e)
+      for (std::size_t l = 0; l < cs.rows[e].size(); ++l) define_by_table(cs, e, l, def, joined);
+    for (const auto& [d, joins] : joined)
+      m.approximations.push_back(joins + ": takes " + m.dof_name_of(cand.list[def[d]]));
+    std::vector<SystemDof> dofs;
+    for (int d = 1; d <= N; ++d) {
+      if (def[d] < 0) throw ModelError(cs.where, "system DOF " + std::to_string(d) + " is unused");
+      dofs.push_back(cand.list[def[d]]);
+    }
+    for (std::size_t e = 0; e < m.elements.size(); ++e) m.elements[e].table_row = cs.rows[e];
+    return dofs;
+  }
+
+  // The table's shape (a row per element, 6 entries per node) and its largest DOF number.
+  int table_size(const CorrelationSpec& cs) const {
     if (cs.rows.size() != m.elements.size())
       throw ModelError(cs.where, "has " + std::to_string(cs.rows.size()) + " rows, expected " +
                                      std::to_string(m.elements.size()) + " (one per element)");
@@ -369,81 +408,103 @@ void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec,
         N = std::max(N, d);
       }
     }
-    std::vector<int> def(N + 1, -1);                  // system DOF -> defining candidate
-    std::vector<std::pair<int, std::string>> joined;  // approximate joins (join_deepest)
-    for (std::size_t e = 0; e < cs.rows.size(); ++e)
-      for (std::size_t l = 0; l < cs.rows[e].size(); ++l) {
-        const int d = cs.rows[e][l], c = all_cand[e][l];
-        if (d == 0) {
-          const std::string note =
-              m.dof_name_of(cand.list[c]) + " (left out by the table although it moves)";
-          if (local_cand[e][l] >= 0 && moves(Ts, c, tol) &&
-              std::find(m.left_out.begin(), m.left_out.end(), note) == m.left_out.end())
-            m.left_out.push_back(note);
-          continue;
-        }
-        if (def[d] < 0) {
-          def[d] = c;
-        } else if (def[d] != c && !same_motion(Ts, def[d], c, tol)) {
-          const std::string joins = "system DOF " + std::to_string(d) + " joins " +
-                                    m.dof_name_of(cand.list[def[d]]) + " and " +
-                                    m.dof_name_of(cand.list[c]) + ", which move differently";
-          if (!cs.join_deepest)
-            throw ModelError(cs.where + "/" + std::to_string(e) + "/" + std::to_string(l), joins);
-          if (depth(m, carrier_body(m, cand.list[c])) >
-              depth(m, carrier_body(m, cand.list[def[d]])))
-            def[d] = c;
-          joined.emplace_back(d, joins);
-        }
-      }
-    for (const auto& [d, joins] : joined)
-      m.approximations.push_back(joins + ": takes " + m.dof_name_of(cand.list[def[d]]));
-    for (int d = 1; d <= N; ++d) {
-      if (def[d] < 0) throw ModelError(cs.where, "system DOF " + std::to_string(d) + " is unused");
-      dofs.push_back(cand.list[def[d]]);
-    }
-    for (std::size_t e = 0; e < m.elements.size(); ++e) m.elements[e].table_row = cs.rows[e];
+    return N;
   }
-  set_dofs(m, dofs);
-  // A table that leaves out a moving DOF a load pushes on would drop the load silently.
-  for (const LoadAt& l : loads)
-    for (int k = 0; k < 3; ++k) {
-      const auto check = [&](DofKind kind, int carrier, int dof, double push) {
-        const int c = cand.index.at(std::make_tuple(static_cast<int>(kind), carrier, k));
-        if (push != 0 && dof < 0 && moves(Ts, c, tol))
-          throw ModelError(l.where, "the load pushes on " + m.dof_name_of(cand.list[c]) +
-                                        ", which the correlation table leaves out");
-      };
-      if (l.force[k] != 0) check(DofKind::Translation, l.node, m.node_dof[l.node][k], l.force[k]);
-      if (!l.torque.isZero(0)) check(DofKind::Rotation, l.body, m.body_rot_dof[l.body][k], 1.0);
+
+  // Entry l of element e's row: 0 leaves its candidate out; a number names the candidate it
+  // was first given to, and joins another only if both move alike (or, with join_deepest, takes
+  // the deeper one's motion, an approximation).
+  void define_by_table(const CorrelationSpec& cs, std::size_t e, std::size_t l,
+                       std::vector<int>& def, std::vector<std::pair<int, std::string>>& joined) {
+    const int d = cs.rows[e][l], c = all_cand[e][l];
+    if (d == 0) {
+      const std::string note =
+          m.dof_name_of(cand.list[c]) + " (left out by the table although it moves)";
+      if (local_cand[e][l] >= 0 && moves(Ts, c, tol) &&
+          std::find(m.left_out.begin(), m.left_out.end(), note) == m.left_out.end())
+        m.left_out.push_back(note);
+      return;
     }
+    if (def[d] < 0) {
+      def[d] = c;
+      return;
+    }
+    if (def[d] == c || same_motion(Ts, def[d], c, tol)) return;
+    const std::string joins = "system DOF " + std::to_string(d) + " joins " +
+                              m.dof_name_of(cand.list[def[d]]) + " and " +
+                              m.dof_name_of(cand.list[c]) + ", which move differently";
+    if (!cs.join_deepest)
+      throw ModelError(cs.where + "/" + std::to_string(e) + "/" + std::to_string(l), joins);
+    if (depth(m, carrier_body(m, cand.list[c])) > depth(m, carrier_body(m, cand.list[def[d]])))
+      def[d] = c;
+    joined.emplace_back(d, joins);
+  }
+
+  // A table that leaves out a moving DOF a load pushes on would drop the load silently.
+  void check_loads_kept() const {
+    for (const LoadAt& l : loads)
+      for (int k = 0; k < 3; ++k) {
+        const auto check = [&](DofKind kind, int carrier, int dof, double push) {
+          const int c = cand.index.at(std::make_tuple(static_cast<int>(kind), carrier, k));
+          if (push != 0 && dof < 0 && moves(Ts, c, tol))
+            throw ModelError(l.where, "the load pushes on " + m.dof_name_of(cand.list[c]) +
+                                          ", which the correlation table leaves out");
+        };
+        if (l.force[k] != 0) check(DofKind::Translation, l.node, m.node_dof[l.node][k], l.force[k]);
+        if (!l.torque.isZero(0)) check(DofKind::Rotation, l.body, m.body_rot_dof[l.body][k], 1.0);
+      }
+  }
 
   // Assembly: M = Σ_e scatter(m_e) through N_m.
-  const int N = m.n_u();
-  std::vector<Eigen::Triplet<double>> trip;
-  for (const ElementEntry& e : m.elements) {
-    const MatX me = e.element->local_mass();
-    const auto& row = e.table_row;
-    for (std::size_t l = 0; l < row.size(); ++l)
-      for (std::size_t k = 0; k < row.size(); ++k)
-        if (row[l] && row[k] && me(l, k) != 0) trip.emplace_back(row[l] - 1, row[k] - 1, me(l, k));
-    if (e.element->has_velocity_force()) m.has_velocity_forces = true;
+  void assemble_mass() {
+    const int N = m.n_u();
+    std::vector<Eigen::Triplet<double>> trip;
+    for (const ElementEntry& e : m.elements) {
+      const MatX me = e.element->local_mass();
+      const auto& row = e.table_row;
+      for (std::size_t l = 0; l < row.size(); ++l)
+        for (std::size_t k = 0; k < row.size(); ++k)
+          if (row[l] && row[k] && me(l, k) != 0)
+            trip.emplace_back(row[l] - 1, row[k] - 1, me(l, k));
+      if (e.element->has_velocity_force()) m.has_velocity_forces = true;
+    }
+    m.M.resize(N, N);
+    m.M.setFromTriplets(trip.begin(), trip.end());
+    m.M.makeCompressed();
   }
-  m.M.resize(N, N);
-  m.M.setFromTriplets(trip.begin(), trip.end());
-  m.M.makeCompressed();
 
   // F = M·G (gravity: every translation accelerates by g) + point loads.
-  VecX G = VecX::Zero(N);
-  for (int i = 0; i < N; ++i)
-    if (m.dofs[i].kind == DofKind::Translation) G[i] = m.gravity[m.dofs[i].axis];
-  m.F_constant = m.M * G;
-  for (const LoadAt& l : loads) {
-    for (int k = 0; k < 3; ++k)
-      if (m.node_dof[l.node][k] >= 0) m.F_constant[m.node_dof[l.node][k]] += l.force[k];
-    if (!l.torque.isZero(0)) m.torques.push_back({l.body, l.torque});
+  void constant_forces() {
+    const int N = m.n_u();
+    VecX G = VecX::Zero(N);
+    for (int i = 0; i < N; ++i)
+      if (m.dofs[i].kind == DofKind::Translation) G[i] = m.gravity[m.dofs[i].axis];
+    m.F_constant = m.M * G;
+    for (const LoadAt& l : loads) {
+      for (int k = 0; k < 3; ++k)
+        if (m.node_dof[l.node][k] >= 0) m.F_constant[m.node_dof[l.node][k]] += l.force[k];
+      if (!l.torque.isZero(0)) m.torques.push_back({l.body, l.torque});
+    }
+    m.has_nodal_forces = !m.torques.empty() || (N > 0 && m.F_constant.cwiseAbs().maxCoeff() > 0);
   }
-  m.has_nodal_forces = !m.torques.empty() || (N > 0 && m.F_constant.cwiseAbs().maxCoeff() > 0);
+};
+
+}  // namespace
+
+std::vector<VecX> sample_states(const Model& m, int count) {
+  std::mt19937 rng(20261122u);
+  std::uniform_real_distribution<double> uni(-2.0, 2.0);
+  std::vector<VecX> qs;
+  for (int s = 0; s < count; ++s) {
+    VecX xi(m.n());
+    for (int a = 0; a < m.n(); ++a) xi[a] = uni(rng);
+    qs.push_back(integrate_posture(m, neutral_posture(m), xi));  // (q = ξ when flat)
+  }
+  return qs;
+}
+
+void build_node_level(MechanismSpec& spec, const std::vector<int>& body_of_spec, Model& m) {
+  NodeLevel(spec, m).build(body_of_spec);
 }
 
 std::optional<MassMatrixProblem> mass_matrix_problem(const Model& m, bool list_inert) {

@@ -1,18 +1,18 @@
+// femdyn JSON (docs/model-format.md) into a MechanismSpec: the document's keys, its bodies with
+// their joints and elements, and its lists; the places on bodies are io/json_places.cpp's, the
+// front door for files io/model_file.cpp's.
 #include "io/model_loader.hpp"
 
-#include <cctype>
 #include <cstdint>
-#include <filesystem>
-#include <fstream>
-#include <optional>
-#include <sstream>
+#include <map>
+#include <string>
+#include <vector>
 
-#include "compile/compile.hpp"
 #include "core/model/limits.hpp"
 #include "core/model/names.hpp"
 #include "io/catalog.hpp"
 #include "io/coupling_json.hpp"
-#include "io/input_file.hpp"
+#include "io/json_places.hpp"
 #include "io/json_text.hpp"
 #include "io/params.hpp"
 #include "io/robot_reference.hpp"
@@ -102,24 +102,6 @@ JointSpec read_joint(const Params& p) {
   return j;
 }
 
-// Every body's named nodes as "body/node" (body frame of that body): an element may reach a
-// node of another body by that name (an element that spans bodies, docs/model-format.md).
-std::map<std::string, Vec3> qualified_nodes(const Json& bodies) {
-  std::map<std::string, Vec3> all;
-  for (const Json& jb : bodies) {
-    if (!jb.is_object() || !jb.contains("nodes") || !jb["nodes"].is_object() ||
-        !jb.contains("name") || !jb["name"].is_string())
-      continue;  // (reported where the body is read)
-    const std::string name = jb["name"].get<std::string>();
-    for (auto it = jb["nodes"].begin(); it != jb["nodes"].end(); ++it)
-      if (it.value().is_array() && it.value().size() == 3 && it.value()[0].is_number() &&
-          it.value()[1].is_number() && it.value()[2].is_number())
-        all[name + "/" + it.key()] = {it.value()[0].get<double>(), it.value()[1].get<double>(),
-                                      it.value()[2].get<double>()};
-  }
-  return all;
-}
-
 BodySpec read_body(const Catalog& catalog, const Json& jb, const std::string& where,
                    const std::map<std::string, Vec3>& other_nodes) {
   const Params p(jb, where);
@@ -154,120 +136,6 @@ BodySpec read_body(const Catalog& catalog, const Json& jb, const std::string& wh
   return b;
 }
 
-// The bodies' JSON objects by name (a list: a duplicate name is reported by compile()).
-using BodiesByName = std::map<std::string, std::vector<const Json*>>;
-
-BodiesByName bodies_by_name(const Json& bodies) {
-  BodiesByName by_name;
-  for (const Json& b : bodies)
-    if (b.is_object() && b.contains("name") && b["name"].is_string())
-      by_name[b["name"].get<std::string>()].push_back(&b);
-  return by_name;
-}
-
-// A point on `body` (body frame): the node named by p's "node", or p's `point_key` (default 0);
-// the two exclude each other.
-Vec3 point_on_body(const Params& p, const std::string& body, const BodiesByName& bodies,
-                   const char* point_key) {
-  if (p.has("node") && p.has(point_key))
-    p.fail(point_key, std::string("give either ") + point_key + " or node, not both");
-  if (!p.has("node")) return p.vec3_or(point_key, Vec3::Zero());
-  std::map<std::string, Vec3> nodes;
-  const auto named = bodies.find(body);
-  if (named != bodies.end())
-    for (const Json* b : named->second)
-      if (b->contains("nodes") && (*b)["nodes"].is_object())
-        for (auto it = (*b)["nodes"].begin(); it != (*b)["nodes"].end(); ++it)
-          nodes[it.key()] = json_vec3(it.value(), p.path("node"));
-  const Params np(p.json(), p.where(), body, &nodes);
-  return np.node("node").position;
-}
-
-// One end of a constraint or spring: "frame, body or world", or {"body", "xyz" | "node", "rpy"}.
-AttachmentSpec read_attachment(const Params& p, const char* key, const BodiesByName& bodies) {
-  AttachmentSpec a;
-  a.where = p.path(key);
-  if (!p.has(key)) p.fail(key, "missing (a frame, a body, \"world\", or {\"body\", \"xyz\"})");
-  const Json& j = p.json().at(key);
-  if (j.is_string()) {
-    a.frame = j.get<std::string>();
-    return a;
-  }
-  if (!j.is_object())
-    p.fail(key, "expected a frame name or {\"body\", \"xyz\" | \"node\", \"rpy\"}");
-  const Params e(j, a.where);
-  e.allow_only({"body", "xyz", "node", "rpy"});
-  a.body = e.string("body");
-  a.xyz = point_on_body(e, a.body, bodies, "xyz");
-  a.rpy = e.vec3_or("rpy", Vec3::Zero());
-  return a;
-}
-
-// {"name", "type", "a", "b", "normal" | "direction" | "length"} or a gear {"name", "type":
-// "gear", "joint", "follows", "ratio", "offset"} (docs/model-format.md#constraints).
-ConstraintSpec read_constraint(const Params& p, const BodiesByName& bodies, std::size_t index) {
-  ConstraintSpec c;
-  c.where = p.where();
-  c.name = p.has("name") ? p.string("name") : "constraint_" + std::to_string(index);
-  c.type = p.string("type");
-  if (c.type == "gear") {
-    p.allow_only({"name", "type", "joint", "follows", "ratio", "offset"});
-    c.joint = p.string("joint");
-    c.terms = read_linear_terms(p);
-    c.offset = p.number_or("offset", 0.0);
-    return c;
-  }
-  const char* axis_key = c.type == "point_on_line" ? "direction" : "normal";
-  if (c.type == "distance")
-    p.allow_only({"name", "type", "a", "b", "length"});
-  else if (c.type == "weld")
-    p.allow_only({"name", "type", "a", "b"});
-  else
-    p.allow_only({"name", "type", "a", "b", axis_key});
-  c.a = read_attachment(p, "a", bodies);
-  c.b = read_attachment(p, "b", bodies);
-  if (p.has(axis_key)) c.axis = p.vec3(axis_key);
-  if (c.type == "distance") c.length = p.positive("length");
-  return c;
-}
-
-// {"name", "a", "b", "stiffness", "rest_length", "damping"}: a two-point spring-damper.
-SpringSpec read_spring(const Params& p, const BodiesByName& bodies, std::size_t index) {
-  p.allow_only({"name", "a", "b", "stiffness", "rest_length", "damping"});
-  SpringSpec s;
-  s.where = p.where();
-  s.name = p.has("name") ? p.string("name") : "spring_" + std::to_string(index);
-  s.a = read_attachment(p, "a", bodies);
-  s.b = read_attachment(p, "b", bodies);
-  s.stiffness = p.non_negative("stiffness");
-  s.rest_length = p.has("rest_length") ? p.non_negative("rest_length") : 0.0;
-  s.damping = p.has("damping") ? p.non_negative("damping") : 0.0;
-  return s;
-}
-
-// {"name", "body", "xyz" | "node", "rpy"}: a frame on a body, at a point or at one of its nodes.
-FrameSpec read_frame(const Params& p, const BodiesByName& bodies) {
-  p.allow_only({"name", "body", "xyz", "node", "rpy"});
-  FrameSpec f;
-  f.where = p.where();
-  f.name = p.string("name");
-  f.body = p.string("body");
-  f.xyz = point_on_body(p, f.body, bodies, "xyz");
-  f.rpy = p.vec3_or("rpy", Vec3::Zero());
-  return f;
-}
-
-LoadSpec read_load(const Params& p, const BodiesByName& bodies) {
-  p.allow_only({"body", "point", "node", "force", "torque"});
-  LoadSpec l;
-  l.where = p.where();
-  l.body = p.string("body");
-  l.point = point_on_body(p, l.body, bodies, "point");
-  l.force = p.vec3_or("force", Vec3::Zero());
-  l.torque = p.vec3_or("torque", Vec3::Zero());
-  return l;
-}
-
 // {"model": NAME, "params": {…}, "name", "description", "gravity", "loads"}: the plugin writes
 // the bodies (and couplings, loads, table); the file's own name, gravity and loads apply on top.
 MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std::string& source);
@@ -287,6 +155,57 @@ Json expand_plugin(const Catalog& catalog, const Json& root, const std::string& 
   Json doc = plugin->expand(p.has("params") ? p.child("params") : Params(empty, p.path("params")));
   apply_overrides(root, p, doc);
   return doc;
+}
+
+// The items of the list root[key] (an array, or absent), each read by `read` from its Params.
+template <class Read>
+void read_list(const Json& root, const char* key, const std::string& source, Read read) {
+  if (!root.contains(key)) return;
+  const std::string where = source + ": /" + key;
+  if (!root[key].is_array()) throw ModelError(where, "expected an array");
+  for (std::size_t i = 0; i < root[key].size(); ++i)
+    read(Params(root[key][i], where + "/" + std::to_string(i)), i);
+}
+
+// One DOF number of an explicit correlation table, range-checked before narrowing: 2^31 must
+// not wrap to a negative int, nor 2^63 to 0.
+int dof_number(const Json& x, const std::string& where) {
+  if (!x.is_number_integer()) throw ModelError(where, "expected an integer DOF number");
+  const bool fits = x.is_number_unsigned()
+                        ? x.get<std::uint64_t>() <= 2147483647u
+                        : x.get<std::int64_t>() >= 0 && x.get<std::int64_t>() <= 2147483647;
+  if (!fits)
+    throw ModelError(where, "DOF number " + x.dump() + " is out of range (0 to 2147483647)");
+  return x.get<int>();
+}
+
+// "correlation_table": [[…], …]  or  {"rows": [[…], …], "join": "same" | "deepest"}.
+CorrelationSpec read_correlation_table(const Json& table, const std::string& where) {
+  const Json* tp = &table;
+  CorrelationSpec cs;
+  cs.where = where;
+  if (tp->is_object()) {
+    const Params tparams(*tp, cs.where);
+    tparams.allow_only({"rows", "join"});
+    const std::string join = tparams.has("join") ? tparams.string("join") : "same";
+    if (join != "same" && join != "deepest")
+      tparams.fail("join", "expected \"same\" or \"deepest\", got \"" + join + "\"");
+    cs.join_deepest = join == "deepest";
+    if (!tp->contains("rows")) tparams.fail("rows", "is missing");
+    tp = &tp->at("rows");
+    cs.where += "/rows";
+  }
+  const Json& t = *tp;
+  if (!t.is_array()) throw ModelError(cs.where, "expected an array of rows");
+  for (std::size_t r = 0; r < t.size(); ++r) {
+    const std::string w = cs.where + "/" + std::to_string(r);
+    if (!t[r].is_array()) throw ModelError(w, "expected an array of integers");
+    std::vector<int> row;
+    for (std::size_t k = 0; k < t[r].size(); ++k)
+      row.push_back(dof_number(t[r][k], w + "/" + std::to_string(k)));
+    cs.rows.push_back(std::move(row));
+  }
+  return cs;
 }
 
 MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std::string& source) {
@@ -315,76 +234,21 @@ MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std
   for (std::size_t i = 0; i < bodies.size(); ++i)
     spec.bodies.push_back(
         read_body(catalog, bodies[i], path("bodies/" + std::to_string(i)), qualified));
-  if (root.contains("couplings")) {
-    if (!root["couplings"].is_array()) throw ModelError(path("couplings"), "expected an array");
-    for (std::size_t i = 0; i < root["couplings"].size(); ++i)
-      spec.couplings.push_back(
-          read_coupling(Params(root["couplings"][i], path("couplings/" + std::to_string(i)))));
-  }
-  if (root.contains("loads")) {
-    if (!root["loads"].is_array()) throw ModelError(path("loads"), "expected an array");
-    const BodiesByName by_name = bodies_by_name(bodies);
-    for (std::size_t i = 0; i < root["loads"].size(); ++i)
-      spec.loads.push_back(
-          read_load(Params(root["loads"][i], path("loads/" + std::to_string(i))), by_name));
-  }
-  if (root.contains("frames")) {
-    if (!root["frames"].is_array()) throw ModelError(path("frames"), "expected an array");
-    const BodiesByName by_name = bodies_by_name(bodies);
-    for (std::size_t i = 0; i < root["frames"].size(); ++i)
-      spec.frames.push_back(
-          read_frame(Params(root["frames"][i], path("frames/" + std::to_string(i))), by_name));
-  }
-  for (const char* list : {"constraints", "springs"}) {
-    if (!root.contains(list)) continue;
-    if (!root[list].is_array()) throw ModelError(path(list), "expected an array");
-    const BodiesByName by_name = bodies_by_name(bodies);
-    for (std::size_t i = 0; i < root[list].size(); ++i) {
-      const Params item(root[list][i], path(std::string(list) + "/" + std::to_string(i)));
-      if (std::string(list) == "constraints")
-        spec.constraints.push_back(read_constraint(item, by_name, i));
-      else
-        spec.springs.push_back(read_spring(item, by_name, i));
-    }
-  }
-  if (root.contains("correlation_table")) {
-    // [[…], …]  or  {"rows": [[…], …], "join": "same" | "deepest"}
-    const Json* tp = &root["correlation_table"];
-    CorrelationSpec cs;
-    cs.where = path("correlation_table");
-    if (tp->is_object()) {
-      const Params tparams(*tp, cs.where);
-      tparams.allow_only({"rows", "join"});
-      const std::string join = tparams.has("join") ? tparams.string("join") : "same";
-      if (join != "same" && join != "deepest")
-        tparams.fail("join", "expected \"same\" or \"deepest\", got \"" + join + "\"");
-      cs.join_deepest = join == "deepest";
-      if (!tp->contains("rows")) tparams.fail("rows", "is missing");
-      tp = &tp->at("rows");
-      cs.where += "/rows";
-    }
-    const Json& t = *tp;
-    if (!t.is_array()) throw ModelError(cs.where, "expected an array of rows");
-    for (std::size_t r = 0; r < t.size(); ++r) {
-      const std::string w = cs.where + "/" + std::to_string(r);
-      if (!t[r].is_array()) throw ModelError(w, "expected an array of integers");
-      std::vector<int> row;
-      for (std::size_t k = 0; k < t[r].size(); ++k) {
-        const Json& x = t[r][k];
-        const std::string wk = w + "/" + std::to_string(k);
-        if (!x.is_number_integer()) throw ModelError(wk, "expected an integer DOF number");
-        // Range-checked before narrowing: 2^31 must not wrap to a negative int, nor 2^63 to 0.
-        const bool fits = x.is_number_unsigned()
-                              ? x.get<std::uint64_t>() <= 2147483647u
-                              : x.get<std::int64_t>() >= 0 && x.get<std::int64_t>() <= 2147483647;
-        if (!fits)
-          throw ModelError(wk, "DOF number " + x.dump() + " is out of range (0 to 2147483647)");
-        row.push_back(x.get<int>());
-      }
-      cs.rows.push_back(std::move(row));
-    }
-    spec.correlation = std::move(cs);
-  }
+  const BodiesByName by_name = bodies_by_name(bodies);
+  read_list(root, "couplings", source,
+            [&](const Params& p, std::size_t) { spec.couplings.push_back(read_coupling(p)); });
+  read_list(root, "loads", source,
+            [&](const Params& p, std::size_t) { spec.loads.push_back(read_load(p, by_name)); });
+  read_list(root, "frames", source,
+            [&](const Params& p, std::size_t) { spec.frames.push_back(read_frame(p, by_name)); });
+  read_list(root, "constraints", source, [&](const Params& p, std::size_t i) {
+    spec.constraints.push_back(read_constraint(p, by_name, i));
+  });
+  read_list(root, "springs", source, [&](const Params& p, std::size_t i) {
+    spec.springs.push_back(read_spring(p, by_name, i));
+  });
+  if (root.contains("correlation_table"))
+    spec.correlation = read_correlation_table(root["correlation_table"], path("correlation_table"));
   return spec;
 }
 
@@ -414,63 +278,6 @@ MechanismSpec parse_model_json(const Json& root, const std::string& source,
   if (root.contains("model"))
     return parse_document(catalog, expand_plugin(catalog, root, source), source);
   return parse_document(catalog, root, source);
-}
-
-namespace {
-
-std::string read_text(const std::string& path) { return read_input_file(path); }
-
-}  // namespace
-
-Json model_document(const std::string& path, const LoadOptions& options) {
-  if (is_robot_file(path)) return robot_document(path, options);
-  const Json root = parse_json(read_text(path), path);
-  if (auto ref = robot_reference(path, root, options)) return std::move(ref->first);
-  refuse_balance_on_json(path, options);
-  const Catalog& catalog = options.catalog ? *options.catalog : default_catalog();
-  (void)parse_model_json(root, path, catalog);  // reports every model error by its path
-  return root.contains("model") ? expand_plugin(catalog, root, path) : root;
-}
-
-MechanismSpec read_spec(const std::string& path, const LoadOptions& options) {
-  const Catalog& catalog = options.catalog ? *options.catalog : default_catalog();
-  if (!is_robot_file(path) && options.floating_base)
-    throw ModelError(path,
-                     "--floating-base is for URDF models: a JSON model gives its root body a "
-                     "free joint itself (\"joint\": {\"type\": \"free\"}), a URDF "
-                     "reference by \"root_joint\": \"free\"");
-  if (!is_robot_file(path)) {
-    const Json root = parse_json(read_text(path), path);
-    if (auto ref = robot_reference(path, root, options)) {
-      try {
-        return parse_model_json(ref->first, ref->second, catalog);
-      } catch (const ModelError& e) {
-        rethrow_for_robot_file(e, ref->first, ref->second);
-      }
-    }
-    refuse_balance_on_json(path, options);
-    return parse_model_json(root, path, catalog);
-  }
-  const Json doc = model_document(path, options);
-  try {
-    return parse_model_json(doc, path, catalog);
-  } catch (const ModelError& e) {
-    rethrow_for_robot_file(e, doc, path);
-  }
-}
-
-Model load_model(const std::string& path, const LoadOptions& options) {
-  MechanismSpec spec = read_spec(path, options);
-  if (options.gravity) {
-    spec.gravity = *options.gravity;
-    spec.gravity_where = spec.where + options.gravity_source;  // (where ends in ": ")
-  }
-  if (!is_robot_file(path)) return compile(std::move(spec), options.compile);
-  try {
-    return compile(std::move(spec), options.compile);
-  } catch (const ModelError& e) {
-    rethrow_for_robot_file(e, model_document(path, options), path);
-  }
 }
 
 }  // namespace femdyn

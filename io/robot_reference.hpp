@@ -1,6 +1,6 @@
-// Robot files (URDF, MJCF) as femdyn JSON documents, for io/model_loader.cpp: given directly, or
-// by reference from a JSON file ({"model": "urdf" | "mjcf", "params": {"file", …}}, the file's
-// own name, description, gravity and loads on top). Not an interface of femdyn.
+// Robot files (URDF, MJCF) as femdyn JSON documents, for io/model_file.cpp and io/model_loader.cpp:
+// given directly, or by reference from a JSON file ({"model": "urdf" | "mjcf", "params": {"file",
+// …}}, the file's own name, description, gravity and loads on top). Not an interface of femdyn.
 #pragma once
 #include <optional>
 #include <string>

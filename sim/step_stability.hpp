@@ -41,7 +41,8 @@ inline constexpr double kStabilitySlack = 1 + 1e-12;
 template <std::size_t N>
 bool polynomial_stable(const std::array<double, N>& c, const ModeSet& modes, double h) {
   for (const std::complex<double>& lambda : modes.eigenvalues) {
-    const std::complex<double> z = h * std::complex<double>(-std::abs(lambda.real()), lambda.imag());
+    const std::complex<double> z =
+        h * std::complex<double>(-std::abs(lambda.real()), lambda.imag());
     std::complex<double> r = c[N - 1];
     for (std::size_t k = N - 1; k-- > 0;) r = r * z + c[k];
     if (std::abs(r) > kStabilitySlack) return false;
@@ -65,7 +66,7 @@ struct StepStability<IntegratorKind::Dopri> {
   static constexpr bool bounded = true, needs_oscillators = false;
   // Dormand–Prince 5(4), the propagated fifth-order solution: the Taylor terms of e^z to z⁵
   // and z⁶/600 (Hairer, Nørsett & Wanner, Solving ODEs I, II.4).
-  static constexpr std::array<double, 7> R = {1,         1,         1.0 / 2,  1.0 / 6,
+  static constexpr std::array<double, 7> R = {1,        1,         1.0 / 2,  1.0 / 6,
                                               1.0 / 24, 1.0 / 120, 1.0 / 600};
   static bool stable(const ModeSet& modes, double h) { return polynomial_stable(R, modes, h); }
 };

@@ -50,7 +50,7 @@ using SpMatX = Eigen::SparseMatrix<double>;
 using Mat3 = Eigen::Matrix3d;
 using Vec3 = Eigen::Vector3d;
 
-// What the twin needs of a femdyn Model (built by twin_model() in validate.cpp).
+// What the twin needs of a femdyn Model (built by twin_model() in twin_model.cpp).
 struct TwinBody {
   std::string name;  // for messages ("Simbody refuses body 'x': …")
   int parent = -1;   // -1: the ground
