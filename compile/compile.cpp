@@ -5,11 +5,13 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <utility>
 
 #include "compile/actuators.hpp"
 #include "compile/compile_level.hpp"
 #include "compile/correlation.hpp"
 #include "compile/loops.hpp"
+#include "compile/routes.hpp"
 #include "core/dynamics/body_inertia.hpp"
 #include "core/joints/kernel.hpp"
 #include "core/joints/rotation.hpp"
@@ -17,7 +19,6 @@
 #include "core/model/limits.hpp"
 #include "core/model/model.hpp"
 #include "core/model/names.hpp"
-#include "core/workspace/mass_solver.hpp"
 
 namespace femdyn {
 namespace {
@@ -314,21 +315,34 @@ void configuration_coupling(Model& m) {
   m.C_configuration.setFromTriplets(entries.begin(), entries.end());
 }
 
-Model compile(MechanismSpec spec, const CompileOptions& options) {
-  if (has_coupling_law(spec)) {
-    // (the law chain reduces the tree's equations through θ = g(q); loops and springs act on
-    // the tree's own coordinates)
-    if (!spec.constraints.empty())
-      throw ModelError(spec.where + "/constraints",
-                       "a model with a coupling law cannot also have constraints (close the loop "
-                       "either by the law or by constraints)");
-    if (!spec.springs.empty())
-      throw ModelError(spec.where + "/springs",
-                       "a model with a coupling law cannot also have two-point springs");
-    return compile_with_coupling_level(std::move(spec), options);
-  }
-  Model m = compile_tree(std::move(spec), options);
+namespace {
+
+// The checks of a finished model, run once its routes are chosen (they evaluate it): its
+// spanning elements keep their lengths, and M^s is positive definite (on the tree of a law
+// model, whose coordinates move freely).
+void check_model(const Model& m, const CompileOptions& options) {
   check_rigid_spans(m);
+  if (options.check_mass) check_mass_matrix(m.tree ? *m.tree : m);
+}
+
+}  // namespace
+
+Model compile(MechanismSpec spec, const CompileOptions& options) {
+  const bool law = has_coupling_law(spec);
+  // (the law chain reduces the tree's equations through θ = g(q); loops and springs act on
+  // the tree's own coordinates)
+  if (law && !spec.constraints.empty())
+    throw ModelError(spec.where + "/constraints",
+                     "a model with a coupling law cannot also have constraints (close the loop "
+                     "either by the law or by constraints)");
+  if (law && !spec.springs.empty())
+    throw ModelError(spec.where + "/springs",
+                     "a model with a coupling law cannot also have two-point springs");
+  const std::vector<CouplingSpec> couplings =
+      law ? std::exchange(spec.couplings, {}) : std::vector<CouplingSpec>{};
+  Model m = compile_tree(std::move(spec), options);
+  if (law) m = with_coupling_level(std::move(m), couplings);
+  check_model(m, options);
   return m;
 }
 
@@ -381,14 +395,10 @@ Model compile_tree(MechanismSpec spec, const CompileOptions& options) {
   configuration_coupling(m);
   compile_actuators(m);
   compile_loops(spec, m);
-  // The passes below run kinematics on the model being built: its routes so far (the reference
-  // ones, no law) until choose_routes settles them.
-  m.routes = choose_equation_routes(m);
+  provisional_routes(m);  // (the node level samples the kinematics)
   build_node_level(spec, body_of_spec, m);
   condense_body_inertia(m);
   choose_routes(m, options.routes);
-  analyse_mass_pattern(m);
-  if (options.check_mass) check_mass_matrix(m);
   return m;
 }
 

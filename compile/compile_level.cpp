@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "compile/actuators.hpp"
+#include "compile/routes.hpp"
 #include "core/joints/kernel.hpp"
 #include "core/kinematics/kinematics.hpp"
 #include "core/kinematics/sampling.hpp"
@@ -104,16 +105,13 @@ void check_range(const CoupledJoint& j, const Model& m) {
 
 }  // namespace
 
-Model compile_with_coupling_level(MechanismSpec spec, const CompileOptions& options) {
-  MechanismSpec tree_spec = spec;  // (elements are shared, immutable)
-  tree_spec.couplings.clear();
-  Model tree = compile_tree(tree_spec, options);
-  Model m = compile_tree(std::move(tree_spec), options);
-
+Model with_coupling_level(Model tree, const std::vector<CouplingSpec>& couplings) {
+  Model m =
+      tree.copy();  // the law model's bodies and elements are its tree's; its coordinates differ
   std::map<std::string, int> theta_of;  // joint name -> θ index
   for (int t = 0; t < m.n_theta(); ++t) theta_of[m.bodies[m.theta_joint[t]].joint.name] = t;
   std::map<int, CoupledJoint> coupled;
-  for (const CouplingSpec& c : spec.couplings) {
+  for (const CouplingSpec& c : couplings) {
     const auto it = theta_of.find(c.joint);
     if (it == theta_of.end())
       throw ModelError(c.where + "/joint", "unknown or fixed joint " + quoted_text(c.joint));
@@ -182,14 +180,11 @@ Model compile_with_coupling_level(MechanismSpec spec, const CompileOptions& opti
     }
   m.identity_coupling = false;
   configuration_coupling(m);
-  m.mass_pattern = MassPattern{};  // (M^s is reduced and factorised densely: coupling_chain)
-  m.dynamics_route = DynamicsRoute::Cholesky;
   m.free_rotors.clear();  // (its tree's equations add these: core/coupling_chain)
   m.rate_dampers.clear();
   m.coupling_level = std::move(level);
   m.tree = std::make_shared<const Model>(std::move(tree));
-  m.routes = choose_equation_routes(m);  // the law chain
-  check_rigid_spans(m);
+  choose_routes(m);  // the law chain
   return m;
 }
 

@@ -1,6 +1,6 @@
 // compile() for a mechanism with a nonlinear coupling law (core/model/coupling_level.hpp): the tree
-// of every joint is compiled twice from the spec (once as Model::tree, once as the model
-// itself), and the model's coordinates become the joints that no coupling sets.
+// of every joint is compiled once, kept as Model::tree, and the model's coordinates become the
+// joints that no coupling sets.
 #pragma once
 #include "compile/compile.hpp"
 #include "compile/spec.hpp"
@@ -10,8 +10,11 @@
 namespace femdyn {
 
 bool has_coupling_law(const MechanismSpec& spec);
-Model compile_with_coupling_level(MechanismSpec spec, const CompileOptions& options);
-// compile() without the check below (the tree of a model with a law moves its joints freely).
+// The law model of `tree` (compiled without couplings): its coupling level from `couplings`
+// (linear ones and laws), its routes the law chain.
+Model with_coupling_level(Model tree, const std::vector<CouplingSpec>& couplings);
+// The tree of bodies, joints and elements with its linear couplings, its routes chosen
+// (compile/routes.hpp); compile() checks the finished model.
 Model compile_tree(MechanismSpec spec, const CompileOptions& options);
 // Passes shared with compile_tree (compile/compile.cpp), run again once the coordinates change:
 // the coordinate joints' addresses in q and the names of q's entries (Model::coordinate_joints

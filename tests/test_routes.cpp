@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/dynamics/articulated.hpp"
+#include "core/workspace/mass_pattern.hpp"
 #include "core/workspace/mass_solver.hpp"
 #include "tests/helpers.hpp"
 

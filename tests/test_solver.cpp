@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 
+#include "core/workspace/mass_pattern.hpp"
 #include "core/workspace/mass_solver.hpp"
 #include "tests/helpers.hpp"
 

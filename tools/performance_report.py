@@ -339,7 +339,7 @@ P("")
 P("## Routes and crossovers")
 P("")
 P("`compile()` chooses three routes per model (core/model/model.hpp, `choose_routes` in "
-  "core/dynamics/body_inertia.cpp). Where the body-level form is exact (automatic correlation table, "
+  "compile/routes.cpp). Where the body-level form is exact (automatic correlation table, "
   "physical elements, velocity forces that are the elements' gyroscopic terms, all checked at "
   "compile): M^s by composite inertias, h and τ by Newton–Euler over the body inertias, and, "
   "without couplings, q̈ by the articulated-body recursion. The reference routes are those the "

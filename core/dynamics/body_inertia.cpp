@@ -85,53 +85,6 @@ void condense_body_inertia(Model& m) {
   if (spans) m.condensable = false;
 }
 
-void choose_routes(Model& m, const RouteChoice& asked) {
-  // Elements spanning bodies that use only their nodes' translations (a coupler rod) keep the
-  // rest of the tree on the body-level routes, their own terms added
-  // (core/dynamics/span_inertia.hpp), where the rest is exact and there is no coupling level to map
-  // them through.
-  const bool spans_on_bodies = !m.condensable && m.condensable_off_spans &&
-                               m.velocity_forces_rigid && m.identity_coupling &&
-                               span_inertia_unsupported(m).empty();
-  const bool body_level = m.condensable || spans_on_bodies;
-  // M^s by composite inertias wherever the body-level form is exact: measured faster than
-  // Tᵀ (M T) on every model, from the 1-DOF pendulum up (docs/performance.md).
-  m.mass_route = body_level ? MassRoute::Composite : MassRoute::Transform;
-  // h and τ: the body-level recursion is exact under the same conditions (couplings are
-  // linear), and it is O(bodies) instead of O(N_u) (measured faster on every model).
-  m.force_route = body_level && m.velocity_forces_rigid ? ForceRoute::Bodies : ForceRoute::Nodes;
-  // The articulated recursion pivots on each joint's block of rates
-  // (core/dynamics/articulated.hpp); couplings (C ≠ I) it cannot eliminate joint by joint.
-  m.dynamics_route = m.condensable && m.velocity_forces_rigid && m.identity_coupling
-                         ? DynamicsRoute::Articulated
-                         : DynamicsRoute::Cholesky;
-  // A route asked for: any reference route, a body-level one only where it was chosen (exact).
-  const auto refuse = [&](const char* route) {
-    throw ModelError(m.where, std::string("the ") + route +
-                                  " route is not exact for this model (compile options)");
-  };
-  if (asked.mass) {
-    if (*asked.mass == MassRoute::Composite && m.mass_route != MassRoute::Composite)
-      refuse("composite mass");
-    m.mass_route = *asked.mass;
-  }
-  if (asked.force) {
-    if (*asked.force == ForceRoute::Bodies && m.force_route != ForceRoute::Bodies)
-      refuse("body-level force");
-    m.force_route = *asked.force;
-  }
-  if (asked.dynamics) {
-    if (*asked.dynamics == DynamicsRoute::Articulated &&
-        m.dynamics_route != DynamicsRoute::Articulated)
-      refuse("articulated");
-    m.dynamics_route = *asked.dynamics;
-  }
-  // The spanning masses where a body-level route carries them (never with the coupling level).
-  const bool carried = m.mass_route == MassRoute::Composite || m.force_route == ForceRoute::Bodies;
-  m.spanning_masses = spans_on_bodies && carried ? spanning_masses(m) : std::vector<SpanningMass>{};
-  m.routes = choose_equation_routes(m);
-}
-
 std::vector<MassProperties> body_mass_properties(const Model& m) {
   std::vector<MassProperties> sum(m.bodies.size());
   std::vector<Vec3> first_moment(m.bodies.size(), Vec3::Zero());

@@ -13,7 +13,7 @@
 // automatic one (an explicit table may give a DOF another body's motion, or leave out one that
 // moves), and when Λ_b does not depend on the body's orientation (translation inertia isotropic,
 // as for every physical element). compile() checks both (Model::condensable) and chooses the
-// routes (choose_routes: Model::mass_route, Model::dynamics_route).
+// routes (choose_routes, compile/routes.hpp: Model::mass_route, Model::dynamics_route).
 //
 // At run time the same Λ_b give M^s by composite inertias (the composite-rigid-body recursion,
 // Featherstone ch. 6), O(bodies · depth) instead of O(Σ p_b²):
@@ -29,11 +29,6 @@
 namespace femdyn {
 
 void condense_body_inertia(Model& model);
-
-// Model::mass_route, force_route and dynamics_route from the structure and an operation count,
-// or those `asked` (throws ModelError for a body-level route where it is not exact); then
-// Model::routes, the table every equations function calls through (core/model/routes.hpp).
-void choose_routes(Model& model, const RouteChoice& asked = {});
 
 // The sum of the body's elements' mass properties (body frame); an element that spans bodies
 // (a rod) moves with no single body and is left out.

@@ -11,7 +11,7 @@
 //   T   += ½ Σ_lj ẋ_lᵀ M_lj ẋ_j.
 // The rest of the tree keeps its composite inertias and Newton–Euler. The node-level routes
 // (Tᵀ M T) compute the same numbers element by element; tests/test_routes.cpp compares them.
-// Used where Model::spans_on_bodies (choose_routes, core/dynamics/body_inertia.cpp).
+// Used where Model::spans_on_bodies (choose_routes, compile/routes.cpp).
 #pragma once
 #include <string>
 #include <vector>

@@ -155,7 +155,7 @@ enum class SolverKind {
 };
 
 // The structure of M^s, analysed once by compile() (analyse_mass_pattern,
-// core/workspace/mass_solver.hpp) and shared by every Workspace.
+// compile/routes.cpp, from core/workspace/mass_pattern.hpp) and shared by every Workspace.
 struct MassPattern {
   SolverKind solver = SolverKind::Dense;
   std::vector<int> coordinate_parent;  // Tree: λ(a) < a, -1 at a root
@@ -169,6 +169,9 @@ struct Model {
   // copies it: an out-of-memory there terminates rather than throws.
   Model(Model&&) noexcept = default;
   Model& operator=(Model&&) noexcept = default;
+  // A copy only where asked for by name (a law model starts as a copy of its tree), never by
+  // accident.
+  Model copy() const { return Model(*this); }
 
   std::string name;
   std::string where;  // the source, for messages
@@ -279,6 +282,9 @@ struct Model {
   int n_u() const { return static_cast<int>(dofs.size()); }
   std::string dof_name(int i) const { return dof_name_of(dofs.at(i)); }
   std::string dof_name_of(const SystemDof& d) const;  // e.g. "link2/tip.x" or "link2.rz"
+
+ private:
+  Model(const Model&) = default;
 };
 
 // (Defined here, with the Model it names, not in compile/: core keeps its own symbols.)

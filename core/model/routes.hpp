@@ -1,5 +1,5 @@
 // EquationRoutes: how one model's equations are computed, chosen once by compile() from the facts
-// it checked (choose_routes, core/dynamics/body_inertia.hpp): a model with a nonlinear coupling law
+// it checked (choose_routes, compile/routes.hpp): a model with a nonlinear coupling law
 // takes the law chain (core/dynamics/coupling_chain.hpp) for every function; any other model the
 // routes of Model::mass_route, force_route and dynamics_route. Each function of
 // core/dynamics/equations.hpp, and propagate_bilinear (core/kinematics/kinematics.hpp), calls

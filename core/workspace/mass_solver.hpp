@@ -45,16 +45,4 @@ class MassSolver {
   std::unique_ptr<Impl> impl_;
 };
 
-// The compile pass that fills Model::mass_pattern: the solver kind and what it needs (the
-// coordinate tree, or CHOLMOD's fill-reducing order), so that no Workspace redoes it.
-void analyse_mass_pattern(Model& model);
-
-// Structural fill ratio of M^s (non-zeros / n²).
-double mass_matrix_fill(const Model& model);
-
-// The coordinate tree λ of M^s's pattern (λ(a) < a, -1 at a root), or nothing when the
-// pattern is not a tree in coordinate order (or the model has an explicit table, whose DOF
-// aliases can couple branches).
-std::vector<int> coordinate_tree(const Model& model);
-
 }  // namespace femdyn
