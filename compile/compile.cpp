@@ -70,24 +70,29 @@ std::vector<int> tree_order(const MechanismSpec& spec) {
   return order;
 }
 
-// The parameters only some types read: universal's second axis (unit, normal to the first),
-// helical's pitch.
+// What the joint's type reads beyond its axis (core/joints/parameters.hpp): a second axis (unit,
+// normal to the first) for a type of two axes, and its own numbers; another type's are refused.
 void check_joint_parameters(const JointSpec& js, Joint& j) {
-  if (js.type == JointType::Universal) {
-    if (!js.axis2) throw ModelError(js.where + "/axis2", "a universal joint needs its second axis");
+  const JointParameters type = joint_parameters(js.type);
+  if (type.axes == JointAxes::Two) {
+    if (!js.axis2)
+      throw ModelError(js.where + "/axis2", "a " + std::string(joint_type_name(js.type)) +
+                                                " joint needs its second axis");
     check_magnitude(*js.axis2, js.where + "/axis2", "axis2");
     if (!(js.axis2->norm() > 1e-12)) throw ModelError(js.where + "/axis2", "axis2 is zero");
     j.axis2 = js.axis2->normalized();
     if (std::abs(j.axis2.dot(j.axis)) > 1e-9)
-      throw ModelError(js.where + "/axis2",
-                       "a universal joint's two axes must be normal to each other");
+      throw ModelError(js.where + "/axis2", "a " + std::string(joint_type_name(js.type)) +
+                                                " joint's two axes must be normal to each other");
   } else if (js.axis2) {
     throw ModelError(js.where + "/axis2", "only a universal joint has a second axis");
   }
-  if (js.type != JointType::Helical && js.pitch != 0)
-    throw ModelError(js.where + "/pitch", "only a helical joint has a pitch");
-  check_magnitude(js.pitch, js.where + "/pitch", "pitch");
-  j.pitch = js.pitch;
+  for (const auto& [key, value] : js.scalars) {
+    const JointScalar* s = joint_scalar(js.type, key);
+    if (!s) throw ModelError(js.where + "/" + key, joint_scalar_refusal(key));
+    check_magnitude(value, js.where + "/" + key, key.c_str());
+    j.*(s->value) = value;
+  }
 }
 
 // An origin given as a quaternion (w, x, y, z): finite, not zero, normalised.

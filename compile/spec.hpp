@@ -4,6 +4,7 @@
 // messages; compile appends JSON-pointer segments to it to name a field.
 #pragma once
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -23,7 +24,8 @@ struct JointSpec {
   std::optional<Eigen::Vector4d> quat;  // or as a quaternion (w, x, y, z), normalised on compile
   Vec3 axis = Vec3::UnitZ();            // in the joint frame (normalised on compile)
   std::optional<Vec3> axis2;            // universal: the second axis, normal to `axis` (required)
-  double pitch = 0;                     // helical: m/rad
+  std::map<std::string, double>
+      scalars;  // the type's own numbers by key (core/joints/parameters.hpp)
   double lower = -std::numeric_limits<double>::infinity();
   double upper = std::numeric_limits<double>::infinity();
   double stiffness = 0, rest = 0, damping = 0;    // linear spring / damper on θ

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/joints/kernel.hpp"
 #include "core/model/limits.hpp"
 #include "core/model/names.hpp"
 #include "io/catalog.hpp"
@@ -45,10 +46,29 @@ void read_actuator(const Params& p, JointSpec& j) {
   }
 }
 
+// What the joint's type reads (core/joints/parameters.hpp): its axes, and each of its own
+// numbers, which are required; another type's number is refused.
+void read_joint_parameters(const Params& p, JointSpec& j) {
+  const JointParameters type = joint_parameters(j.type);
+  if (type.moves && type.axes == JointAxes::None && p.has("axis"))
+    p.fail("axis", "a " + std::string(joint_type_name(j.type)) +
+                       " joint turns about every axis: it takes no axis");
+  if (type.axes != JointAxes::None) j.axis = p.vec3("axis");
+  if (p.has("axis2")) j.axis2 = p.vec3("axis2");  // (compile: a type of two axes only)
+  for (const JointScalar& s : type.scalars) {
+    const std::string key(s.key);
+    j.scalars[key] = p.number(key.c_str());
+  }
+  for (auto it = p.json().begin(); it != p.json().end(); ++it)
+    if (is_joint_scalar(it.key()) && !joint_scalar(j.type, it.key()))
+      p.fail(it.key().c_str(), joint_scalar_refusal(it.key()));
+}
+
 JointSpec read_joint(const Params& p) {
-  p.allow_only({"name", "type", "origin", "axis", "axis2", "pitch", "limits", "spring", "damping",
+  p.allow_only({"name", "type", "origin", "axis", "axis2", "limits", "spring", "damping",
                 "armature", "gear", "friction", "friction_velocity", "effort_limit",
-                "velocity_limit", "stop", "initial", "actuated"});
+                "velocity_limit", "stop", "initial", "actuated"},
+               is_joint_scalar);
   JointSpec j;
   j.where = p.where();
   j.name = p.has("name") ? p.string("name") : "";
@@ -67,15 +87,7 @@ JointSpec read_joint(const Params& p) {
         (*j.quat)[k] = json_number(w[k], o.path("quat") + "/" + std::to_string(k));
     }
   }
-  const bool any_axis = j.type == JointType::Spherical || j.type == JointType::Free;
-  if (any_axis && p.has("axis"))
-    p.fail("axis", "a spherical or free joint turns about every axis: it takes no axis");
-  if (j.type != JointType::Fixed && !any_axis) j.axis = p.vec3("axis");
-  if (p.has("axis2")) j.axis2 = p.vec3("axis2");  // (compile: universal only)
-  if (j.type == JointType::Helical)
-    j.pitch = p.number("pitch");
-  else if (p.has("pitch"))
-    p.fail("pitch", "only a helical joint has a pitch");
+  read_joint_parameters(p, j);
   if (j.type == JointType::Fixed)
     for (const char* key : {"axis", "limits", "spring", "damping"})
       if (p.has(key))

@@ -139,8 +139,13 @@ NodeRef Params::node_at(const char* key, std::size_t index) const {
 }
 
 void Params::allow_only(std::initializer_list<const char*> keys) const {
+  allow_only(keys, [](std::string_view) { return false; });
+}
+
+void Params::allow_only(std::initializer_list<const char*> keys,
+                        bool (*also)(std::string_view)) const {
   for (auto it = j_.begin(); it != j_.end(); ++it) {
-    bool ok = false;
+    bool ok = also(it.key());
     for (const char* k : keys) ok = ok || it.key() == k;
     if (!ok)
       throw ModelError(where_ + "/" + truncated(it.key()), "unknown key " + quoted_text(it.key()));

@@ -5,6 +5,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 
 #include "core/model/errors.hpp"
 #include "core/spatial/math.hpp"
@@ -49,6 +50,8 @@ class Params {
 
   // Rejects keys not in the list (catches typos such as "mas").
   void allow_only(std::initializer_list<const char*> keys) const;
+  // The same, also allowing every key `also` accepts (a joint type's own numbers).
+  void allow_only(std::initializer_list<const char*> keys, bool (*also)(std::string_view)) const;
   [[noreturn]] void fail(const char* key, const std::string& what) const;
 
  private:

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <variant>
 
+#include "core/joints/kernel.hpp"
 #include "core/model/names.hpp"
 #include "io/model_loader.hpp"
 #include "models/builder.hpp"
@@ -114,6 +115,26 @@ void actuator_arg(const ActuatorArgs& a, JointSpec& j) {
   }
 }
 
+// A joint type's own numbers (core/joints/parameters.hpp), given as keywords: a helical joint's
+// pitch. A keyword no type takes is a TypeError, as Python's own; one another type takes, or a
+// number that is not finite, a ValueError naming it.
+void scalar_args(const py::kwargs& scalars, JointSpec& j) {
+  for (const auto& [k, v] : scalars) {
+    const std::string key = py::cast<std::string>(k);
+    if (!is_joint_scalar(key))
+      throw py::type_error("body() got an unexpected keyword argument " + quoted_text(key));
+    if (!joint_scalar(j.type, key)) throw py::value_error(key + ": " + joint_scalar_refusal(key));
+    double x = 0;
+    try {
+      x = py::cast<double>(v);
+    } catch (const py::cast_error&) {
+      throw py::value_error(key + ": expected a number");
+    }
+    if (!std::isfinite(x)) throw py::value_error(key + ": NaN or Inf");
+    j.scalars[key] = x;
+  }
+}
+
 // Builder.body's joint: `type` and the arguments that describe the joint, each None when not
 // given. Without a type the body is welded to its parent (a fixed joint at its origin), so a
 // joint argument without one is refused: it would be ignored, or (xyz, rpy) weld a body that
@@ -123,12 +144,16 @@ JointSpec joint_arg(const std::optional<std::string>& type_in,
                     const std::optional<std::string>& name, const OptArray& axis,
                     const OptArray& xyz, const OptArray& rpy,
                     const std::optional<std::pair<double, double>>& limits, OptNumber stiffness,
-                    OptNumber rest, OptNumber damping, const OptArray& axis2, OptNumber pitch) {
+                    OptNumber rest, OptNumber damping, const OptArray& axis2,
+                    const py::kwargs& scalars) {
   const std::pair<const char*, bool> motion[] = {
-      {"axis", axis.has_value()},           {"axis2", axis2.has_value()},
-      {"pitch", pitch.has_value()},         {"limits", limits.has_value()},
-      {"stiffness", stiffness.has_value()}, {"rest", rest.has_value()},
-      {"damping", damping.has_value()}};
+      {"axis", axis.has_value()},
+      {"axis2", axis2.has_value()},
+      {"limits", limits.has_value()},
+      {"stiffness", stiffness.has_value()},
+      {"rest", rest.has_value()},
+      {"damping", damping.has_value()},
+      {"the type's own numbers (such as pitch)", !scalars.empty()}};
   if (!type_in) {
     for (const auto& [arg, given] :
          {std::pair{"joint", name.has_value()}, {"xyz", xyz.has_value()}, {"rpy", rpy.has_value()}})
@@ -161,12 +186,7 @@ JointSpec joint_arg(const std::optional<std::string>& type_in,
   if (name) j.name = *name;
   if (axis) j.axis = vec3_arg(*axis, "axis");
   if (axis2) j.axis2 = vec3_arg(*axis2, "axis2");  // (compile: universal only)
-  if (pitch) {
-    if (j.type != JointType::Helical)
-      throw py::value_error("pitch: only a helical joint has a pitch");
-    if (!std::isfinite(*pitch)) throw py::value_error("pitch: NaN or Inf");
-    j.pitch = *pitch;
-  }
+  scalar_args(scalars, j);
   if (xyz) j.xyz = vec3_arg(*xyz, "xyz");
   if (rpy) j.rpy = vec3_arg(*rpy, "rpy");
   if (limits) {
@@ -196,10 +216,10 @@ void bind_builder(py::module_& m) {
              const std::optional<std::string>& type, const std::optional<std::string>& joint,
              const OptArray& axis, const OptArray& xyz, const OptArray& rpy,
              const std::optional<std::pair<double, double>>& limits, OptNumber stiffness,
-             OptNumber rest, OptNumber damping, const OptArray& axis2, OptNumber pitch,
-             OptNumber armature, OptNumber gear, OptNumber friction, OptNumber friction_velocity,
+             OptNumber rest, OptNumber damping, const OptArray& axis2, OptNumber armature,
+             OptNumber gear, OptNumber friction, OptNumber friction_velocity,
              OptNumber effort_limit, OptNumber velocity_limit, const py::object& stop,
-             OptNumber initial, std::optional<bool> actuated) {
+             OptNumber initial, std::optional<bool> actuated, const py::kwargs& scalars) {
             const ActuatorArgs act{armature,     gear,           friction, friction_velocity,
                                    effort_limit, velocity_limit, stop,     actuated};
             if (!type && act.given())
@@ -207,7 +227,7 @@ void bind_builder(py::module_& m) {
                   "actuator, friction or stop: given without a joint type; a body without "
                   "type= is welded to its parent (say type='revolute' or 'prismatic')");
             JointSpec j = joint_arg(text_arg(type, "type"), text_arg(joint, "joint"), axis, xyz,
-                                    rpy, limits, stiffness, rest, damping, axis2, pitch);
+                                    rpy, limits, stiffness, rest, damping, axis2, scalars);
             actuator_arg(act, j);
             if (initial) j.initial = *initial;
             b.body(text_arg(name, "name"), text_arg(parent, "parent"), std::move(j));
@@ -217,16 +237,17 @@ void bind_builder(py::module_& m) {
           py::arg("rpy") = py::none(), py::arg("limits") = py::none(),
           py::arg("stiffness") = py::none(), py::arg("rest") = py::none(),
           py::arg("damping") = py::none(), py::arg("axis2") = py::none(),
-          py::arg("pitch") = py::none(), py::arg("armature") = py::none(),
-          py::arg("gear") = py::none(), py::arg("friction") = py::none(),
-          py::arg("friction_velocity") = py::none(), py::arg("effort_limit") = py::none(),
-          py::arg("velocity_limit") = py::none(), py::arg("stop") = py::none(),
-          py::arg("initial") = py::none(), py::arg("actuated") = py::none(),
+          py::arg("armature") = py::none(), py::arg("gear") = py::none(),
+          py::arg("friction") = py::none(), py::arg("friction_velocity") = py::none(),
+          py::arg("effort_limit") = py::none(), py::arg("velocity_limit") = py::none(),
+          py::arg("stop") = py::none(), py::arg("initial") = py::none(),
+          py::arg("actuated") = py::none(),
           "A body on `parent` ('world': the ground) by a joint of `type` (revolute, prismatic, "
           "fixed, helical, universal, planar, spherical, free; docs/notation.md) named `joint` "
           "(default: the body's name), at xyz, rpy (default 0), about axis (default (0, 0, 1)), "
           "with limits (lower, upper), a spring (stiffness, rest) and a damper; a universal "
-          "joint's second axis `axis2`, a helical joint's `pitch` (m/rad); a rotor `armature` "
+          "joint's second axis `axis2`, the type's own numbers as keywords (a helical joint's "
+          "`pitch`, m/rad; docs/model-format.md); a rotor `armature` "
           "(kg·m²) behind a `gear` ratio, Coulomb `friction` regularised at `friction_velocity`, "
           "`effort_limit`, `velocity_limit`, and `stop` (True or {'stiffness': k, "
           "'dissipation': d}) enforcing the limits (docs/control.md), `actuated` (default: True "

@@ -231,7 +231,8 @@ TEST_CASE("a twin built with a wrong joint parameter does not match", "[validati
     FAIL("no body " << name);
     return tm.bodies[0];
   };
-  CHECK(error([&](validation::TwinModel& tm) { named(tm, "screw").pitch *= 1.01; }) > 1e-6);
+  CHECK(error([&](validation::TwinModel& tm) { named(tm, "screw").scalars.at("pitch") *= 1.01; }) >
+        1e-6);
   CHECK(error([&](validation::TwinModel& tm) {
           auto& b = named(tm, "cardan");
           b.axis2 = -b.axis2;

@@ -38,9 +38,12 @@
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
+
+#include "core/model/joint_type.hpp"
 
 namespace femdyn::validation {
 
@@ -52,25 +55,17 @@ using Vec3 = Eigen::Vector3d;
 
 // What the twin needs of a femdyn Model (built by twin_model() in twin_model.cpp).
 struct TwinBody {
-  std::string name;  // for messages ("Simbody refuses body 'x': …")
-  int parent = -1;   // -1: the ground
-  enum class Joint {
-    Revolute,
-    Prismatic,
-    Fixed,
-    Helical,
-    Universal,
-    Planar,
-    Spherical,
-    Free
-  } joint = Joint::Fixed;
+  std::string name;         // for messages ("Simbody refuses body 'x': …")
+  int parent = -1;          // -1: the ground
+  using Joint = JointType;  // (core/model/joint_type.hpp: plain C++17, no Eigen or Simbody)
+  Joint joint = Joint::Fixed;
   Mat3 R_pj = Mat3::Identity();  // joint frame in the parent body frame
   Vec3 p_pj = Vec3::Zero();
   Vec3 axis = Vec3::UnitZ();   // unit, joint frame
   Vec3 axis2 = Vec3::UnitX();  // universal: a₂ (B); planar: e₁ (joint frame, ⊥ axis)
-  double pitch = 0;            // helical, m/rad
-  int theta = -1;              // its first coordinate in θ (nq of them)
-  int rate = -1;               // its first rate in θ̇ (nv of them; = theta for nq = nv)
+  std::map<std::string, double> scalars;  // the type's own numbers (helical: "pitch", m/rad)
+  int theta = -1;                         // its first coordinate in θ (nq of them)
+  int rate = -1;  // its first rate in θ̇ (nv of them; = theta for nq = nv)
   double stiffness = 0, rest = 0, damping = 0;
   // An enforced stop on [lower, upper] (Force::MobilityLinearStop, femdyn's law exactly).
   bool stop = false;

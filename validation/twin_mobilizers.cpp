@@ -83,7 +83,8 @@ void SimbodyTwin::Impl::add_body(const TwinBody& j) {
       case TwinBody::Joint::Helical: {
         const Rotation R_a(UnitVec3(to_simtk(j.axis)), ZAxis);  // Screw: about and along z
         mobod.push_back(MobilizedBody::Screw(parent, Transform(R_pj * R_a, p_pj), rigid,
-                                             Transform(R_a, SimTK::Vec3(0)), j.pitch));
+                                             Transform(R_a, SimTK::Vec3(0)),
+                                             j.scalars.at("pitch")));
         break;
       }
       case TwinBody::Joint::Universal: {  // about x, then the new y: x -> a₁, y -> a₂

@@ -134,37 +134,13 @@ TwinModel twin_model(const Model& m) {
     TwinBody tb;
     tb.name = m.bodies[b].name;
     tb.parent = m.bodies[b].parent;
-    switch (j.type) {
-      case JointType::Revolute:
-        tb.joint = TwinBody::Joint::Revolute;
-        break;
-      case JointType::Prismatic:
-        tb.joint = TwinBody::Joint::Prismatic;
-        break;
-      case JointType::Helical:
-        tb.joint = TwinBody::Joint::Helical;
-        break;
-      case JointType::Universal:
-        tb.joint = TwinBody::Joint::Universal;
-        break;
-      case JointType::Planar:
-        tb.joint = TwinBody::Joint::Planar;
-        break;
-      case JointType::Spherical:
-        tb.joint = TwinBody::Joint::Spherical;
-        break;
-      case JointType::Free:
-        tb.joint = TwinBody::Joint::Free;
-        break;
-      case JointType::Fixed:
-        tb.joint = TwinBody::Joint::Fixed;
-        break;
-    }
+    tb.joint = j.type;
     tb.R_pj = j.R_pj;
     tb.p_pj = j.p_pj;
     tb.axis = j.axis;
     tb.axis2 = j.axis2;
-    tb.pitch = j.pitch;
+    for (const JointScalar& s : joint_parameters(j.type).scalars)
+      tb.scalars[std::string(s.key)] = j.*(s.value);
     tb.theta = j.idx_q;
     tb.rate = j.idx_v;
     tb.stiffness = j.stiffness;

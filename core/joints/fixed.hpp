@@ -2,12 +2,14 @@
 // coordinate, S has no column.
 #pragma once
 #include "core/joints/flat.hpp"
+#include "core/joints/parameters.hpp"
 #include "core/model/model.hpp"
 
 namespace femdyn {
 
 struct FixedJoint : FlatJoint<0> {
   static constexpr int nq = 0, nv = 0;
+  static constexpr JointAxes axes = JointAxes::None;
   static constexpr bool angular = false, linear = false;
 
   static void pose(const Joint& j, const double*, Mat3& R, Vec3& d) {

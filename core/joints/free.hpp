@@ -5,6 +5,7 @@
 //   X_J(q) = (R(q), p),   S = 1 (6 × 6) in B's axes, linear columns first (constant), c_J = 0.
 // q ⊕ ξ = (p + R ξ_p, q ⊗ exp(ξ_r)); in the chart around q_c, ξ̇ = (exp(ξ_r) v, J_r(ξ_r)⁻¹ ω).
 #pragma once
+#include "core/joints/parameters.hpp"
 #include "core/joints/rotation.hpp"
 #include "core/model/model.hpp"
 
@@ -12,6 +13,7 @@ namespace femdyn {
 
 struct FreeJoint {
   static constexpr int nq = 7, nv = 6;
+  static constexpr JointAxes axes = JointAxes::None;
   static constexpr bool angular = true, linear = true, flat = false;
 
   static void pose(const Joint& j, const double* q, Mat3& R, Vec3& d) {

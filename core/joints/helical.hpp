@@ -5,12 +5,16 @@
 #include <cmath>
 
 #include "core/joints/flat.hpp"
+#include "core/joints/parameters.hpp"
 #include "core/model/model.hpp"
 
 namespace femdyn {
 
 struct HelicalJoint : FlatJoint<1> {
   static constexpr int nq = 1, nv = 1;
+  static constexpr JointAxes axes = JointAxes::One;
+  static constexpr JointScalar scalars[] = {
+      {"pitch", &Joint::pitch, "the advance along the axis per radian, m/rad", 0.05}};
   static constexpr bool angular = true, linear = true;
 
   // R_pj Rot(a, θ) by Rodrigues (as the revolute joint), d = p θ R_pj a.

@@ -23,10 +23,12 @@
 #include <array>
 #include <random>
 #include <string>
+#include <string_view>
 
 #include "core/joints/fixed.hpp"
 #include "core/joints/free.hpp"
 #include "core/joints/helical.hpp"
+#include "core/joints/parameters.hpp"
 #include "core/joints/planar.hpp"
 #include "core/joints/prismatic.hpp"
 #include "core/joints/revolute.hpp"
@@ -67,6 +69,21 @@ template <class F>
 }
 
 inline bool moves(const Joint& j) { return j.nv > 0; }
+
+// What the type reads of its description (core/joints/parameters.hpp).
+inline JointParameters joint_parameters(JointType type) {
+  return visit_joint(type, []<class J>(J) {
+    JointParameters p{J::axes, {}, J::nv > 0};
+    if constexpr (requires { J::scalars; }) p.scalars = J::scalars;
+    return p;
+  });
+}
+// The number `key` as `type` declares it, or null where the type takes no such number.
+const JointScalar* joint_scalar(JointType type, std::string_view key);
+// Whether some joint type takes the number `key`.
+bool is_joint_scalar(std::string_view key);
+// Why `key` is refused on a joint of another type: "only a helical joint has a pitch".
+std::string joint_scalar_refusal(std::string_view key);
 
 // Whether column k of the joint is fixed in the parent's joint frame (else in B).
 inline bool column_in_parent(const Joint& j, int k) {

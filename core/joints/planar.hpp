@@ -8,12 +8,14 @@
 #include <cmath>
 
 #include "core/joints/flat.hpp"
+#include "core/joints/parameters.hpp"
 #include "core/model/model.hpp"
 
 namespace femdyn {
 
 struct PlanarJoint : FlatJoint<3> {
   static constexpr int nq = 3, nv = 3;
+  static constexpr JointAxes axes = JointAxes::One;
   static constexpr bool angular = true, linear = true;
 
   static void pose(const Joint& j, const double* q, Mat3& R, Vec3& d) {

@@ -3,12 +3,14 @@
 //   c_J = 0.
 #pragma once
 #include "core/joints/flat.hpp"
+#include "core/joints/parameters.hpp"
 #include "core/model/model.hpp"
 
 namespace femdyn {
 
 struct PrismaticJoint : FlatJoint<1> {
   static constexpr int nq = 1, nv = 1;
+  static constexpr JointAxes axes = JointAxes::One;
   static constexpr bool angular = false, linear = true;
 
   static void pose(const Joint& j, const double* theta, Mat3& R, Vec3& d) {

@@ -7,12 +7,14 @@
 #include <cmath>
 
 #include "core/joints/flat.hpp"
+#include "core/joints/parameters.hpp"
 #include "core/model/model.hpp"
 
 namespace femdyn {
 
 struct RevoluteJoint : FlatJoint<1> {
   static constexpr int nq = 1, nv = 1;
+  static constexpr JointAxes axes = JointAxes::One;
   static constexpr bool angular = true, linear = false;  // the non-zero halves of S
 
   // B's orientation in the parent's frame, R_pj R_J(θ), and its origin's displacement from the

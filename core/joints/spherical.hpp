@@ -7,6 +7,7 @@
 #pragma once
 #include <random>
 
+#include "core/joints/parameters.hpp"
 #include "core/joints/rotation.hpp"
 #include "core/model/model.hpp"
 
@@ -14,6 +15,7 @@ namespace femdyn {
 
 struct SphericalJoint {
   static constexpr int nq = 4, nv = 3;
+  static constexpr JointAxes axes = JointAxes::None;
   static constexpr bool angular = true, linear = false, flat = false;
 
   static void pose(const Joint& j, const double* q, Mat3& R, Vec3& d) {

@@ -6,12 +6,14 @@
 //      frame into account (kernel.hpp): c_J = ω_P × s₁ θ̇₁ + ω_B × s₂ θ̇₂ in world axes.
 #pragma once
 #include "core/joints/flat.hpp"
+#include "core/joints/parameters.hpp"
 #include "core/model/model.hpp"
 
 namespace femdyn {
 
 struct UniversalJoint : FlatJoint<2> {
   static constexpr int nq = 2, nv = 2;
+  static constexpr JointAxes axes = JointAxes::Two;
   static constexpr bool angular = true, linear = false;
 
   static void pose(const Joint& j, const double* theta, Mat3& R, Vec3& d) {
