@@ -183,13 +183,12 @@ void check_one_rate(const Model& m, int t, const std::string& where) {
                                 " rates): couplings join joints of one coordinate");
 }
 
-// The coupling level: C (nθ x n) and θ0 from the couplings; the remaining movable joints,
-// in tree order, are the generalized coordinates q.
-void compile_coupling(const MechanismSpec& spec, Model& m) {
-  std::map<std::string, int> theta_of;                  // joint name -> θ index
-  for (std::size_t t = m.theta_joint.size(); t-- > 0;)  // a joint's first rate
-    theta_of[m.bodies[m.theta_joint[t]].joint.name] = static_cast<int>(t);
-  std::map<int, const CouplingSpec*> coupled;
+using ThetaOf = std::map<std::string, int>;          // joint name -> its first rate in θ
+using Coupled = std::map<int, const CouplingSpec*>;  // θ index -> its coupling
+
+// Each coupling checked: a joint of one rate coupled once, following joints of one rate.
+Coupled checked_couplings(const MechanismSpec& spec, const Model& m, const ThetaOf& theta_of) {
+  Coupled coupled;
   for (const CouplingSpec& c : spec.couplings) {
     auto it = theta_of.find(c.joint);
     if (it == theta_of.end())
@@ -207,6 +206,12 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
       check_magnitude(ratio, c.where + "/ratio", "ratio");
     }
   }
+  return coupled;
+}
+
+// The joints no coupling sets are the coordinates q, in tree order: q_of[t] for each, -1 for a
+// coupled one; their names and Model::coordinate_joints.
+std::vector<int> number_coordinates(Model& m, const Coupled& coupled) {
   const int nt = m.n_theta();
   std::vector<int> q_of(nt, -1);
   for (int t = 0; t < nt; ++t)
@@ -216,24 +221,24 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
       if (t == j.idx_v) m.coordinate_joints.push_back({m.theta_joint[t], 0, q_of[t]});
       m.coordinate_names.push_back(j.nv == 1 ? j.name : j.name + "." + rate_name(j, t - j.idx_v));
     }
-  const int n = static_cast<int>(m.coordinate_names.size());
-  if (nt == 0) throw ModelError(m.where, "has no movable joint: there is no motion to compute");
-  // (n = 0 with nθ > 0 would need every joint coupled, i.e. a cycle: reported below.)
-  std::vector<std::map<int, double>> rows(nt);  // C row by row: O(non-zeros), not nθ × n
+  return q_of;
+}
+
+// C row by row (O(non-zeros), not nθ × n) and θ0: each joint's row after the rows of the joints
+// it follows, depth-first with an explicit stack (a chain of couplings of any length cannot
+// overflow the call stack); a cycle is reported at a joint on it.
+std::vector<std::map<int, double>> coupling_rows(Model& m, const Coupled& coupled,
+                                                 const ThetaOf& theta_of,
+                                                 const std::vector<int>& q_of) {
+  const int nt = m.n_theta();
+  std::vector<std::map<int, double>> rows(nt);
   m.theta0 = VecX::Zero(nt);
   std::vector<int> state(nt, 0);  // 0 new, 1 in progress, 2 done
-  // Resolve each joint's row of C after the rows of the joints it follows: depth-first with an
-  // explicit stack (a chain of couplings of any length cannot overflow the call stack).
-  const auto cycle = [&](int t) {
-    return ModelError(coupled.at(t)->where, "couplings form a cycle through joint '" +
-                                                m.bodies[m.theta_joint[t]].joint.name + "'");
-  };
   for (int t0 = 0; t0 < nt; ++t0) {
     if (state[t0] == 2) continue;
     std::vector<std::pair<int, std::size_t>> stack = {{t0, 0}};  // (joint, next term)
     while (!stack.empty()) {
-      const int t = stack.back().first;
-      const std::size_t k = stack.back().second;
+      const auto [t, k] = stack.back();
       if (k == 0 && state[t] == 0) {
         state[t] = 1;
         if (q_of[t] >= 0) {  // a coordinate: its own row
@@ -252,7 +257,9 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
       }
       const auto& [name, ratio] = terms[k];
       const int f = theta_of.at(name);
-      if (state[f] == 1) throw cycle(f);
+      if (state[f] == 1)
+        throw ModelError(coupled.at(f)->where, "couplings form a cycle through joint '" +
+                                                   m.bodies[m.theta_joint[f]].joint.name + "'");
       if (state[f] == 0) {
         stack.emplace_back(f, 0);
         continue;
@@ -262,6 +269,21 @@ void compile_coupling(const MechanismSpec& spec, Model& m) {
       ++stack.back().second;
     }
   }
+  return rows;
+}
+
+// The coupling level: C (nθ x n) and θ0 from the couplings; the remaining movable joints,
+// in tree order, are the generalized coordinates q.
+void compile_coupling(const MechanismSpec& spec, Model& m) {
+  ThetaOf theta_of;
+  for (std::size_t t = m.theta_joint.size(); t-- > 0;)  // a joint's first rate
+    theta_of[m.bodies[m.theta_joint[t]].joint.name] = static_cast<int>(t);
+  const Coupled coupled = checked_couplings(spec, m, theta_of);
+  const std::vector<int> q_of = number_coordinates(m, coupled);
+  const int nt = m.n_theta(), n = static_cast<int>(m.coordinate_names.size());
+  if (nt == 0) throw ModelError(m.where, "has no movable joint: there is no motion to compute");
+  // (n = 0 with nθ > 0 would need every joint coupled, i.e. a cycle: reported below.)
+  const std::vector<std::map<int, double>> rows = coupling_rows(m, coupled, theta_of, q_of);
   // The hot path's form of C (core/kinematics/coupling.hpp).
   std::vector<Eigen::Triplet<double>> entries;
   bool identity = nt == n && m.theta0.isZero(0);

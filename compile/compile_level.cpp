@@ -105,9 +105,11 @@ void check_range(const CoupledJoint& j, const Model& m) {
 
 }  // namespace
 
-Model with_coupling_level(Model tree, const std::vector<CouplingSpec>& couplings) {
-  Model m =
-      tree.copy();  // the law model's bodies and elements are its tree's; its coordinates differ
+namespace {
+
+// The coupled joints by θ index, each checked (a known joint, coupled once).
+std::map<int, CoupledJoint> coupled_joints(const std::vector<CouplingSpec>& couplings,
+                                           const Model& m) {
   std::map<std::string, int> theta_of;  // joint name -> θ index
   for (int t = 0; t < m.n_theta(); ++t) theta_of[m.bodies[m.theta_joint[t]].joint.name] = t;
   std::map<int, CoupledJoint> coupled;
@@ -119,6 +121,13 @@ Model with_coupling_level(Model tree, const std::vector<CouplingSpec>& couplings
       throw ModelError(c.where + "/joint", "joint '" + c.joint + "' is coupled twice");
     coupled.emplace(it->second, coupled_joint(c, theta_of, it->second));
   }
+  return coupled;
+}
+
+// The level's coordinates: the joints no coupling sets, laid out in q as the model's
+// coordinates (their names and Model::coordinate_joints), and the coupled joints in dependency
+// order, each law checked over its input's range.
+std::shared_ptr<CouplingLevel> level_coordinates(Model& m, std::map<int, CoupledJoint> coupled) {
   auto level = std::make_shared<CouplingLevel>();
   level->n_theta = m.n_theta();
   level->n_theta_q = m.n_theta_q;
@@ -145,21 +154,24 @@ Model with_coupling_level(Model tree, const std::vector<CouplingSpec>& couplings
     level->largest_arity = std::max(level->largest_arity, static_cast<int>(j.sources.size()));
     check_range(j, m);
   }
+  return level;
+}
 
-  // C and θ0: g's linearisation at q_ref (each coordinate at 0, or its nearest limit), for the
-  // reports and structure analyses only; a dependence with zero slope there is stored as 1.
-  const int n = level->n, nt = level->n_theta;
+// C and θ0: g's linearisation at q_ref (each coordinate at 0, or its nearest limit), for the
+// reports and structure analyses only; a dependence with zero slope there is stored as 1.
+void linearise_level(Model& m, const CouplingLevel& level) {
+  const int n = level.n, nt = level.n_theta;
   const VecX q_ref = reference_posture(m);  // (by m.coordinate_joints, already the level's)
-  CouplingLevelState s(*level);
+  CouplingLevelState s(level);
   const VecX zero = VecX::Zero(n);
-  if (!evaluate_level(*level, q_ref, zero, zero, s))
-    throw ModelError(level->coupled[s.failed].where,
-                     "the law of joint '" + level->coupled[s.failed].name +
+  if (!evaluate_level(level, q_ref, zero, zero, s))
+    throw ModelError(level.coupled[s.failed].where,
+                     "the law of joint '" + level.coupled[s.failed].name +
                          "' is not defined at the reference posture (every coordinate at 0 or "
                          "its nearest limit)");
   std::vector<std::vector<bool>> depends(nt, std::vector<bool>(n, false));
-  for (int a = 0; a < n; ++a) depends[level->coordinate_theta[a]][a] = true;
-  for (const CoupledJoint& j : level->coupled)
+  for (int a = 0; a < n; ++a) depends[level.coordinate_theta[a]][a] = true;
+  for (const CoupledJoint& j : level.coupled)
     for (int src : j.sources)
       for (int a = 0; a < n; ++a) depends[j.theta][a] = depends[j.theta][a] || depends[src][a];
   std::vector<Eigen::Triplet<double>> entries;
@@ -169,15 +181,24 @@ Model with_coupling_level(Model tree, const std::vector<CouplingSpec>& couplings
   m.C.resize(nt, n);
   m.C.setFromTriplets(entries.begin(), entries.end());
   m.C_sparse = m.C;
-  compile_actuators(m);
   m.theta0 = VecX::Zero(nt);  // θ0 = g(q_ref) − G q_ref on the one-coordinate joints
   for (int t = 0; t < nt; ++t)
-    if (level->theta_q[t] >= 0) {
-      m.theta0[t] = s.theta[level->theta_q[t]];
+    if (level.theta_q[t] >= 0) {
+      m.theta0[t] = s.theta[level.theta_q[t]];
       for (int a = 0; a < n; ++a)
-        if (const int i = level->theta_q[level->coordinate_theta[a]]; i >= 0 && s.G(t, a) != 0)
+        if (const int i = level.theta_q[level.coordinate_theta[a]]; i >= 0 && s.G(t, a) != 0)
           m.theta0[t] -= s.G(t, a) * s.theta[i];
     }
+}
+
+}  // namespace
+
+Model with_coupling_level(Model tree, const std::vector<CouplingSpec>& couplings) {
+  // The law model's bodies and elements are its tree's; its coordinates differ.
+  Model m = tree.copy();
+  std::shared_ptr<CouplingLevel> level = level_coordinates(m, coupled_joints(couplings, m));
+  linearise_level(m, *level);
+  compile_actuators(m);
   m.identity_coupling = false;
   configuration_coupling(m);
   m.free_rotors.clear();  // (its tree's equations add these: core/coupling_chain)

@@ -23,7 +23,7 @@ packages=(cmake g++ make ninja-build libeigen3-dev libsuitesparse-dev nlohmann-j
           libtinyxml2-dev libsundials-dev libqhull-dev)
 if [ "$all" = 1 ]; then
   packages+=(catch2 libsimbody-dev libmujoco-dev libbenchmark-dev gnuplot-nox
-             fonts-dejavu-core clang libclang-rt-14-dev clang-format
+             fonts-dejavu-core clang libclang-rt-14-dev clang-format universal-ctags
              pybind11-dev python3-dev python3-numpy python3-pytest python3-pandas
              python3-matplotlib python3-distributed python3-jsonschema python3-scipy
              chromium)

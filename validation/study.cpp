@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -183,39 +184,73 @@ StudyMachine study_machine() {
   return m;
 }
 
-StudyReport run_study(const Model& m, const StudyOptions& o,
-                      const std::function<void(const std::string&)>& log) {
+namespace {
+
+// One work-precision study: its samples, the reference solution and the measure of errors
+// against it, the sweeps of both engines, and the report they fill.
+class Study {
+ public:
+  Study(const Model& m, const StudyOptions& o) : m(m), o(o) {
+    for (int k = 1; k <= o.samples; ++k) times.push_back(o.t_end * k / o.samples);
+    with_zero = times;  // Simbody samples t = 0 too
+    with_zero.insert(with_zero.begin(), 0.0);
+    describe();
+  }
+
+  StudyReport run(const std::function<void(const std::string&)>& log) {
+    measure_reference();
+    femdyn_sweeps();
+    const TwinModel tm = twin_model(m);
+    note_formulation(tm);
+    SimbodyTwin twin(tm);
+    simbody_sweeps(twin);
+    std::vector<Sweep*> order;  // the engines alternating
+    for (std::size_t i = 0; i < std::max(femdyn.size(), simbody.size()); ++i) {
+      if (i < femdyn.size()) order.push_back(&femdyn[i]);
+      if (i < simbody.size()) order.push_back(&simbody[i]);
+    }
+    warm_up(order, log);
+    timed_runs(order);
+    rep.machine.load_end = load_average();
+    return std::move(rep);
+  }
+
+ private:
+  const Model& m;
+  const StudyOptions& o;
+  std::vector<double> times, with_zero;
   StudyReport rep;
-  rep.machine = study_machine();
-  rep.machine.load_start = load_average();
-  rep.model = m.name;
-  rep.n = m.n();
-  rep.t_end = o.t_end;
-  rep.samples = o.samples;
-  rep.q0 = o.q0;
-  rep.qd0 = o.qd0;
-  rep.interpolate = o.interpolate;
-  rep.conservative = m.torques.empty();
-  for (const Body& b : m.bodies) rep.conservative = rep.conservative && b.joint.damping == 0;
-  std::vector<double> times;
-  for (int k = 1; k <= o.samples; ++k) times.push_back(o.t_end * k / o.samples);
-  std::vector<double> with_zero = times;  // Simbody samples t = 0 too
-  with_zero.insert(with_zero.begin(), 0.0);
-  const TwinSampling twin_sampling =
-      o.interpolate ? TwinSampling::Interpolate : TwinSampling::StepToEach;
-  rep.sampling =
-      o.interpolate
-          ? "both engines step freely and interpolate at the samples: femdyn's dopri and bdf by "
-            "their dense output, Simbody's integrators by Integrator::stepTo with no scheduled "
-            "event (cubic Hermite; CPodes its own), neither stepping past the last sample; "
-            "femdyn's rk4 and euler land on the samples, their steps dividing the sample spacing"
-          : "both engines land on every sample: femdyn's dopri and bdf shorten a step to end on "
-            "it (stop_at_outputs), Simbody's integrators through TimeStepper (each sample a "
-            "scheduled event; CPodes still interpolates inside CPODES); femdyn's rk4 and euler "
-            "land on the samples, their steps dividing the sample spacing";
+  Sampled ref;
+  std::optional<Measure> measure;
+  std::vector<Sweep> femdyn, simbody;
+  std::vector<std::pair<Sweep*, std::size_t>> made;  // each run's sweep and index in rep.runs
+
+  void describe() {
+    rep.machine = study_machine();
+    rep.machine.load_start = load_average();
+    rep.model = m.name;
+    rep.n = m.n();
+    rep.t_end = o.t_end;
+    rep.samples = o.samples;
+    rep.q0 = o.q0;
+    rep.qd0 = o.qd0;
+    rep.interpolate = o.interpolate;
+    rep.conservative = m.torques.empty();
+    for (const Body& b : m.bodies) rep.conservative = rep.conservative && b.joint.damping == 0;
+    rep.sampling =
+        o.interpolate
+            ? "both engines step freely and interpolate at the samples: femdyn's dopri and bdf by "
+              "their dense output, Simbody's integrators by Integrator::stepTo with no scheduled "
+              "event (cubic Hermite; CPodes its own), neither stepping past the last sample; "
+              "femdyn's rk4 and euler land on the samples, their steps dividing the sample spacing"
+            : "both engines land on every sample: femdyn's dopri and bdf shorten a step to end on "
+              "it (stop_at_outputs), Simbody's integrators through TimeStepper (each sample a "
+              "scheduled event; CPodes still interpolates inside CPODES); femdyn's rk4 and euler "
+              "land on the samples, their steps dividing the sample spacing";
+  }
 
   // Reference: Dormand–Prince landing on every sample, at rtol 1e-14 and 1e-13.
-  const auto reference = [&](double rtol) {
+  Sampled reference(double rtol) const {
     IntegratorOptions ro{
         .kind = IntegratorKind::Dopri,
         .adaptive = {
@@ -223,94 +258,107 @@ StudyReport run_study(const Model& m, const StudyOptions& o,
     Sampled s = femdyn_run(m, ro, o, times);
     if (!s.status.ok) throw femdyn::Error("the reference solution failed: " + s.status.message);
     return s;
-  };
-  rep.reference_rtol = 1e-14;
-  rep.reference_method =
-      "femdyn dopri (Dormand-Prince 5(4), SUNDIALS ARKODE) landing on each "
-      "sample, rtol = atol = 1e-14";
-  const Sampled ref = reference(rep.reference_rtol), coarse = reference(10 * rep.reference_rtol);
-  const Measure measure(m, ref.x);
-  for (int g = 0; g < 4; ++g)
-    if (measure.present[g])
-      rep.scales.push_back({Measure::kName[g], measure.size[g], Measure::kUnit[g]});
-  for (std::size_t k = 0; k < ref.x.size(); ++k)
-    rep.reference_error = std::max(rep.reference_error, measure.relative(coarse.x[k], ref.x[k]));
-  rep.resolution = 100 * rep.reference_error;
+  }
+
+  void measure_reference() {
+    rep.reference_rtol = 1e-14;
+    rep.reference_method =
+        "femdyn dopri (Dormand-Prince 5(4), SUNDIALS ARKODE) landing on each "
+        "sample, rtol = atol = 1e-14";
+    ref = reference(rep.reference_rtol);
+    const Sampled coarse = reference(10 * rep.reference_rtol);
+    measure.emplace(m, ref.x);
+    for (int g = 0; g < 4; ++g)
+      if (measure->present[g])
+        rep.scales.push_back({Measure::kName[g], measure->size[g], Measure::kUnit[g]});
+    for (std::size_t k = 0; k < ref.x.size(); ++k)
+      rep.reference_error = std::max(rep.reference_error, measure->relative(coarse.x[k], ref.x[k]));
+    rep.resolution = 100 * rep.reference_error;
+  }
 
   // femdyn sweeps. Fixed steps: N = samples·2^k steps, so the samples lie on the grid.
-  std::vector<Sweep> femdyn, simbody;
-  const int doublings = o.quick ? 6 : 14;
-  for (IntegratorKind kind : kIntegrators) {
-    Sweep s{"femdyn", integrator_name(kind), is_adaptive(kind) ? "rtol" : "dt", {}, {}};
-    if (is_adaptive(kind)) {
-      s.values = o.quick ? decades(3, 9) : decades(3, kind == IntegratorKind::Bdf ? 11 : 12);
-    } else {
-      const int first = kind == IntegratorKind::Euler ? 2 : 0;
-      for (int k = first; k <= first + doublings; ++k)
-        s.values.push_back(o.t_end / (o.samples * std::pow(2.0, k)));
+  void femdyn_sweeps() {
+    const int doublings = o.quick ? 6 : 14;
+    for (IntegratorKind kind : kIntegrators) {
+      Sweep s{"femdyn", integrator_name(kind), is_adaptive(kind) ? "rtol" : "dt", {}, {}};
+      if (is_adaptive(kind)) {
+        s.values = o.quick ? decades(3, 9) : decades(3, kind == IntegratorKind::Bdf ? 11 : 12);
+      } else {
+        const int first = kind == IntegratorKind::Euler ? 2 : 0;
+        for (int k = first; k <= first + doublings; ++k)
+          s.values.push_back(o.t_end / (o.samples * std::pow(2.0, k)));
+      }
+      s.run = [this, kind](double value) {
+        IntegratorOptions io{.kind = kind};
+        if (is_adaptive(kind))
+          io.adaptive = {.rtol = value,
+                         .atol = value,
+                         .max_steps = 100'000'000,
+                         .stop_at_outputs = !o.interpolate};
+        else
+          io.fixed = {.dt = value};
+        const Sampled r = femdyn_run(m, io, o, times);
+        StudyRun run{.engine = "femdyn",
+                     .integrator = integrator_name(kind),
+                     .setting = is_adaptive(kind) ? "rtol" : "dt",
+                     .value = value};
+        run.wall_time = r.stats.wall_time;
+        run.steps = r.stats.steps;
+        run.rhs_evals = r.stats.rhs_evals;
+        run.ok = r.status.ok;
+        run.failure = r.status.message;
+        if (run.ok) score(run, r.x, r.energy, ref.x, *measure);
+        return run;
+      };
+      femdyn.push_back(std::move(s));
     }
-    s.run = [&, kind](double value) {
-      IntegratorOptions io{.kind = kind};
-      if (is_adaptive(kind))
-        io.adaptive = {.rtol = value,
-                       .atol = value,
-                       .max_steps = 100'000'000,
-                       .stop_at_outputs = !o.interpolate};
-      else
-        io.fixed = {.dt = value};
-      const Sampled r = femdyn_run(m, io, o, times);
-      StudyRun run{.engine = "femdyn",
-                   .integrator = integrator_name(kind),
-                   .setting = is_adaptive(kind) ? "rtol" : "dt",
-                   .value = value};
-      run.wall_time = r.stats.wall_time;
-      run.steps = r.stats.steps;
-      run.rhs_evals = r.stats.rhs_evals;
-      run.ok = r.status.ok;
-      run.failure = r.status.message;
-      if (run.ok) score(run, r.x, r.energy, ref.x, measure);
-      return run;
-    };
-    femdyn.push_back(std::move(s));
+  }
+
+  // Whether both engines integrate the same equations (a coupled or closed model: not).
+  void note_formulation(const TwinModel& tm) {
+    if (tm.closed_loop()) {
+      rep.same_formulation = false;
+      rep.femdyn_formulation = "reduced law";
+      rep.simbody_formulation = "constrained loop";
+      rep.notes.push_back(
+          "not the same formulation: femdyn integrates the reduced law (" + std::to_string(m.n()) +
+          " coordinates; the coupled joints follow θ = g(q)), Simbody's twin a constrained loop (" +
+          std::to_string(tm.n_theta()) + " joints, " + std::to_string(tm.laws.size()) +
+          " coupled joint(s) and " + std::to_string(tm.rods.size()) +
+          " rod(s) as CoordinateCoupler and Ball constraints, kept on them by projection). "
+          "The times compare the two formulations, not the two engines on the same equations.");
+    } else if (tm.n_theta() > tm.n()) {
+      rep.same_formulation = false;
+      rep.femdyn_formulation = "reduced coordinates";
+      rep.simbody_formulation = "coordinate couplers";
+      rep.notes.push_back(
+          "not the same formulation: femdyn integrates the reduced coordinates (" +
+          std::to_string(m.n()) + " of them, θ = C q + θ0), Simbody's twin all " +
+          std::to_string(tm.n_theta()) +
+          " joints with the coupling as CoordinateCoupler constraints, kept on them by "
+          "projection. The times compare the two formulations, not the two engines on the same "
+          "equations.");
+    } else {
+      rep.femdyn_formulation = rep.simbody_formulation = "tree coordinates";
+    }
   }
 
   // Simbody sweeps over accuracies, when the twin can integrate the model.
-  const TwinModel tm = twin_model(m);
-  if (tm.closed_loop()) {
-    rep.same_formulation = false;
-    rep.femdyn_formulation = "reduced law";
-    rep.simbody_formulation = "constrained loop";
-    rep.notes.push_back(
-        "not the same formulation: femdyn integrates the reduced law (" + std::to_string(m.n()) +
-        " coordinates; the coupled joints follow θ = g(q)), Simbody's twin a constrained loop (" +
-        std::to_string(tm.n_theta()) + " joints, " + std::to_string(tm.laws.size()) +
-        " coupled joint(s) and " + std::to_string(tm.rods.size()) +
-        " rod(s) as CoordinateCoupler and Ball constraints, kept on them by projection). "
-        "The times compare the two formulations, not the two engines on the same equations.");
-  } else if (tm.n_theta() > tm.n()) {
-    rep.same_formulation = false;
-    rep.femdyn_formulation = "reduced coordinates";
-    rep.simbody_formulation = "coordinate couplers";
-    rep.notes.push_back(
-        "not the same formulation: femdyn integrates the reduced coordinates (" +
-        std::to_string(m.n()) + " of them, θ = C q + θ0), Simbody's twin all " +
-        std::to_string(tm.n_theta()) +
-        " joints with the coupling as CoordinateCoupler constraints, kept on them by "
-        "projection. The times compare the two formulations, not the two engines on the same "
-        "equations.");
-  } else {
-    rep.femdyn_formulation = rep.simbody_formulation = "tree coordinates";
-  }
-  SimbodyTwin twin(tm);
-  std::string why_not;
-  if (twin.can_simulate(&why_not)) {
+  void simbody_sweeps(SimbodyTwin& twin) {
+    std::string why_not;
+    if (!twin.can_simulate(&why_not)) {
+      rep.notes.push_back("Simbody's integrators were not run: " + why_not);
+      return;
+    }
+    const TwinSampling twin_sampling =
+        o.interpolate ? TwinSampling::Interpolate : TwinSampling::StepToEach;
     for (SimbodyIntegrator which : simbody_integrators()) {
       Sweep s{"Simbody",
               simbody_integrator_name(which),
               "accuracy",
               o.quick ? decades(2, 8) : decades(2, 10),
               {}};
-      s.run = [&, which](double accuracy) {
+      s.run = [this, &twin, which, twin_sampling](double accuracy) {
         const TwinRun r = twin.simulate(o.q0, o.qd0, with_zero, accuracy, which, twin_sampling);
         StudyRun run{.engine = "Simbody",
                      .integrator = simbody_integrator_name(which),
@@ -330,72 +378,75 @@ StudyReport run_study(const Model& m, const StudyOptions& o,
             x.push_back(std::move(v));
             energy.push_back(t.energy);
           }
-          score(run, x, energy, ref.x, measure);
+          score(run, x, energy, ref.x, *measure);
         }
         return run;
       };
       simbody.push_back(std::move(s));
     }
-  } else {
-    rep.notes.push_back("Simbody's integrators were not run: " + why_not);
   }
 
   // Round-robin, the engines alternating: each run once, as the warm-up of its setting, whose
   // error and time decide whether the sweep goes on. A sweep stops after a run over budget or
   // an error below the reference's resolution (a failed run, e.g. a step beyond the stability
   // limit, does not stop it: a finer setting may succeed).
-  std::vector<Sweep*> order;
-  for (std::size_t i = 0; i < std::max(femdyn.size(), simbody.size()); ++i) {
-    if (i < femdyn.size()) order.push_back(&femdyn[i]);
-    if (i < simbody.size()) order.push_back(&simbody[i]);
-  }
-  std::vector<std::pair<Sweep*, std::size_t>> made;  // each run's sweep and index in rep.runs
-  const double budget = o.quick ? 0.2 : o.run_budget;
-  for (bool any = true; any;) {
-    any = false;
-    for (Sweep* s : order) {
-      if (!s->active || s->next >= s->values.size()) continue;
-      any = true;
-      StudyRun r = s->run(s->values[s->next++]);
-      r.warm_up_time = r.wall_time;
-      r.resolved = r.ok && r.error >= rep.resolution;
-      if (log)
-        log(r.engine + " " + r.integrator + " " + r.setting + " " + format_number(r.value, "%.3g") +
-            (r.ok ? ": error " + format_number(r.error, "%.2e") + ", warm-up " +
-                        format_number(r.wall_time, "%.3g s")
-                  : ": failed: " + r.failure));
-      s->active = r.wall_time < budget && (!r.ok || r.error >= rep.resolution);
-      made.emplace_back(s, rep.runs.size());
-      rep.runs.push_back(std::move(r));
+  void warm_up(const std::vector<Sweep*>& order,
+               const std::function<void(const std::string&)>& log) {
+    const double budget = o.quick ? 0.2 : o.run_budget;
+    for (bool any = true; any;) {
+      any = false;
+      for (Sweep* s : order) {
+        if (!s->active || s->next >= s->values.size()) continue;
+        any = true;
+        StudyRun r = s->run(s->values[s->next++]);
+        r.warm_up_time = r.wall_time;
+        r.resolved = r.ok && r.error >= rep.resolution;
+        if (log)
+          log(r.engine + " " + r.integrator + " " + r.setting + " " +
+              format_number(r.value, "%.3g") +
+              (r.ok ? ": error " + format_number(r.error, "%.2e") + ", warm-up " +
+                          format_number(r.wall_time, "%.3g s")
+                    : ": failed: " + r.failure));
+        s->active = r.wall_time < budget && (!r.ok || r.error >= rep.resolution);
+        made.emplace_back(s, rep.runs.size());
+        rep.runs.push_back(std::move(r));
+      }
     }
   }
 
   // The timed runs, in rounds, in the same alternating order; a failed run keeps its one time.
-  rep.timed_repeats = o.quick ? 3 : std::max(1, o.repeats);
-  rep.timed_repeats_long = o.quick ? 3 : std::max(1, o.long_repeats);
-  const auto wanted = [&](const StudyRun& r) {
-    return !r.ok ? 0
-                 : (r.warm_up_time < o.repeat_below ? rep.timed_repeats : rep.timed_repeats_long);
-  };
-  for (int round = 0; round < std::max(rep.timed_repeats, rep.timed_repeats_long); ++round)
-    for (Sweep* s : order)
-      for (const auto& [sweep, i] : made) {
-        StudyRun& r = rep.runs[i];
-        if (sweep != s || round >= wanted(r)) continue;
-        const StudyRun again = s->run(r.value);
-        r.times.push_back(again.wall_time);
-        if (again.steps != r.steps)  // a run is deterministic: the same steps every time
-          rep.notes.push_back(r.engine + " " + r.integrator + " " + r.setting + " " +
-                              format_number(r.value, "%.3g") + " took " +
-                              std::to_string(again.steps) + " steps in a timed run, " +
-                              std::to_string(r.steps) + " in its warm-up");
-      }
-  for (StudyRun& r : rep.runs) {
-    if (r.times.empty()) r.times = {r.warm_up_time};
-    r.wall_time = median(r.times);
+  void timed_runs(const std::vector<Sweep*>& order) {
+    rep.timed_repeats = o.quick ? 3 : std::max(1, o.repeats);
+    rep.timed_repeats_long = o.quick ? 3 : std::max(1, o.long_repeats);
+    const auto wanted = [&](const StudyRun& r) {
+      return !r.ok ? 0
+                   : (r.warm_up_time < o.repeat_below ? rep.timed_repeats : rep.timed_repeats_long);
+    };
+    for (int round = 0; round < std::max(rep.timed_repeats, rep.timed_repeats_long); ++round)
+      for (Sweep* s : order)
+        for (const auto& [sweep, i] : made) {
+          StudyRun& r = rep.runs[i];
+          if (sweep != s || round >= wanted(r)) continue;
+          const StudyRun again = s->run(r.value);
+          r.times.push_back(again.wall_time);
+          if (again.steps != r.steps)  // a run is deterministic: the same steps every time
+            rep.notes.push_back(r.engine + " " + r.integrator + " " + r.setting + " " +
+                                format_number(r.value, "%.3g") + " took " +
+                                std::to_string(again.steps) + " steps in a timed run, " +
+                                std::to_string(r.steps) + " in its warm-up");
+        }
+    for (StudyRun& r : rep.runs) {
+      if (r.times.empty()) r.times = {r.warm_up_time};
+      r.wall_time = median(r.times);
+    }
   }
-  rep.machine.load_end = load_average();
-  return rep;
+};
+
+}  // namespace
+
+StudyReport run_study(const Model& m, const StudyOptions& o,
+                      const std::function<void(const std::string&)>& log) {
+  return Study(m, o).run(log);
 }
 
 const StudyRun* fastest(const StudyReport& rep, const std::string& engine, double target) {

@@ -156,15 +156,9 @@ void block_step(const Joint& J, ArticulatedBody& A, const Vec6* columns, Articul
   return true;
 }
 
-}  // namespace
-
-Status articulated_forward_dynamics(const Model& model, Workspace& ws, const VecX& q,
-                                    const VecX& qd, const VecX& tau) {
+// 1. Velocities, velocity-product accelerations and bias forces, root to leaves.
+[[gnu::always_inline]] inline void articulated_velocities(const Model& model, Workspace& ws) {
   const int nb = static_cast<int>(model.bodies.size());
-  propagate(model, ws, q, qd, {.jacobian = false, .bias = false, .rows = false});  // poses, θ
-  ws.theta_dot = qd;                                                               // C = I
-
-  // 1. Velocities, velocity-product accelerations and bias forces, root to leaves.
   for (int b = 0; b < nb; ++b) {
     const Body& body = model.bodies[b];
     ArticulatedBody& A = ws.articulated[b];
@@ -186,9 +180,12 @@ Status articulated_forward_dynamics(const Model& model, Workspace& ws, const Vec
     A.pA = cross_force(A.V, I * A.V);
     A.I = I;  // kept for the derivatives (core/derivatives/derivatives.cpp)
   }
-  subtract_body_loads(model, ws);
+}
 
-  // 2. Articulated inertias and bias forces, leaves to root.
+// 2. Articulated inertias and bias forces, leaves to root.
+[[gnu::always_inline]] inline void articulated_inertias(const Model& model, Workspace& ws,
+                                                        const VecX& tau) {
+  const int nb = static_cast<int>(model.bodies.size());
   for (int b = nb - 1; b >= 0; --b) {
     const Body& body = model.bodies[b];
     ArticulatedBody& A = ws.articulated[b];
@@ -210,20 +207,26 @@ Status articulated_forward_dynamics(const Model& model, Workspace& ws, const Vec
     ws.articulated[p].pA += A.pA;
     ws.articulated[p].trace += A.trace;
   }
+}
 
-  // Regularity. M^s(j, j) = S_jᵀ I^c_b S_j ≤ tr(I^c_b) |S_j|², so a pivot above 1e-13 of that
-  // bound passes the Cholesky route's test; otherwise that test is run exactly.
+// Regularity. M^s(j, j) = S_jᵀ I^c_b S_j ≤ tr(I^c_b) |S_j|², so a pivot above 1e-13 of that
+// bound passes the Cholesky route's test; otherwise that test is run exactly.
+[[gnu::always_inline]] inline Status articulated_regularity(const Model& model, Workspace& ws) {
+  const int nb = static_cast<int>(model.bodies.size());
   for (int b = 0; b < nb; ++b) {
     const ArticulatedBody& A = ws.articulated[b];
     const Joint& J = model.bodies[b].joint;
     if (J.nv == 1 ? A.d > 1e-13 * A.trace * A.S.squaredNorm() && std::isfinite(A.u)
                   : !moves(J) || block_pivots_clear(J, ws, A))
       continue;
-    if (Status st = check_regularity(model, ws); !st.ok) return st;
-    break;
+    return check_regularity(model, ws);
   }
+  return {};
+}
 
-  // 3. Accelerations, root to leaves, from the base acceleration −g that stands for gravity.
+// 3. Accelerations, root to leaves, from the base acceleration −g that stands for gravity.
+[[gnu::always_inline]] inline void articulated_accelerations(const Model& model, Workspace& ws) {
+  const int nb = static_cast<int>(model.bodies.size());
   const Vec6 a_base = gravity_base_acceleration(model);
   for (int b = 0; b < nb; ++b) {
     const Body& body = model.bodies[b];
@@ -237,6 +240,19 @@ Status articulated_forward_dynamics(const Model& model, Workspace& ws, const Vec
       block_acceleration(body.joint, ws, A);
     }
   }
+}
+
+}  // namespace
+
+Status articulated_forward_dynamics(const Model& model, Workspace& ws, const VecX& q,
+                                    const VecX& qd, const VecX& tau) {
+  propagate(model, ws, q, qd, {.jacobian = false, .bias = false, .rows = false});  // poses, θ
+  ws.theta_dot = qd;                                                               // C = I
+  articulated_velocities(model, ws);
+  subtract_body_loads(model, ws);
+  articulated_inertias(model, ws, tau);
+  if (Status st = articulated_regularity(model, ws); !st.ok) return st;
+  articulated_accelerations(model, ws);
   return {};
 }
 
