@@ -284,9 +284,10 @@ int cmd_equations(int argc, char** argv) {
                           Result{"q̈", ws.qdd.data(), st.ok ? ws.qdd.size() : 0, ws.qdd.size()}})
     for (Eigen::Index i = 0; i < x.size; ++i) {
       if (std::isfinite(x.data[i])) continue;
-      std::cerr << "femdyn equations: " << escaped(a.positional[0]) << ": at this state " << x.what
-                << " of '" << m.coordinate_names[i % x.rows]
-                << "' is NaN or Inf (the forces or the state overflow double precision)\n";
+      std::cerr << "femdyn equations: " << escaped(a.positional[0]) << ": "
+                << overflow_text(std::string(x.what) + " of '" + m.coordinate_names[i % x.rows] +
+                                 "'")
+                << "\n";
       return 1;
     }
   std::vector<MatX> D;

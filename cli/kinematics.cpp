@@ -114,14 +114,13 @@ int cmd_kinematics(int argc, char** argv) {
   propagate(m, ws, q, qd, {.jacobian = true, .bias = true, .rows = false});
   MomentumKinematics c;
   momentum_kinematics(m, ws, c);
-  if (!c.A.allFinite() || !c.bias.allFinite())
-    throw CliError("the momentum is not finite at this state");
+  if (!c.A.allFinite() || !c.bias.allFinite()) throw CliError(overflow_text("the momentum"));
   const bool floating = floating_tree(m);
   for (const int f : frames) {
     frame_kinematics(m, ws, f, axes, k);
     if (!k.J.allFinite() || !k.bias.allFinite() || !k.p.allFinite())
-      throw CliError("the kinematics of frame " + quoted_text(m.frames[f].name) +
-                     " are not finite at this state");
+      throw CliError(
+          overflow_text("the kinematics of frame " + quoted_text(m.frames[f].name), true));
     const std::string body = m.bodies[m.frames[f].body].name;
     Json entry = {{"name", m.frames[f].name},   {"body", body},
                   {"p", vector_json(k.p)},      {"R", matrix_json(k.R)},

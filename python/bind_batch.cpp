@@ -157,8 +157,9 @@ py::array_t<double> dynamics_batch(const PyModel& self, const Array& q, const Op
           }
           for (Eigen::Index a = 0; a < n; ++a)
             if (!std::isfinite((*result)[a]))
-              throw NumericalError("row " + std::to_string(i) + ": " + (Forward ? "q̈" : "τ") +
-                                   " of '" + m.coordinate_names[a] + "' is NaN or Inf");
+              throw NumericalError("row " + std::to_string(i) + ": " +
+                                   overflow_text(std::string(Forward ? "q̈" : "τ") + " of '" +
+                                                 m.coordinate_names[a] + "'"));
           Eigen::Map<VecX>(po + i * n, n) = *result;
         });
   }
@@ -173,9 +174,7 @@ void store(double* base, Eigen::Index i, const Mat& x) {
 }
 
 void require_finite_row(bool finite, Eigen::Index i, const std::string& what) {
-  if (!finite)
-    throw NumericalError("row " + std::to_string(i) + ": " + what +
-                         " is NaN or Inf (the state overflows double precision)");
+  if (!finite) throw NumericalError("row " + std::to_string(i) + ": " + overflow_text(what));
 }
 
 // A thread's buffers for the derivatives (their workspace, at Baumgarte's rate ω for closed loops;

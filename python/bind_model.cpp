@@ -27,9 +27,8 @@ void require_finite(const Model& model, const double* x, Eigen::Index size, Eige
                     const char* what) {
   for (Eigen::Index i = 0; i < size; ++i)
     if (!std::isfinite(x[i]))
-      throw NumericalError(std::string("at this state ") + what + " of '" +
-                           model.coordinate_names[i % rows] +
-                           "' is NaN or Inf (the forces or the state overflow double precision)");
+      throw NumericalError(
+          overflow_text(std::string(what) + " of '" + model.coordinate_names[i % rows] + "'"));
 }
 
 std::unique_ptr<PyModel> load(const std::string& path, const OptArray& gravity, bool floating_base,
@@ -106,8 +105,7 @@ py::dict frame_of(PyModel& self, const std::string& name, const Array& q, const 
   FrameKinematics k;
   frame_kinematics(m, self.ws, configuration_arg(q, "q", m), vector_arg(qd, "qd", m), f, axes, k);
   if (!k.J.allFinite() || !k.bias.allFinite() || !k.p.allFinite())
-    throw NumericalError("at this state the kinematics of frame " + quoted_text(name) +
-                         " are NaN or Inf (the state overflows double precision)");
+    throw NumericalError(overflow_text("the kinematics of frame " + quoted_text(name), true));
   py::dict out;
   out["p"] = VecX(k.p);
   out["R"] = MatX(k.R);
@@ -134,9 +132,7 @@ py::dict centroidal_dict(const MomentumKinematics& c) {
 
 void require_finite_momentum(const MomentumKinematics& c) {
   if (!c.A.allFinite() || !c.bias.allFinite() || !std::isfinite(c.mass))
-    throw NumericalError(
-        "at this state the momentum is NaN or Inf (the state overflows double "
-        "precision)");
+    throw NumericalError(overflow_text("the momentum"));
 }
 
 py::dict centroidal_of(PyModel& self, const Array& q, const OptArray& qd) {

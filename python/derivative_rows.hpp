@@ -12,9 +12,7 @@
 namespace femdyn::python {
 
 inline void require_finite(const MatX& x, const char* what) {
-  if (!x.allFinite())
-    throw NumericalError(std::string("at this state ") + what +
-                         " is NaN or Inf (the state overflows double precision)");
+  if (!x.allFinite()) throw NumericalError(overflow_text(what));
 }
 
 // Baumgarte's rate for a closed loop's constrained equations (1/s): the argument, checked, or the

@@ -139,4 +139,12 @@ inline std::string safe_message(std::string_view text) {
   return escaped(text.substr(0, head)) + " … " + escaped(text.substr(tail));
 }
 
+// The one sentence for a result that is NaN or Inf at a state that is finite (every door says
+// it so): "at this state <what> is NaN or Inf (the state or the forces overflow double
+// precision)"; "are" for a plural `what`.
+inline std::string overflow_text(std::string_view what, bool plural = false) {
+  return "at this state " + std::string(what) + (plural ? " are" : " is") +
+         " NaN or Inf (the state or the forces overflow double precision)";
+}
+
 }  // namespace femdyn
