@@ -353,6 +353,174 @@ Json mode_json(const Model& m, const Mode& md) {
           {"where", where(m, md.coordinate)}};
 }
 
+// What check found: the diagnosis over the states, the states pressed into stops, the bodies
+// worth a look, and the advice verified.
+struct CheckReport {
+  int states = 0, pressed = 0;
+  Diagnosis d;
+  std::vector<SuspiciousBody> bodies;
+  Advice advice;
+  double tol = 0;
+};
+
+// Checking K states costs about per_state each: beyond the budget, refused naming the way on.
+bool within_budget(const Args& a, const Model& m, int K, double budget) {
+  const int n = m.n();
+  const double per_state = seconds_per_state(m);
+  if (per_state * K <= budget) return true;
+  const int fit = static_cast<int>(budget / per_state);
+  std::cerr << "femdyn check: " << escaped(a.positional[0]) << ": checking " << K << " states of "
+            << n << " coordinates would take about " << format_duration(per_state * K) << " ("
+            << format_duration(per_state)
+            << " a state: 4n evaluations and dense eigenproblems of 2n = " << 2 * n
+            << "), beyond the budget of " << format_duration(budget) << ": "
+            << (fit >= 1 ? "use --states " + std::to_string(fit) + " or raise --budget"
+                         : "even one state exceeds it; raise --budget to at least " +
+                               format_number(std::ceil(per_state), "%.0f") +
+                               " (seconds) with --states 1")
+            << "\n";
+  return false;
+}
+
+// The diagnosis at K states: the neutral posture at rest, then seeded random ones (each
+// assembled onto the loops first, where there are loops).
+Diagnosis diagnose(const Model& m, int K, std::mt19937& rng, const std::string& label) {
+  const int n = m.n();
+  Workspace ws(m);
+  Diagnosis d;
+  const bool dampers = has_dampers(m);
+  Progress progress(K, "states");
+  for (int k = 0; k < K; ++k) {
+    VecX q = k == 0 ? neutral_posture(m) : random_posture(m, rng);
+    VecX qd = k == 0 ? VecX::Zero(n) : random_uniform(n, 1.0, rng);
+    if (m.constraints.empty() || diagnose_loops(m, k, q, qd, d))
+      diagnose_state(m, ws, q, qd, dampers, d);
+    progress.update(k + 1);
+  }
+  // Loops that close at none of the states tried leave nothing to diagnose: refused as simulate
+  // refuses them (exit 1), never a report of empty ranges.
+  if (!m.constraints.empty() && d.unassembled == K)
+    throw StateError(label + ": the loops close at none of the " + std::to_string(K) +
+                     " states tried: " + d.unassembled_message);
+  return d;
+}
+
+Json check_json(const Model& m, const CheckReport& r) {
+  const int n = m.n(), K = r.states, pressed = r.pressed;
+  const Diagnosis& d = r.d;
+  const Advice& advice = r.advice;
+  const std::vector<SuspiciousBody>& bodies = r.bodies;
+  const double tol = r.tol;
+  Json j = {{"model", m.name},
+            {"n", n},
+            {"coordinates", m.coordinate_names},
+            {"actuated", actuated_names(m)},
+            {"states", K},
+            {"stop_states", pressed},
+            {"condition", {{"min", finite_or_null(d.cond_lo)}, {"max", finite_or_null(d.cond_hi)}}},
+            {"condition_overflows", d.singular_states < K && !std::isfinite(d.cond_hi)},
+            {"digits_lost", finite_or_null(std::log10(d.cond_hi))},
+            {"asymmetry", d.asym},
+            {"singular_states", d.singular_states},
+            {"stiffest_mode", mode_json(m, d.stiffest)},
+            {"fastest_motion", mode_json(m, d.fastest)},
+            {"recommendation", advice.text},
+            {"recommended",
+             {{"integrator", advice.integrator},
+              {"tol", tol},
+              {"rk4_dt", advice.dt_rk4},
+              {"euler_dt", advice.dt_euler},
+              {"rk4_error_per_period", advice.error_per_period},
+              {"period", advice.period},
+              {"stability_limited", advice.stability_limited}}}};
+  if (advice.trial)
+    j["recommended"]["trial"] = {
+        {"verified", advice.trial->verified},
+        {"rk4_dt", advice.trial->dt},
+        {"halvings", advice.trial->halvings},
+        {"horizon", advice.trial->horizon},
+        {"error_per_period", finite_or_null(advice.trial->error_per_period)},
+        {"error", finite_or_null(advice.trial->error)},
+        {"failure", advice.trial->failure}};
+  Json steps = Json::object();
+  for (int i = 0; i < 3; ++i)
+    steps[integrator_name(kExplicit[i])] =
+        std::isfinite(d.h_max[i]) ? Json(d.h_max[i]) : Json(nullptr);
+  j["largest_stable_step"] = steps;
+  Json flags = Json::array(), notes = Json::array();
+  for (const auto& b : bodies)
+    (b.note ? notes : flags).push_back({{"body", b.name}, {"why", b.why}});
+  j["suspicious_bodies"] = flags;
+  j["notes"] = notes;
+  if (!d.singular_message.empty()) j["singular"] = d.singular_message;
+  if (!m.constraints.empty())
+    j["loops"] = {{"equations", m.constraint_rows},
+                  {"rank", d.rank},
+                  {"redundant", d.redundant},
+                  {"unassembled_states", d.unassembled},
+                  {"dead_point_ratio", finite_or_null(d.dead_ratio)},
+                  {"near_dead_point", d.dead_ratio < kDeadPointRatio}};
+  return j;
+}
+
+void print_check(const Model& m, const CheckReport& r) {
+  const int n = m.n(), K = r.states, pressed = r.pressed;
+  const Diagnosis& d = r.d;
+  const Advice& advice = r.advice;
+  const std::vector<SuspiciousBody>& bodies = r.bodies;
+  std::cout << "model: " << m.name << " (" << n << " coordinates, " << m.bodies.size()
+            << " bodies), " << K << " states"
+            << (pressed ? " and " + std::to_string(pressed) + " pressed into their joint stops"
+                        : std::string())
+            << "\n";
+  if (!m.fully_actuated()) {  // (docs/control.md#actuation)
+    std::cout << "actuation: " << m.n_actuated() << " of " << n << " coordinates driven; not:";
+    for (int i = 0, k = 0; i < n; ++i)
+      if (k < m.n_actuated() && m.actuated[k] == i)
+        ++k;
+      else
+        std::cout << " " << m.coordinate_names[i];
+    std::cout << "\n";
+  }
+  if (d.singular_states)
+    std::cout << "M^s: singular at " << d.singular_states << " of " << K
+              << " states: " << d.singular_message << "\n";
+  if (d.singular_states < K)
+    std::cout << "M^s: " << condition_text(d.cond_lo, d.cond_hi) << ", symmetric to "
+              << format_short(d.asym)
+              << (d.singular_states ? "" : ", positive definite at every state") << "\n";
+  if (!m.constraints.empty()) {
+    std::cout << "loops: " << m.constraint_rows << " constraint equations, rank " << d.rank << " ("
+              << d.redundant << " redundant) at the states assembled onto them";
+    if (d.unassembled)
+      std::cout << "; " << d.unassembled << " of " << K
+                << " states could not be assembled (left out): " << d.unassembled_message;
+    if (std::isfinite(d.dead_ratio))
+      std::cout << "\nnearest dead point: sigma_min/sigma_max of Phi_q = "
+                << format_short(d.dead_ratio) << " at state " << d.dead_state
+                << (d.dead_ratio < kDeadPointRatio
+                        ? " (near a dead point: the constraint forces there are large, and at "
+                          "the point itself the motion fails)"
+                        : "");
+    std::cout << "\n";
+  }
+  std::cout << "stiffest mode: |λ| = " << format_short(d.stiffest.omega) << " 1/s, "
+            << d.stiffest.text() << ", in " << where(m, d.stiffest.coordinate) << "\n"
+            << "fastest motion: " << d.fastest.text() << ", in " << where(m, d.fastest.coordinate)
+            << "\nlargest stable step:";
+  for (int i = 0; i < 3; ++i)
+    std::cout << " " << integrator_name(kExplicit[i]) << " "
+              << (std::isfinite(d.h_max[i]) ? format_short(d.h_max[i]) + " s"
+                                            : std::string("unlimited"))
+              << (i < 2 ? "," : "");
+  std::cout << " (bdf: unlimited)\n";
+  if (bodies.empty()) std::cout << "suspicious bodies: none\n";
+  for (const auto& b : bodies)
+    std::cout << (b.note ? "note: body '" : "suspicious body '") << b.name << "': " << b.why
+              << "\n";
+  std::cout << "recommended: " << advice.text << "\n";
+}
+
 }  // namespace
 
 int cmd_check(int argc, char** argv) {
@@ -363,173 +531,42 @@ int cmd_check(int argc, char** argv) {
     return 0;
   }
   const Model m = load(a);
-  const int K = static_cast<int>(integer_option(a, "states", 10, 1, 10000));
-  std::mt19937 rng(static_cast<unsigned>(integer_option(a, "seed", 1, 0, 4294967295.0)));
-  const double tol = number_option(a, "tol", 1e-3);
-  if (!(tol > 0 && tol < 1)) throw CliError("--tol expects a relative error in (0, 1)");
+  CheckReport r;
+  r.states = static_cast<int>(integer_option(a, "states", 10, 1, 10000));
+  const unsigned seed = static_cast<unsigned>(integer_option(a, "seed", 1, 0, 4294967295.0));
+  r.tol = number_option(a, "tol", 1e-3);
+  if (!(r.tol > 0 && r.tol < 1)) throw CliError("--tol expects a relative error in (0, 1)");
   const double budget = number_option(a, "budget", 120);
   if (!(budget > 0)) throw CliError("--budget expects a positive number of seconds");
-  const int n = m.n();
-
-  // Bounded work: estimated up front, refused beyond the memory limit and the budget. Memory:
-  // the workspace's M^s, the 2n x 2n linearisation A and its eigenproblem (the real Schur form,
-  // its vectors and the complex eigenvectors, about 6 matrices of 2n).
-  const double bytes = evaluation_bytes(m) + 6 * dense_bytes(2 * n, 2 * n);
-  require_memory(a.positional[0] + ": checking n = " + std::to_string(n) + " coordinates", bytes,
-                 max_memory(a), "use " + max_memory_option(bytes) + " if that much memory is free");
-  const double per_state = seconds_per_state(m);
-  if (per_state * K > budget) {
-    const int fit = static_cast<int>(budget / per_state);
-    std::cerr << "femdyn check: " << escaped(a.positional[0]) << ": checking " << K << " states of "
-              << n << " coordinates would take about " << format_duration(per_state * K) << " ("
-              << format_duration(per_state)
-              << " a state: 4n evaluations and dense eigenproblems of 2n = " << 2 * n
-              << "), beyond the budget of " << format_duration(budget) << ": "
-              << (fit >= 1 ? "use --states " + std::to_string(fit) + " or raise --budget"
-                           : "even one state exceeds it; raise --budget to at least " +
-                                 format_number(std::ceil(per_state), "%.0f") +
-                                 " (seconds) with --states 1")
-              << "\n";
-    return 1;
-  }
-
-  Workspace ws(m);
-  Diagnosis d;
-  const bool dampers = has_dampers(m);
-  {
-    Progress progress(K, "states");
-    for (int k = 0; k < K; ++k) {
-      VecX q = k == 0 ? neutral_posture(m) : random_posture(m, rng);
-      VecX qd = k == 0 ? VecX::Zero(n) : random_uniform(n, 1.0, rng);
-      if (m.constraints.empty() || diagnose_loops(m, k, q, qd, d))
-        diagnose_state(m, ws, q, qd, dampers, d);
-      progress.update(k + 1);
-    }
-  }
-  // Loops that close at none of the states tried leave nothing to diagnose: refused as simulate
-  // refuses them (exit 1), never a report of empty ranges.
-  if (!m.constraints.empty() && d.unassembled == K)
-    throw StateError(a.positional[0] + ": the loops close at none of the " + std::to_string(K) +
-                     " states tried: " + d.unassembled_message);
-  const int pressed = diagnose_stops(m, ws, dampers, d);
-  const std::vector<SuspiciousBody> bodies = suspicious_bodies(m);
-  bool flagged = false;
-  for (const auto& b : bodies) flagged = flagged || !b.note;
-  Advice advice = advise(m, d, tol);
   double t_end = 0;
   if (a.has("t-end")) {
     t_end = number_option(a, "t-end", 0);
     if (!(t_end > 0) || t_end > 1e6) throw CliError("--t-end expects a time in (0, 1e6] s");
   }
-  verify_advice(m, tol, static_cast<unsigned>(integer_option(a, "seed", 1, 0, 4294967295.0)), t_end,
-                advice);
 
-  if (a.has("json")) {
-    Json j = {
-        {"model", m.name},
-        {"n", n},
-        {"coordinates", m.coordinate_names},
-        {"actuated", actuated_names(m)},
-        {"states", K},
-        {"stop_states", pressed},
-        {"condition", {{"min", finite_or_null(d.cond_lo)}, {"max", finite_or_null(d.cond_hi)}}},
-        {"condition_overflows", d.singular_states < K && !std::isfinite(d.cond_hi)},
-        {"digits_lost", finite_or_null(std::log10(d.cond_hi))},
-        {"asymmetry", d.asym},
-        {"singular_states", d.singular_states},
-        {"stiffest_mode", mode_json(m, d.stiffest)},
-        {"fastest_motion", mode_json(m, d.fastest)},
-        {"recommendation", advice.text},
-        {"recommended",
-         {{"integrator", advice.integrator},
-          {"tol", tol},
-          {"rk4_dt", advice.dt_rk4},
-          {"euler_dt", advice.dt_euler},
-          {"rk4_error_per_period", advice.error_per_period},
-          {"period", advice.period},
-          {"stability_limited", advice.stability_limited}}}};
-    if (advice.trial)
-      j["recommended"]["trial"] = {
-          {"verified", advice.trial->verified},
-          {"rk4_dt", advice.trial->dt},
-          {"halvings", advice.trial->halvings},
-          {"horizon", advice.trial->horizon},
-          {"error_per_period", finite_or_null(advice.trial->error_per_period)},
-          {"error", finite_or_null(advice.trial->error)},
-          {"failure", advice.trial->failure}};
-    Json steps = Json::object();
-    for (int i = 0; i < 3; ++i)
-      steps[integrator_name(kExplicit[i])] =
-          std::isfinite(d.h_max[i]) ? Json(d.h_max[i]) : Json(nullptr);
-    j["largest_stable_step"] = steps;
-    Json flags = Json::array(), notes = Json::array();
-    for (const auto& b : bodies)
-      (b.note ? notes : flags).push_back({{"body", b.name}, {"why", b.why}});
-    j["suspicious_bodies"] = flags;
-    j["notes"] = notes;
-    if (!d.singular_message.empty()) j["singular"] = d.singular_message;
-    if (!m.constraints.empty())
-      j["loops"] = {{"equations", m.constraint_rows},
-                    {"rank", d.rank},
-                    {"redundant", d.redundant},
-                    {"unassembled_states", d.unassembled},
-                    {"dead_point_ratio", finite_or_null(d.dead_ratio)},
-                    {"near_dead_point", d.dead_ratio < kDeadPointRatio}};
-    std::cout << json_text(j) << "\n";
-  } else {
-    std::cout << "model: " << m.name << " (" << n << " coordinates, " << m.bodies.size()
-              << " bodies), " << K << " states"
-              << (pressed ? " and " + std::to_string(pressed) + " pressed into their joint stops"
-                          : std::string())
-              << "\n";
-    if (!m.fully_actuated()) {  // (docs/control.md#actuation)
-      std::cout << "actuation: " << m.n_actuated() << " of " << n << " coordinates driven; not:";
-      for (int i = 0, k = 0; i < n; ++i)
-        if (k < m.n_actuated() && m.actuated[k] == i)
-          ++k;
-        else
-          std::cout << " " << m.coordinate_names[i];
-      std::cout << "\n";
-    }
-    if (d.singular_states)
-      std::cout << "M^s: singular at " << d.singular_states << " of " << K
-                << " states: " << d.singular_message << "\n";
-    if (d.singular_states < K)
-      std::cout << "M^s: " << condition_text(d.cond_lo, d.cond_hi) << ", symmetric to "
-                << format_short(d.asym)
-                << (d.singular_states ? "" : ", positive definite at every state") << "\n";
-    if (!m.constraints.empty()) {
-      std::cout << "loops: " << m.constraint_rows << " constraint equations, rank " << d.rank
-                << " (" << d.redundant << " redundant) at the states assembled onto them";
-      if (d.unassembled)
-        std::cout << "; " << d.unassembled << " of " << K
-                  << " states could not be assembled (left out): " << d.unassembled_message;
-      if (std::isfinite(d.dead_ratio))
-        std::cout << "\nnearest dead point: sigma_min/sigma_max of Phi_q = "
-                  << format_short(d.dead_ratio) << " at state " << d.dead_state
-                  << (d.dead_ratio < kDeadPointRatio
-                          ? " (near a dead point: the constraint forces there are large, and at "
-                            "the point itself the motion fails)"
-                          : "");
-      std::cout << "\n";
-    }
-    std::cout << "stiffest mode: |λ| = " << format_short(d.stiffest.omega) << " 1/s, "
-              << d.stiffest.text() << ", in " << where(m, d.stiffest.coordinate) << "\n"
-              << "fastest motion: " << d.fastest.text() << ", in " << where(m, d.fastest.coordinate)
-              << "\nlargest stable step:";
-    for (int i = 0; i < 3; ++i)
-      std::cout << " " << integrator_name(kExplicit[i]) << " "
-                << (std::isfinite(d.h_max[i]) ? format_short(d.h_max[i]) + " s"
-                                              : std::string("unlimited"))
-                << (i < 2 ? "," : "");
-    std::cout << " (bdf: unlimited)\n";
-    if (bodies.empty()) std::cout << "suspicious bodies: none\n";
-    for (const auto& b : bodies)
-      std::cout << (b.note ? "note: body '" : "suspicious body '") << b.name << "': " << b.why
-                << "\n";
-    std::cout << "recommended: " << advice.text << "\n";
-  }
-  return d.singular_states > 0 || flagged ? 1 : 0;
+  // Bounded work: estimated up front, refused beyond the memory limit and the budget. Memory:
+  // the workspace's M^s, the 2n x 2n linearisation A and its eigenproblem (the real Schur form,
+  // its vectors and the complex eigenvectors, about 6 matrices of 2n).
+  const int n = m.n();
+  const double bytes = evaluation_bytes(m) + 6 * dense_bytes(2 * n, 2 * n);
+  require_memory(a.positional[0] + ": checking n = " + std::to_string(n) + " coordinates", bytes,
+                 max_memory(a), "use " + max_memory_option(bytes) + " if that much memory is free");
+  if (!within_budget(a, m, r.states, budget)) return 1;
+
+  std::mt19937 rng(seed);
+  r.d = diagnose(m, r.states, rng, a.positional[0]);
+  Workspace ws(m);
+  r.pressed = diagnose_stops(m, ws, has_dampers(m), r.d);
+  r.bodies = suspicious_bodies(m);
+  bool flagged = false;
+  for (const auto& b : r.bodies) flagged = flagged || !b.note;
+  r.advice = advise(m, r.d, r.tol);
+  verify_advice(m, r.tol, seed, t_end, r.advice);
+  if (a.has("json"))
+    std::cout << json_text(check_json(m, r)) << "\n";
+  else
+    print_check(m, r);
+  return r.d.singular_states > 0 || flagged ? 1 : 0;
 }
 
 }  // namespace femdyn::cli

@@ -102,6 +102,138 @@ double linearize_along(const Model& m, const StressRun& ref, std::vector<double>
   return stiffest;
 }
 
+// Conditioning along the reference (at its ends only for a large model).
+void conditioning_along(const Model& m, Workspace& ws, bool large, const StressRun& ref,
+                        StressResult& r) {
+  r.cond_min = INFINITY;
+  for (const VecX& x : large ? std::vector<VecX>{ref.x.front(), ref.x.back()} : ref.x) {
+    evaluate(m, ws, x.head(m.n()), x.tail(m.n()), VecX());
+    const MassMatrixHealth h = mass_matrix_health(ws.Ms);
+    r.cond_min = std::min(r.cond_min, h.condition);
+    r.cond_max = std::max(r.cond_max, h.condition);
+    r.asymmetry = std::max(r.asymmetry, h.asymmetry);
+    r.positive_definite = r.positive_definite && h.positive_definite;
+  }
+}
+
+// The largest step at which `kind` stays stable, from the linear estimate 1/|λ|: bracketed by
+// factors of 2 (every explicit method here is unstable beyond h |λ| = 10), then bisected on
+// log h to 1 %. A trial run covers at least kMinSteps steps and kPeriods periods of the stiffest
+// mode, however long or short the scenario is, and is stable when it neither diverges nor fails.
+double measured_stable_step(const Model& m, const StressScenario& s, IntegratorKind kind,
+                            double stiffest) {
+  const double period = 2 * std::numbers::pi / stiffest;
+  const auto stable = [&](double dt) {
+    const double span = std::max(kPeriods * period, kMinSteps * dt);
+    auto integ =
+        make_integrator(m, {.kind = kind, .fixed = {.dt = dt, .max_steps = 1'000'000'000}});
+    integ->reset(0, s.q0, s.qd0, span);
+    return integ->advance_to(span).ok;
+  };
+  double lo = 1 / stiffest;
+  while (!stable(lo) && lo * stiffest > 1e-6) lo /= 2;
+  double hi = 2 * lo;
+  while (stable(hi) && hi * stiffest < 100) hi *= 2;
+  while (hi / lo > 1.01) {
+    const double mid = lo * std::sqrt(hi / lo);
+    (stable(mid) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+// Every integrator at the scenario's step or tolerance against the reference; the fixed-step
+// ones' stable limit, by theory (the linearisation at the start and along the motion) and
+// measured.
+void run_integrators(const Model& m, const StressScenario& s, const std::vector<double>& times,
+                     const StressRun& ref, const Linearization& lin,
+                     const std::vector<double>& along, double state_scale, StressResult& r) {
+  for (IntegratorKind kind : kIntegrators) {
+    StressIntegrator it{.name = integrator_name(kind)};
+    if (s.large && is_adaptive(kind)) {
+      it.failure = "not run: too large for a quick adaptive run";
+      r.integrators.push_back(std::move(it));
+      continue;
+    }
+    IntegratorOptions o{.kind = kind};
+    if (is_adaptive(kind))
+      o.adaptive = {.rtol = 1e-6, .atol = 1e-8, .max_steps = 200'000, .stop_at_outputs = true};
+    else
+      o.fixed = {.dt = s.dt};
+    const StressRun run = integrate(m, o, s, times, false);
+    it.steps = run.stats.steps;
+    if (run.status.ok) {
+      it.error = max_error(run.x, ref.x) / state_scale;
+      if (!m.constraints.empty()) it.max_position_residual = run.residual.position;
+    } else {
+      it.failure = run.status.message;
+    }
+    if (!is_adaptive(kind) && r.stiffest > 0) {
+      if (const auto h = largest_stable_step(lin, kind); h && std::isfinite(*h))
+        it.theory_step = *h;
+      it.theory_step_along = along[r.integrators.size()];
+      it.largest_stable_step = measured_stable_step(m, s, kind, r.stiffest);
+    }
+    r.integrators.push_back(std::move(it));
+  }
+}
+
+// Simbody's run of the same scenario against the reference (in joint coordinates θ).
+void compare_simbody(const Model& m, const StressScenario& s, const std::vector<double>& times,
+                     const StressRun& ref, double state_scale, StressResult& r) {
+  try {
+    SimbodyTwin twin(twin_model(m));
+    twin.close_loops(!m.constraints.empty());  // the constrained motion, from the assembled start
+    std::vector<double> with_zero = times;
+    with_zero.insert(with_zero.begin(), 0.0);
+    std::string why;
+    if (!twin.can_simulate(&why)) {
+      r.simbody_note = why;
+    } else {
+      const TwinRun run =
+          twin.simulate(s.q0, s.qd0, with_zero, 1e-12, SimbodyIntegrator::RungeKuttaMerson);
+      if (!run.stats.ok) {
+        r.simbody_note = "Simbody failed: " + run.stats.failure;
+      } else {
+        std::vector<VecX> x;
+        for (std::size_t k = 1; k < run.samples.size(); ++k) {
+          VecX v(2 * m.n_theta());
+          v << run.samples[k].theta, run.samples[k].theta_dot;
+          x.push_back(std::move(v));
+        }
+        std::vector<VecX> ref_theta;
+        for (const VecX& y : ref.x) {
+          VecX v(2 * m.n_theta());
+          v << m.C * y.head(m.n()) + m.theta0, m.C * y.tail(m.n());
+          ref_theta.push_back(std::move(v));
+        }
+        r.simbody_error = max_error(x, ref_theta) / state_scale;
+      }
+    }
+  } catch (const std::exception& e) {
+    r.simbody_note = std::string("Simbody cannot hold the model: ") + e.what();
+  }
+}
+
+void give_verdict(StressResult& r, bool stiffest_dissipative) {
+  const StressIntegrator& rk4 = r.integrators[0];
+  const bool stiff = (rk4.largest_stable_step >= 0 && rk4.largest_stable_step < 1e-4) ||
+                     r.reference.rfind("bdf", 0) == 0;
+  if (!r.positive_definite)
+    r.verdict = "refused: M^s loses definiteness along the motion";
+  else if (r.cond_max > 1e12)
+    r.verdict = "ill-conditioned: cond(M^s) up to " + format_short(r.cond_max) +
+                ", q̈ loses about " + format_short(std::log10(r.cond_max)) + " of 16 digits";
+  else if (stiff && stiffest_dissipative)
+    r.verdict =
+        "stable only with bdf: rk4 needs dt < " + format_short(rk4.largest_stable_step) + " s";
+  else if (stiff)  // as femdyn check advises: bdf is stable here, but by damping the oscillation
+    r.verdict = "stiff and undamped: rk4 needs dt < " + format_short(rk4.largest_stable_step) +
+                " s; bdf stays stable only by damping the mode numerically (remove, damp or "
+                "resolve it)";
+  else
+    r.verdict = "stable";
+}
+
 }  // namespace
 
 StressResult refused_case(const std::string& why) {
@@ -172,66 +304,9 @@ StressResult run_stress(const Model& m, const StressScenario& given) {
   for (std::size_t k = 0; k < ref.balance.size(); ++k)
     r.energy_error = std::max(r.energy_error, ref.scale[k] > 0 ? ref.balance[k] / ref.scale[k] : 0);
 
-  // Conditioning along the reference (at its ends only for a large model).
-  r.cond_min = INFINITY;
-  for (const VecX& x : s.large ? std::vector<VecX>{ref.x.front(), ref.x.back()} : ref.x) {
-    evaluate(m, ws, x.head(m.n()), x.tail(m.n()), VecX());
-    const MassMatrixHealth h = mass_matrix_health(ws.Ms);
-    r.cond_min = std::min(r.cond_min, h.condition);
-    r.cond_max = std::max(r.cond_max, h.condition);
-    r.asymmetry = std::max(r.asymmetry, h.asymmetry);
-    r.positive_definite = r.positive_definite && h.positive_definite;
-  }
+  conditioning_along(m, ws, s.large, ref, r);
 
-  // Every integrator at the scenario's step or tolerance; the fixed-step ones' stable limit.
-  // A trial run covers at least kMinSteps steps and kPeriods periods of the stiffest mode, however
-  // long or short the scenario is, and is stable when it neither diverges nor fails.
-  const double period = r.stiffest > 0 ? 2 * std::numbers::pi / r.stiffest : 0;
-  const auto stable = [&](IntegratorKind kind, double dt) {
-    const double span = std::max(kPeriods * period, kMinSteps * dt);
-    auto integ =
-        make_integrator(m, {.kind = kind, .fixed = {.dt = dt, .max_steps = 1'000'000'000}});
-    integ->reset(0, s.q0, s.qd0, span);
-    return integ->advance_to(span).ok;
-  };
-  for (IntegratorKind kind : kIntegrators) {
-    StressIntegrator it{.name = integrator_name(kind)};
-    if (s.large && is_adaptive(kind)) {
-      it.failure = "not run: too large for a quick adaptive run";
-      r.integrators.push_back(std::move(it));
-      continue;
-    }
-    IntegratorOptions o{.kind = kind};
-    if (is_adaptive(kind))
-      o.adaptive = {.rtol = 1e-6, .atol = 1e-8, .max_steps = 200'000, .stop_at_outputs = true};
-    else
-      o.fixed = {.dt = s.dt};
-    const StressRun run = integrate(m, o, s, times, false);
-    it.steps = run.stats.steps;
-    if (run.status.ok) {
-      it.error = max_error(run.x, ref.x) / state_scale;
-      if (!m.constraints.empty()) it.max_position_residual = run.residual.position;
-    } else {
-      it.failure = run.status.message;
-    }
-    if (!is_adaptive(kind) && r.stiffest > 0) {
-      if (const auto h = largest_stable_step(lin, kind); h && std::isfinite(*h))
-        it.theory_step = *h;
-      it.theory_step_along = along[r.integrators.size()];
-      // Bracket from the linear estimate by factors of 2 (every explicit method here is
-      // unstable beyond h |λ| = 10), then bisect on log h to 1 %.
-      double lo = 1 / r.stiffest;
-      while (!stable(kind, lo) && lo * r.stiffest > 1e-6) lo /= 2;
-      double hi = 2 * lo;
-      while (stable(kind, hi) && hi * r.stiffest < 100) hi *= 2;
-      while (hi / lo > 1.01) {
-        const double mid = lo * std::sqrt(hi / lo);
-        (stable(kind, mid) ? lo : hi) = mid;
-      }
-      it.largest_stable_step = lo;
-    }
-    r.integrators.push_back(std::move(it));
-  }
+  run_integrators(m, s, times, ref, lin, along, state_scale, r);
   if (s.large)
     r.search_note =
         "no step search: the linearisation (4n evaluations and a dense eigenproblem of 2n = " +
@@ -239,62 +314,11 @@ StressResult run_stress(const Model& m, const StressScenario& given) {
   else if (r.stiffest == 0)
     r.search_note = "no step search: no mode at the initial state (every step is stable)";
 
-  // Simbody.
-  if (s.large) {
+  if (s.large)
     r.simbody_note = "not run (size)";
-  } else {
-    try {
-      SimbodyTwin twin(twin_model(m));
-      twin.close_loops(!m.constraints.empty());  // the constrained motion, from the assembled start
-      std::vector<double> with_zero = times;
-      with_zero.insert(with_zero.begin(), 0.0);
-      std::string why;
-      if (!twin.can_simulate(&why)) {
-        r.simbody_note = why;
-      } else {
-        const TwinRun run =
-            twin.simulate(s.q0, s.qd0, with_zero, 1e-12, SimbodyIntegrator::RungeKuttaMerson);
-        if (!run.stats.ok) {
-          r.simbody_note = "Simbody failed: " + run.stats.failure;
-        } else {
-          std::vector<VecX> x;
-          for (std::size_t k = 1; k < run.samples.size(); ++k) {
-            VecX v(2 * m.n_theta());
-            v << run.samples[k].theta, run.samples[k].theta_dot;
-            x.push_back(std::move(v));
-          }
-          std::vector<VecX> ref_theta;
-          for (const VecX& y : ref.x) {
-            VecX v(2 * m.n_theta());
-            v << m.C * y.head(m.n()) + m.theta0, m.C * y.tail(m.n());
-            ref_theta.push_back(std::move(v));
-          }
-          r.simbody_error = max_error(x, ref_theta) / state_scale;
-        }
-      }
-    } catch (const std::exception& e) {
-      r.simbody_note = std::string("Simbody cannot hold the model: ") + e.what();
-    }
-  }
-
-  // Verdict.
-  const StressIntegrator& rk4 = r.integrators[0];
-  const bool stiff = (rk4.largest_stable_step >= 0 && rk4.largest_stable_step < 1e-4) ||
-                     r.reference.rfind("bdf", 0) == 0;
-  if (!r.positive_definite)
-    r.verdict = "refused: M^s loses definiteness along the motion";
-  else if (r.cond_max > 1e12)
-    r.verdict = "ill-conditioned: cond(M^s) up to " + format_short(r.cond_max) +
-                ", q̈ loses about " + format_short(std::log10(r.cond_max)) + " of 16 digits";
-  else if (stiff && stiffest_dissipative)
-    r.verdict =
-        "stable only with bdf: rk4 needs dt < " + format_short(rk4.largest_stable_step) + " s";
-  else if (stiff)  // as femdyn check advises: bdf is stable here, but by damping the oscillation
-    r.verdict = "stiff and undamped: rk4 needs dt < " + format_short(rk4.largest_stable_step) +
-                " s; bdf stays stable only by damping the mode numerically (remove, damp or "
-                "resolve it)";
   else
-    r.verdict = "stable";
+    compare_simbody(m, s, times, ref, state_scale, r);
+  give_verdict(r, stiffest_dissipative);
   return r;
 }
 
