@@ -406,72 +406,67 @@ Diagnosis diagnose(const Model& m, int K, std::mt19937& rng, const std::string& 
 }
 
 Json check_json(const Model& m, const CheckReport& r) {
-  const int n = m.n(), K = r.states, pressed = r.pressed;
-  const Diagnosis& d = r.d;
-  const Advice& advice = r.advice;
-  const std::vector<SuspiciousBody>& bodies = r.bodies;
-  const double tol = r.tol;
-  Json j = {{"model", m.name},
-            {"n", n},
-            {"coordinates", m.coordinate_names},
-            {"actuated", actuated_names(m)},
-            {"states", K},
-            {"stop_states", pressed},
-            {"condition", {{"min", finite_or_null(d.cond_lo)}, {"max", finite_or_null(d.cond_hi)}}},
-            {"condition_overflows", d.singular_states < K && !std::isfinite(d.cond_hi)},
-            {"digits_lost", finite_or_null(std::log10(d.cond_hi))},
-            {"asymmetry", d.asym},
-            {"singular_states", d.singular_states},
-            {"stiffest_mode", mode_json(m, d.stiffest)},
-            {"fastest_motion", mode_json(m, d.fastest)},
-            {"recommendation", advice.text},
-            {"recommended",
-             {{"integrator", advice.integrator},
-              {"tol", tol},
-              {"rk4_dt", advice.dt_rk4},
-              {"euler_dt", advice.dt_euler},
-              {"rk4_error_per_period", advice.error_per_period},
-              {"period", advice.period},
-              {"stability_limited", advice.stability_limited}}}};
-  if (advice.trial)
+  const int n = m.n();
+  Json j = {
+      {"model", m.name},
+      {"n", n},
+      {"coordinates", m.coordinate_names},
+      {"actuated", actuated_names(m)},
+      {"states", r.states},
+      {"stop_states", r.pressed},
+      {"condition", {{"min", finite_or_null(r.d.cond_lo)}, {"max", finite_or_null(r.d.cond_hi)}}},
+      {"condition_overflows", r.d.singular_states < r.states && !std::isfinite(r.d.cond_hi)},
+      {"digits_lost", finite_or_null(std::log10(r.d.cond_hi))},
+      {"asymmetry", r.d.asym},
+      {"singular_states", r.d.singular_states},
+      {"stiffest_mode", mode_json(m, r.d.stiffest)},
+      {"fastest_motion", mode_json(m, r.d.fastest)},
+      {"recommendation", r.advice.text},
+      {"recommended",
+       {{"integrator", r.advice.integrator},
+        {"tol", r.tol},
+        {"rk4_dt", r.advice.dt_rk4},
+        {"euler_dt", r.advice.dt_euler},
+        {"rk4_error_per_period", r.advice.error_per_period},
+        {"period", r.advice.period},
+        {"stability_limited", r.advice.stability_limited}}}};
+  if (r.advice.trial)
     j["recommended"]["trial"] = {
-        {"verified", advice.trial->verified},
-        {"rk4_dt", advice.trial->dt},
-        {"halvings", advice.trial->halvings},
-        {"horizon", advice.trial->horizon},
-        {"error_per_period", finite_or_null(advice.trial->error_per_period)},
-        {"error", finite_or_null(advice.trial->error)},
-        {"failure", advice.trial->failure}};
+        {"verified", r.advice.trial->verified},
+        {"rk4_dt", r.advice.trial->dt},
+        {"halvings", r.advice.trial->halvings},
+        {"horizon", r.advice.trial->horizon},
+        {"error_per_period", finite_or_null(r.advice.trial->error_per_period)},
+        {"error", finite_or_null(r.advice.trial->error)},
+        {"failure", r.advice.trial->failure}};
   Json steps = Json::object();
   for (int i = 0; i < 3; ++i)
     steps[integrator_name(kExplicit[i])] =
-        std::isfinite(d.h_max[i]) ? Json(d.h_max[i]) : Json(nullptr);
+        std::isfinite(r.d.h_max[i]) ? Json(r.d.h_max[i]) : Json(nullptr);
   j["largest_stable_step"] = steps;
   Json flags = Json::array(), notes = Json::array();
-  for (const auto& b : bodies)
+  for (const auto& b : r.bodies)
     (b.note ? notes : flags).push_back({{"body", b.name}, {"why", b.why}});
   j["suspicious_bodies"] = flags;
   j["notes"] = notes;
-  if (!d.singular_message.empty()) j["singular"] = d.singular_message;
+  if (!r.d.singular_message.empty()) j["singular"] = r.d.singular_message;
   if (!m.constraints.empty())
     j["loops"] = {{"equations", m.constraint_rows},
-                  {"rank", d.rank},
-                  {"redundant", d.redundant},
-                  {"unassembled_states", d.unassembled},
-                  {"dead_point_ratio", finite_or_null(d.dead_ratio)},
-                  {"near_dead_point", d.dead_ratio < kDeadPointRatio}};
+                  {"rank", r.d.rank},
+                  {"redundant", r.d.redundant},
+                  {"unassembled_states", r.d.unassembled},
+                  {"dead_point_ratio", finite_or_null(r.d.dead_ratio)},
+                  {"near_dead_point", r.d.dead_ratio < kDeadPointRatio}};
   return j;
 }
 
 void print_check(const Model& m, const CheckReport& r) {
-  const int n = m.n(), K = r.states, pressed = r.pressed;
-  const Diagnosis& d = r.d;
-  const Advice& advice = r.advice;
-  const std::vector<SuspiciousBody>& bodies = r.bodies;
+  const int n = m.n();
   std::cout << "model: " << m.name << " (" << n << " coordinates, " << m.bodies.size()
-            << " bodies), " << K << " states"
-            << (pressed ? " and " + std::to_string(pressed) + " pressed into their joint stops"
-                        : std::string())
+            << " bodies), " << r.states << " states"
+            << (r.pressed
+                    ? " and " + std::to_string(r.pressed) + " pressed into their joint stops"
+                    : std::string())
             << "\n";
   if (!m.fully_actuated()) {  // (docs/control.md#actuation)
     std::cout << "actuation: " << m.n_actuated() << " of " << n << " coordinates driven; not:";
@@ -482,43 +477,43 @@ void print_check(const Model& m, const CheckReport& r) {
         std::cout << " " << m.coordinate_names[i];
     std::cout << "\n";
   }
-  if (d.singular_states)
-    std::cout << "M^s: singular at " << d.singular_states << " of " << K
-              << " states: " << d.singular_message << "\n";
-  if (d.singular_states < K)
-    std::cout << "M^s: " << condition_text(d.cond_lo, d.cond_hi) << ", symmetric to "
-              << format_short(d.asym)
-              << (d.singular_states ? "" : ", positive definite at every state") << "\n";
+  if (r.d.singular_states)
+    std::cout << "M^s: singular at " << r.d.singular_states << " of " << r.states
+              << " states: " << r.d.singular_message << "\n";
+  if (r.d.singular_states < r.states)
+    std::cout << "M^s: " << condition_text(r.d.cond_lo, r.d.cond_hi) << ", symmetric to "
+              << format_short(r.d.asym)
+              << (r.d.singular_states ? "" : ", positive definite at every state") << "\n";
   if (!m.constraints.empty()) {
-    std::cout << "loops: " << m.constraint_rows << " constraint equations, rank " << d.rank << " ("
-              << d.redundant << " redundant) at the states assembled onto them";
-    if (d.unassembled)
-      std::cout << "; " << d.unassembled << " of " << K
-                << " states could not be assembled (left out): " << d.unassembled_message;
-    if (std::isfinite(d.dead_ratio))
+    std::cout << "loops: " << m.constraint_rows << " constraint equations, rank " << r.d.rank
+              << " (" << r.d.redundant << " redundant) at the states assembled onto them";
+    if (r.d.unassembled)
+      std::cout << "; " << r.d.unassembled << " of " << r.states
+                << " states could not be assembled (left out): " << r.d.unassembled_message;
+    if (std::isfinite(r.d.dead_ratio))
       std::cout << "\nnearest dead point: sigma_min/sigma_max of Phi_q = "
-                << format_short(d.dead_ratio) << " at state " << d.dead_state
-                << (d.dead_ratio < kDeadPointRatio
+                << format_short(r.d.dead_ratio) << " at state " << r.d.dead_state
+                << (r.d.dead_ratio < kDeadPointRatio
                         ? " (near a dead point: the constraint forces there are large, and at "
                           "the point itself the motion fails)"
                         : "");
     std::cout << "\n";
   }
-  std::cout << "stiffest mode: |λ| = " << format_short(d.stiffest.omega) << " 1/s, "
-            << d.stiffest.text() << ", in " << where(m, d.stiffest.coordinate) << "\n"
-            << "fastest motion: " << d.fastest.text() << ", in " << where(m, d.fastest.coordinate)
-            << "\nlargest stable step:";
+  std::cout << "stiffest mode: |λ| = " << format_short(r.d.stiffest.omega) << " 1/s, "
+            << r.d.stiffest.text() << ", in " << where(m, r.d.stiffest.coordinate) << "\n"
+            << "fastest motion: " << r.d.fastest.text() << ", in "
+            << where(m, r.d.fastest.coordinate) << "\nlargest stable step:";
   for (int i = 0; i < 3; ++i)
     std::cout << " " << integrator_name(kExplicit[i]) << " "
-              << (std::isfinite(d.h_max[i]) ? format_short(d.h_max[i]) + " s"
-                                            : std::string("unlimited"))
+              << (std::isfinite(r.d.h_max[i]) ? format_short(r.d.h_max[i]) + " s"
+                                              : std::string("unlimited"))
               << (i < 2 ? "," : "");
   std::cout << " (bdf: unlimited)\n";
-  if (bodies.empty()) std::cout << "suspicious bodies: none\n";
-  for (const auto& b : bodies)
+  if (r.bodies.empty()) std::cout << "suspicious bodies: none\n";
+  for (const auto& b : r.bodies)
     std::cout << (b.note ? "note: body '" : "suspicious body '") << b.name << "': " << b.why
               << "\n";
-  std::cout << "recommended: " << advice.text << "\n";
+  std::cout << "recommended: " << r.advice.text << "\n";
 }
 
 }  // namespace
