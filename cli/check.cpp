@@ -464,9 +464,8 @@ void print_check(const Model& m, const CheckReport& r) {
   const int n = m.n();
   std::cout << "model: " << m.name << " (" << n << " coordinates, " << m.bodies.size()
             << " bodies), " << r.states << " states"
-            << (r.pressed
-                    ? " and " + std::to_string(r.pressed) + " pressed into their joint stops"
-                    : std::string())
+            << (r.pressed ? " and " + std::to_string(r.pressed) + " pressed into their joint stops"
+                          : std::string())
             << "\n";
   if (!m.fully_actuated()) {  // (docs/control.md#actuation)
     std::cout << "actuation: " << m.n_actuated() << " of " << n << " coordinates driven; not:";

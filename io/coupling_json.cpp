@@ -9,58 +9,60 @@
 namespace femdyn {
 namespace {
 
-// A nonlinear law: "polynomial", "spline" or "four_bar" (docs/model-format.md#couplings).
-std::shared_ptr<const CouplingFunction> read_law(const Params& p, int arity) {
-  const auto numbers = [&](const Json& row, const std::string& where) {
-    if (!row.is_array()) throw ModelError(where, "expected an array of numbers");
-    std::vector<double> v;
-    for (std::size_t i = 0; i < row.size(); ++i)
-      v.push_back(json_number(row[i], where + "/" + std::to_string(i)));
-    return v;
-  };
-  if (p.has("polynomial")) {
-    // [[c, p_1, …, p_k], …]: c Π θ_i^{p_i}
-    const Json& terms = p.json().at("polynomial");
-    if (!terms.is_array() || terms.empty())
-      p.fail("polynomial", "expected a non-empty array of [coefficient, power per joint]");
-    std::vector<PolynomialCoupling::Term> list;
-    for (std::size_t t = 0; t < terms.size(); ++t) {
-      const std::string where = p.path("polynomial") + "/" + std::to_string(t);
-      const std::vector<double> v = numbers(terms[t], where);
-      if (static_cast<int>(v.size()) != arity + 1)
-        throw ModelError(where, "expected [coefficient, " + std::to_string(arity) +
-                                    " power(s)]: one power per followed joint");
-      PolynomialCoupling::Term term{v[0], {}};
-      check_magnitude(v[0], where + "/0", "coefficient");
-      for (int k = 1; k <= arity; ++k) {
-        if (!(v[k] >= 0 && v[k] <= 16 && v[k] == std::floor(v[k])))
-          throw ModelError(where + "/" + std::to_string(k), "a power is an integer from 0 to 16");
-        term.powers.push_back(static_cast<int>(v[k]));
-      }
-      list.push_back(std::move(term));
+// A row of numbers (a polynomial term, a spline point).
+std::vector<double> numbers(const Json& row, const std::string& where) {
+  if (!row.is_array()) throw ModelError(where, "expected an array of numbers");
+  std::vector<double> v;
+  for (std::size_t i = 0; i < row.size(); ++i)
+    v.push_back(json_number(row[i], where + "/" + std::to_string(i)));
+  return v;
+}
+
+std::shared_ptr<const CouplingFunction> read_polynomial(const Params& p, int arity) {
+  // [[c, p_1, …, p_k], …]: c Π θ_i^{p_i}
+  const Json& terms = p.json().at("polynomial");
+  if (!terms.is_array() || terms.empty())
+    p.fail("polynomial", "expected a non-empty array of [coefficient, power per joint]");
+  std::vector<PolynomialCoupling::Term> list;
+  for (std::size_t t = 0; t < terms.size(); ++t) {
+    const std::string where = p.path("polynomial") + "/" + std::to_string(t);
+    const std::vector<double> v = numbers(terms[t], where);
+    if (static_cast<int>(v.size()) != arity + 1)
+      throw ModelError(where, "expected [coefficient, " + std::to_string(arity) +
+                                  " power(s)]: one power per followed joint");
+    PolynomialCoupling::Term term{v[0], {}};
+    check_magnitude(v[0], where + "/0", "coefficient");
+    for (int k = 1; k <= arity; ++k) {
+      if (!(v[k] >= 0 && v[k] <= 16 && v[k] == std::floor(v[k])))
+        throw ModelError(where + "/" + std::to_string(k), "a power is an integer from 0 to 16");
+      term.powers.push_back(static_cast<int>(v[k]));
     }
-    return std::make_shared<PolynomialCoupling>(arity, std::move(list));
+    list.push_back(std::move(term));
   }
-  if (arity != 1) p.fail("follows", "a spline or four-bar law follows exactly one joint");
-  if (p.has("spline")) {
-    // [[θ_in, θ_out], …], θ_in strictly increasing
-    const Json& pts = p.json().at("spline");
-    if (!pts.is_array() || pts.size() < 2)
-      p.fail("spline", "expected at least 2 points [θ_in, θ_out]");
-    std::vector<double> x, y;
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      const std::string where = p.path("spline") + "/" + std::to_string(i);
-      const std::vector<double> v = numbers(pts[i], where);
-      if (v.size() != 2) throw ModelError(where, "expected a point [θ_in, θ_out]");
-      check_magnitude(v[0], where + "/0", "θ_in");
-      check_magnitude(v[1], where + "/1", "θ_out");
-      if (!x.empty() && !(v[0] > x.back()))
-        throw ModelError(where + "/0", "θ_in must increase strictly from point to point");
-      x.push_back(v[0]);
-      y.push_back(v[1]);
-    }
-    return std::make_shared<SplineCoupling>(std::move(x), std::move(y));
+  return std::make_shared<PolynomialCoupling>(arity, std::move(list));
+}
+
+std::shared_ptr<const CouplingFunction> read_spline(const Params& p) {
+  // [[θ_in, θ_out], …], θ_in strictly increasing
+  const Json& pts = p.json().at("spline");
+  if (!pts.is_array() || pts.size() < 2)
+    p.fail("spline", "expected at least 2 points [θ_in, θ_out]");
+  std::vector<double> x, y;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const std::string where = p.path("spline") + "/" + std::to_string(i);
+    const std::vector<double> v = numbers(pts[i], where);
+    if (v.size() != 2) throw ModelError(where, "expected a point [θ_in, θ_out]");
+    check_magnitude(v[0], where + "/0", "θ_in");
+    check_magnitude(v[1], where + "/1", "θ_out");
+    if (!x.empty() && !(v[0] > x.back()))
+      throw ModelError(where + "/0", "θ_in must increase strictly from point to point");
+    x.push_back(v[0]);
+    y.push_back(v[1]);
   }
+  return std::make_shared<SplineCoupling>(std::move(x), std::move(y));
+}
+
+std::shared_ptr<const CouplingFunction> read_four_bar(const Params& p) {
   const Params f = p.child("four_bar");
   f.allow_only({"ground", "input", "coupler", "output", "branch", "input_offset", "input_sign",
                 "output_offset", "output_sign"});
@@ -93,6 +95,14 @@ std::shared_ptr<const CouplingFunction> read_law(const Params& p, int arity) {
   for (double len : {g.ground, g.input, g.coupler, g.output})
     check_magnitude(len, f.where(), "link length");
   return std::make_shared<FourBarCoupling>(g);
+}
+
+// A nonlinear law: "polynomial", "spline" or "four_bar" (docs/model-format.md#couplings).
+std::shared_ptr<const CouplingFunction> read_law(const Params& p, int arity) {
+  if (p.has("polynomial")) return read_polynomial(p, arity);
+  if (arity != 1) p.fail("follows", "a spline or four-bar law follows exactly one joint");
+  if (p.has("spline")) return read_spline(p);
+  return read_four_bar(p);
 }
 
 }  // namespace

@@ -219,10 +219,31 @@ std::vector<std::string> actuated_names(const Model& model) {
   return names;
 }
 
-std::string info_text(const Model& model) {
-  std::ostringstream out;
-  out << "model: " << model.name << "\n";
-  out << "gravity: [" << model.gravity.transpose() << "] m/s^2\n";
+namespace {
+
+// "theta = …": how a joint's coordinate follows q (a law, several rates, or a row of C).
+void joint_relation(std::ostream& out, const Model& model, const Joint& j,
+                    const CoupledJoint* law) {
+  if (law) {  // θ = f(θ_followed…)
+    out << "   theta = " << law->law->form() << " of";
+    for (int s : law->sources) out << " " << model.bodies[model.theta_joint[s]].joint.name;
+  } else if (j.nv > 1) {  // (never coupled)
+    out << "   " << j.nq << " coordinates, " << j.nv << " rates";
+  } else if (moves(j)) {
+    out << "   theta =";
+    bool first = true;
+    for (SpRowMat::InnerIterator it(model.C_sparse, j.idx_v); it; ++it) {
+      const double c = it.value();
+      if (c == 0) continue;
+      out << (first ? " " : " + ") << (c == 1 ? "" : num(c) + "*")
+          << model.coordinate_names[it.col()];
+      first = false;
+    }
+    if (model.theta0[j.idx_v] != 0) out << " + " << model.theta0[j.idx_v];
+  }
+}
+
+void coordinates_text(std::ostream& out, const Model& model) {
   out << "coordinates (n = " << model.n() << "):";
   for (const auto& c : model.coordinate_names) out << " " << c;
   out << "\n";
@@ -236,6 +257,9 @@ std::string info_text(const Model& model) {
     for (const std::string& c : actuated_names(model)) out << " " << c;
     out << "\n";
   }
+}
+
+void joints_text(std::ostream& out, const Model& model) {
   // Joints counted as joints (a ball or free joint is one, of 3 or 6 rates θ̇).
   const auto movable = std::count_if(model.bodies.begin(), model.bodies.end(),
                                      [](const Body& b) { return moves(b.joint); });
@@ -249,27 +273,14 @@ std::string info_text(const Model& model) {
     const std::string_view type = joint_type_name(j.type);
     out << "  " << j.name << " (" << type << ") "
         << (b.parent < 0 ? std::string("world") : model.bodies[b.parent].name) << " -> " << b.name;
-    const CoupledJoint* law = j.idx_v >= 0 ? law_of[j.idx_v] : nullptr;
-    if (law) {  // θ = f(θ_followed…)
-      out << "   theta = " << law->law->form() << " of";
-      for (int s : law->sources) out << " " << model.bodies[model.theta_joint[s]].joint.name;
-    } else if (j.nv > 1) {  // (never coupled)
-      out << "   " << j.nq << " coordinates, " << j.nv << " rates";
-    } else if (moves(j)) {
-      out << "   theta =";
-      bool first = true;
-      for (SpRowMat::InnerIterator it(model.C_sparse, j.idx_v); it; ++it) {
-        const double c = it.value();
-        if (c == 0) continue;
-        out << (first ? " " : " + ") << (c == 1 ? "" : num(c) + "*")
-            << model.coordinate_names[it.col()];
-        first = false;
-      }
-      if (model.theta0[j.idx_v] != 0) out << " + " << model.theta0[j.idx_v];
-    }
+    joint_relation(out, model, j, j.idx_v >= 0 ? law_of[j.idx_v] : nullptr);
     out << "\n";
     if (const std::string p = joint_properties_text(j); !p.empty()) out << "      " << p << "\n";
   }
+}
+
+// Bodies with their elements, frames, and the loops and springs between places.
+void bodies_text(std::ostream& out, const Model& model) {
   out << "bodies and elements (" << model.elements.size() << " elements):\n";
   std::vector<std::string> element_types(model.bodies.size());
   for (const ElementEntry& e : model.elements)
@@ -300,6 +311,10 @@ std::string info_text(const Model& model) {
           << ", k " << s.stiffness << " N/m, rest " << s.rest_length << " m, c " << s.damping
           << " N s/m\n";
   }
+}
+
+// The node level: the transition coordinates kept and left out, and the table's approximations.
+void node_level_text(std::ostream& out, const Model& model) {
   out << "transition coordinates u (N_u = " << model.n_u() << " kept):\n";
   for (int i = 0; i < model.n_u(); ++i)
     out << "  " << std::setw(3) << i + 1 << " " << model.dof_name(i) << "\n";
@@ -310,6 +325,18 @@ std::string info_text(const Model& model) {
     out << "approximations made by the table (" << model.approximations.size() << "):\n";
     for (const auto& s : model.approximations) out << "  " << s << "\n";
   }
+}
+
+}  // namespace
+
+std::string info_text(const Model& model) {
+  std::ostringstream out;
+  out << "model: " << model.name << "\n";
+  out << "gravity: [" << model.gravity.transpose() << "] m/s^2\n";
+  coordinates_text(out, model);
+  joints_text(out, model);
+  bodies_text(out, model);
+  node_level_text(out, model);
   out << "routes (which algorithm computes what; docs/design.md):\n";
   for (const auto& [key, name] : route_report(model).fields())
     out << "  " << key << ": " << name << "\n";
