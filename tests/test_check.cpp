@@ -168,6 +168,9 @@ TEST_CASE("check: a thin disc is a note with exit 0, work beyond the budget is r
   INFO(r.out);
   CHECK(r.code == 0);
   CHECK_THAT(r.out, Catch::Contains("note: body 'disc'") && Catch::Contains("flat body"));
+  // The text's head and tail name what was checked, as the JSON counts it.
+  CHECK_THAT(r.out, Catch::StartsWith("model: rotor (1 coordinates, 1 bodies), 10 states\n"));
+  CHECK_THAT(r.out, Catch::Contains("\nrecommended: "));
   const nlohmann::json j = check_json(s / "disc.json");
   CHECK(j["suspicious_bodies"].empty());
   CHECK(j["notes"].size() == 1);
