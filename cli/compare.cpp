@@ -2,6 +2,7 @@
 // seeded random states and at given postures — e.g. the paper's discretisation against the
 // exact finger.
 #include <algorithm>
+#include <array>
 #include <climits>
 #include <cmath>
 #include <iomanip>
@@ -36,6 +37,63 @@ above R (each one above is named on stderr), exit 0 if none is. Without it the e
 
 double rel(const MatX& a, const MatX& b) { return relative_error(a, b, 0.0); }
 
+constexpr const char* kQuantities[3] = {"M^s", "h", "qdd"};
+
+// The relative errors of M^s, h and q̈ between A and B over the compared states: the max and the
+// median of each.
+struct CompareErrors {
+  std::array<double, 3> max{}, median{};  // M^s, h, q̈
+};
+
+CompareErrors compare_states(const Args& a, const Model& A, const Model& B, int K, unsigned seed,
+                             double vscale) {
+  Workspace wa(A), wb(B);
+  std::mt19937 rng(seed);
+  std::array<std::vector<double>, 3> e;
+  const VecX tau = state_vector(a, "tau", A);
+  for (int k = 0; k < K; ++k) {
+    VecX q, qd;
+    if (a.has("q")) {
+      q = configuration_vector(a, "q", A);
+      qd = state_vector(a, "qd", A);
+    } else {
+      q = random_posture(A, rng);
+      qd = random_uniform(A.n(), vscale, rng);
+    }
+    const Status sa = tree_forward_dynamics(A, wa, q, qd, tau),
+                 sb = tree_forward_dynamics(B, wb, q, qd, tau);
+    evaluate(A, wa, q, qd, tau);
+    evaluate(B, wb, q, qd, tau);
+    if (!sa.ok || !sb.ok)
+      throw CliError("M^s singular at a sampled state: " + (sa.ok ? sb : sa).message);
+    e[0].push_back(rel(wa.Ms, wb.Ms));
+    e[1].push_back(qd.isZero(0) ? 0.0 : rel(wa.h, wb.h));
+    e[2].push_back(rel(wa.qdd, wb.qdd));
+  }
+  CompareErrors out;
+  for (int i = 0; i < 3; ++i) {
+    std::sort(e[i].begin(), e[i].end());
+    out.max[i] = e[i].back();
+    out.median[i] = e[i][e[i].size() / 2];
+  }
+  return out;
+}
+
+void print_compare(const Args& a, const Model& B, int K, unsigned seed, const CompareErrors& e,
+                   bool test, int code, double rtol) {
+  std::cout << "A: " << escaped(a.positional[0]) << "\nB: " << escaped(B.where) << "\n"
+            << K
+            << (a.has("q") ? " given state"
+                           : " seeded random states (seed " + std::to_string(seed) + ")")
+            << "; relative error ‖A − B‖ / ‖B‖\n"
+            << "quantity   max         median\n"
+            << std::scientific << std::setprecision(3);
+  for (int i = 0; i < 3; ++i)
+    std::cout << std::left << std::setw(10) << kQuantities[i] << " " << e.max[i] << "   "
+              << e.median[i] << "\n";
+  if (test) std::cout << (code ? "FAIL" : "PASS") << " (--rtol " << format_number(rtol) << ")\n";
+}
+
 }  // namespace
 
 int cmd_compare(int argc, char** argv) {
@@ -67,42 +125,14 @@ int cmd_compare(int argc, char** argv) {
   if (test && !(rtol > 0))
     throw CliError("--rtol: " + format_number(rtol) +
                    " is not a tolerance (expected a number > 0)");
-  Workspace wa(A), wb(B);
-  std::mt19937 rng(seed);
-  std::vector<double> eM, eh, eqdd;
-  const VecX tau = state_vector(a, "tau", A);
-  for (int k = 0; k < K; ++k) {
-    VecX q, qd;
-    if (a.has("q")) {
-      q = configuration_vector(a, "q", A);
-      qd = state_vector(a, "qd", A);
-    } else {
-      q = random_posture(A, rng);
-      qd = random_uniform(A.n(), vscale, rng);
-    }
-    const Status sa = tree_forward_dynamics(A, wa, q, qd, tau),
-                 sb = tree_forward_dynamics(B, wb, q, qd, tau);
-    evaluate(A, wa, q, qd, tau);
-    evaluate(B, wb, q, qd, tau);
-    if (!sa.ok || !sb.ok)
-      throw CliError("M^s singular at a sampled state: " + (sa.ok ? sb : sa).message);
-    eM.push_back(rel(wa.Ms, wb.Ms));
-    eh.push_back(qd.isZero(0) ? 0.0 : rel(wa.h, wb.h));
-    eqdd.push_back(rel(wa.qdd, wb.qdd));
-  }
-  auto stats = [](std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return std::pair{v.back(), v[v.size() / 2]};
-  };
-  const auto [mM, dM] = stats(eM);
-  const auto [mh, dh] = stats(eh);
-  const auto [mq, dq] = stats(eqdd);
+  const CompareErrors e = compare_states(a, A, B, K, seed, vscale);
   // Under --rtol: the quantities whose max error is above it (NaN counts as above).
   std::string above;
   if (test)
-    for (auto [name, mx] : {std::pair{"M^s", mM}, {"h", mh}, {"qdd", mq}})
-      if (!(mx <= rtol))
-        above += (above.empty() ? "" : ", ") + std::string(name) + " " + format_number(mx, "%.3e");
+    for (int i = 0; i < 3; ++i)
+      if (!(e.max[i] <= rtol))
+        above += (above.empty() ? "" : ", ") + std::string(kQuantities[i]) + " " +
+                 format_number(e.max[i], "%.3e");
   const int code = above.empty() ? 0 : 1;
   if (!above.empty())
     std::cerr << "femdyn compare: max relative error above --rtol " << format_number(rtol) << ": "
@@ -114,8 +144,8 @@ int cmd_compare(int argc, char** argv) {
               {"coordinates", A.coordinate_names},
               {"states", K},
               {"seed", seed},
-              {"max_rel_error", {{"M", mM}, {"h", mh}, {"qdd", mq}}},
-              {"median_rel_error", {{"M", dM}, {"h", dh}, {"qdd", dq}}}};
+              {"max_rel_error", {{"M", e.max[0]}, {"h", e.max[1]}, {"qdd", e.max[2]}}},
+              {"median_rel_error", {{"M", e.median[0]}, {"h", e.median[1]}, {"qdd", e.median[2]}}}};
     if (test) {
       j["rtol"] = rtol;
       j["pass"] = code == 0;
@@ -123,16 +153,7 @@ int cmd_compare(int argc, char** argv) {
     std::cout << json_text(j) << "\n";
     return code;
   }
-  std::cout << "A: " << escaped(a.positional[0]) << "\nB: " << escaped(B.where) << "\n"
-            << K
-            << (a.has("q") ? " given state"
-                           : " seeded random states (seed " + std::to_string(seed) + ")")
-            << "; relative error ‖A − B‖ / ‖B‖\n"
-            << "quantity   max         median\n"
-            << std::scientific << std::setprecision(3);
-  for (auto [name, mx, md] : {std::tuple{"M^s", mM, dM}, {"h", mh, dh}, {"qdd", mq, dq}})
-    std::cout << std::left << std::setw(10) << name << " " << mx << "   " << md << "\n";
-  if (test) std::cout << (code ? "FAIL" : "PASS") << " (--rtol " << format_number(rtol) << ")\n";
+  print_compare(a, B, K, seed, e, test, code, rtol);
   return code;
 }
 
