@@ -483,6 +483,72 @@ bool run_gnuplot(const fs::path& dir, const std::string& png) {
   return WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }
 
+// The output directory, created, its four files checked before any work (kept without --force).
+fs::path output_directory(const Args& a) {
+  const fs::path dir = a.has("out") ? fs::path(a.options.at("out")) : fs::path("study");
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (!fs::is_directory(dir))
+    throw CliError("--out " + dir.string() + ": cannot create the directory");
+  for (const char* f : {"study.csv", "study.gp", "study.png", "study.md"})
+    if (fs::exists(dir / f) && !a.has("force"))
+      throw CliError((dir / f).string() + ": exists (use --force to replace it)");
+  return dir;
+}
+
+// The command as the files quote it: without --force, --json and --out, which do not change
+// the study.
+std::string study_command(const Args& a, int argc, char** argv) {
+  std::string command = "femdyn study " + a.positional[0];
+  for (int i = 3; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--force" || arg == "--json") continue;
+    if (arg == "--out" && i + 1 < argc) {
+      ++i;
+      continue;
+    }
+    command += " " + arg;
+  }
+  return command;
+}
+
+// study.csv, study.gp, study.png (when gnuplot runs) and study.md, each whole; whether plotted.
+bool write_study(const fs::path& dir, const StudyReport& rep, const std::string& command,
+                 const std::string& md) {
+  std::error_code ec;
+  const auto write = [&](const char* name, const std::string& text) {
+    AtomicFile f((dir / name).string(), true);
+    f.stream() << text;
+    f.commit();
+  };
+  write("study.csv", csv_text(rep, command));
+  write("study.gp", gnuplot_text(rep));
+  // gnuplot renders into a temporary name, renamed when it succeeded.
+  const bool plotted = run_gnuplot(dir, ".study.png.tmp");
+  if (plotted) fs::rename(dir / ".study.png.tmp", dir / "study.png", ec);
+  fs::remove(dir / ".study.png.tmp", ec);
+  write("study.md", md);
+  if (!plotted)
+    std::cerr << "femdyn study: warning: gnuplot failed or is missing (apt install gnuplot-nox); "
+              << (dir / "study.gp").string() << " is written, study.png is not\n";
+  return plotted;
+}
+
+void print_study(const fs::path& dir, const StudyReport& rep, const std::string& md, bool plotted) {
+  std::cout << "model: " << escaped(rep.model) << " (" << rep.n << " coordinates), t = 0…"
+            << rep.t_end << " s, " << rep.runs.size()
+            << " runs\nreference: " << rep.reference_method << ", estimated error "
+            << format_sci(rep.reference_error) << "\nsampling: " << sampling_short(rep)
+            << "; wall time: " << timing_text(rep) << "\n";
+  if (!rep.same_formulation) std::cout << "formulation: " << formulation_text(rep) << "\n";
+  std::istringstream lines(md);
+  std::string line;
+  while (std::getline(lines, line))
+    if (line.rfind("| target", 0) == 0 || line.rfind("| 1e-", 0) == 0) std::cout << line << "\n";
+  std::cout << "wrote " << escaped((dir / "study.csv").string()) << ", study.md, study.gp"
+            << (plotted ? ", study.png" : "") << "\n";
+}
+
 }  // namespace
 
 int cmd_study(int argc, char** argv) {
@@ -505,66 +571,20 @@ int cmd_study(int argc, char** argv) {
   std::mt19937 rng(1);
   o.q0 = a.has("q0") ? configuration_vector(a, "q0", m) : random_posture(m, rng);
   o.qd0 = a.has("qd0") ? state_vector(a, "qd0", m) : random_uniform(m.n(), 1.0, rng);
-
   // Outputs: checked before any work; each file appears whole.
-  const fs::path dir = a.has("out") ? fs::path(a.options.at("out")) : fs::path("study");
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (!fs::is_directory(dir))
-    throw CliError("--out " + dir.string() + ": cannot create the directory");
-  for (const char* f : {"study.csv", "study.gp", "study.png", "study.md"})
-    if (fs::exists(dir / f) && !a.has("force"))
-      throw CliError((dir / f).string() + ": exists (use --force to replace it)");
-
-  std::string command = "femdyn study " + a.positional[0];
-  for (int i = 3; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--force" || arg == "--json") continue;
-    if (arg == "--out" && i + 1 < argc) {
-      ++i;
-      continue;
-    }
-    command += " " + arg;
-  }
+  const fs::path dir = output_directory(a);
+  const std::string command = study_command(a, argc, argv);
   const bool tty = isatty(STDERR_FILENO) == 1;
   const StudyReport rep = validation::run_study(m, o, [tty](const std::string& line) {
     if (tty) std::cerr << "  " << line << "\n";
   });
-
-  const auto write = [&](const char* name, const std::string& text) {
-    AtomicFile f((dir / name).string(), true);
-    f.stream() << text;
-    f.commit();
-  };
-  write("study.csv", csv_text(rep, command));
-  write("study.gp", gnuplot_text(rep));
-  // gnuplot renders into a temporary name, renamed when it succeeded.
-  const bool plotted = run_gnuplot(dir, ".study.png.tmp");
-  if (plotted) fs::rename(dir / ".study.png.tmp", dir / "study.png", ec);
-  fs::remove(dir / ".study.png.tmp", ec);
   const std::string md = markdown_text(rep, command);
-  write("study.md", md);
-  if (!plotted)
-    std::cerr << "femdyn study: warning: gnuplot failed or is missing (apt install gnuplot-nox); "
-              << (dir / "study.gp").string() << " is written, study.png is not\n";
-
+  const bool plotted = write_study(dir, rep, command, md);
   if (a.has("json")) {
     std::cout << json_text(report_json(rep, command, o)) << "\n";
     return 0;
   }
-  // The summary table on stdout.
-  std::cout << "model: " << escaped(rep.model) << " (" << rep.n << " coordinates), t = 0…"
-            << rep.t_end << " s, " << rep.runs.size()
-            << " runs\nreference: " << rep.reference_method << ", estimated error "
-            << format_sci(rep.reference_error) << "\nsampling: " << sampling_short(rep)
-            << "; wall time: " << timing_text(rep) << "\n";
-  if (!rep.same_formulation) std::cout << "formulation: " << formulation_text(rep) << "\n";
-  std::istringstream lines(md);
-  std::string line;
-  while (std::getline(lines, line))
-    if (line.rfind("| target", 0) == 0 || line.rfind("| 1e-", 0) == 0) std::cout << line << "\n";
-  std::cout << "wrote " << escaped((dir / "study.csv").string()) << ", study.md, study.gp"
-            << (plotted ? ", study.png" : "") << "\n";
+  print_study(dir, rep, md, plotted);
   return 0;
 }
 
