@@ -84,6 +84,50 @@ bool floating_tree(const Model& m) {
   }
 }
 
+// One frame's kinematics as JSON and as text; with a floating base, its generalized Jacobian.
+Json frame_entry(const Model& m, int f, const FrameKinematics& k, const MomentumKinematics& c,
+                 bool floating, std::ostream& text) {
+  const std::string body = m.bodies[m.frames[f].body].name;
+  Json entry = {{"name", m.frames[f].name},   {"body", body},
+                {"p", vector_json(k.p)},      {"R", matrix_json(k.R)},
+                {"J", matrix_json(k.J)},      {"velocity", vector_json(k.velocity)},
+                {"bias", vector_json(k.bias)}};
+  text << "\nframe " << m.frames[f].name << " (body " << body << ")\n  p = " << k.p.transpose()
+       << "\n  R =\n"
+       << k.R << "\n  J (linear rows, then angular) =\n"
+       << k.J << "\n  velocity (v, w) = " << k.velocity.transpose()
+       << "\n  Jdot v (q'' = 0)  = " << k.bias.transpose() << "\n";
+  if (floating) {
+    GeneralizedJacobian g;
+    generalized_jacobian(m, k, c, g);
+    std::vector<std::string> rates;
+    for (const int r : g.rates) rates.push_back(m.coordinate_names[r]);
+    entry["generalized_jacobian"] = {
+        {"rates", rates}, {"J", matrix_json(g.J)}, {"drift", vector_json(g.drift)}};
+    text << "  generalized Jacobian J* (base floating; columns: every rate after the base's) =\n"
+         << g.J << "\n  drift J_b A_b^-1 h = " << g.drift.transpose() << "\n";
+  }
+  return entry;
+}
+
+// The mechanism's centre of mass and centroidal momentum as JSON, and as text.
+Json centroidal_entry(const MomentumKinematics& c, std::ostream& text) {
+  text << "\nmechanism: mass " << c.mass << " kg\n  com c = " << c.com.transpose() << "\n  J_c =\n"
+       << c.Jcom << "\n  com velocity = " << c.com_velocity.transpose()
+       << "\n  com acceleration at q'' = 0 = " << c.com_bias.transpose()
+       << "\n  centroidal momentum h_G (P, L_G) = " << c.momentum.transpose() << "\n  A_G =\n"
+       << c.A << "\n  A_G-dot v (q'' = 0) = " << c.bias.transpose() << "\n";
+  return {{"mass", c.mass},
+          {"com", vector_json(c.com)},
+          {"Jcom", matrix_json(c.Jcom)},
+          {"com_velocity", vector_json(c.com_velocity)},
+          {"com_bias", vector_json(c.com_bias)},
+          {"inertia_com", matrix_json(c.inertia_com)},
+          {"momentum", vector_json(c.momentum)},
+          {"A", matrix_json(c.A)},
+          {"bias", vector_json(c.bias)}};
+}
+
 }  // namespace
 
 int cmd_kinematics(int argc, char** argv) {
@@ -121,42 +165,9 @@ int cmd_kinematics(int argc, char** argv) {
     if (!k.J.allFinite() || !k.bias.allFinite() || !k.p.allFinite())
       throw CliError(
           overflow_text("the kinematics of frame " + quoted_text(m.frames[f].name), true));
-    const std::string body = m.bodies[m.frames[f].body].name;
-    Json entry = {{"name", m.frames[f].name},   {"body", body},
-                  {"p", vector_json(k.p)},      {"R", matrix_json(k.R)},
-                  {"J", matrix_json(k.J)},      {"velocity", vector_json(k.velocity)},
-                  {"bias", vector_json(k.bias)}};
-    text << "\nframe " << m.frames[f].name << " (body " << body << ")\n  p = " << k.p.transpose()
-         << "\n  R =\n"
-         << k.R << "\n  J (linear rows, then angular) =\n"
-         << k.J << "\n  velocity (v, w) = " << k.velocity.transpose()
-         << "\n  Jdot v (q'' = 0)  = " << k.bias.transpose() << "\n";
-    if (floating) {
-      GeneralizedJacobian g;
-      generalized_jacobian(m, k, c, g);
-      std::vector<std::string> rates;
-      for (const int r : g.rates) rates.push_back(m.coordinate_names[r]);
-      entry["generalized_jacobian"] = {
-          {"rates", rates}, {"J", matrix_json(g.J)}, {"drift", vector_json(g.drift)}};
-      text << "  generalized Jacobian J* (base floating; columns: every rate after the base's) =\n"
-           << g.J << "\n  drift J_b A_b^-1 h = " << g.drift.transpose() << "\n";
-    }
-    list.push_back(std::move(entry));
+    list.push_back(frame_entry(m, f, k, c, floating, text));
   }
-  text << "\nmechanism: mass " << c.mass << " kg\n  com c = " << c.com.transpose() << "\n  J_c =\n"
-       << c.Jcom << "\n  com velocity = " << c.com_velocity.transpose()
-       << "\n  com acceleration at q'' = 0 = " << c.com_bias.transpose()
-       << "\n  centroidal momentum h_G (P, L_G) = " << c.momentum.transpose() << "\n  A_G =\n"
-       << c.A << "\n  A_G-dot v (q'' = 0) = " << c.bias.transpose() << "\n";
-  const Json centroidal = {{"mass", c.mass},
-                           {"com", vector_json(c.com)},
-                           {"Jcom", matrix_json(c.Jcom)},
-                           {"com_velocity", vector_json(c.com_velocity)},
-                           {"com_bias", vector_json(c.com_bias)},
-                           {"inertia_com", matrix_json(c.inertia_com)},
-                           {"momentum", vector_json(c.momentum)},
-                           {"A", matrix_json(c.A)},
-                           {"bias", vector_json(c.bias)}};
+  const Json centroidal = centroidal_entry(c, text);
   if (a.has("json"))
     std::cout << json_text(Json{{"model", m.name},
                                 {"n", m.n()},
