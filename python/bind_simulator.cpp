@@ -163,8 +163,25 @@ class Simulator {
     return d;
   }
 
-  py::dict run(const py::object& controller, double t_end, const std::string& mode, bool check) {
-    not_running("run");
+  // The controller's largest output of a run.
+  struct Largest {
+    double value = 0, t = 0;
+    Eigen::Index i = -1;
+  };
+  struct Unset {  // the Python controller leaves the loop with the run, whatever happens
+    ControlLoop& loop;
+    ~Unset() { loop.set_controller({}); }
+  };
+  struct Running {  // while the run lasts, whatever ends it: reset, step and run refuse
+    bool& flag;
+    explicit Running(bool& f) : flag(f) { flag = true; }
+    ~Running() { flag = false; }
+  };
+
+  // Run's arguments checked, and its memory before any is allocated: a row a period,
+  // n_q + 3n + 2 numbers, held in growing vectors and then copied into arrays (twice that at the
+  // end). Whether the mode holds τ over a period.
+  bool check_run(const py::object& controller, double t_end, const std::string& mode) {
     const bool hold = text_arg(mode, "mode") == "hold";
     if (!hold && mode != "evaluation")
       throw py::value_error(
@@ -179,8 +196,6 @@ class Simulator {
     if (Status plan = integ.plan(t_end); !plan.ok) throw py::value_error(plan.message);
     check_baumgarte_rate(*model_, options_, t_end - integ.t());
     const Model& m = *model_;
-    // Memory, before any is allocated: a row a period, n_q + 3n + 2 numbers, held in growing
-    // vectors and then copied into arrays (twice that at the end).
     const double T = loop_->options().period;
     const double row_count = std::ceil((t_end - integ.t()) / T) + 2;
     const double bytes = 2 * row_count * dense_bytes(m.n_q() + 3.0 * m.n() + 2, 1);
@@ -188,12 +203,54 @@ class Simulator {
                        " rows of n = " + std::to_string(m.n()) + " coordinates",
                    bytes, 0,
                    "a shorter run (several run() calls), or " + set_max_memory_text(bytes));
+    return hold;
+  }
+
+  // The rows as arrays, and the summary's fields as femdyn.simulate's (sim/run_report.hpp; a
+  // controller acts), then the loop's own.
+  py::dict run_result(const ControlRows& rows, RunWatch& watch, const Status& st,
+                      const std::string& mode, long calls, long k_before,
+                      const IntegratorStats& before,
+                      std::chrono::steady_clock::time_point begin) const {
+    const Integrator& integ = loop_->integrator();
+    const Model& m = *model_;
+    const double T = loop_->options().period;
+    const IntegratorStats& s = integ.stats();
+    py::dict stats = json_to_python(run_summary_json(m, watch.run(), false));
+    stats["integrator"] = std::string(integ.name());
+    stats["mode"] = mode;
+    stats["dt"] = T;
+    stats["periods"] = loop_->period_index() - k_before;
+    stats["controller_calls"] = calls;
+    stats["steps"] = s.steps - before.steps;
+    stats["rejected"] = s.rejected - before.rejected;
+    stats["rhs_evals"] = s.rhs_evals - before.rhs_evals;
+    stats["integration_time"] = s.wall_time - before.wall_time;
+    stats["wall_time"] =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+    stats["t_reached"] = integ.t();
+    stats["ok"] = st.ok;
+    stats["diverged"] = st.diverged;
+    stats["failure"] = st.message;
+    py::dict d;
+    d["t"] = table(rows.t, 0);
+    d["q"] = table(rows.q, m.n_q());
+    d["qd"] = table(rows.qd, m.n());
+    d["tau"] = table(rows.tau, m.n());
+    d["work"] = table(rows.work, 0);
+    d["total"] = table(rows.total, 0);
+    d["stats"] = stats;
+    return d;
+  }
+
+  py::dict run(const py::object& controller, double t_end, const std::string& mode, bool check) {
+    not_running("run");
+    const bool hold = check_run(controller, t_end, mode);
+    Integrator& integ = loop_->integrator();
+    const Model& m = *model_;
+    const double T = loop_->options().period;
     VecX tau = VecX::Zero(m.n());
-    // The controller's largest output of the run: the suspect a divergence report names.
-    struct Largest {
-      double value = 0, t = 0;
-      Eigen::Index i = -1;
-    } largest;
+    Largest largest;  // the suspect a divergence report names
     // The controller at the current state, into tau (the GIL held).
     const auto call = [&](double t, const VecX& q, const VecX& qd, VecX& out) {
       tau_of(controller(t, copy_array(q), copy_array(qd)), m, t, out);
@@ -201,15 +258,8 @@ class Simulator {
       if (out.size() && out.cwiseAbs().maxCoeff(&i) > std::abs(largest.value))
         largest = {out[i], t, i};
     };
-    struct Unset {  // the Python controller leaves the loop with the run, whatever happens
-      ControlLoop& loop;
-      ~Unset() { loop.set_controller({}); }
-    } unset{*loop_};
-    struct Running {  // while the run lasts, whatever ends it: reset, step and run refuse
-      bool& flag;
-      explicit Running(bool& f) : flag(f) { flag = true; }
-      ~Running() { flag = false; }
-    } running{running_};
+    const Unset unset{*loop_};
+    const Running running{running_};
     long calls = 0;
     if (!hold)
       loop_->set_controller([&](double t, const VecX& q, const VecX& qd, VecX& out) {
@@ -264,34 +314,7 @@ class Simulator {
       if (const std::string why = controller_clause(); !why.empty()) st.message += "; " + why;
     }
     if (!st.ok && check) throw NumericalError(st.message);
-    const IntegratorStats& s = integ.stats();
-    // The summary's fields as femdyn.simulate's (sim/run_report.hpp; a controller acts), then the
-    // loop's own.
-    py::dict stats = json_to_python(run_summary_json(m, watch.run(), false));
-    stats["integrator"] = std::string(integ.name());
-    stats["mode"] = mode;
-    stats["dt"] = T;
-    stats["periods"] = loop_->period_index() - k_before;
-    stats["controller_calls"] = calls;
-    stats["steps"] = s.steps - before.steps;
-    stats["rejected"] = s.rejected - before.rejected;
-    stats["rhs_evals"] = s.rhs_evals - before.rhs_evals;
-    stats["integration_time"] = s.wall_time - before.wall_time;
-    stats["wall_time"] =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-    stats["t_reached"] = integ.t();
-    stats["ok"] = st.ok;
-    stats["diverged"] = st.diverged;
-    stats["failure"] = st.message;
-    py::dict d;
-    d["t"] = table(rows.t, 0);
-    d["q"] = table(rows.q, m.n_q());
-    d["qd"] = table(rows.qd, m.n());
-    d["tau"] = table(rows.tau, m.n());
-    d["work"] = table(rows.work, 0);
-    d["total"] = table(rows.total, 0);
-    d["stats"] = stats;
-    return d;
+    return run_result(rows, watch, st, mode, calls, k_before, before, begin);
   }
 
   double t() const { return loop_->t(); }

@@ -15,8 +15,11 @@ namespace femdyn::python {
 #ifdef FEMDYN_WITH_SIMBODY
 namespace {
 
-py::dict validate(const PyModel& self, int states, unsigned seed, std::optional<double> tolerance,
-                  double t_end, int samples, double budget, std::optional<double> max_memory) {
+// The options, each checked as the CLI checks its flag.
+validation::ValidationOptions validation_options(int states, unsigned seed,
+                                                 std::optional<double> tolerance, double t_end,
+                                                 int samples, double budget,
+                                                 std::optional<double> max_memory) {
   if (states < 1) throw py::value_error("states: expected an integer >= 1");
   // The CLI's limit on --t-end (validation::kMaxTrajectoryTime), shared, not copied.
   if (!(t_end >= 0 && t_end <= validation::kMaxTrajectoryTime))
@@ -38,19 +41,10 @@ py::dict validate(const PyModel& self, int states, unsigned seed, std::optional<
   o.samples = samples;
   o.budget = budget;
   if (max_memory) o.memory_limit = *max_memory * 1e9;
-  // Estimated before any state, and refused beyond the budget with the CLI's message.
-  validation::ValidationReport r;
-  std::string refusal;
-  {
-    py::gil_scoped_release release;
-    validation::Validator v(*self.model, o);
-    refusal = v.refusal(self.model->where.empty() ? self.model->name : self.model->where);
-    if (refusal.empty()) r = v.run();
-    // As `femdyn validate FILE`: the import against the robot file it was read from.
-    if (refusal.empty() && !self.source.empty())
-      validation::add_file_rows(r, *self.model, self.source, o, self.load);
-  }
-  if (!refusal.empty()) throw py::value_error(refusal);
+  return o;
+}
+
+py::dict quantities_dict(const validation::ValidationReport& r) {
   py::dict quantities;
   for (const validation::QuantityError& q : r.quantities) {
     py::dict d;
@@ -60,7 +54,10 @@ py::dict validate(const PyModel& self, int states, unsigned seed, std::optional<
     d["pass"] = q.pass();
     quantities[py::str(q.name)] = d;
   }
-  const validation::TrajectoryReport& t = r.trajectory;
+  return quantities;
+}
+
+py::dict trajectory_dict(const validation::TrajectoryReport& t) {
   py::dict traj;
   traj["run"] = t.run;
   traj["skipped"] = t.skipped;
@@ -80,8 +77,13 @@ py::dict validate(const PyModel& self, int states, unsigned seed, std::optional<
   traj["pass"] = t.pass();
   if (!t.stopped.empty()) traj["stopped"] = t.stopped;
   if (!t.refinement.empty()) traj["refinement"] = t.refinement;
+  return traj;
+}
+
+// As `femdyn validate --json`'s "work".
+py::dict work_dict(const validation::ValidationReport& r) {
   const validation::WorkEstimate& e = r.estimate;
-  py::dict work;  // as `femdyn validate --json`'s "work"
+  py::dict work;
   work["estimated_s"] = e.seconds();
   work["estimated_pointwise_s"] = e.pointwise;
   work["estimated_trajectory_s"] = e.trajectory;
@@ -92,15 +94,35 @@ py::dict validate(const PyModel& self, int states, unsigned seed, std::optional<
   work["memory_limit_bytes"] =
       std::isfinite(e.memory_limit) ? py::object(py::float_(e.memory_limit)) : py::none();
   work["mass_comparison"] = r.dense_mass ? "entries" : "products";
+  return work;
+}
+
+py::dict validate(const PyModel& self, int states, unsigned seed, std::optional<double> tolerance,
+                  double t_end, int samples, double budget, std::optional<double> max_memory) {
+  const validation::ValidationOptions o =
+      validation_options(states, seed, tolerance, t_end, samples, budget, max_memory);
+  // Estimated before any state, and refused beyond the budget with the CLI's message.
+  validation::ValidationReport r;
+  std::string refusal;
+  {
+    py::gil_scoped_release release;
+    validation::Validator v(*self.model, o);
+    refusal = v.refusal(self.model->where.empty() ? self.model->name : self.model->where);
+    if (refusal.empty()) r = v.run();
+    // As `femdyn validate FILE`: the import against the robot file it was read from.
+    if (refusal.empty() && !self.source.empty())
+      validation::add_file_rows(r, *self.model, self.source, o, self.load);
+  }
+  if (!refusal.empty()) throw py::value_error(refusal);
   py::dict d;
   d["model"] = r.model;
   d["n"] = r.n;
   d["coordinates"] = self.model->coordinate_names;
   d["states"] = r.states;
-  d["quantities"] = quantities;
-  d["trajectory"] = traj;
+  d["quantities"] = quantities_dict(r);
+  d["trajectory"] = trajectory_dict(r.trajectory);
   d["notes"] = r.notes;
-  d["work"] = work;
+  d["work"] = work_dict(r);
   d["failure"] = r.failure;
   d["compared"] = !r.not_comparable;
   d["pass"] = r.pass();
