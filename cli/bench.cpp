@@ -20,6 +20,7 @@
 #include <string_view>
 #include <vector>
 
+#include "cli/bench_timing.hpp"
 #include "cli/commands.hpp"
 #include "core/derivatives/derivatives.hpp"
 #include "core/dynamics/equations.hpp"
@@ -44,7 +45,6 @@ namespace femdyn::cli {
 namespace {
 
 namespace fv = femdyn::validation;
-using Clock = std::chrono::steady_clock;
 
 constexpr const char* kBenchHelp =
     R"(usage: femdyn bench MODEL [--json] [--quick] [--states N] [--gravity gx,gy,gz]
@@ -224,89 +224,6 @@ void check_mujoco_agreement(const std::string& path, const Model& m, Workspace& 
 }
 #endif
 
-// Keeps the compiler from dropping work whose result it could prove unused.
-inline void keep(const void* p) { asm volatile("" : : "g"(p) : "memory"); }
-
-// ns per call of `calls` calls of fn over the cycled states.
-template <class Fn>
-double batch_ns(Fn& fn, long calls, int K) {
-  int k = 0;
-  const Clock::time_point start = Clock::now();
-  for (long i = 0; i < calls; ++i) {
-    fn(k);
-    if (++k == K) k = 0;
-  }
-  return std::chrono::duration<double, std::nano>(Clock::now() - start).count() /
-         static_cast<double>(calls);
-}
-
-// Warm-up and calibration: every state once (buffers are sized by the first call), runs
-// doubling in length until one lasts a tenth of a batch, which fixes the calls a batch makes,
-// then one whole batch whose time is thrown away. Returns the calls a batch makes.
-template <class Fn>
-long calls_per_batch(Fn& fn, int K, double batch_time_ns) {
-  for (int k = 0; k < K; ++k) fn(k);
-  for (long calls = 1;; calls *= 2) {
-    const double per_call = batch_ns(fn, calls, K);
-    if (per_call * static_cast<double>(calls) >= batch_time_ns / 10 || calls >= (1L << 30)) {
-      const long batch = std::max(1L, std::lround(batch_time_ns / std::max(per_call, 1e-3)));
-      batch_ns(fn, batch, K);
-      return batch;
-    }
-  }
-}
-
-struct Timing {
-  double median = 0, min = 0, max = 0;  // ns per call, over the batches
-};
-
-Timing summarize(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t h = v.size() / 2;
-  return {v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]), v.front(), v.back()};
-}
-
-struct Method {
-  int batches = 15;
-  double batch_time_ns = 20e6;
-};
-
-struct Row {
-  std::string quantity;
-  Timing femdyn;
-  std::optional<Timing> simbody;  // none for the derivatives
-  std::optional<Timing> mujoco;   // M, qdd and tau of a URDF robot, built with MuJoCo
-};
-
-// One quantity on both engines (and MuJoCo when `mujoco_call` is given): each calibrated, then
-// `batches` rounds of a femdyn batch and a Simbody batch (and a MuJoCo batch), so slow drifts of
-// the machine hit them alike.
-template <class F, class S>
-Row time_both(const std::string& quantity, F&& femdyn_call, S&& simbody_call, int K,
-              const Method& method, std::function<void(int)> mujoco_call = {}) {
-  const long nf = calls_per_batch(femdyn_call, K, method.batch_time_ns);
-  const long ns = calls_per_batch(simbody_call, K, method.batch_time_ns);
-  const long nm = mujoco_call ? calls_per_batch(mujoco_call, K, method.batch_time_ns) : 0;
-  std::vector<double> f, s, mj;
-  for (int b = 0; b < method.batches; ++b) {
-    f.push_back(batch_ns(femdyn_call, nf, K));
-    s.push_back(batch_ns(simbody_call, ns, K));
-    if (mujoco_call) mj.push_back(batch_ns(mujoco_call, nm, K));
-  }
-  Row row{quantity, summarize(f), summarize(s), std::nullopt};
-  if (mujoco_call) row.mujoco = summarize(mj);
-  return row;
-}
-
-// One quantity on femdyn alone: calibrated, then `batches` batches.
-template <class F>
-Row time_femdyn(const std::string& quantity, F&& femdyn_call, int K, const Method& method) {
-  const long nf = calls_per_batch(femdyn_call, K, method.batch_time_ns);
-  std::vector<double> f;
-  for (int b = 0; b < method.batches; ++b) f.push_back(batch_ns(femdyn_call, nf, K));
-  return {quantity, summarize(f), std::nullopt, std::nullopt};
-}
-
 // dtau and dqdd (femdyn alone); none, with a note, on a model the derivatives do not cover.
 std::vector<Row> time_derivative_rows(const Model& m, Workspace& ws, const States& s, int K,
                                       const Method& method) {
@@ -453,6 +370,97 @@ nlohmann::ordered_json report_json(const std::string& path, const Model& m,
           {"results", results}};
 }
 
+// The Simbody twin the rows are timed against (its errors, which span lines, in one line).
+std::unique_ptr<fv::SimbodyTwin> bench_twin(const Model& m, const std::string& path) {
+  std::unique_ptr<fv::SimbodyTwin> twin;
+  try {
+    twin = std::make_unique<fv::SimbodyTwin>(fv::twin_model(m));
+  } catch (const std::exception& e) {  // Simbody's messages span lines: one line here
+    std::istringstream words(e.what());
+    std::string why, word;
+    while (words >> word) why += (why.empty() ? "" : " ") + word;
+    throw ModelError(path, "Simbody refused the twin: " + why);
+  }
+  return twin;
+}
+
+// MuJoCo's calls for M, qdd and tau (none: not a URDF robot, or built without MuJoCo).
+struct MujocoCalls {
+  std::function<void(int)> mass, forward, inverse;
+};
+
+// Every row: M, h, g, Q, q̈, the constrained q̈ of a closed model, τ, the derivatives (femdyn
+// alone) and D unless `skipped` says why not.
+std::vector<Row> time_rows(const std::string& path, const Model& m, Workspace& ws,
+                           fv::SimbodyTwin& twin, const States& s, int K, const Method& method,
+                           const MujocoCalls& mj, const std::string& skipped) {
+  std::vector<Row> rows;
+  // M^s: femdyn's mass_matrix (M^s alone) / Simbody's calcM at Position.
+  rows.push_back(time_both(
+      "M",
+      [&](int k) {
+        mass_matrix(m, ws, s.q[k]);
+        keep(ws.Ms.data());
+      },
+      [&](int k) { twin.time_mass(s.q[k]); }, K, method, mj.mass));
+  // h without gravity: velocity terms alone.
+  rows.push_back(time_both(
+      "h",
+      [&](int k) {
+        evaluate_bias(m, ws, s.q[k], s.qd[k]);
+        keep(ws.h.data());
+      },
+      [&](int k) { twin.time_bias(s.q[k], s.qd[k]); }, K, method));
+  // Gravity and the other state-independent forces at rest: τ = −Q(q̇ = 0).
+  rows.push_back(time_both(
+      "g",
+      [&](int k) {
+        inverse_dynamics(m, ws, s.q[k], s.rest, s.rest);
+        keep(ws.tau.data());
+      },
+      [&](int k) { twin.time_gravity(s.q[k]); }, K, method));
+  // Q: femdyn assembles it in evaluate() with M^s and h; Simbody calcM + residual (h − Q).
+  rows.push_back(time_both(
+      "Q",
+      [&](int k) {
+        evaluate(m, ws, s.q[k], s.qd[k], s.tau[k]);
+        keep(ws.Q.data());
+      },
+      [&](int k) { twin.time_mass_and_bias(s.q[k], s.qd[k]); }, K, method));
+  // q̈: forward dynamics.
+  rows.push_back(time_both(
+      "qdd",
+      [&](int k) {
+        tree_forward_dynamics(m, ws, s.q[k], s.qd[k], s.tau[k]);
+        keep(ws.qdd.data());
+      },
+      [&](int k) { twin.time_forward(s.q[k], s.qd[k], s.tau[k]); }, K, method, mj.forward));
+  // Constrained q̈ (a model with loop constraints), at states assembled onto the loops.
+  if (!m.constraints.empty())
+    if (std::optional<Row> row = time_constrained_row(path, m, twin, K, method))
+      rows.push_back(std::move(*row));
+  // τ: inverse dynamics.
+  rows.push_back(time_both(
+      "tau",
+      [&](int k) {
+        inverse_dynamics(m, ws, s.q[k], s.qd[k], s.qdd[k]);
+        keep(ws.tau.data());
+      },
+      [&](int k) { twin.time_inverse(s.q[k], s.qd[k], s.qdd[k]); }, K, method, mj.inverse));
+  // The analytic derivatives, femdyn alone.
+  for (Row& row : time_derivative_rows(m, ws, s, K, method)) rows.push_back(std::move(row));
+  // D: femdyn's tensor / Simbody's symmetric part by polarization of h.
+  if (skipped.empty())
+    rows.push_back(time_both(
+        "D",
+        [&](int k) {
+          const std::vector<MatX> D = third_order_tensor(m, ws, s.q[k]);
+          keep(D.data());
+        },
+        [&](int k) { twin.time_tensor(s.q[k]); }, K, method));
+  return rows;
+}
+
 }  // namespace
 
 int cmd_bench(int argc, char** argv) {
@@ -472,20 +480,11 @@ int cmd_bench(int argc, char** argv) {
   const bool quick = a.has("quick");
   const Method method = quick ? Method{3, 2e6} : Method{};
 
-  std::unique_ptr<fv::SimbodyTwin> twin;
-  try {
-    twin = std::make_unique<fv::SimbodyTwin>(fv::twin_model(m));
-  } catch (const std::exception& e) {  // Simbody's messages span lines: one line here
-    std::istringstream words(e.what());
-    std::string why, word;
-    while (words >> word) why += (why.empty() ? "" : " ") + word;
-    throw ModelError(path, "Simbody refused the twin: " + why);
-  }
+  const std::unique_ptr<fv::SimbodyTwin> twin = bench_twin(m, path);
   Workspace ws(m);
   const States s = random_states(m, K);
   check_agreement(path, m, ws, *twin, s);
-  // MuJoCo's calls for M, qdd and tau (none: not a URDF robot, or built without MuJoCo).
-  std::function<void(int)> mj_mass, mj_forward, mj_inverse;
+  MujocoCalls mj;
 #ifdef FEMDYN_WITH_MUJOCO
   std::unique_ptr<fv::MujocoPeer> peer;
   std::vector<fv::MujocoPeer::State> mj_states;
@@ -496,81 +495,17 @@ int cmd_bench(int argc, char** argv) {
       check_mujoco_agreement(path, m, ws, *peer, s);
       for (int k = 0; k < K; ++k)
         mj_states.push_back(peer->state(s.q[k], s.qd[k], s.tau[k], s.qdd[k]));
-      mj_mass = [&](int k) { peer->time_mass(mj_states[k]); };
-      mj_forward = [&](int k) { peer->time_forward(mj_states[k]); };
-      mj_inverse = [&](int k) { peer->time_inverse(mj_states[k]); };
+      mj.mass = [&](int k) { peer->time_mass(mj_states[k]); };
+      mj.forward = [&](int k) { peer->time_forward(mj_states[k]); };
+      mj.inverse = [&](int k) { peer->time_inverse(mj_states[k]); };
     } catch (const std::runtime_error& e) {
       std::cerr << "femdyn bench: warning: MuJoCo not timed: " << safe_message(e.what()) << "\n";
     }
   }
 #endif
 
-  std::vector<Row> rows;
-  // M^s: femdyn's mass_matrix (M^s alone) / Simbody's calcM at Position.
-  rows.push_back(time_both(
-      "M",
-      [&](int k) {
-        mass_matrix(m, ws, s.q[k]);
-        keep(ws.Ms.data());
-      },
-      [&](int k) { twin->time_mass(s.q[k]); }, K, method, mj_mass));
-  // h without gravity: velocity terms alone.
-  rows.push_back(time_both(
-      "h",
-      [&](int k) {
-        evaluate_bias(m, ws, s.q[k], s.qd[k]);
-        keep(ws.h.data());
-      },
-      [&](int k) { twin->time_bias(s.q[k], s.qd[k]); }, K, method));
-  // Gravity and the other state-independent forces at rest: τ = −Q(q̇ = 0).
-  rows.push_back(time_both(
-      "g",
-      [&](int k) {
-        inverse_dynamics(m, ws, s.q[k], s.rest, s.rest);
-        keep(ws.tau.data());
-      },
-      [&](int k) { twin->time_gravity(s.q[k]); }, K, method));
-  // Q: femdyn assembles it in evaluate() with M^s and h; Simbody calcM + residual (h − Q).
-  rows.push_back(time_both(
-      "Q",
-      [&](int k) {
-        evaluate(m, ws, s.q[k], s.qd[k], s.tau[k]);
-        keep(ws.Q.data());
-      },
-      [&](int k) { twin->time_mass_and_bias(s.q[k], s.qd[k]); }, K, method));
-  // q̈: forward dynamics.
-  rows.push_back(time_both(
-      "qdd",
-      [&](int k) {
-        tree_forward_dynamics(m, ws, s.q[k], s.qd[k], s.tau[k]);
-        keep(ws.qdd.data());
-      },
-      [&](int k) { twin->time_forward(s.q[k], s.qd[k], s.tau[k]); }, K, method, mj_forward));
-  // Constrained q̈ (a model with loop constraints), at states assembled onto the loops.
-  if (!m.constraints.empty())
-    if (std::optional<Row> row = time_constrained_row(path, m, *twin, K, method))
-      rows.push_back(std::move(*row));
-  // τ: inverse dynamics.
-  rows.push_back(time_both(
-      "tau",
-      [&](int k) {
-        inverse_dynamics(m, ws, s.q[k], s.qd[k], s.qdd[k]);
-        keep(ws.tau.data());
-      },
-      [&](int k) { twin->time_inverse(s.q[k], s.qd[k], s.qdd[k]); }, K, method, mj_inverse));
-  // The analytic derivatives, femdyn alone.
-  for (Row& row : time_derivative_rows(m, ws, s, K, method)) rows.push_back(std::move(row));
-  // D: femdyn's tensor / Simbody's symmetric part by polarization of h.
   const std::string skipped = tensor_skipped(n, quick);
-  if (skipped.empty())
-    rows.push_back(time_both(
-        "D",
-        [&](int k) {
-          const std::vector<MatX> D = third_order_tensor(m, ws, s.q[k]);
-          keep(D.data());
-        },
-        [&](int k) { twin->time_tensor(s.q[k]); }, K, method));
-
+  const std::vector<Row> rows = time_rows(path, m, ws, *twin, s, K, method, mj, skipped);
   if (a.has("json")) {
     if (!skipped.empty()) std::cerr << "femdyn bench: D not timed (" << skipped << ")\n";
     std::cout << json_text(report_json(path, m, rows)) << "\n";

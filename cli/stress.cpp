@@ -80,6 +80,112 @@ Json loops_json(const validation::StressResult& r) {
           {"stiffest_along", r.stiffest_along}};
 }
 
+// A case's integrator figures by index (rk4, euler, dopri, bdf), -1 where there is none.
+double column(const validation::StressResult& r, std::size_t i,
+              double validation::StressIntegrator::*field) {
+  return i < r.integrators.size() ? r.integrators[i].*field : -1.0;
+}
+double err(const validation::StressResult& r, std::size_t i) {
+  return column(r, i, &validation::StressIntegrator::error);
+}
+double step(const validation::StressResult& r, std::size_t i) {
+  return column(r, i, &validation::StressIntegrator::largest_stable_step);
+}
+double theory(const validation::StressResult& r, std::size_t i) {
+  return column(r, i, &validation::StressIntegrator::theory_step);
+}
+// "0.417" at the start; closed loops add "; ≥ 0.0123 along" (the smallest along the motion).
+std::string theory_cell(const validation::StressResult& r, std::size_t i) {
+  const double along = column(r, i, &validation::StressIntegrator::theory_step_along);
+  return g(theory(r, i)) + (along >= 0 ? "; " + g(along) + " along" : std::string());
+}
+
+// One case compiled and run (a refusal is its result).
+validation::StressResult run_case(const StressCase& c) {
+  validation::StressResult r;
+  try {
+    const Model m = compile(parse_model_json(c.model, "stress case '" + c.name + "'"));
+    validation::StressScenario s;
+    const auto state = [&](const std::vector<double>& v) -> VecX {
+      if (v.empty()) return VecX::Zero(m.n());
+      if (static_cast<int>(v.size()) != m.n())
+        throw std::logic_error("stress case '" + c.name + "': state of the wrong size");
+      return Eigen::Map<const VecX>(v.data(), m.n());
+    };
+    s.q0 = state(c.q0);
+    s.qd0 = state(c.qd0);
+    s.t_end = c.t_end;
+    s.dt = c.dt;
+    s.large = c.large;
+    r = validation::run_stress(m, s);
+  } catch (const Error& e) {
+    r = validation::refused_case(e.what());
+  }
+  return r;
+}
+
+Json case_json(const StressCase& c, const validation::StressResult& r, double seconds) {
+  Json j = {{"class", c.klass},     {"case", c.name},       {"description", c.description},
+            {"expected", c.expect}, {"verdict", r.verdict}, {"n", r.n},
+            {"seconds", seconds}};
+  if (r.equations > 0) j["loops"] = loops_json(r);
+  if (r.refused.empty()) {
+    j.update({{"cond_min", r.cond_min},
+              {"cond_max", r.cond_max},
+              {"positive_definite", r.positive_definite},
+              {"asymmetry", r.asymmetry},
+              {"stiffest", r.stiffest},
+              {"reference", r.reference},
+              {"energy_error", r.energy_error},
+              {"simbody_error", r.simbody_error},
+              {"simbody_note", r.simbody_note},
+              {"search_note", r.search_note},
+              {"dt", c.dt}});
+    Json its = Json::array();
+    for (const auto& it : r.integrators)
+      its.push_back({{"integrator", it.name},
+                     {"largest_stable_step", it.largest_stable_step},
+                     {"theory_step", it.theory_step},
+                     {"theory_step_along", it.theory_step_along},
+                     {"error", it.error},
+                     {"steps", it.steps},
+                     {"failure", it.failure},
+                     {"max_position_residual", it.max_position_residual}});
+    j["integrators"] = its;
+  }
+  return j;
+}
+
+void md_row(std::ostream& md, const StressCase& c, const validation::StressResult& r) {
+  md << "| " << c.klass << " | " << c.name << " | " << r.n << " | ";
+  if (r.refused.empty())
+    md << g(r.cond_min) << " … " << g(r.cond_max) << " | " << (r.positive_definite ? "yes" : "no")
+       << " | " << (r.stiffest > 0 ? g(r.stiffest) : "—") << " | "
+       << (r.search_note.empty() ? g(step(r, 0)) + " (" + theory_cell(r, 0) + ") / " +
+                                       g(step(r, 1)) + " (" + theory_cell(r, 1) + ")"
+                                 : r.search_note)
+       << " | at " << g(c.dt) << " s: " << (err(r, 0) < 0 ? "unstable" : g(err(r, 0))) << " / "
+       << (err(r, 1) < 0 ? "unstable" : g(err(r, 1))) << "; rtol 1e-6: " << g(err(r, 2)) << " / "
+       << g(err(r, 3)) << " | " << g(r.energy_error) << " | "
+       << (r.simbody_error >= 0     ? g(r.simbody_error)
+           : r.simbody_note.empty() ? "—"
+                                    : "not run")
+       << " | " << loops_cell(r) << " | " << r.verdict << " |\n";
+  else
+    md << "— | — | — | — | — | — | — | " << loops_cell(r) << " | " << r.verdict << " |\n";
+}
+
+void csv_row(std::ostream& csv, const StressCase& c, const validation::StressResult& r) {
+  std::string verdict = r.verdict;
+  std::replace(verdict.begin(), verdict.end(), ',', ';');
+  csv << csv_field(c.klass) << "," << csv_field(c.name) << "," << r.n << "," << r.cond_min << ","
+      << r.cond_max << "," << r.positive_definite << "," << r.stiffest << "," << step(r, 0) << ","
+      << step(r, 1) << "," << theory(r, 0) << "," << theory(r, 1) << "," << c.dt << "," << err(r, 0)
+      << "," << err(r, 1) << "," << err(r, 2) << "," << err(r, 3) << "," << r.energy_error << ","
+      << r.simbody_error << "," << r.equations << "," << r.rank << "," << r.redundant << ","
+      << r.max_position_residual << "," << r.dead_point_ratio << ",\"" << verdict << "\"\n";
+}
+
 }  // namespace
 
 int cmd_stress(int argc, char** argv) {
@@ -122,95 +228,13 @@ int cmd_stress(int argc, char** argv) {
          "simbody_error,equations,rank,redundant,max_position_residual,dead_point_ratio,verdict\n";
   for (const StressCase& c : cases) {
     const auto begin = std::chrono::steady_clock::now();
-    validation::StressResult r;
-    try {
-      const Model m = compile(parse_model_json(c.model, "stress case '" + c.name + "'"));
-      validation::StressScenario s;
-      const auto state = [&](const std::vector<double>& v) -> VecX {
-        if (v.empty()) return VecX::Zero(m.n());
-        if (static_cast<int>(v.size()) != m.n())
-          throw std::logic_error("stress case '" + c.name + "': state of the wrong size");
-        return Eigen::Map<const VecX>(v.data(), m.n());
-      };
-      s.q0 = state(c.q0);
-      s.qd0 = state(c.qd0);
-      s.t_end = c.t_end;
-      s.dt = c.dt;
-      s.large = c.large;
-      r = validation::run_stress(m, s);
-    } catch (const Error& e) {
-      r = validation::refused_case(e.what());
-    }
+    const validation::StressResult r = run_case(c);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
     if (tty) std::cerr << "  " << c.name << ": " << r.verdict << " (" << g(seconds) << " s)\n";
-    const auto err = [&](std::size_t i) {
-      return i < r.integrators.size() ? r.integrators[i].error : -1.0;
-    };
-    const auto step = [&](std::size_t i) {
-      return i < r.integrators.size() ? r.integrators[i].largest_stable_step : -1.0;
-    };
-    const auto theory = [&](std::size_t i) {
-      return i < r.integrators.size() ? r.integrators[i].theory_step : -1.0;
-    };
-    // "0.417" at the start; closed loops add "; ≥ 0.0123 along" (the smallest along the motion).
-    const auto theory_cell = [&](std::size_t i) {
-      const double along = i < r.integrators.size() ? r.integrators[i].theory_step_along : -1.0;
-      return g(theory(i)) + (along >= 0 ? "; " + g(along) + " along" : std::string());
-    };
-    Json j = {{"class", c.klass},     {"case", c.name},       {"description", c.description},
-              {"expected", c.expect}, {"verdict", r.verdict}, {"n", r.n},
-              {"seconds", seconds}};
-    if (r.equations > 0) j["loops"] = loops_json(r);
-    if (r.refused.empty()) {
-      j.update({{"cond_min", r.cond_min},
-                {"cond_max", r.cond_max},
-                {"positive_definite", r.positive_definite},
-                {"asymmetry", r.asymmetry},
-                {"stiffest", r.stiffest},
-                {"reference", r.reference},
-                {"energy_error", r.energy_error},
-                {"simbody_error", r.simbody_error},
-                {"simbody_note", r.simbody_note},
-                {"search_note", r.search_note},
-                {"dt", c.dt}});
-      Json its = Json::array();
-      for (const auto& it : r.integrators)
-        its.push_back({{"integrator", it.name},
-                       {"largest_stable_step", it.largest_stable_step},
-                       {"theory_step", it.theory_step},
-                       {"theory_step_along", it.theory_step_along},
-                       {"error", it.error},
-                       {"steps", it.steps},
-                       {"failure", it.failure},
-                       {"max_position_residual", it.max_position_residual}});
-      j["integrators"] = its;
-    }
-    results.push_back(j);
-    md << "| " << c.klass << " | " << c.name << " | " << r.n << " | ";
-    if (r.refused.empty())
-      md << g(r.cond_min) << " … " << g(r.cond_max) << " | " << (r.positive_definite ? "yes" : "no")
-         << " | " << (r.stiffest > 0 ? g(r.stiffest) : "—") << " | "
-         << (r.search_note.empty() ? g(step(0)) + " (" + theory_cell(0) + ") / " + g(step(1)) +
-                                         " (" + theory_cell(1) + ")"
-                                   : r.search_note)
-         << " | at " << g(c.dt) << " s: " << (err(0) < 0 ? "unstable" : g(err(0))) << " / "
-         << (err(1) < 0 ? "unstable" : g(err(1))) << "; rtol 1e-6: " << g(err(2)) << " / "
-         << g(err(3)) << " | " << g(r.energy_error) << " | "
-         << (r.simbody_error >= 0     ? g(r.simbody_error)
-             : r.simbody_note.empty() ? "—"
-                                      : "not run")
-         << " | " << loops_cell(r) << " | " << r.verdict << " |\n";
-    else
-      md << "— | — | — | — | — | — | — | " << loops_cell(r) << " | " << r.verdict << " |\n";
-    std::string verdict = r.verdict;
-    std::replace(verdict.begin(), verdict.end(), ',', ';');
-    csv << csv_field(c.klass) << "," << csv_field(c.name) << "," << r.n << "," << r.cond_min << ","
-        << r.cond_max << "," << r.positive_definite << "," << r.stiffest << "," << step(0) << ","
-        << step(1) << "," << theory(0) << "," << theory(1) << "," << c.dt << "," << err(0) << ","
-        << err(1) << "," << err(2) << "," << err(3) << "," << r.energy_error << ","
-        << r.simbody_error << "," << r.equations << "," << r.rank << "," << r.redundant << ","
-        << r.max_position_residual << "," << r.dead_point_ratio << ",\"" << verdict << "\"\n";
+    results.push_back(case_json(c, r, seconds));
+    md_row(md, c, r);
+    csv_row(csv, c, r);
   }
   if (write) {
     for (const auto& [name, text] : {std::pair{"stress.md", md.str()}, {"stress.csv", csv.str()}}) {
