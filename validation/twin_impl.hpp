@@ -136,6 +136,12 @@ struct SimbodyTwin::Impl {
   // cannot be posed as couplers (!couplers), else unused.
   TwinKinematics kinematics(const VecX& q, const VecX& qd, const VecX& tau, const VecX& qdd,
                             const std::vector<TwinFrame>& frames, bool jacobian);
+  // Its parts, at the state kinematics() set: the frames' Jacobian J (6 per frame, linear rows
+  // first, n columns), and the frames' and the mass centre's accelerations.
+  MatX frame_jacobians(const VecX& q, const std::vector<TwinFrame>& frames,
+                       const std::vector<SimTK::Transform>& X_BF) const;
+  void accelerations(const VecX& tau, const VecX& qdd, const std::vector<TwinFrame>& frames,
+                     const std::vector<SimTK::Transform>& X_BF, TwinKinematics& out);
 };
 
 }  // namespace femdyn::validation

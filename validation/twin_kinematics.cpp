@@ -83,6 +83,75 @@ TwinKinematics SimbodyTwin::kinematics(const VecX& q, const VecX& qd, const VecX
   }
 }
 
+// J's column k: the frames' velocities at q̇ = e_k, u = P θ̇(e_k) with θ̇ = C e_k (a tree)
+// or G e_k (a closed loop: the laws' chain rule; the rods' u stay 0, they carry no frame).
+MatX SimbodyTwin::Impl::frame_jacobians(const VecX& q, const std::vector<TwinFrame>& frames,
+                                        const std::vector<SimTK::Transform>& X_BF) const {
+  using namespace SimTK;
+  const int nf = static_cast<int>(frames.size());
+  const auto body = [&](int f) -> const MobilizedBody& { return mobod[frames[f].body]; };
+  const int n = model.n();
+  Array_<MobilizedBodyIndex> bodies;
+  Array_<SimTK::Vec3> stations;
+  for (int f = 0; f < nf; ++f) {
+    bodies.push_back(body(f).getMobilizedBodyIndex());
+    stations.push_back(X_BF[f].p());
+  }
+  MatX J(6 * nf, n);
+  VecX e = VecX::Zero(n), theta, theta_dot;
+  Vector_<SpatialVec> JFu;
+  for (int k = 0; k < n; ++k) {
+    e.setZero();
+    e[k] = 1;
+    Vector u;
+    if (model.closed_loop()) {
+      loops::joint_state(model, q, e, theta, theta_dot);
+      u = scatter(theta_dot, rot);
+    } else {
+      u = expand(e);
+    }
+    matter.multiplyByFrameJacobian(state, bodies, stations, u, JFu);
+    for (int f = 0; f < nf; ++f) J.block<6, 1>(6 * f, k) = linear_first(JFu[f]);
+  }
+  return J;
+}
+
+// Accelerations under Simbody's forward dynamics with τ on the coordinates.
+void SimbodyTwin::Impl::accelerations(const VecX& tau, const VecX& qdd,
+                                      const std::vector<TwinFrame>& frames,
+                                      const std::vector<SimTK::Transform>& X_BF,
+                                      TwinKinematics& out) {
+  using namespace SimTK;
+  const int nf = static_cast<int>(frames.size());
+  const auto body = [&](int f) -> const MobilizedBody& { return mobod[frames[f].body]; };
+  out.acceleration.resize(6, nf);
+  if (couplers) {  // a tree, linear couplers or a closed loop: realized with τ applied
+    const AppliedWhileInScope applied(tau_forces, state, independent_forces(tau));
+    system.realize(state, Stage::Acceleration);
+    for (int f = 0; f < nf; ++f)
+      out.acceleration.col(f) = linear_first(body(f).findFrameAccelerationInGround(state, X_BF[f]));
+    out.com_acceleration = from_simtk(matter.calcSystemMassCenterAccelerationInGround(state));
+    return;
+  }
+  // u̇ = P C q̈ + Ṗ v from the reduced equations' q̈; the bodies' A_GB by Simbody's kinematics,
+  // each shifted to a frame's origin (a_F = a_B + α × r + ω × (ω × r)) or its mass centre.
+  Vector_<SpatialVec> A_GB;
+  matter.calcBodyAccelerationFromUDot(state, expand(qdd) + pdot_v, A_GB);
+  const auto shifted = [&](const MobilizedBody& B, const SimTK::Vec3& station) {
+    return shiftAccelerationBy(A_GB[B.getMobilizedBodyIndex()], B.getBodyAngularVelocity(state),
+                               B.getBodyRotation(state) * station);
+  };
+  for (int f = 0; f < nf; ++f)
+    out.acceleration.col(f) = linear_first(shifted(body(f), X_BF[f].p()));
+  SimTK::Vec3 ma(0);  // Σ m_b a_cb
+  for (MobilizedBodyIndex b(1); b < matter.getNumBodies(); ++b) {
+    const MobilizedBody& B = matter.getMobilizedBody(b);
+    const MassProperties& props = B.getBodyMassProperties(state);
+    ma += props.getMass() * shifted(B, props.getMassCenter())[1];
+  }
+  out.com_acceleration = from_simtk(ma) / out.mass;
+}
+
 TwinKinematics SimbodyTwin::Impl::kinematics(const VecX& q, const VecX& qd, const VecX& tau,
                                              const VecX& qdd, const std::vector<TwinFrame>& frames,
                                              bool jacobian) {
@@ -110,61 +179,9 @@ TwinKinematics SimbodyTwin::Impl::kinematics(const VecX& q, const VecX& qd, cons
   out.com_velocity = from_simtk(matter.calcSystemMassCenterVelocityInGround(state));
   out.momentum = linear_first(matter.calcSystemCentralMomentum(state));
 
-  // J's column k: the frames' velocities at q̇ = e_k, u = P θ̇(e_k) with θ̇ = C e_k (a tree)
-  // or G e_k (a closed loop: the laws' chain rule; the rods' u stay 0, they carry no frame).
-  if (jacobian) {
-    const int n = model.n();
-    Array_<MobilizedBodyIndex> bodies;
-    Array_<SimTK::Vec3> stations;
-    for (int f = 0; f < nf; ++f) {
-      bodies.push_back(body(f).getMobilizedBodyIndex());
-      stations.push_back(X_BF[f].p());
-    }
-    out.J.resize(6 * nf, n);
-    VecX e = VecX::Zero(n), theta, theta_dot;
-    Vector_<SpatialVec> JFu;
-    for (int k = 0; k < n; ++k) {
-      e.setZero();
-      e[k] = 1;
-      Vector u;
-      if (model.closed_loop()) {
-        loops::joint_state(model, q, e, theta, theta_dot);
-        u = scatter(theta_dot, rot);
-      } else {
-        u = expand(e);
-      }
-      matter.multiplyByFrameJacobian(state, bodies, stations, u, JFu);
-      for (int f = 0; f < nf; ++f) out.J.block<6, 1>(6 * f, k) = linear_first(JFu[f]);
-    }
-  }
+  if (jacobian) out.J = frame_jacobians(q, frames, X_BF);
 
-  // Accelerations under Simbody's forward dynamics with τ on the coordinates.
-  out.acceleration.resize(6, nf);
-  if (couplers) {  // a tree, linear couplers or a closed loop: realized with τ applied
-    const AppliedWhileInScope applied(tau_forces, state, independent_forces(tau));
-    system.realize(state, Stage::Acceleration);
-    for (int f = 0; f < nf; ++f)
-      out.acceleration.col(f) = linear_first(body(f).findFrameAccelerationInGround(state, X_BF[f]));
-    out.com_acceleration = from_simtk(matter.calcSystemMassCenterAccelerationInGround(state));
-    return out;
-  }
-  // u̇ = P C q̈ + Ṗ v from the reduced equations' q̈; the bodies' A_GB by Simbody's kinematics,
-  // each shifted to a frame's origin (a_F = a_B + α × r + ω × (ω × r)) or its mass centre.
-  Vector_<SpatialVec> A_GB;
-  matter.calcBodyAccelerationFromUDot(state, expand(qdd) + pdot_v, A_GB);
-  const auto shifted = [&](const MobilizedBody& B, const SimTK::Vec3& station) {
-    return shiftAccelerationBy(A_GB[B.getMobilizedBodyIndex()], B.getBodyAngularVelocity(state),
-                               B.getBodyRotation(state) * station);
-  };
-  for (int f = 0; f < nf; ++f)
-    out.acceleration.col(f) = linear_first(shifted(body(f), X_BF[f].p()));
-  SimTK::Vec3 ma(0);  // Σ m_b a_cb
-  for (MobilizedBodyIndex b(1); b < matter.getNumBodies(); ++b) {
-    const MobilizedBody& B = matter.getMobilizedBody(b);
-    const MassProperties& props = B.getBodyMassProperties(state);
-    ma += props.getMass() * shifted(B, props.getMassCenter())[1];
-  }
-  out.com_acceleration = from_simtk(ma) / out.mass;
+  accelerations(tau, qdd, frames, X_BF, out);
   return out;
 }
 

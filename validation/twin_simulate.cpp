@@ -159,6 +159,33 @@ void count(const SimTK::Integrator& integ, TwinRunStats& stats) {
   stats.convergence_failures = integ.getNumConvergenceTestFailures();
 }
 
+// The integrator with the run's settings (below); `final_times` non-empty when it interpolates.
+// A time bound: the integrator hands control back every kChunk steps (ReachedStepLimit), and
+// the stepper every significant state, so the clock can be read between steps.
+std::unique_ptr<SimTK::Integrator> configured_integrator(SimbodyIntegrator which,
+                                                         const SimTK::MultibodySystem& system,
+                                                         double accuracy,
+                                                         const std::vector<double>& final_times,
+                                                         bool bounded) {
+  constexpr int kChunk = 16;
+  std::unique_ptr<SimTK::Integrator> integ = make_integrator(which, system);
+  integ->setAccuracy(accuracy);
+  integ->setConstraintTolerance(accuracy);
+  integ->setReturnEveryInternalStep(false);
+  integ->setAllowInterpolation(true);
+  if (!final_times.empty() && final_times.back() > 0) integ->setFinalTime(final_times.back());
+  if (bounded) integ->setInternalStepLimit(kChunk);
+  return integ;
+}
+
+std::string out_of_time_text(SimbodyIntegrator which, double t, double t_end, double bound) {
+  char text[160];
+  std::snprintf(text, sizeof text,
+                " stopped at t = %.3g s of %.3g s: its time bound of %.3g s ran out", t, t_end,
+                bound);
+  return simbody_integrator_name(which) + std::string(text);
+}
+
 }  // namespace
 
 // Settings: setAccuracy and setConstraintTolerance at `accuracy`; Simbody's defaults otherwise,
@@ -184,18 +211,10 @@ TwinRun SimbodyTwin::simulate(const VecX& q0, const VecX& qd0, const std::vector
     s.enable_loops(s.simulate_closed);  // the integrator starts from (a copy of) this state
     s.set_state(q0, qd0, SimTK::Stage::Velocity);
     s.state.setTime(0);
-    integ = make_integrator(which, s.system);
-    integ->setAccuracy(accuracy);
-    integ->setConstraintTolerance(accuracy);
-    integ->setReturnEveryInternalStep(false);
-    integ->setAllowInterpolation(true);
     const bool interpolate = sampling == TwinSampling::Interpolate;
-    if (interpolate && !times.empty() && times.back() > 0) integ->setFinalTime(times.back());
-    // A time bound: the integrator hands control back every kChunk steps (ReachedStepLimit),
-    // and the stepper every significant state, so the clock can be read between steps.
-    constexpr int kChunk = 16;
     const bool bounded = limits.wall_time > 0;
-    if (bounded) integ->setInternalStepLimit(kChunk);
+    integ = configured_integrator(which, s.system, accuracy,
+                                  interpolate ? times : std::vector<double>{}, bounded);
     SimTK::TimeStepper stepper(s.system, *integ);
     if (bounded) stepper.setReportAllSignificantStates(true);
     const auto start = std::chrono::steady_clock::now();
@@ -229,11 +248,7 @@ TwinRun SimbodyTwin::simulate(const VecX& q0, const VecX& qd0, const std::vector
       if (timed_out) {
         stats.ok = false;
         stats.out_of_time = true;
-        char text[160];
-        std::snprintf(text, sizeof text,
-                      " stopped at t = %.3g s of %.3g s: its time bound of %.3g s ran out",
-                      integ->getTime(), times.back(), limits.wall_time);
-        stats.failure = simbody_integrator_name(which) + std::string(text);
+        stats.failure = out_of_time_text(which, integ->getTime(), times.back(), limits.wall_time);
         break;
       }
       if (std::abs(integ->getTime() - t) > 1e-12 * std::max(1.0, t)) {

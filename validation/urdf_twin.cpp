@@ -121,6 +121,30 @@ struct UrdfTwin::Impl {
   };
   std::map<std::string, Mimic> mimic;
   State state;
+
+  // Simbody's M, h and Q at `state` (u set), reduced to femdyn's rates v by u = C v:
+  // M_v = Cᵀ M C, h_v = Cᵀ (h + M Ċ v), Q_v = Cᵀ Q.
+  UrdfTwinEquations reduced_equations(const ::Eigen::MatrixXd& C, const ::Eigen::VectorXd& Cdot_v) {
+    const int nu = state.getNU();
+    system.realize(state, Stage::Dynamics);
+    Matrix M;
+    matter.calcM(state, M);
+    Vector zero(nu, 0.0), bias, with_forces;
+    const Vector_<SpatialVec> no_body(matter.getNumBodies(), SpatialVec(Vec3(0), Vec3(0)));
+    matter.calcResidualForceIgnoringConstraints(state, zero, no_body, zero, bias);
+    matter.calcResidualForceIgnoringConstraints(
+        state, system.getMobilityForces(state, Stage::Dynamics),
+        system.getRigidBodyForces(state, Stage::Dynamics), zero, with_forces);
+    ::Eigen::MatrixXd Mt(nu, nu);
+    ::Eigen::VectorXd ht(nu), Qt(nu);
+    for (int a = 0; a < nu; ++a) {
+      ht[a] = bias[a];
+      Qt[a] = bias[a] - with_forces[a];
+      for (int b = 0; b < nu; ++b) Mt(a, b) = M(a, b);
+    }
+    // M_v = Cᵀ M C, h_v = Cᵀ (h + M Ċ v), Q_v = Cᵀ Q.
+    return {C.transpose() * Mt * C, C.transpose() * (ht + Mt * Cdot_v), C.transpose() * Qt};
+  }
 };
 
 namespace {
@@ -363,24 +387,7 @@ UrdfTwinEquations UrdfTwin::equations(const std::vector<std::string>& rate_names
     const ::Eigen::VectorXd u = C * qd;
     for (int a = 0; a < nu; ++a) s.state.updU()[a] = u[a];
   }
-  s.system.realize(s.state, Stage::Dynamics);
-  Matrix M;
-  s.matter.calcM(s.state, M);
-  Vector zero(nu, 0.0), bias, with_forces;
-  const Vector_<SpatialVec> no_body(s.matter.getNumBodies(), SpatialVec(Vec3(0), Vec3(0)));
-  s.matter.calcResidualForceIgnoringConstraints(s.state, zero, no_body, zero, bias);
-  s.matter.calcResidualForceIgnoringConstraints(
-      s.state, s.system.getMobilityForces(s.state, Stage::Dynamics),
-      s.system.getRigidBodyForces(s.state, Stage::Dynamics), zero, with_forces);
-  ::Eigen::MatrixXd Mt(nu, nu);
-  ::Eigen::VectorXd ht(nu), Qt(nu);
-  for (int a = 0; a < nu; ++a) {
-    ht[a] = bias[a];
-    Qt[a] = bias[a] - with_forces[a];
-    for (int b = 0; b < nu; ++b) Mt(a, b) = M(a, b);
-  }
-  // M_v = Cᵀ M C, h_v = Cᵀ (h + M Ċ v), Q_v = Cᵀ Q.
-  return {C.transpose() * Mt * C, C.transpose() * (ht + Mt * Cdot_v), C.transpose() * Qt};
+  return s.reduced_equations(C, Cdot_v);
 }
 
 }  // namespace femdyn::validation
