@@ -13,8 +13,8 @@
 #include "core/model/limits.hpp"
 #include "core/model/names.hpp"
 #include "core/workspace/memory.hpp"
-#include "io/model_loader.hpp"
 #include "io/output.hpp"
+#include "models/model_files.hpp"
 
 namespace femdyn::cli {
 namespace {

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "core/model/errors.hpp"
-#include "io/model_loader.hpp"
+#include "models/model_files.hpp"
 
 namespace femdyn::cli {
 

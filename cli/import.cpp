@@ -4,8 +4,8 @@
 
 #include "cli/commands.hpp"
 #include "io/atomic_file.hpp"
-#include "io/model_loader.hpp"
 #include "io/output.hpp"
+#include "models/model_files.hpp"
 
 namespace femdyn::cli {
 namespace {

@@ -15,9 +15,9 @@
 #include "core/workspace/memory.hpp"
 #include "io/actuation_table.hpp"
 #include "io/atomic_file.hpp"
-#include "io/model_loader.hpp"
 #include "io/output.hpp"
 #include "io/trajectory_csv.hpp"
+#include "models/model_files.hpp"
 #include "sim/run_report.hpp"
 #include "sim/simulation_request.hpp"
 

@@ -18,8 +18,8 @@
 #include "core/model/names.hpp"
 #include "io/atomic_file.hpp"
 #include "io/csv.hpp"
-#include "io/model_loader.hpp"
 #include "io/output.hpp"
+#include "models/model_files.hpp"
 
 namespace femdyn::cli {
 namespace {

@@ -5,7 +5,7 @@
 #include "cli/commands.hpp"
 #include "core/model/names.hpp"
 #include "io/atomic_file.hpp"
-#include "io/model_loader.hpp"
+#include "models/model_files.hpp"
 #include "view/page.hpp"
 
 namespace femdyn::cli {

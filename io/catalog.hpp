@@ -1,8 +1,8 @@
 // The catalog the JSON loader builds from: element types (name -> factory) and parametric
-// model plugins (name -> document). The loader is given one (LoadOptions::catalog, or the
-// catalog argument of parse_spec): io/ defines what an entry is and never includes elements/
-// or models/. femdyn's own catalog is their two lists (elements/registry.cpp,
-// models/plugins.cpp), joined in models/catalog.cpp as default_catalog().
+// model plugins (name -> document). The loader is given one: every loading function of
+// io/model_loader.hpp takes it as an argument. io/ defines what an entry is and never includes
+// or calls elements/ or models/. femdyn's own catalog is their two lists (elements/registry.cpp,
+// models/plugins.cpp), joined in models/catalog.cpp as default_catalog() (models/model_files.hpp).
 #pragma once
 #include <memory>
 #include <string>
@@ -49,8 +49,5 @@ struct Catalog {
   Registry<ElementType> elements;
   Registry<ModelPlugin> plugins;
 };
-
-// femdyn's element types and model plugins (defined in models/catalog.cpp).
-const Catalog& default_catalog();
 
 }  // namespace femdyn

@@ -10,18 +10,17 @@
 
 namespace femdyn {
 
-Json model_document(const std::string& path, const LoadOptions& options) {
+Json model_document(const Catalog& catalog, const std::string& path, const LoadOptions& options) {
   if (is_robot_file(path)) return robot_document(path, options);
   const Json root = parse_json(read_input_file(path), path);
   if (auto ref = robot_reference(path, root, options)) return std::move(ref->first);
   refuse_balance_on_json(path, options);
-  const Catalog& catalog = options.catalog ? *options.catalog : default_catalog();
   (void)parse_model_json(root, path, catalog);  // reports every model error by its path
   return root.contains("model") ? expand_plugin(catalog, root, path) : root;
 }
 
-MechanismSpec read_spec(const std::string& path, const LoadOptions& options) {
-  const Catalog& catalog = options.catalog ? *options.catalog : default_catalog();
+MechanismSpec read_spec(const Catalog& catalog, const std::string& path,
+                        const LoadOptions& options) {
   if (!is_robot_file(path) && options.floating_base)
     throw ModelError(path,
                      "--floating-base is for URDF models: a JSON model gives its root body a "
@@ -39,7 +38,7 @@ MechanismSpec read_spec(const std::string& path, const LoadOptions& options) {
     refuse_balance_on_json(path, options);
     return parse_model_json(root, path, catalog);
   }
-  const Json doc = model_document(path, options);
+  const Json doc = model_document(catalog, path, options);
   try {
     return parse_model_json(doc, path, catalog);
   } catch (const ModelError& e) {
@@ -47,8 +46,8 @@ MechanismSpec read_spec(const std::string& path, const LoadOptions& options) {
   }
 }
 
-Model load_model(const std::string& path, const LoadOptions& options) {
-  MechanismSpec spec = read_spec(path, options);
+Model load_model(const Catalog& catalog, const std::string& path, const LoadOptions& options) {
+  MechanismSpec spec = read_spec(catalog, path, options);
   if (options.gravity) {
     spec.gravity = *options.gravity;
     spec.gravity_where = spec.where + options.gravity_source;  // (where ends in ": ")
@@ -57,7 +56,7 @@ Model load_model(const std::string& path, const LoadOptions& options) {
   try {
     return compile(std::move(spec), options.compile);
   } catch (const ModelError& e) {
-    rethrow_for_robot_file(e, model_document(path, options), path);
+    rethrow_for_robot_file(e, model_document(catalog, path, options), path);
   }
 }
 

@@ -18,21 +18,23 @@ struct LoadOptions {
   std::optional<Vec3> gravity;                          // overrides the model's gravity
   std::string gravity_source = "LoadOptions::gravity";  // names it in messages ("--gravity")
   std::function<void(const std::string&)> warn;  // non-fatal notes (e.g. URDF friction ignored)
-  const Catalog* catalog = nullptr;  // element types and model plugins; null: default_catalog()
-  CompileOptions compile;            // e.g. the routes (compile/compile.hpp)
-  bool floating_base = false;        // URDF: a free joint under the root link (io/urdf_loader.hpp)
-  bool balance_inertia = false;      // URDF: a non-physical body inertia -> the nearest physical
-  bool exact_mesh_inertia = false;   // MJCF: every mesh weighs its solid (io/mjcf_loader.hpp)
+  CompileOptions compile;                        // e.g. the routes (compile/compile.hpp)
+  bool floating_base = false;       // URDF: a free joint under the root link (io/urdf_loader.hpp)
+  bool balance_inertia = false;     // URDF: a non-physical body inertia -> the nearest physical
+  bool exact_mesh_inertia = false;  // MJCF: every mesh weighs its solid (io/mjcf_loader.hpp)
 };
 
+// Each takes the element types and model plugins it builds from (io/catalog.hpp); femdyn's own,
+// and these functions with it, are models/model_files.hpp's.
 // A model file: femdyn JSON, or URDF by its extension .urdf (io/urdf_loader.hpp).
-MechanismSpec read_spec(const std::string& path, const LoadOptions& options = {});
+MechanismSpec read_spec(const Catalog& catalog, const std::string& path,
+                        const LoadOptions& options = {});
 MechanismSpec parse_spec(const std::string& text, const std::string& source_name,
-                         const Catalog& catalog = default_catalog());
+                         const Catalog& catalog);
 // A parsed JSON model document (plain or {"model": plugin, "params": …}).
 MechanismSpec parse_model_json(const Json& root, const std::string& source_name,
-                               const Catalog& catalog = default_catalog());
-Model load_model(const std::string& path, const LoadOptions& options = {});
+                               const Catalog& catalog);
+Model load_model(const Catalog& catalog, const std::string& path, const LoadOptions& options = {});
 // One entry of "couplings" as the JSON format writes it ({"joint", "follows", "ratio" |
 // "polynomial" | "spline" | "four_bar", …}), read and checked as in a file; `where` names it in
 // messages. For builders that take a coupling in that form (the Python module).
@@ -45,7 +47,8 @@ SpringSpec parse_spring(const Json& spring, const std::string& where, std::size_
 
 // The model document a file describes (a URDF converted, a plugin expanded), as JSON that
 // loads back to the same equations: what `femdyn import` writes.
-Json model_document(const std::string& path, const LoadOptions& options = {});
+Json model_document(const Catalog& catalog, const std::string& path,
+                    const LoadOptions& options = {});
 // The robot file whose bodies the model in `path` has: `path` itself for a URDF or MJCF file,
 // the file a JSON reference names ({"model": "urdf" | "mjcf", "params": {"file"}}, relative to
 // it), "" for any other model. For what reads the robot file's other parts (femdyn view's

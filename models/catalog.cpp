@@ -1,5 +1,6 @@
 // femdyn's own catalog for the loader (io/catalog.hpp): every element type and model plugin.
 #include "elements/registry.hpp"
+#include "models/model_files.hpp"
 #include "models/plugins.hpp"
 
 namespace femdyn {

@@ -9,8 +9,8 @@
 
 #include "core/joints/kernel.hpp"
 #include "core/model/names.hpp"
-#include "io/model_loader.hpp"
 #include "models/builder.hpp"
+#include "models/model_files.hpp"
 #include "python/py_model.hpp"
 
 namespace femdyn::python {

@@ -3,7 +3,7 @@
 #include <pybind11/stl.h>
 
 #include "io/atomic_file.hpp"
-#include "io/model_loader.hpp"
+#include "models/model_files.hpp"
 #include "python/py_model.hpp"
 #include "view/page.hpp"
 

@@ -9,7 +9,7 @@
 #include "core/loops/constrained_dynamics.hpp"
 #include "core/workspace/memory.hpp"
 #include "core/workspace/workspace.hpp"
-#include "io/model_loader.hpp"
+#include "models/model_files.hpp"
 #include "python/arrays.hpp"
 
 namespace femdyn::python {

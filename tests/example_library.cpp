@@ -3,7 +3,7 @@
 #include <iostream>
 
 #include "core/dynamics/equations.hpp"
-#include "io/model_loader.hpp"
+#include "models/model_files.hpp"
 
 int main(int argc, char** argv) {
   using namespace femdyn;

@@ -11,7 +11,7 @@
 #include "core/dynamics/equations.hpp"
 #include "core/kinematics/kinematics.hpp"
 #include "core/kinematics/sampling.hpp"
-#include "io/model_loader.hpp"
+#include "models/model_files.hpp"
 
 namespace femdyn::test {
 

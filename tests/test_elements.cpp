@@ -10,7 +10,7 @@
 #include "elements/lumped_point.hpp"
 #include "elements/registry.hpp"
 #include "elements/space_bar.hpp"
-#include "io/model_loader.hpp"
+#include "models/model_files.hpp"
 #include "models/plugins.hpp"
 #include "tests/helpers.hpp"
 

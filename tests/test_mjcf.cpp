@@ -11,7 +11,7 @@
 #include "core/dynamics/equations.hpp"
 #include "core/joints/passive.hpp"
 #include "core/kinematics/sampling.hpp"
-#include "io/model_loader.hpp"
+#include "models/model_files.hpp"
 #include "tests/helpers.hpp"
 #include "validation/mujoco_peer.hpp"
 

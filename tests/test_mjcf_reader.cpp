@@ -12,7 +12,7 @@
 #include "core/kinematics/sampling.hpp"
 #include "core/loops/assembly.hpp"
 #include "core/loops/constraint_kinematics.hpp"
-#include "io/model_loader.hpp"
+#include "models/model_files.hpp"
 #include "tests/helpers.hpp"
 
 using namespace femdyn;

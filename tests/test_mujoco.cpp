@@ -9,8 +9,8 @@
 
 #include "core/dynamics/equations.hpp"
 #include "core/kinematics/sampling.hpp"
-#include "io/model_loader.hpp"
 #include "io/urdf_loader.hpp"
+#include "models/model_files.hpp"
 #include "tests/helpers.hpp"
 #include "validation/mujoco_peer.hpp"
 

@@ -13,8 +13,8 @@
 #include "core/dynamics/equations.hpp"
 #include "core/kinematics/sampling.hpp"
 #include "core/model/errors.hpp"
-#include "io/model_loader.hpp"
 #include "io/urdf_loader.hpp"
+#include "models/model_files.hpp"
 #include "tests/helpers.hpp"
 #include "tests/urdf_twin_checks.hpp"
 #ifdef FEMDYN_WITH_SIMBODY

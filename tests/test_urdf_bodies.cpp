@@ -13,7 +13,7 @@
 #include "core/model/errors.hpp"
 #include "core/spatial/inertia.hpp"
 #include "io/centroidal_mass.hpp"
-#include "io/model_loader.hpp"
+#include "models/model_files.hpp"
 #include "tests/helpers.hpp"
 #include "tests/urdf_twin_checks.hpp"
 

@@ -65,7 +65,7 @@
 #include "core/kinematics/sampling.hpp"
 #include "core/loops/assembly.hpp"
 #include "core/spatial/math.hpp"
-#include "io/model_loader.hpp"
+#include "models/model_files.hpp"
 #include "validation/alloc_counter.hpp"
 #ifdef FEMDYN_WITH_MUJOCO
 #include "validation/mujoco_peer.hpp"

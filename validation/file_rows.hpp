@@ -7,7 +7,7 @@
 #include <string>
 
 #include "core/model/model.hpp"
-#include "io/model_loader.hpp"
+#include "models/model_files.hpp"
 #include "validation/validate.hpp"
 
 namespace femdyn::validation {

@@ -5,9 +5,9 @@
 
 #include "io/input_file.hpp"
 #include "io/mjcf_loader.hpp"
-#include "io/model_loader.hpp"
 #include "io/output.hpp"
 #include "io/urdf_loader.hpp"
+#include "models/model_files.hpp"
 #include "view/assets.hpp"
 #include "view/scene.hpp"
 

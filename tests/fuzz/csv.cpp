@@ -13,8 +13,8 @@
 #include "compile/compile.hpp"
 #include "core/model/limits.hpp"
 #include "io/actuation_table.hpp"
-#include "io/model_loader.hpp"
 #include "io/trajectory_csv.hpp"
+#include "models/model_files.hpp"
 #include "tests/fuzz/common.hpp"
 
 using namespace femdyn;

@@ -4,7 +4,7 @@
 
 #include "compile/compile.hpp"
 #include "core/model/errors.hpp"
-#include "io/model_loader.hpp"
+#include "models/model_files.hpp"
 #include "tests/fuzz/common.hpp"
 
 using namespace femdyn;

@@ -10,8 +10,8 @@
 #include <optional>
 
 #include "core/model/errors.hpp"
-#include "io/model_loader.hpp"
 #include "io/urdf_loader.hpp"
+#include "models/model_files.hpp"
 #include "tests/fuzz/common.hpp"
 
 using namespace femdyn;
