@@ -384,9 +384,9 @@ bool within_budget(const Args& a, const Model& m, int K, double budget) {
 
 // The diagnosis at K states: the neutral posture at rest, then seeded random ones (each
 // assembled onto the loops first, where there are loops).
-Diagnosis diagnose(const Model& m, int K, std::mt19937& rng, const std::string& label) {
+Diagnosis diagnose(const Model& m, Workspace& ws, int K, std::mt19937& rng,
+                   const std::string& label) {
   const int n = m.n();
-  Workspace ws(m);
   Diagnosis d;
   const bool dampers = has_dampers(m);
   Progress progress(K, "states");
@@ -548,8 +548,8 @@ int cmd_check(int argc, char** argv) {
   if (!within_budget(a, m, r.states, budget)) return 1;
 
   std::mt19937 rng(seed);
-  r.d = diagnose(m, r.states, rng, a.positional[0]);
   Workspace ws(m);
+  r.d = diagnose(m, ws, r.states, rng, a.positional[0]);
   r.pressed = diagnose_stops(m, ws, has_dampers(m), r.d);
   r.bodies = suspicious_bodies(m);
   bool flagged = false;

@@ -85,7 +85,7 @@ void check_joint_parameters(const JointSpec& js, Joint& j) {
       throw ModelError(js.where + "/axis2", "a " + std::string(joint_type_name(js.type)) +
                                                 " joint's two axes must be normal to each other");
   } else if (js.axis2) {
-    throw ModelError(js.where + "/axis2", "only a universal joint has a second axis");
+    throw ModelError(js.where + "/axis2", joint_axis2_refusal());
   }
   for (const auto& [key, value] : js.scalars) {
     const JointScalar* s = joint_scalar(js.type, key);

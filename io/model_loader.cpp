@@ -51,8 +51,7 @@ void read_actuator(const Params& p, JointSpec& j) {
 void read_joint_parameters(const Params& p, JointSpec& j) {
   const JointParameters type = joint_parameters(j.type);
   if (type.moves && type.axes == JointAxes::None && p.has("axis"))
-    p.fail("axis", "a " + std::string(joint_type_name(j.type)) +
-                       " joint turns about every axis: it takes no axis");
+    p.fail("axis", joint_axis_refusal(j.type));
   if (type.axes != JointAxes::None) j.axis = p.vec3("axis");
   if (p.has("axis2")) j.axis2 = p.vec3("axis2");  // (compile: a type of two axes only)
   for (const JointScalar& s : type.scalars) {

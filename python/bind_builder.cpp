@@ -180,9 +180,9 @@ JointSpec joint_arg(const std::optional<std::string>& type_in,
       if (given)
         throw py::value_error(std::string(arg) +
                               ": a fixed joint has no motion: no axis, limits, spring or damping");
-  if ((j.type == JointType::Spherical || j.type == JointType::Free) && axis)
-    throw py::value_error(
-        "axis: a spherical or free joint turns about every axis: it takes no axis");
+  if (const JointParameters p = joint_parameters(j.type);
+      p.moves && p.axes == JointAxes::None && axis)
+    throw py::value_error("axis: " + joint_axis_refusal(j.type));
   if (name) j.name = *name;
   if (axis) j.axis = vec3_arg(*axis, "axis");
   if (axis2) j.axis2 = vec3_arg(*axis2, "axis2");  // (compile: universal only)

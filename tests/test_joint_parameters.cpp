@@ -120,6 +120,20 @@ TEST_CASE("every joint type refuses another type's numbers, naming the key") {
         CHECK_THAT(why, Catch::Contains("/bodies/0/joint/" + std::string(s.key)));
         CHECK_THAT(why, Catch::Contains(joint_scalar_refusal(s.key)));
       }
+  // The axes each type does not read, refused in the words its declaration gives.
+  for (const JointType type : joint_types()) {
+    INFO(joint_type_name(type));
+    const JointParameters p = joint_parameters(type);
+    if (p.moves && p.axes == JointAxes::None)
+      CHECK_THAT(
+          text_error(model_json(type, R"(, "axis": [0, 0, 1])")),
+          Catch::Contains("/bodies/0/joint/axis") && Catch::Contains(joint_axis_refusal(type)));
+    if (p.moves && p.axes == JointAxes::One)
+      CHECK_THAT(
+          text_error(model_json(type, R"(, "axis2": [1, 0, 0])")),
+          Catch::Contains("/bodies/0/joint/axis2") && Catch::Contains(joint_axis2_refusal()));
+  }
+  CHECK(joint_axis2_refusal() == "only a universal joint has a second axis");
   CHECK(joint_scalar_refusal("pitch") == "only a helical joint has a pitch");
   CHECK(joint_scalar_refusal("lead") == "no joint type has a lead");
 }

@@ -84,6 +84,10 @@ const JointScalar* joint_scalar(JointType type, std::string_view key);
 bool is_joint_scalar(std::string_view key);
 // Why `key` is refused on a joint of another type: "only a helical joint has a pitch".
 std::string joint_scalar_refusal(std::string_view key);
+// Why a moving joint of `type` that reads no axis refuses one: "a spherical joint turns about
+// every axis: it takes no axis"; and why a type of fewer than two axes refuses `axis2`.
+std::string joint_axis_refusal(JointType type);
+std::string joint_axis2_refusal();
 
 // Whether column k of the joint is fixed in the parent's joint frame (else in B).
 inline bool column_in_parent(const Joint& j, int k) {

@@ -18,6 +18,19 @@ bool is_joint_scalar(std::string_view key) {
   return false;
 }
 
+std::string joint_axis_refusal(JointType type) {
+  return "a " + std::string(joint_type_name(type)) +
+         " joint turns about every axis: it takes no axis";
+}
+
+std::string joint_axis2_refusal() {
+  std::string types;  // the canonical names of the types of two axes
+  for (const JointTypeName& t : kJointTypeNames)
+    if (t.name == joint_type_name(t.type) && joint_parameters(t.type).axes == JointAxes::Two)
+      types += (types.empty() ? "" : " or ") + std::string(t.name);
+  return "only a " + types + " joint has a second axis";
+}
+
 std::string joint_scalar_refusal(std::string_view key) {
   std::string types;  // the canonical names of the types that take it
   for (const JointTypeName& t : kJointTypeNames)
