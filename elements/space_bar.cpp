@@ -54,6 +54,35 @@ std::unique_ptr<SpaceBar> SpaceBar::from_mass_properties(const Vec3& a, const Ve
   return std::make_unique<SpaceBar>(a, b, m, J);
 }
 
+std::unique_ptr<SpaceBar> SpaceBar::from_section(const Vec3& a, const Vec3& b,
+                                                 const BarSection& s) {
+  const double l = (b - a).norm();
+  const Mat3 R = bar_frame(a, b, s.section_y ? &*s.section_y : nullptr);
+  const double rho_l = s.density * l;
+  const Vec3 Jbar(rho_l * (s.Iy + s.Iz), rho_l * (s.Iy - s.area * l * l / 6.0),
+                  rho_l * (s.Iz - s.area * l * l / 6.0));
+  Mat3 J = R * Jbar.asDiagonal() * R.transpose();
+  J = 0.5 * (J + J.transpose()).eval();  // exactly symmetric
+  return std::make_unique<SpaceBar>(a, b, s.density * s.area * l, J);
+}
+
+std::unique_ptr<SpaceBar> SpaceBar::from_paper_lumping(const Vec3& a, const Vec3& b,
+                                                       const BarSection& s) {
+  // Kept to reproduce the paper's case study (docs/finger.md). Not equivalent to the bar: its
+  // torsion term is ⅙ of the bar's and the axes are not the bar's.
+  const double l = (b - a).norm(), rho_l = s.density * l;
+  const Vec3 J(rho_l * (s.Iy + s.Iz) / 6.0, rho_l * (s.Iy - s.area * l * l / 6.0),
+               rho_l * (s.Iz - s.area * l * l / 6.0));
+  return std::make_unique<SpaceBar>(a, b, s.density * s.area * l, J.asDiagonal());
+}
+
+std::optional<std::string> SpaceBar::section_y_problem(const Vec3& a, const Vec3& b,
+                                                       const Vec3& hint) {
+  const Vec3 x = (b - a).normalized();
+  if ((hint - hint.dot(x) * x).norm() < 1e-9 * (1 + hint.norm())) return "is parallel to the bar";
+  return std::nullopt;
+}
+
 // {"type": "space_bar", "nodes": [a, b], "density": ρ, "area": A, "Iy": …, "Iz": …,
 //  "section_y": [..]}  or  {"type": "space_bar", "nodes": [a, b], "mass": m, "inertia": I_c}
 void SpaceBar::from_params(const Params& p, ElementSink& sink) {
@@ -65,53 +94,34 @@ void SpaceBar::from_params(const Params& p, ElementSink& sink) {
   if (!p.has("nodes") || !p.json().at("nodes").is_array() || p.json().at("nodes").size() != 2)
     p.fail("nodes", "expected the bar's 2 nodes [a, b]");
   const NodeRef a = p.node_at("nodes", 0), b = p.node_at("nodes", 1);
-  const double l = (b.position - a.position).norm();
-  if (!(l > 1e-12)) p.fail("nodes", "the two nodes of a space bar coincide");
-  const Vec3 x = (b.position - a.position) / l;
-  double m;
-  Mat3 J;
+  if (!((b.position - a.position).norm() > 1e-12))
+    p.fail("nodes", "the two nodes of a space bar coincide");
   if (p.has("mass")) {
     if (lumping != "exact")
       p.fail("lumping", "the paper's lumping is given by density and section");
     for (const char* key : {"density", "area", "Iy", "Iz", "section_y"})
       if (p.has(key)) p.fail(key, "give either mass and inertia or density, area, Iy, Iz");
-    m = p.positive("mass");
+    const double m = p.positive("mass");
     const Mat3 Ic = p.inertia("inertia");
     if (auto problem = inertia_problem(Ic)) p.fail("inertia", *problem);
     sink.add(from_mass_properties(a.position, b.position, m, Ic), {a.label, b.label});
     return;
-  } else {
-    if (p.has("inertia"))
-      p.fail("inertia", "give either mass and inertia or density, area, Iy, Iz");
-    const double rho = p.positive("density"), A = p.positive("area");
-    const double Iy = p.positive("Iy"), Iz = p.positive("Iz");
-    Vec3 hint;
-    const bool has_hint = p.has("section_y");
-    if (has_hint) {
-      hint = p.vec3("section_y");
-      if ((hint - hint.dot(x) * x).norm() < 1e-9 * (1 + hint.norm()))
-        p.fail("section_y", "is parallel to the bar");
-    }
-    const Mat3 R = bar_frame(a.position, b.position, has_hint ? &hint : nullptr);
-    m = rho * A * l;
-    if (lumping == "paper") {
-      // The paper's printed lumping, kept to reproduce its case study (docs/finger.md):
-      // J = diag(⅙ρl(I_y+I_z), ρl(I_y − A l²/6), ρl(I_z − A l²/6)) on the body axes as they are.
-      // Not equivalent to the bar: its torsion term is ⅙ of the bar's and the axes are not
-      // the bar's.
-      if (has_hint) p.fail("section_y", "the paper's lumping uses the body axes as they are");
-      J = Vec3(rho * l * (Iy + Iz) / 6.0, rho * l * (Iy - A * l * l / 6.0),
-               rho * l * (Iz - A * l * l / 6.0))
-              .asDiagonal();
-      sink.add(std::make_unique<SpaceBar>(a.position, b.position, m, J), {a.label, b.label});
-      return;
-    }
-    const Vec3 Jbar(rho * l * (Iy + Iz), rho * l * (Iy - A * l * l / 6.0),
-                    rho * l * (Iz - A * l * l / 6.0));
-    J = R * Jbar.asDiagonal() * R.transpose();
-    J = 0.5 * (J + J.transpose()).eval();  // exactly symmetric
   }
-  sink.add(std::make_unique<SpaceBar>(a.position, b.position, m, J), {a.label, b.label});
+  if (p.has("inertia")) p.fail("inertia", "give either mass and inertia or density, area, Iy, Iz");
+  BarSection section{p.positive("density"), p.positive("area"), p.positive("Iy"), p.positive("Iz"),
+                     std::nullopt};
+  if (p.has("section_y")) {
+    section.section_y = p.vec3("section_y");
+    if (auto problem = section_y_problem(a.position, b.position, *section.section_y))
+      p.fail("section_y", *problem);
+  }
+  if (lumping == "paper") {
+    if (section.section_y)
+      p.fail("section_y", "the paper's lumping uses the body axes as they are");
+    sink.add(from_paper_lumping(a.position, b.position, section), {a.label, b.label});
+    return;
+  }
+  sink.add(from_section(a.position, b.position, section), {a.label, b.label});
 }
 
 }  // namespace femdyn

@@ -9,10 +9,18 @@
 // "lumping": "paper" reproduces the paper's printed (erroneous) lumping for its case study.
 #pragma once
 #include <array>
+#include <optional>
 
 #include "elements/registry.hpp"
 
 namespace femdyn {
+
+// A uniform bar's material and section: density ρ, area A and the second moments I_y, I_z
+// about the section's axes ŷ, ẑ; ŷ is section_y projected off the bar (see bar_frame).
+struct BarSection {
+  double density = 0, area = 0, Iy = 0, Iz = 0;
+  std::optional<Vec3> section_y;
+};
 
 class SpaceBar final : public Element {
  public:
@@ -33,6 +41,17 @@ class SpaceBar final : public Element {
   // "inertia"; a ≠ b and I_c physical are checked by the caller).
   static std::unique_ptr<SpaceBar> from_mass_properties(const Vec3& a, const Vec3& b, double m,
                                                         const Mat3& I_c);
+  // The bar of this section between a and b, J_rot as above (the JSON form with "density";
+  // a ≠ b, positive numbers and section_y_problem checked by the caller).
+  static std::unique_ptr<SpaceBar> from_section(const Vec3& a, const Vec3& b,
+                                                const BarSection& section);
+  // The paper's printed lumping (its case study only): J_rot = diag(⅙ρl(I_y+I_z),
+  // ρl(I_y − A l²/6), ρl(I_z − A l²/6)) on the body axes as they are.
+  static std::unique_ptr<SpaceBar> from_paper_lumping(const Vec3& a, const Vec3& b,
+                                                      const BarSection& section);
+  // Why section_y cannot orient the bar a → b (it is parallel to it), or nothing.
+  static std::optional<std::string> section_y_problem(const Vec3& a, const Vec3& b,
+                                                      const Vec3& section_y);
   static void from_params(const Params& p, ElementSink& sink);
 
  private:

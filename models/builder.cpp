@@ -165,6 +165,26 @@ void MechanismBuilder::space_bar(const std::string& body, const NodeDescription&
       .add(SpaceBar::from_mass_properties(pa, pb, mass, inertia), {la, lb});
 }
 
+void MechanismBuilder::space_bar(const std::string& body, const NodeDescription& a,
+                                 const NodeDescription& b, const BarSection& section) {
+  BodySpec& bs = body_named(body, "space_bar");
+  const std::string where = next_element(bs);
+  const auto [pa, la] = resolve(bs, a, where + "/nodes/0");
+  const auto [pb, lb] = resolve(bs, b, where + "/nodes/1");
+  if (!((pb - pa).norm() > 1e-12))
+    throw ModelError(where + "/nodes", "the two nodes of a space bar coincide");
+  check_positive(section.density, where + "/density");
+  check_positive(section.area, where + "/area");
+  check_positive(section.Iy, where + "/Iy");
+  check_positive(section.Iz, where + "/Iz");
+  if (section.section_y) {
+    check_magnitude(*section.section_y, where + "/section_y", "section axis");
+    if (auto problem = SpaceBar::section_y_problem(pa, pb, *section.section_y))
+      throw ModelError(where + "/section_y", *problem);
+  }
+  ElementSink(bs.elements, where).add(SpaceBar::from_section(pa, pb, section), {la, lb});
+}
+
 void MechanismBuilder::rod(const std::string& body, const NodeDescription& a,
                            const NodeDescription& b, double mass) {
   BodySpec& bs = body_named(body, "rod");

@@ -19,6 +19,8 @@
 
 namespace femdyn {
 
+struct BarSection;  // elements/space_bar.hpp
+
 // A node of a body: a name from its node table ("tip"; "other_body/tip" for a rod's far end),
 // or a position in the body frame.
 using NodeDescription = std::variant<std::string, Vec3>;
@@ -45,6 +47,9 @@ class MechanismBuilder {
   // form of space_bar).
   void space_bar(const std::string& body, const NodeDescription& a, const NodeDescription& b,
                  double mass, const Mat3& inertia);
+  // A uniform bar from a to b of this material and section (the JSON "density" form).
+  void space_bar(const std::string& body, const NodeDescription& a, const NodeDescription& b,
+                 const BarSection& section);
   void rod(const std::string& body, const NodeDescription& a, const NodeDescription& b,
            double mass);
 

@@ -9,6 +9,7 @@
 
 #include "core/joints/kernel.hpp"
 #include "core/model/names.hpp"
+#include "elements/space_bar.hpp"
 #include "models/builder.hpp"
 #include "models/model_files.hpp"
 #include "python/py_model.hpp"
@@ -294,6 +295,20 @@ void bind_builder(py::module_& m) {
           },
           py::arg("body"), py::arg("a"), py::arg("b"), py::arg("mass"), py::arg("inertia"),
           "a rigid bar from a to b of this mass and centroidal inertia")
+      .def(
+          "space_bar",
+          [](MechanismBuilder& b, const std::string& body, const py::object& a,
+             const py::object& b_node, double density, double area, double Iy, double Iz,
+             const py::object& section_y) {
+            BarSection section{density, area, Iy, Iz, std::nullopt};
+            if (!section_y.is_none())
+              section.section_y = vec3_arg(section_y.cast<Array>(), "section_y");
+            b.space_bar(text_arg(body, "body"), node_arg(a, "a"), node_arg(b_node, "b"), section);
+          },
+          py::arg("body"), py::arg("a"), py::arg("b"), py::kw_only(), py::arg("density"),
+          py::arg("area"), py::arg("Iy"), py::arg("Iz"), py::arg("section_y") = py::none(),
+          "a uniform bar from a to b of this density, section area and second moments (I_y, I_z "
+          "about the section's axes; section_y orients them)")
       .def(
           "rod",
           [](MechanismBuilder& b, const std::string& body, const py::object& a,

@@ -7,6 +7,7 @@
 
 #include "core/dynamics/equations.hpp"
 #include "core/kinematics/sampling.hpp"
+#include "elements/space_bar.hpp"
 #include "models/builder.hpp"
 #include "tests/helpers.hpp"
 
@@ -36,7 +37,9 @@ const char* kJson = R"({"name": "everything", "gravity": [0.3, -9.81, -1.0], "bo
                  "inertia": [[0.0001, 0, 0], [0, 0.0014, 0], [0, 0, 0.0014]]}]},
   {"name": "hand", "parent": "slider", "joint": {"name": "j5", "type": "revolute",
    "axis": [1, 0, 0], "origin": {"xyz": [0.2, 0.02, 0]}},
-   "elements": [{"type": "lumped_point", "node": [0, 0.05, 0], "mass": 0.1}]},
+   "elements": [{"type": "lumped_point", "node": [0, 0.05, 0], "mass": 0.1},
+                {"type": "space_bar", "nodes": [[0, 0, 0], [0.01, 0.1, 0.02]], "density": 2700,
+                 "area": 1e-4, "Iy": 2e-9, "Iz": 3e-9, "section_y": [1, 0, 0.3]}]},
   {"name": "finger", "parent": "hand", "joint": {"name": "j6", "type": "revolute",
    "axis": [0, 0, 1], "origin": {"xyz": [0, 0.05, 0]}},
    "elements": [{"type": "lumped_point", "node": [0.04, 0, 0], "mass": 0.05}]}],
@@ -91,6 +94,8 @@ MechanismBuilder everything() {
               tensor(0.0001, 0.0014, 0.0014, 0, 0, 0));
   b.body("hand", "slider", revolute("j5", Vec3::UnitX(), {0.2, 0.02, 0}));
   b.lumped_point("hand", Vec3(0, 0.05, 0), 0.1);
+  b.space_bar("hand", Vec3(0, 0, 0), Vec3(0.01, 0.1, 0.02),
+              BarSection{2700, 1e-4, 2e-9, 3e-9, Vec3(1, 0, 0.3)});
   b.body("finger", "hand", revolute("j6", Vec3::UnitZ(), {0, 0.05, 0}));
   b.lumped_point("finger", Vec3(0.04, 0, 0), 0.05);
   FourBarCoupling::Geometry g;
@@ -153,6 +158,12 @@ TEST_CASE("the builder refuses bad arguments with the loader's paths", "[builder
                     "arm (builder): /bodies/0/elements/0/com: centre of mass is NaN or Inf");
   CHECK_THROWS_WITH(b.space_bar("link", Vec3(1, 0, 0), Vec3(1, 0, 0), 1, Mat3::Identity()),
                     Catch::Contains("the two nodes of a space bar coincide"));
+  CHECK_THROWS_WITH(
+      b.space_bar("link", Vec3(0, 0, 0), Vec3(1, 0, 0), BarSection{2700, 1e-4, -1, 1e-9, {}}),
+      "arm (builder): /bodies/0/elements/0/Iy: must be positive, got -1");
+  CHECK_THROWS_WITH(b.space_bar("link", Vec3(0, 0, 0), Vec3(1, 0, 0),
+                                BarSection{2700, 1e-4, 1e-9, 1e-9, Vec3(-2, 0, 0)}),
+                    "arm (builder): /bodies/0/elements/0/section_y: is parallel to the bar");
   // What compile() checks is reported by compile(), with the builder's paths.
   b.lumped_point("link", Vec3(0, 0, -1), 1);
   b.body("other", "missing", revolute("k", Vec3::UnitZ()));

@@ -40,7 +40,10 @@ DOCUMENT = {
         {"name": "hand", "parent": "slider",
          "joint": {"name": "j5", "type": "revolute", "axis": [1, 0, 0],
                    "origin": {"xyz": [0.2, 0.02, 0]}},
-         "elements": [{"type": "lumped_point", "node": [0, 0.05, 0], "mass": 0.1}]},
+         "elements": [{"type": "lumped_point", "node": [0, 0.05, 0], "mass": 0.1},
+                      {"type": "space_bar", "nodes": [[0, 0, 0], [0.01, 0.1, 0.02]],
+                       "density": 2700, "area": 1e-4, "Iy": 2e-9, "Iz": 3e-9,
+                       "section_y": [1, 0, 0.3]}]},
         {"name": "finger", "parent": "hand",
          "joint": {"name": "j6", "type": "revolute", "axis": [0, 0, 1],
                    "origin": {"xyz": [0, 0.05, 0]}},
@@ -74,6 +77,8 @@ def built():
     b.space_bar("slider", [0, 0, 0], [0.2, 0.02, 0], 0.4, np.diag([0.0001, 0.0014, 0.0014]))
     b.body("hand", "slider", type="revolute", joint="j5", axis=[1, 0, 0], xyz=[0.2, 0.02, 0])
     b.lumped_point("hand", [0, 0.05, 0], 0.1)
+    b.space_bar("hand", [0, 0, 0], [0.01, 0.1, 0.02], density=2700, area=1e-4, Iy=2e-9, Iz=3e-9,
+                section_y=[1, 0, 0.3])
     b.body("finger", "hand", type="revolute", joint="j6", axis=[0, 0, 1], xyz=[0, 0.05, 0])
     b.lumped_point("finger", [0.04, 0, 0], 0.05)
     b.coupling("j2", "j1", four_bar={"ground": 0.3, "input": 0.1, "coupler": 0.35,
