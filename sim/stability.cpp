@@ -173,11 +173,7 @@ Linearization difference_linearization(const Model& m, Workspace& ws, const VecX
     else
       qp = q;
   }
-  if (!flat)
-    for (int j = 0; j < n; ++j) {
-      const VecX e = VecX::Unit(n, j) * 1e-6;
-      lin.A.block(0, j, n, 1) = (chart_rates(m, q, e, qd) - chart_rates(m, q, -e, qd)) / 2e-6;
-    }
+  lin.A.topLeftCorner(n, n) = chart_rate_jacobian(m, qd);  // each joint type's ∂ξ̇/∂ξ
   analyse(lin);
   return lin;
 }

@@ -54,8 +54,9 @@ struct Linearization {
 // cover the model; otherwise difference_linearization's.
 Linearization linearize(const Model& model, Workspace& ws, const VecX& q, const VecX& qd,
                         const VecX& tau, double baumgarte = Motion::kDefaultBaumgarte);
-// A by central differences of forward dynamics (2n pairs of evaluations, step 1e-6 relative),
-// in the same chart, for every model.
+// ∂q̈/∂(q, v) by central differences of forward dynamics (2n pairs of evaluations, step 1e-6
+// relative), in the same chart, for every model; the chart block ∂ξ̇/∂ξ is each joint type's own
+// (chart_rate_jacobian), as in linearize.
 Linearization difference_linearization(const Model& model, Workspace& ws, const VecX& q,
                                        const VecX& qd, const VecX& tau,
                                        double baumgarte = Motion::kDefaultBaumgarte);

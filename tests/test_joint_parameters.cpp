@@ -151,3 +151,28 @@ TEST_CASE("every joint type from its declaration matches its Simbody twin") {
   }
 }
 #endif
+
+TEST_CASE("every joint type's chart Jacobian is the derivative of its chart rate at ξ = 0") {
+  // The top-left block of every linearisation (sim/stability.cpp, core/derivatives): a type
+  // that moves on a manifold and gave 0 here would linearise about the wrong chart.
+  for (const JointType type : joint_types()) {
+    INFO(joint_type_name(type));
+    const Model m = load_text(model_json(type));
+    std::mt19937 rng(3);
+    for (int k = 0; k < 3; ++k) {
+      const VecX q = random_posture(m, rng), v = random_uniform(m.n(), 2.0, rng);
+      const MatX A = chart_rate_jacobian(m, v);
+      MatX by_differences(m.n(), m.n());
+      const double h = 1e-6;
+      for (int j = 0; j < m.n(); ++j) {
+        const VecX e = VecX::Unit(m.n(), j) * h;
+        by_differences.col(j) = (chart_rates(m, q, e, v) - chart_rates(m, q, -e, v)) / (2 * h);
+      }
+      CHECK((A - by_differences).cwiseAbs().maxCoeff() < 1e-8);  // (central differences: h²)
+      if (is_flat(m.bodies[0].joint))
+        CHECK(A.isZero(0));
+      else
+        CHECK(A.norm() > 0.1);  // (the rates are O(1): the block is not 0)
+    }
+  }
+}

@@ -10,6 +10,7 @@
 #include "core/joints/rotor.hpp"
 #include "core/kinematics/coupling.hpp"
 #include "core/kinematics/kinematics.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/model/arguments.hpp"
 #include "core/model/errors.hpp"
 
@@ -373,15 +374,7 @@ void linearization(const Model& m, const DerivativeWorkspace& d, const VecX& qd,
   A.bottomRightCorner(n, n) = d.dqdd_dv;
   for (int k = 0; k < m.n_actuated(); ++k)  // B = [0; M⁻¹ S], S = I[:, actuated]
     B.col(k).tail(n) = d.Minv.col(m.actuated[k]);
-  for (const CoordinateJoint& c : m.coordinate_joints) {
-    const Joint& J = m.bodies[c.body].joint;
-    if (J.type == JointType::Spherical) {  // ξ̇ = J_r(ξ)⁻¹ ω: −½ [ω]×
-      A.block<3, 3>(c.v, c.v) = -0.5 * skew(qd.segment<3>(c.v));
-    } else if (J.type == JointType::Free) {  // ξ̇_p = exp(ξ_r) v_p: −[v_p]×; ξ̇_r as above
-      A.block<3, 3>(c.v, c.v + 3) = -skew(qd.segment<3>(c.v));
-      A.block<3, 3>(c.v + 3, c.v + 3) = -0.5 * skew(qd.segment<3>(c.v + 3));
-    }
-  }
+  A.topLeftCorner(n, n) = chart_rate_jacobian(m, qd);  // each joint type's ∂ξ̇/∂ξ
 }
 
 Status linearize_state(const Model& m, Workspace& ws, DerivativeWorkspace& d, const VecX& q,

@@ -142,8 +142,8 @@ Status forward_dynamics_derivatives(const Model& model, Workspace& ws, Derivativ
 // A = ∂(ξ̇, v̇)/∂(ξ, v) at ξ = 0 (2n × 2n) and B = ∂(ξ̇, v̇)/∂u (2n × n_a) from the forward
 // derivatives in d at (q, v), u the actuated coordinates' τ (τ = S u, S = I[:, model.actuated]:
 // B's columns are those of [0; M⁻¹] at the actuated rates, docs/control.md#actuation).
-// ξ̇ = v on flat joints; in the chart ξ ↦ q ⊕ ξ a spherical joint has
-// ξ̇ = J_r(ξ)⁻¹ ω, so ∂ξ̇/∂ξ = −½ [ω]×, and a free joint also ξ̇_p = exp(ξ_r) v_p, −[v_p]×.
+// ∂ξ̇/∂ξ is each joint type's chart_rate_jacobian (core/kinematics/sampling.hpp): 0 on flat
+// joints, −½ [ω]× for a spherical one (ξ̇ = J_r(ξ)⁻¹ ω), and −[v_p]× besides for a free one.
 void linearization(const Model& model, const DerivativeWorkspace& d, const VecX& qd, MatX& A,
                    MatX& B);
 

@@ -1,6 +1,6 @@
 // What a joint whose coordinates form a vector space (nq = nv, θ̇_J the derivative of θ_J) gives
 // the kernel for its configuration: q ⊕ ξ = q + ξ, q₁ ⊖ q₀ = q₁ − q₀, ξ̇ = v in every chart,
-// the neutral configuration 0. Every type but spherical and free inherits it.
+// the neutral configuration 0, ∂ξ̇/∂ξ = 0. Every type but spherical and free inherits it.
 #pragma once
 #include <random>
 
@@ -21,6 +21,8 @@ struct FlatJoint {
                          double* xi_dot) {
     for (int k = 0; k < N; ++k) xi_dot[k] = v[k];
   }
+  // ∂ξ̇/∂ξ at ξ = 0 (nv × nv, row-major into A, zero on entry): ξ̇ = v does not depend on ξ.
+  static void chart_rate_jacobian(const Joint&, const double*, double*) {}
   // The suffix naming coordinate k (and rate k): "" for a joint of one coordinate.
   static const char* coordinate_name(int) { return ""; }
   static const char* rate_name(int k) { return coordinate_name(k); }

@@ -56,6 +56,12 @@ struct FreeJoint {
     const Vec3 p = E * Vec3(v[0], v[1], v[2]), a = inverse_right_jacobian_times(r, w);
     for (int k = 0; k < 3; ++k) xi_dot[k] = p[k], xi_dot[3 + k] = a[k];
   }
+  // ∂ξ̇/∂ξ at ξ = 0 (6 × 6, row-major into A): ξ̇_p = exp(ξ_r) v_p = v_p − [v_p]× ξ_r + O(ξ²)
+  // gives −[v_p]× in the block (p, r); ξ̇_r as a spherical joint's, −½ [ω]× in (r, r).
+  static void chart_rate_jacobian(const Joint&, const double* v, double* A) {
+    add_skew(-1.0, v, A + 3, 6);
+    add_skew(-0.5, v + 3, A + 6 * 3 + 3, 6);
+  }
   // Along the ray q(s) = q_c ⊕ sΔ: p = p_c + R_c s Δ_p turns into B's axes as B turns by
   // exp(sΔ_r), so the rates per unit s are w = (exp(sΔ_r)ᵀ Δ_p, Δ_r), dw/ds = (−Δ_r × w_p, 0).
   static void ray_rates(const Joint&, const double* delta, double s, double* w, double* dw) {

@@ -239,6 +239,12 @@ inline void chart_rate(const Joint& j, const double* q_c, const double* xi, cons
   visit_joint(j.type, [&]<class J>(J) { J::chart_rate(j, q_c, xi, v, xi_dot); });
 }
 
+// ∂ξ̇/∂ξ at ξ = 0 for the rates v: the joint's nv × nv block of the linearisation's top rows,
+// row-major into A (zero on entry; 0 for a flat joint).
+inline void chart_rate_jacobian(const Joint& j, const double* v, double* A) {
+  visit_joint(j.type, [&]<class J>(J) { J::chart_rate_jacobian(j, v, A); });
+}
+
 // A random configuration of a joint of more than one rate into q[0 .. nq): each flat coordinate
 // uniform within the type's half range (±π for angles), a rotation uniform over SO(3).
 inline void random_configuration(const Joint& j, std::mt19937& rng, double* q) {

@@ -49,4 +49,11 @@ inline Vec3 inverse_right_jacobian_times(const Vec3& xi, const Vec3& w) {
   return w + 0.5 * xw + c * xi.cross(xw);
 }
 
+// A += s [v]× on the 3 × 3 block at A of a row-major matrix with this row stride.
+inline void add_skew(double s, const double* v, double* A, int stride) {
+  A[1] -= s * v[2], A[2] += s * v[1];
+  A[stride] += s * v[2], A[stride + 2] -= s * v[0];
+  A[2 * stride] -= s * v[1], A[2 * stride + 1] += s * v[0];
+}
+
 }  // namespace femdyn

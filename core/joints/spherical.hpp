@@ -47,6 +47,10 @@ struct SphericalJoint {
     const Vec3 r = inverse_right_jacobian_times(Vec3(xi[0], xi[1], xi[2]), Vec3(v[0], v[1], v[2]));
     for (int k = 0; k < 3; ++k) xi_dot[k] = r[k];
   }
+  // ∂ξ̇/∂ξ at ξ = 0: J_r(ξ)⁻¹ ω = ω + ½ ξ × ω + O(ξ²), so −½ [ω]× (row-major into A).
+  static void chart_rate_jacobian(const Joint&, const double* v, double* A) {
+    add_skew(-0.5, v, A, 3);
+  }
   static void neutral(double* q) { q[0] = 1, q[1] = q[2] = q[3] = 0; }
   static constexpr double kRandomHalfRange = 3.141592653589793;  // uniform over all rotations
 };

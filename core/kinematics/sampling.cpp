@@ -1,6 +1,7 @@
 #include "core/kinematics/sampling.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -86,6 +87,19 @@ VecX chart_rates(const Model& m, const VecX& q, const VecX& xi, const VecX& v) {
     chart_rate(m.bodies[c.body].joint, q.data() + c.q, xi.data() + c.v, v.data() + c.v,
                out.data() + c.v);
   return out;
+}
+
+MatX chart_rate_jacobian(const Model& m, const VecX& v) {
+  MatX A = MatX::Zero(m.n(), m.n());
+  if (flat_model(m)) return A;
+  for (const CoordinateJoint& c : m.coordinate_joints) {
+    const Joint& J = m.bodies[c.body].joint;
+    using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    std::array<double, 36> block{};  // (nv × nv, row-major)
+    chart_rate_jacobian(J, v.data() + c.v, block.data());
+    A.block(c.v, c.v, J.nv, J.nv) = Eigen::Map<const RowMajor>(block.data(), J.nv, J.nv);
+  }
+  return A;
 }
 
 std::string normalize_quaternions(const Model& m, VecX& q) {

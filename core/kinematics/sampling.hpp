@@ -18,6 +18,9 @@ VecX neutral_posture(const Model& model);
 VecX integrate_posture(const Model& model, const VecX& q, const VecX& xi);
 // ξ̇ = the chart rates at (q ⊕ ξ) for the rates v, joint by joint (v when flat).
 VecX chart_rates(const Model& model, const VecX& q, const VecX& xi, const VecX& v);
+// ∂ξ̇/∂ξ at ξ = 0 for the rates v (n × n): each joint's own block (chart_rate_jacobian), 0 when
+// flat. The top-left block of every linearisation A = ∂(ξ̇, v̇)/∂(ξ, v).
+MatX chart_rate_jacobian(const Model& model, const VecX& v);
 // Whether every joint is flat (q holds one entry per rate, q ⊕ ξ = q + ξ).
 bool flat_model(const Model& model);
 // Each quaternion in q normalised (one already unit to within 4 ε left as it is: normalising
