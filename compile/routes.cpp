@@ -2,6 +2,7 @@
 
 #include "core/dynamics/equations.hpp"
 #include "core/dynamics/span_inertia.hpp"
+#include "core/loops/constrained_dynamics.hpp"
 #include "core/model/errors.hpp"
 #include "core/workspace/mass_pattern.hpp"
 
@@ -84,6 +85,15 @@ void choose_routes(Model& m, const RouteChoice& asked) {
     analyse_mass_pattern(m);
   }
   m.routes = choose_equation_routes(m);
+  if (m.constraints.empty()) {
+    m.routes.mechanism_forward_dynamics = tree_mechanism_forward_dynamics;
+    m.routes.names.mechanism = m.routes.names.forward;
+  } else {
+    m.routes.mechanism_forward_dynamics = closed_mechanism_forward_dynamics;
+    m.routes.names.mechanism =
+        "the constrained q̈ of M^s q̈ + h = Q + Φ_qᵀ λ, Φ_q q̈ = −Φ̇_q q̇ (S = Φ_q (M^s)⁻¹ Φ_qᵀ by "
+        "pivoted Cholesky)";
+  }
 }
 
 void provisional_routes(Model& m) { m.routes = choose_equation_routes(m); }

@@ -486,10 +486,7 @@ RouteReport route_report(const Model& model) {
         r.solver = "the coordinate tree's LTDL";
         break;
     }
-  if (!model.constraints.empty())
-    r.loops =
-        "the constrained q̈ of M^s q̈ + h = Q + Φ_qᵀ λ, Φ_q q̈ = −Φ̇_q q̇ (S = Φ_q (M^s)⁻¹ Φ_qᵀ by "
-        "pivoted Cholesky)";
+  if (!model.constraints.empty()) r.loops = names.mechanism;
   return r;
 }
 

@@ -193,7 +193,16 @@ Status closed_state(const Model& model, Workspace& ws, ConstraintKinematics& k, 
 
 Status mechanism_forward_dynamics(const Model& model, Workspace& ws, LoopWorkspace* lws,
                                   const VecX& q, const VecX& v, const VecX& tau) {
-  if (model.constraints.empty()) return forward_dynamics(model, ws, q, v, tau);
+  return model.routes.mechanism_forward_dynamics(model, ws, lws, q, v, tau);
+}
+
+Status tree_mechanism_forward_dynamics(const Model& model, Workspace& ws, LoopWorkspace*,
+                                       const VecX& q, const VecX& v, const VecX& tau) {
+  return forward_dynamics(model, ws, q, v, tau);
+}
+
+Status closed_mechanism_forward_dynamics(const Model& model, Workspace& ws, LoopWorkspace* lws,
+                                         const VecX& q, const VecX& v, const VecX& tau) {
   require_state(model, "mechanism_forward_dynamics", q, &v);
   if (!lws)
     throw ArgumentError("mechanism_forward_dynamics: the model '" + model.name +

@@ -66,6 +66,12 @@ Status constrained_forward_dynamics(const Model& model, Workspace& ws, LoopWorks
 // may be null only on a model without constraints.
 Status mechanism_forward_dynamics(const Model& model, Workspace& ws, LoopWorkspace* lws,
                                   const VecX& q, const VecX& v, const VecX& tau);
+// Its two routes (EquationRoutes::mechanism_forward_dynamics, chosen at compile): the tree's
+// forward_dynamics, and the constrained q̈ at ω = 0 from the closed state.
+Status tree_mechanism_forward_dynamics(const Model& model, Workspace& ws, LoopWorkspace* lws,
+                                       const VecX& q, const VecX& v, const VecX& tau);
+Status closed_mechanism_forward_dynamics(const Model& model, Workspace& ws, LoopWorkspace* lws,
+                                         const VecX& q, const VecX& v, const VecX& tau);
 
 // L, the size of the loops: the largest distance of a constraint's place (gears have none) from
 // its body's origin, or, on the world, from the reference point `origin` (Workspace::origin of

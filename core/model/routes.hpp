@@ -17,13 +17,15 @@ struct Workspace;
 struct Status;
 struct Energy;
 struct KinematicsRequest;
+struct LoopWorkspace;
 
 // What each route is, named where choose_equation_routes chooses it, so that reports say which
 // one ran (route_report, core/dynamics/equations.hpp).
 struct RouteNames {
-  const char* mass = "";     // M^s
-  const char* force = "";    // h and τ
-  const char* forward = "";  // the tree's q̈
+  const char* mass = "";       // M^s
+  const char* force = "";      // h and τ
+  const char* forward = "";    // the tree's q̈
+  const char* mechanism = "";  // the mechanism's q̈: the tree's, or the constrained one on loops
 };
 
 struct EquationRoutes {
@@ -41,6 +43,11 @@ struct EquationRoutes {
   void (*joint_state)(const Model&, Workspace&, const VecX& q, const VecX& qd) = nullptr;
   void (*propagate_bilinear)(const Model&, Workspace&, const VecX& q, const VecX& x, const VecX& y,
                              KinematicsRequest request) = nullptr;
+  // q̈ of the mechanism (mechanism_forward_dynamics, core/loops/constrained_dynamics.hpp): the
+  // tree's forward_dynamics, or on a model with loops the constrained equations (its
+  // LoopWorkspace given). Chosen by compile's choose_routes, which alone sees both.
+  Status (*mechanism_forward_dynamics)(const Model&, Workspace&, LoopWorkspace*, const VecX& q,
+                                       const VecX& v, const VecX& tau) = nullptr;
   RouteNames names;
 };
 
