@@ -151,14 +151,22 @@ void MechanismBuilder::rigid_body(const std::string& body, double mass, const Ve
   RigidBodyShorthand::point_rotary(mass, com, inertia, sink);
 }
 
+MechanismBuilder::BarEnds MechanismBuilder::space_bar_ends(const BodySpec& bs,
+                                                           const NodeDescription& a,
+                                                           const NodeDescription& b,
+                                                           const std::string& where) const {
+  auto [pa, la] = resolve(bs, a, where + "/nodes/0");
+  auto [pb, lb] = resolve(bs, b, where + "/nodes/1");
+  if (!((pb - pa).norm() > 1e-12))
+    throw ModelError(where + "/nodes", "the two nodes of a space bar coincide");
+  return {pa, std::move(la), pb, std::move(lb)};
+}
+
 void MechanismBuilder::space_bar(const std::string& body, const NodeDescription& a,
                                  const NodeDescription& b, double mass, const Mat3& inertia) {
   BodySpec& bs = body_named(body, "space_bar");
   const std::string where = next_element(bs);
-  const auto [pa, la] = resolve(bs, a, where + "/nodes/0");
-  const auto [pb, lb] = resolve(bs, b, where + "/nodes/1");
-  if (!((pb - pa).norm() > 1e-12))
-    throw ModelError(where + "/nodes", "the two nodes of a space bar coincide");
+  const auto [pa, la, pb, lb] = space_bar_ends(bs, a, b, where);
   check_positive(mass, where + "/mass");
   check_inertia(inertia, where + "/inertia");
   ElementSink(bs.elements, where)
@@ -169,10 +177,7 @@ void MechanismBuilder::space_bar(const std::string& body, const NodeDescription&
                                  const NodeDescription& b, const BarSection& section) {
   BodySpec& bs = body_named(body, "space_bar");
   const std::string where = next_element(bs);
-  const auto [pa, la] = resolve(bs, a, where + "/nodes/0");
-  const auto [pb, lb] = resolve(bs, b, where + "/nodes/1");
-  if (!((pb - pa).norm() > 1e-12))
-    throw ModelError(where + "/nodes", "the two nodes of a space bar coincide");
+  const auto [pa, la, pb, lb] = space_bar_ends(bs, a, b, where);
   check_positive(section.density, where + "/density");
   check_positive(section.area, where + "/area");
   check_positive(section.Iy, where + "/Iy");

@@ -86,6 +86,15 @@ class MechanismBuilder {
   std::string next_element(const BodySpec& b) const;  // "…/bodies/i/elements/k"
   std::pair<Vec3, std::string> resolve(const BodySpec& b, const NodeDescription& node,
                                        const std::string& where) const;
+  // A space bar's two ends, resolved, refused where they coincide.
+  struct BarEnds {
+    Vec3 a;
+    std::string a_label;
+    Vec3 b;
+    std::string b_label;
+  };
+  BarEnds space_bar_ends(const BodySpec& bs, const NodeDescription& a, const NodeDescription& b,
+                         const std::string& where) const;
   MechanismSpec spec_;
   std::map<std::string, std::map<std::string, Vec3>> nodes_;  // body -> name -> position
 };

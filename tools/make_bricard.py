@@ -16,10 +16,9 @@ a point on the line through E along x (2 equations: the bar's x-axis stays on th
 axis). 5 coordinates, 5 equations: Grübler counts 0 DOF, yet the equations have rank 4 and the
 mechanism moves with 1 (one equation is redundant). From rest, under gravity 9.81 in -y.
 """
-import json
-import os
-import re
 import sys
+
+import model_json
 
 BARS = [  # name, joint point at the start (world), axis, CoM from the joint, long axis
     ("OA", (0, 0, 0), (0, 1, 0), (0.5, 0, 0), 0),
@@ -72,17 +71,5 @@ def model():
     }
 
 
-def dump(doc):
-    """JSON with two-space indents, each list of numbers on one line."""
-    text = json.dumps(doc, indent=2, ensure_ascii=False)
-    return re.sub(r"\[\s*([-0-9.e,\s]+?)\s*\]",
-                  lambda m: "[" + ", ".join(x.strip() for x in m.group(1).split(",")) + "]",
-                  text) + "\n"
-
-
 if __name__ == "__main__":
-    root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
-    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(root, "models",
-                                                            "iftomm_a04_bricard.json")
-    with open(out, "w") as f:
-        f.write(dump(model()))
+    model_json.write(model(), sys.argv[1] if len(sys.argv) > 1 else None, "iftomm_a04_bricard.json")

@@ -15,11 +15,10 @@ the rods' middles: 0.5 m long at the start, so unloaded. No loop constraints: a 
 joints with two springs. Each rod and its tip mass are one rigid body (its CoM and inertia
 combined here). The shaft's initial rate, 2π rad/s, is --qd0 6.283185307179586,0,0,0.
 """
-import json
 import math
-import os
-import re
 import sys
+
+import model_json
 
 DENSITY = 3000.0
 SHAFT_MASS = round(DENSITY * 1.0 * 0.01 * 0.01, 12)  # 0.3 kg
@@ -89,17 +88,5 @@ def model():
     }
 
 
-def dump(doc):
-    """JSON with two-space indents, each list of numbers on one line."""
-    text = json.dumps(doc, indent=2, ensure_ascii=False)
-    return re.sub(r"\[\s*([-0-9.e,\s]+?)\s*\]",
-                  lambda m: "[" + ", ".join(x.strip() for x in m.group(1).split(",")) + "]",
-                  text) + "\n"
-
-
 if __name__ == "__main__":
-    root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
-    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(root, "models",
-                                                            "iftomm_a05_flyball.json")
-    with open(out, "w") as f:
-        f.write(dump(model()))
+    model_json.write(model(), sys.argv[1] if len(sys.argv) > 1 else None, "iftomm_a05_flyball.json")

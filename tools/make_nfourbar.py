@@ -21,10 +21,9 @@ Every joint coordinate is 0 at the start, so the file needs no "initial". The in
 chain's relative coordinates, q̇ = (-1, +1, -1, +1, ..., -1): pass it to femdyn simulate as
 --qd0 (this script prints it with --qd0).
 """
-import json
-import os
-import re
 import sys
+
+import model_json
 
 L, M, G = 1.0, 1.0, 9.81
 I_ROD = M * L * L / 12  # slender rod about its CoM (the out-of-plane axes do not enter)
@@ -82,14 +81,6 @@ def qd0(n):
     return [-1.0 if k % 2 == 0 else 1.0 for k in range(2 * n + 1)]
 
 
-def dump(doc):
-    """JSON with two-space indents, each list of numbers on one line."""
-    text = json.dumps(doc, indent=2, ensure_ascii=False)
-    return re.sub(r"\[\s*([-0-9.e,\s]+?)\s*\]",
-                  lambda m: "[" + ", ".join(x.strip() for x in m.group(1).split(",")) + "]",
-                  text) + "\n"
-
-
 if __name__ == "__main__":
     args = sys.argv[1:]
     if args[:1] == ["--qd0"]:
@@ -97,7 +88,4 @@ if __name__ == "__main__":
         print(",".join(f"{x:g}" for x in qd0(n)))
         sys.exit(0)
     n = int(args[0]) if args else 40
-    root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
-    out = args[1] if len(args) > 1 else os.path.join(root, "models", "iftomm_a02_nfourbar.json")
-    with open(out, "w") as f:
-        f.write(dump(model(n)))
+    model_json.write(model(n), args[1] if len(args) > 1 else None, "iftomm_a02_nfourbar.json")

@@ -9,6 +9,7 @@
 
 #include "core/model/errors.hpp"
 #include "core/model/names.hpp"
+#include "validation/simtk_convert.hpp"
 #include "validation/twin_impl.hpp"
 
 namespace femdyn::validation {
@@ -16,15 +17,6 @@ namespace femdyn::validation {
 namespace constraints {
 
 namespace {
-
-SimTK::Vec3 to_simtk(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
-
-SimTK::Rotation to_simtk(const Mat3& R) {
-  SimTK::Mat33 m;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) m(i, j) = R(i, j);
-  return SimTK::Rotation(m, true);  // an attachment's axes are orthonormal
-}
 
 SimTK::MobilizedBody& body(SimTK::SimbodyMatterSubsystem& matter,
                            std::vector<SimTK::MobilizedBody>& tree, int b) {

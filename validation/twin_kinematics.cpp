@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/model/errors.hpp"
+#include "validation/simtk_convert.hpp"
 #include "validation/twin_impl.hpp"
 #include "validation/twin_loops.hpp"
 
@@ -19,24 +20,6 @@ namespace femdyn::validation {
 namespace {
 
 using Vec6 = ::Eigen::Matrix<double, 6, 1>;
-
-SimTK::Vec3 to_simtk(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
-
-SimTK::Rotation to_simtk(const Mat3& R) {
-  SimTK::Mat33 m;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) m(i, j) = R(i, j);
-  return SimTK::Rotation(m, true);  // R_BF is orthonormal (the model's frames are)
-}
-
-Vec3 from_simtk(const SimTK::Vec3& v) { return {v[0], v[1], v[2]}; }
-
-Mat3 from_simtk(const SimTK::Mat33& m) {
-  Mat3 out;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) out(i, j) = m(i, j);
-  return out;
-}
 
 // Simbody's (angular, linear) as femdyn's (linear, angular).
 Vec6 linear_first(const SimTK::SpatialVec& V) {

@@ -5,12 +5,11 @@
 #include <string>
 
 #include "core/model/names.hpp"
+#include "validation/simtk_convert.hpp"
 
 namespace femdyn::validation::loops {
 
 namespace {
-
-SimTK::Vec3 to_simtk(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
 // φ(θ_t, θ_s1, …, θ_sk) = θ_t − f(θ_s1, …, θ_sk): the coupler's constraint function, with
 // ∂φ/∂θ_t = 1, ∂φ/∂θ_si = −f_i, and second derivatives −f_ij (none involve θ_t).

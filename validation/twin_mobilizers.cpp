@@ -4,6 +4,7 @@
 #include <Simbody.h>
 
 #include "core/model/names.hpp"
+#include "validation/simtk_convert.hpp"
 #include "validation/twin_constraints.hpp"
 #include "validation/twin_friction.hpp"
 #include "validation/twin_impl.hpp"
@@ -12,15 +13,6 @@
 namespace femdyn::validation {
 
 namespace {
-
-SimTK::Vec3 to_simtk(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
-
-SimTK::Rotation to_simtk(const Mat3& R) {
-  SimTK::Mat33 m;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) m(i, j) = R(i, j);
-  return SimTK::Rotation(m, true);  // R is orthonormal (built from rpy)
-}
 
 SimTK::MassProperties mass_properties(const TwinBody& p) {
   const Mat3& I = p.inertia_origin;  // Simbody wants the inertia about the body origin
