@@ -40,10 +40,12 @@ inline Mat3 axis_rotation(const Vec3& unit_axis, double angle) {
   return Eigen::AngleAxisd(angle, unit_axis).toRotationMatrix();
 }
 
-// A(i, j) = A(j, i) below the diagonal, in 32 × 32 tiles so that the strided reads stay in cache.
+// A(i, j) = A(j, i) below the diagonal, in square tiles so that the strided reads stay in cache.
+// Rows of a large A a power of two apart (n = 512: 4 KiB) fall in one L1 set, whose 8 ways a
+// 32-row tile overflows: tiles of 8 from n = 256 up (n = 512: 2× faster than 32, n = 500 within
+// 10 %), of 32 below, where they are the faster.
 inline void mirror_upper(MatX& A) {
-  constexpr Eigen::Index kTile = 32;
-  const Eigen::Index n = A.rows();
+  const Eigen::Index n = A.rows(), kTile = n >= 256 ? 8 : 32;
   for (Eigen::Index j0 = 0; j0 < n; j0 += kTile)
     for (Eigen::Index i0 = j0; i0 < n; i0 += kTile)
       for (Eigen::Index j = j0; j < std::min(j0 + kTile, n); ++j)
