@@ -13,6 +13,7 @@
 #include "core/model/names.hpp"
 #include "io/catalog.hpp"
 #include "io/coupling_json.hpp"
+#include "io/flexible_bar.hpp"
 #include "io/json_places.hpp"
 #include "io/json_text.hpp"
 #include "io/params.hpp"
@@ -225,8 +226,9 @@ MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std
   const auto path = [&](const std::string& s) { return source + ": /" + s; };
   for (auto it = root.begin(); it != root.end(); ++it) {
     static const char* known[] = {
-        "name",        "description", "gravity",           "bodies", "couplings", "loads", "frames",
-        "constraints", "springs",     "correlation_table", "$schema"};
+        "name",    "description",  "gravity",     "bodies",  "couplings",
+        "loads",   "frames",       "constraints", "springs", "correlation_table",
+        "$schema", "flexible_bars"};
     bool ok = false;
     for (const char* k : known) ok = ok || it.key() == k;
     if (!ok) throw ModelError(path(truncated(it.key())), "unknown key " + quoted_text(it.key()));
@@ -238,13 +240,24 @@ MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std
   if (root.contains("gravity")) spec.gravity = json_vec3(root["gravity"], path("gravity"));
   if (!root.contains("bodies") || !root["bodies"].is_array())
     throw ModelError(path("bodies"), "expected an array of bodies");
-  const Json& bodies = root["bodies"];
-  if (bodies.size() > static_cast<std::size_t>(kMaxBodies))  // before anything is built for them
-    throw ModelError(path("bodies"), too_many_bodies_text(bodies.size()));
+  if (root["bodies"].size() > static_cast<std::size_t>(kMaxBodies))  // before anything is built
+    throw ModelError(path("bodies"), too_many_bodies_text(root["bodies"].size()));
+  // The file's bodies, then each flexible bar's (io/flexible_bar.hpp), each with its own path.
+  Json bodies = root["bodies"];
+  std::vector<std::string> where;
+  for (std::size_t i = 0; i < bodies.size(); ++i)
+    where.push_back(path("bodies/" + std::to_string(i)));
+  read_list(root, "flexible_bars", source, [&](const Params& p, std::size_t) {
+    for (Json& b : flexible_bar_bodies(p)) {
+      where.push_back(p.where() + " (its body " + quoted_text(b["name"].get<std::string>()) + ")");
+      bodies.push_back(std::move(b));
+    }
+    if (bodies.size() > static_cast<std::size_t>(kMaxBodies))
+      throw ModelError(p.where(), too_many_bodies_text(bodies.size()));
+  });
   const std::map<std::string, Vec3> qualified = qualified_nodes(bodies);
   for (std::size_t i = 0; i < bodies.size(); ++i)
-    spec.bodies.push_back(
-        read_body(catalog, bodies[i], path("bodies/" + std::to_string(i)), qualified));
+    spec.bodies.push_back(read_body(catalog, bodies[i], where[i], qualified));
   const BodiesByName by_name = bodies_by_name(bodies);
   read_list(root, "couplings", source,
             [&](const Params& p, std::size_t) { spec.couplings.push_back(read_coupling(p)); });
@@ -264,6 +277,15 @@ MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std
 }
 
 }  // namespace
+
+std::vector<BodySpec> parse_flexible_bar(const Catalog& catalog, const Json& bar,
+                                         const std::string& where) {
+  std::vector<BodySpec> out;
+  for (const Json& b : flexible_bar_bodies(Params(bar, where)))
+    out.push_back(read_body(
+        catalog, b, where + " (its body " + quoted_text(b["name"].get<std::string>()) + ")", {}));
+  return out;
+}
 
 CouplingSpec parse_coupling(const Json& coupling, const std::string& where) {
   return read_coupling(Params(coupling, where));

@@ -12,6 +12,7 @@
 #include "elements/rod.hpp"
 #include "elements/rotary_node.hpp"
 #include "elements/space_bar.hpp"
+#include "models/model_files.hpp"
 
 namespace femdyn {
 
@@ -188,6 +189,12 @@ void MechanismBuilder::space_bar(const std::string& body, const NodeDescription&
       throw ModelError(where + "/section_y", *problem);
   }
   ElementSink(bs.elements, where).add(SpaceBar::from_section(pa, pb, section), {la, lb});
+}
+
+void MechanismBuilder::flexible_bar(const Json& bar) {
+  const std::string where = spec_.where + "/flexible_bars/" + std::to_string(flexible_bars_++);
+  for (BodySpec& b : parse_flexible_bar(default_catalog(), bar, where))
+    spec_.bodies.push_back(std::move(b));
 }
 
 void MechanismBuilder::rod(const std::string& body, const NodeDescription& a,

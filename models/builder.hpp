@@ -16,6 +16,7 @@
 
 #include "compile/spec.hpp"
 #include "core/model/model.hpp"
+#include "io/params.hpp"
 
 namespace femdyn {
 
@@ -50,6 +51,9 @@ class MechanismBuilder {
   // A uniform bar from a to b of this material and section (the JSON "density" form).
   void space_bar(const std::string& body, const NodeDescription& a, const NodeDescription& b,
                  const BarSection& section);
+  // A flexible bar in its JSON form ({"name", "parent", "length", "segments", "section", …},
+  // docs/model-format.md#flexible-bars): its bodies, as a file would give them.
+  void flexible_bar(const Json& bar);
   void rod(const std::string& body, const NodeDescription& a, const NodeDescription& b,
            double mass);
 
@@ -96,6 +100,7 @@ class MechanismBuilder {
   BarEnds space_bar_ends(const BodySpec& bs, const NodeDescription& a, const NodeDescription& b,
                          const std::string& where) const;
   MechanismSpec spec_;
+  int flexible_bars_ = 0;                                     // (for their paths in messages)
   std::map<std::string, std::map<std::string, Vec3>> nodes_;  // body -> name -> position
 };
 

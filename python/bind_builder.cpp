@@ -351,6 +351,20 @@ void bind_builder(py::module_& m) {
           "{'body': …, 'xyz': …}) and normal=, direction=, length=; or 'gear' with joint=, "
           "follows=, ratio=, offset=; name= (docs/loops.md)")
       .def(
+          "flexible_bar",
+          [](MechanismBuilder& b, const std::string& name, const std::string& parent,
+             const py::kwargs& fields) {
+            Json bar = to_json(fields, "flexible_bar");
+            bar["name"] = text_arg(name, "name");
+            bar["parent"] = text_arg(parent, "parent");
+            b.flexible_bar(bar);
+          },
+          py::arg("name"), py::arg("parent"),
+          "a flexible bar clamped to `parent` in the JSON format's words: length=, segments=, "
+          "section={'E', 'G', 'density', 'area', 'Iy', 'Iz', 'J'} or {'EA', 'EIy', 'EIz', 'GJ', "
+          "'rhoA', 'rhoIy', 'rhoIz'}, origin={'xyz', 'rpy'}, axial=, torsion=, "
+          "damping={'stiffness_proportional': β} (docs/model-format.md#flexible-bars)")
+      .def(
           "spring",
           [](MechanismBuilder& b, const py::kwargs& fields) {
             b.spring(parse_spring(to_json(fields, "spring"), b.next_spring(), b.spring_count()));

@@ -1,0 +1,143 @@
+#include "io/flexible_bar.hpp"
+
+#include <string>
+#include <tuple>
+
+#include "core/model/limits.hpp"
+#include "core/model/names.hpp"
+
+namespace femdyn {
+
+namespace {
+
+// The section's stiffnesses and mass per unit length.
+struct Section {
+  double EA = 0, EIy = 0, EIz = 0, GJ = 0;  // N, N m², N m², N m²
+  double rhoA = 0, rhoIy = 0, rhoIz = 0;    // kg/m, kg m (rotary inertia per length)
+};
+
+// {"E", "G", "density", "area", "Iy", "Iz", "J"} or {"EA", "EIy", "EIz", "GJ", "rhoA", "rhoIy",
+// "rhoIz"}; what a locked deformation does not use may be left out.
+Section read_section(const Params& s, bool axial, bool torsion) {
+  Section out;
+  if (s.has("E")) {
+    s.allow_only({"E", "G", "density", "area", "Iy", "Iz", "J"});
+    const double E = s.positive("E"), rho = s.positive("density"), A = s.positive("area");
+    const double Iy = s.positive("Iy"), Iz = s.positive("Iz");
+    out = {E * A, E * Iy, E * Iz, 0, rho * A, rho * Iy, rho * Iz};
+    if (torsion) out.GJ = s.positive("G") * s.positive("J");
+    return out;
+  }
+  s.allow_only({"EA", "EIy", "EIz", "GJ", "rhoA", "rhoIy", "rhoIz"});
+  if (!s.has("EIy") && !s.has("EIz"))
+    s.fail("EIy",
+           "give the section as E, G, density, area, Iy, Iz, J or as EA, EIy, EIz, GJ, "
+           "rhoA (rhoIy, rhoIz)");
+  out.EIy = s.positive("EIy");
+  out.EIz = s.positive("EIz");
+  out.rhoA = s.positive("rhoA");
+  if (axial || s.has("EA")) out.EA = s.positive("EA");
+  if (torsion) out.GJ = s.positive("GJ");
+  // The rotary inertia: given, or a homogeneous section's, ρI = ρA I/A = ρA EI/EA. Without it a
+  // long chain of pieces has articulated inertias that vanish geometrically along the bar.
+  for (auto [key, rhoI, EI] :
+       {std::tuple{"rhoIy", &out.rhoIy, out.EIy}, std::tuple{"rhoIz", &out.rhoIz, out.EIz}}) {
+    if (s.has(key))
+      *rhoI = s.positive(key);
+    else if (out.EA > 0)
+      *rhoI = out.rhoA * EI / out.EA;
+    else
+      s.fail(key,
+             "is needed when EA is not given (the section's rotary inertia per length, "
+             "kg m; a homogeneous section has ρA EI/EA)");
+  }
+  return out;
+}
+
+Json vec(const Vec3& v) { return Json::array({v[0], v[1], v[2]}); }
+
+// A rigid piece of the bar, of length l from its body's origin along x.
+Json piece(const Section& s, double l) {
+  const double m = s.rhoA * l;
+  const double Ixx = (s.rhoIy + s.rhoIz) * l, Iyy = s.rhoIy * l + m * l * l / 12,
+               Izz = s.rhoIz * l + m * l * l / 12;
+  return Json::array({{{"type", "rigid_body"},
+                       {"mass", m},
+                       {"com", vec(Vec3(l / 2, 0, 0))},
+                       {"inertia", {{Ixx, 0, 0}, {0, Iyy, 0}, {0, 0, Izz}}}}});
+}
+
+Json body(const std::string& name, const std::string& parent, Json joint, Json elements) {
+  Json b = {{"name", name}, {"parent", parent}, {"joint", std::move(joint)}};
+  if (!elements.empty()) b["elements"] = std::move(elements);
+  return b;
+}
+
+Json one_rate_joint(const std::string& name, const char* type, const Vec3& axis, double k, double c,
+                    const Vec3& xyz) {
+  Json j = {{"name", name}, {"type", type}, {"axis", vec(axis)}, {"spring", {{"stiffness", k}}}};
+  if (c > 0) j["damping"] = c;
+  if (xyz != Vec3::Zero()) j["origin"] = {{"xyz", vec(xyz)}};
+  return j;
+}
+
+}  // namespace
+
+Json flexible_bar_bodies(const Params& p) {
+  p.allow_only(
+      {"name", "parent", "origin", "length", "segments", "section", "axial", "torsion", "damping"});
+  const std::string name = p.string("name"), parent = p.string("parent");
+  const double L = p.positive("length");
+  const Json& jn = p.json().at("segments");
+  if (!jn.is_number_integer() || jn.get<long long>() < 1 || jn.get<long long>() > kMaxBodies / 4)
+    p.fail("segments", "expected an integer from 1 to " + std::to_string(kMaxBodies / 4));
+  const int n = jn.get<int>();
+  const bool axial = p.boolean_or("axial", true), torsion = p.boolean_or("torsion", true);
+  const Section s = read_section(p.child("section"), axial, torsion);
+  double beta = 0;  // c = β k on every spring (stiffness-proportional Rayleigh damping)
+  if (p.has("damping")) {
+    const Params d = p.child("damping");
+    d.allow_only({"stiffness_proportional"});
+    beta = d.non_negative("stiffness_proportional");
+  }
+  Json clamp = {{"name", name + ".0"}, {"type", "fixed"}};
+  if (p.has("origin")) clamp["origin"] = p.json().at("origin");
+  const double delta = L / n;
+  Json bodies = Json::array({body(name + ".0", parent, clamp, piece(s, delta / 2))});
+  for (int i = 1; i <= n; ++i) {
+    const std::string at = name + "." + std::to_string(i),
+                      previous = name + "." + std::to_string(i - 1);
+    const Vec3 offset(i == 1 ? delta / 2 : delta, 0, 0);  // from the previous piece's origin
+    struct Rate {
+      const char* suffix;
+      const char* type;
+      Vec3 axis;
+      double k;
+      bool used;
+    };
+    const Rate rates[] = {{"ry", "revolute", Vec3::UnitY(), s.EIy / delta, true},
+                          {"rz", "revolute", Vec3::UnitZ(), s.EIz / delta, true},
+                          {"rx", "revolute", Vec3::UnitX(), s.GJ / delta, torsion},
+                          {"ux", "prismatic", Vec3::UnitX(), s.EA / delta, axial}};
+    std::string chain = previous;
+    Vec3 xyz = offset;
+    for (const Rate& r : rates) {
+      if (!r.used) continue;
+      const std::string joint = at + "." + r.suffix;
+      const bool last = &r == &rates[axial ? 3 : torsion ? 2 : 1];  // the piece hangs from the last rate
+      bodies.push_back(body(last ? at : joint, chain,
+                            one_rate_joint(joint, r.type, r.axis, r.k, beta * r.k, xyz),
+                            last ? piece(s, i == n ? delta / 2 : delta) : Json::array()));
+      chain = joint;
+      xyz = Vec3::Zero();
+    }
+  }
+  bodies.push_back(body(name + ".tip", name + "." + std::to_string(n),
+                        {{"name", name + ".tip"},
+                         {"type", "fixed"},
+                         {"origin", {{"xyz", vec(Vec3(delta / 2, 0, 0))}}}},
+                        Json::array()));
+  return bodies;
+}
+
+}  // namespace femdyn

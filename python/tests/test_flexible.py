@@ -1,0 +1,87 @@
+"""Flexible bars through the Python doors (docs/flexible.md): the Builder's bar is the file's to
+the bit, its coordinates are named as documented, a refused bar names the key, and the tables
+of docs/flexible.md are what tools/flexible_modes.py computes now."""
+import json
+import sys
+
+import numpy as np
+import pytest
+
+import femdyn
+from conftest import ROOT
+
+SECTION = {"E": 7e10, "G": 2.6e10, "density": 2700, "area": 1e-4, "Iy": 2e-9, "Iz": 3e-9,
+           "J": 4e-9}
+BAR = {"length": 0.8, "segments": 3, "origin": {"xyz": [0.1, 0, 0], "rpy": [0, 0.2, 0]},
+       "section": SECTION, "damping": {"stiffness_proportional": 1e-4}}
+
+
+def built(gravity=(0, 0, -9.81)):
+    b = femdyn.Builder("hub and bar", gravity=list(gravity))
+    b.body("hub", "world", type="revolute", joint="hub", axis=[0, 0, 1])
+    b.rigid_body("hub", 2.0, [0, 0, 0], np.diag([0.1, 0.1, 0.2]))
+    b.flexible_bar("arm", "hub", **BAR)
+    b.lumped_point("arm.tip", [0, 0, 0], 0.05)
+    return b.build()
+
+
+def from_file(tmp_path):
+    doc = {"name": "hub and bar", "gravity": [0, 0, -9.81], "bodies": [
+        {"name": "hub", "parent": "world",
+         "joint": {"name": "hub", "type": "revolute", "axis": [0, 0, 1]},
+         "elements": [{"type": "rigid_body", "mass": 2.0, "com": [0, 0, 0],
+                       "inertia": [[0.1, 0, 0], [0, 0.1, 0], [0, 0, 0.2]]}]},
+        {"name": "payload", "parent": "arm.tip", "joint": {"type": "fixed"},
+         "elements": [{"type": "lumped_point", "node": [0, 0, 0], "mass": 0.05}]}],
+        "flexible_bars": [dict(name="arm", parent="hub", **BAR)]}
+    path = tmp_path / "hub_bar.json"
+    path.write_text(json.dumps(doc))
+    return femdyn.load(str(path))
+
+
+def test_builder_bar_is_the_files(tmp_path):
+    a, b = built(), from_file(tmp_path)
+    assert a.coordinates == b.coordinates
+    assert a.coordinates[:5] == ["hub", "arm.1.ry", "arm.1.rz", "arm.1.rx", "arm.1.ux"]
+    assert len(a.coordinates) == 1 + 4 * 3
+    rng = np.random.default_rng(4)
+    for _ in range(3):
+        q, qd = rng.uniform(-0.05, 0.05, a.n), rng.uniform(-1, 1, a.n)
+        tau = np.zeros(a.n)
+        ea, eb = a.equations(q, qd, tau), b.equations(q, qd, tau)
+        for key in ("M", "h", "Q", "qdd"):
+            # (the payload: a lumped point on arm.tip, or on a fixed child of it: one body)
+            assert np.allclose(ea[key], eb[key], rtol=1e-13, atol=1e-13 * np.abs(eb[key]).max()), key
+
+
+def test_spring_forces_are_minus_k_q():
+    # Q of each elastic rate with the bar straight but that rate at 1e-3, gravity off: −k θ,
+    # k = EI/Δ, GJ/Δ, EA/Δ (docs/flexible.md).
+    m = built(gravity=(0, 0, 0))
+    delta = 0.8 / 3
+    k = {"ry": 7e10 * 2e-9 / delta, "rz": 7e10 * 3e-9 / delta, "rx": 2.6e10 * 4e-9 / delta,
+         "ux": 7e10 * 1e-4 / delta}
+    for i, name in enumerate(m.coordinates[1:], start=1):
+        q = np.zeros(m.n)
+        q[i] = 1e-3
+        Q = m.equations(q, np.zeros(m.n), np.zeros(m.n))["Q"]
+        assert Q[i] == pytest.approx(-k[name.split(".")[-1]] * 1e-3, rel=1e-12), name
+
+
+def test_bad_bar_names_the_key():
+    b = femdyn.Builder("bad")
+    with pytest.raises(femdyn.ModelError, match=r"/flexible_bars/0/segments: expected an integer"):
+        b.flexible_bar("arm", "world", length=1, segments=0, section=SECTION)
+    with pytest.raises(femdyn.ModelError, match=r"/flexible_bars/1/section/G: "):
+        b.flexible_bar("arm", "world", length=1, segments=2,
+                       section={k: v for k, v in SECTION.items() if k != "G"})
+
+
+def test_docs_tables_are_current():
+    sys.path.insert(0, str(ROOT / "tools"))
+    import flexible_modes
+    doc = (ROOT / "docs" / "flexible.md").read_text()
+    for key, make in flexible_modes.TABLES.items():
+        table = getattr(flexible_modes, make)()
+        assert table in doc, f"docs/flexible.md: the {key} table is stale " \
+                             "(tools/flexible_modes.py --update)"
