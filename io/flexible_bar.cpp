@@ -124,7 +124,9 @@ Json flexible_bar_bodies(const Params& p) {
     for (const Rate& r : rates) {
       if (!r.used) continue;
       const std::string joint = at + "." + r.suffix;
-      const bool last = &r == &rates[axial ? 3 : torsion ? 2 : 1];  // the piece hangs from the last rate
+      const bool last = &r == &rates[axial     ? 3
+                                     : torsion ? 2
+                                               : 1];  // the piece hangs from the last rate
       bodies.push_back(body(last ? at : joint, chain,
                             one_rate_joint(joint, r.type, r.axis, r.k, beta * r.k, xyz),
                             last ? piece(s, i == n ? delta / 2 : delta) : Json::array()));
