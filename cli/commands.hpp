@@ -69,6 +69,7 @@ int cmd_simulate(int argc, char** argv);
 int cmd_check(int argc, char** argv);
 int cmd_kinematics(int argc, char** argv);
 int cmd_linearize(int argc, char** argv);
+int cmd_statics(int argc, char** argv);
 int cmd_view(int argc, char** argv);    // only with FEMDYN_WITH_VIEW (web/node_modules)
 int cmd_study(int argc, char** argv);   // only with FEMDYN_WITH_SIMBODY
 int cmd_stress(int argc, char** argv);  // only with FEMDYN_WITH_SIMBODY

@@ -24,6 +24,7 @@ commands:
   check       numerical diagnosis: conditioning, stiffest mode, stable steps, suspicious bodies
   kinematics  pose, Jacobian, velocity and J̇v of frames at a state (control)
   linearize   A = ∂(ξ̇, v̇)/∂(ξ, v) and B = ∂(ξ̇, v̇)/∂τ at a state, by analytic derivatives
+  statics     where the mechanism rests under springs, gravity and loads (Newton, continuation)
   stress      the stability suite on generated stiff and extreme cases (docs/stability.md)
   study       error against run time of every femdyn and Simbody integrator (work-precision)
   bench       ns per call of M^s, h, g, Q, q̈, τ and D against the model's Simbody twin
@@ -73,6 +74,7 @@ int main(int argc, char** argv) {
     if (cmd == "check") return cmd_check(argc, argv);
     if (cmd == "kinematics") return cmd_kinematics(argc, argv);
     if (cmd == "linearize") return cmd_linearize(argc, argv);
+    if (cmd == "statics") return cmd_statics(argc, argv);
     if (cmd == "import") return cmd_import(argc, argv);
 #ifdef FEMDYN_WITH_VIEW
     if (cmd == "view") return cmd_view(argc, argv);

@@ -387,7 +387,9 @@ void bind_builder(py::module_& m) {
               py::gil_scoped_release release;
               model = b.build();
             }
-            return std::make_unique<PyModel>(std::move(model));
+            auto pm = std::make_unique<PyModel>(std::move(model));
+            pm->spec = std::make_shared<const MechanismSpec>(b.spec());
+            return pm;
           },
           "compile the mechanism (the checks of a JSON file's compile) into a femdyn.Model");
 }

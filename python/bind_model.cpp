@@ -51,6 +51,7 @@ std::unique_ptr<PyModel> load(const std::string& path, const OptArray& gravity, 
   {
     py::gil_scoped_release release;
     model = std::make_unique<PyModel>(load_model(text_arg(path, "path"), options));
+    model->spec = std::make_shared<const MechanismSpec>(read_spec(path, options));
   }
   model->source = path;
   model->load = options;

@@ -97,4 +97,5 @@ PYBIND11_MODULE(_femdyn, m) {
   bind_simulator(m);
   bind_validate(m);
   bind_builder(m);
+  bind_statics(m);
 }

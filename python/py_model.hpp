@@ -28,6 +28,9 @@ struct PyModel {
   std::unique_ptr<DerivativeWorkspace> derivatives;  // made by the first derivatives call
   std::string source;  // the file it was loaded from (femdyn.load), else ""
   LoadOptions load;    // how it was loaded (gravity, floating base, inertia balancing)
+  // What it was compiled from (the file's spec, or the Builder's): Model.statics compiles it at
+  // each load factor (sim/statics.hpp).
+  std::shared_ptr<const MechanismSpec> spec;
 };
 
 // M, h, Q and q̈ at one state; qdd is absent when forward dynamics failed (then `failure`
@@ -62,6 +65,7 @@ void bind_simulate(py::module_& m);
 void bind_simulator(py::module_& m);
 void bind_validate(py::module_& m);
 void bind_builder(py::module_& m);
+void bind_statics(py::module_& m);  // Model.statics (python/bind_statics.cpp)
 void bind_loops(py::module_& m);
 void bind_derivatives(py::module_& m);  // after bind_model: methods of Model
 void bind_view(py::module_& m);         // after bind_model; only with FEMDYN_WITH_VIEW

@@ -687,6 +687,9 @@ TEST_CASE("femdyn track refuses what computed torque would ignore: loops, a free
 
 }  // namespace femdyn::test
 
+using namespace femdyn;  // (what follows is outside femdyn::test; a unity build must not lend it)
+using namespace femdyn::test;
+
 namespace {
 
 std::string cli_numbers(const VecX& x) {
