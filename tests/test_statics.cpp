@@ -116,8 +116,9 @@ TEST_CASE("statics: Bathe and Bolourchi's 45-degree bend under a load out of its
   for (int k = 0; k < K; ++k)
     bars += std::string(k ? ", " : "") + R"({"name": "b)" + std::to_string(k) +
             R"(", "parent": ")" + (k ? "b" + std::to_string(k - 1) + ".tip" : "world") +
-            R"(", "length": )" + statics_number(chord) + R"(, "segments": 1, "origin": {"rpy": [0, 0, )" +
-            statics_number(k ? dphi : dphi / 2) + R"(]}, "section": {"E": 1e7, "G": 5e6, "density": 1,
+            R"(", "length": )" + statics_number(chord) +
+            R"(, "segments": 1, "origin": {"rpy": [0, 0, )" + statics_number(k ? dphi : dphi / 2) +
+            R"(]}, "section": {"E": 1e7, "G": 5e6, "density": 1,
             "area": 1, "Iy": 0.08333333333333333, "Iz": 0.08333333333333333, "J": 0.1406}})";
   const MechanismSpec spec =
       parse_spec(R"({"name": "bend", "bodies": [], "flexible_bars": [)" + bars + "]}", "bend");
