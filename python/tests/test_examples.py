@@ -57,3 +57,17 @@ def test_ilqr_swings_the_double_pendulum_up():
     assert r["history"][-1] < 1e-2 * r["history"][0]
     xf = np.r_[r["q"][-1], r["qd"][-1]]
     assert np.abs(xf - example.GOAL).max() < 1e-2  # upright and at rest on femdyn.Simulator
+
+
+def test_spin_up_beam_follows_its_hub_and_writes_the_columns(tmp_path):
+    # A short run (2 parts, 2 s): the hub follows the prescribed angle, the tip lags behind it
+    # (v_tip < 0 while the hub accelerates) and stays near the bar's length.
+    m = load_example("spin_up_beam")
+    rows, hub_error = m.run(2, 1e-8, t_end=2.0)
+    assert hub_error < 1e-6
+    assert list(rows[:, 0]) == [0.0, 0.5, 1.0, 1.5, 2.0]
+    assert (rows[1:, 1] < 0).all() and abs(rows[-1, 1]) < 0.2
+    assert abs(rows[-1, 2]) < 1e-2
+    out = run(ROOT / "examples" / "spin_up_beam.py", "--segments", "2", "--t-end", "1", "--csv")
+    assert out.splitlines()[0] == "t,v_tip,u_tip"
+    assert len(out.splitlines()) == 4  # 0, 0.5, 1
