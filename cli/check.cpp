@@ -12,6 +12,7 @@
 #include <optional>
 #include <random>
 
+#include "cli/check_modes.hpp"
 #include "cli/commands.hpp"
 #include "cli/progress.hpp"
 #include "core/kinematics/sampling.hpp"
@@ -40,6 +41,10 @@ stop, at rest: a stop's stiffness is felt only there; "stop_states" in --json):
     (the fastest mode but the stiff dissipative ones: dissipative and 100x faster than the
     slowest mode);
   - from A the largest stable step of rk4, euler and dopri, the smallest over the states;
+  - the natural modes: the oscillatory modes of A about the static equilibrium (femdyn statics
+    with τ = 0, q̇ = 0), lowest first, in rad/s and Hz with the coordinate each moves most (an
+    elastic model's frequencies, docs/flexible.md); not listed, with the reason, where there is
+    no equilibrium or the model has closed loops ("natural_modes" in --json);
   - bodies with suspicious mass properties, by name: near-zero mass or a mass ratio beyond 1e6
     to a neighbour, a near-zero principal inertia, an inertia that violates the triangle
     inequality; a flat body (a disc or plate, on the inequality's boundary) is a note;
@@ -361,6 +366,7 @@ struct CheckReport {
   std::vector<SuspiciousBody> bodies;
   Advice advice;
   double tol = 0;
+  NaturalModes natural;  // about the static equilibrium (cli/check_modes.hpp)
 };
 
 // Checking K states costs about per_state each: beyond the budget, refused naming the way on.
@@ -457,6 +463,7 @@ Json check_json(const Model& m, const CheckReport& r) {
                   {"unassembled_states", r.d.unassembled},
                   {"dead_point_ratio", finite_or_null(r.d.dead_ratio)},
                   {"near_dead_point", r.d.dead_ratio < kDeadPointRatio}};
+  j["natural_modes"] = natural_modes_json(m, r.natural);
   return j;
 }
 
@@ -507,7 +514,7 @@ void print_check(const Model& m, const CheckReport& r) {
               << (std::isfinite(r.d.h_max[i]) ? format_short(r.d.h_max[i]) + " s"
                                               : std::string("unlimited"))
               << (i < 2 ? "," : "");
-  std::cout << " (bdf: unlimited)\n";
+  std::cout << " (bdf: unlimited)\n" << natural_modes_text(m, r.natural) << "\n";
   if (r.bodies.empty()) std::cout << "suspicious bodies: none\n";
   for (const auto& b : r.bodies)
     std::cout << (b.note ? "note: body '" : "suspicious body '") << b.name << "': " << b.why
@@ -555,6 +562,7 @@ int cmd_check(int argc, char** argv) {
   bool flagged = false;
   for (const auto& b : r.bodies) flagged = flagged || !b.note;
   r.advice = advise(m, r.d, r.tol);
+  r.natural = natural_modes(a, m);
   verify_advice(m, r.tol, seed, t_end, r.advice);
   if (a.has("json"))
     std::cout << json_text(check_json(m, r)) << "\n";

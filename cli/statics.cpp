@@ -22,8 +22,8 @@ the model's loads, the joint forces --tau (n values) and the loads --load: each 
 world axes, fixed in direction) and optionally a torque (N m) on BODY at the point x, y, z of
 its frame (default its origin), several separated by ';'. It solves
   r(q) = τ − τ_id(q, 0, 0) = 0,   τ_id(q, 0, 0) = −Q(q),
-by Newton's method with the analytic stiffness ∂τ_id/∂q, each step halved until the residual
-falls, and continuation in the load: gravity, the loads and τ are scaled by λ from 0 to 1 in
+by Newton's method with the analytic stiffness ∂τ_id/∂q (a Levenberg–Marquardt step where it is
+singular: a pendulum started horizontal), each step halved until the residual falls, and continuation in the load: gravity, the loads and τ are scaled by λ from 0 to 1 in
 steps that halve where Newton fails (large deflections) and double where it converges. From
 --q0 (n_q values), else the neutral configuration. Converged when |r|∞ ≤ R times the largest
 force met (--tolerance, default 1e-10). No equilibrium found (a coordinate nothing holds, a load

@@ -65,6 +65,7 @@ struct Problem {
 
 // Newton at one λ from q: true when |r|∞ ≤ tolerance × scale; q and the counts updated.
 bool newton(Problem& p, const StaticsOptions& o, VecX& q, StaticsResult& out, std::string& why) {
+  bool singular = false;
   double forces = 0;
   VecX r = p.residual(q, forces);
   out.scale = std::max({out.scale, forces, p.tau.size() ? p.tau.cwiseAbs().maxCoeff() : 0.0});
@@ -79,12 +80,15 @@ bool newton(Problem& p, const StaticsOptions& o, VecX& q, StaticsResult& out, st
       return true;
     }
     if (it == o.max_iterations) break;
-    const Eigen::FullPivLU<MatX> lu(p.stiffness(q));
+    MatX K = p.stiffness(q);
+    Eigen::FullPivLU<MatX> lu(K);
     if (lu.rank() < p.model.n()) {
-      why =
-          "the stiffness ∂τ/∂q is singular (a coordinate that nothing holds: no spring, load "
-          "or gravity acts on it)";
-      return false;
+      // Singular here (a pendulum horizontal: gravity's stiffness is 0 there; or a coordinate
+      // nothing holds): a Levenberg–Marquardt step (K + μ 1) Δ = r moves along r instead.
+      singular = true;
+      const double mu = std::max({K.cwiseAbs().maxCoeff(), out.scale, 1e-300});  // (|Δ| ≲ 1)
+      K.diagonal().array() += mu;
+      lu.compute(K);
     }
     const VecX step = lu.solve(r);
     // Halve the step until the residual falls (at most 20 times).
@@ -101,7 +105,10 @@ bool newton(Problem& p, const StaticsOptions& o, VecX& q, StaticsResult& out, st
     }
     ++out.iterations;
   }
-  why = "Newton did not converge in " + std::to_string(o.max_iterations) + " steps";
+  why = "Newton did not converge in " + std::to_string(o.max_iterations) + " steps" +
+        (singular ? " (the stiffness ∂τ/∂q was singular on the way: a coordinate that nothing "
+                    "holds, no spring, load or gravity stiffens it)"
+                  : "");
   return false;
 }
 

@@ -1,6 +1,7 @@
 // Statics: the configuration q at which the mechanism rests under its loads,
 //   r(q) = λ τ − τ_id(q, 0, 0) = 0,      τ_id(q, 0, 0) = −Q(q)  (springs, gravity, loads),
-// by Newton's method with the analytic stiffness ∂τ_id/∂q (core/derivatives), a step halved
+// by Newton's method with the analytic stiffness ∂τ_id/∂q (core/derivatives; where it is
+// singular, a Levenberg–Marquardt step (K + μ 1) Δ = r, μ the largest |K| or force), a step halved
 // until the residual falls, and continuation in the load: λ scales the applied τ, gravity and
 // the loads (the model's and `loads` given here) from 0 to 1, in steps that halve where Newton
 // does not converge and double where it does. The springs are not scaled. Each step compiles

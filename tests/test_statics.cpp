@@ -134,6 +134,13 @@ TEST_CASE("statics: Bathe and Bolourchi's 45-degree bend under a load out of its
   CHECK(std::abs(d.y() - -13.4) < 0.75);
 }
 
+TEST_CASE("statics: a pendulum started horizontal finds where it hangs", "[statics]") {
+  // At θ = 0 gravity's stiffness m g l sin θ is 0: Newton's matrix is singular there, and a
+  // Levenberg–Marquardt step moves it on; the rest is θ = π/2 (hanging), not the upright −π/2.
+  const StaticsResult r = solved(parse_spec(arm_json(0, 0, 9.81), "pendulum"));
+  CHECK(std::abs(r.q[0] - std::numbers::pi / 2) < 1e-10);
+}
+
 TEST_CASE("statics refuses what it cannot solve, in one line", "[statics]") {
   // No spring and a torque beyond m g l: nothing holds the arm.
   StaticsOptions o;

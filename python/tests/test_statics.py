@@ -52,3 +52,28 @@ def test_no_equilibrium_is_a_numerical_error():
         b.build().statics(tau=[20.0])
     with pytest.raises(ValueError, match=r"loads\[0\]: unknown key 'forse'"):
         b.build().statics(loads=[{"body": "arm", "forse": [0, 0, 1]}])
+
+
+def test_check_lists_the_natural_modes_about_the_equilibrium(tmp_path):
+    # The sprung arm (1 kg at 1 m, spring k, gravity g) rests at k θ = g cos θ; about it
+    # ω² = k + g sin θ. And a cantilever's lowest modes are beam theory's (8 parts: 3.6e-3).
+    k, g = 20.0, 9.81
+    arm = {"name": "arm", "gravity": [0, 0, -g], "bodies": [{
+        "name": "arm", "parent": "world",
+        "joint": {"name": "theta", "type": "revolute", "axis": [0, 1, 0],
+                  "spring": {"stiffness": k}},
+        "elements": [{"type": "lumped_point", "node": [1, 0, 0], "mass": 1.0}]}]}
+    path = tmp_path / "arm.json"
+    path.write_text(json.dumps(arm))
+    modes = cli_json("check", str(path), "--json")["natural_modes"]
+    theta = femdyn.load(str(path)).statics()["q"][0]
+    assert len(modes["oscillatory"]) == 1 and modes["unstable"] == 0
+    assert modes["oscillatory"][0]["omega"] == pytest.approx(math.sqrt(k + g * math.sin(theta)),
+                                                             rel=1e-9)
+    path = tmp_path / "cantilever.json"
+    path.write_text(json.dumps(dict(CANTILEVER, gravity=[0, 0, 0])))
+    modes = cli_json("check", str(path), "--json")["natural_modes"]["oscillatory"]
+    first = 1.8751040687119611 ** 2 * math.sqrt(2.07e11 * 8.333333333333333e-6 / (7800 * 0.01 * 16))
+    assert modes[0]["omega"] == pytest.approx(first, rel=5e-3)
+    assert modes[0]["omega"] != pytest.approx(first, rel=1e-3)  # (8 parts: not yet converged)
+    assert modes[0]["coordinate"].startswith("beam.")
