@@ -75,7 +75,12 @@ Json body(const std::string& name, const std::string& parent, Json joint, Json e
 
 Json one_rate_joint(const std::string& name, const char* type, const Vec3& axis, double k, double c,
                     const Vec3& xyz) {
-  Json j = {{"name", name}, {"type", type}, {"axis", vec(axis)}, {"spring", {{"stiffness", k}}}};
+  // No actuator drives a bar's strain: its rates are left out of τ = S u (docs/control.md).
+  Json j = {{"name", name},
+            {"type", type},
+            {"axis", vec(axis)},
+            {"spring", {{"stiffness", k}}},
+            {"actuated", false}};
   if (c > 0) j["damping"] = c;
   if (xyz != Vec3::Zero()) j["origin"] = {{"xyz", vec(xyz)}};
   return j;

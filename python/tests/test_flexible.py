@@ -44,6 +44,8 @@ def test_builder_bar_is_the_files(tmp_path):
     assert a.coordinates == b.coordinates
     assert a.coordinates[:5] == ["hub", "arm.1.ry", "arm.1.rz", "arm.1.rx", "arm.1.ux"]
     assert len(a.coordinates) == 1 + 4 * 3
+    assert list(a.actuated) == [0]  # no actuator drives a strain: only the hub's τ is an input
+    assert a.linearize(np.zeros(a.n_q), np.zeros(a.n), np.zeros(a.n))[1].shape == (2 * a.n, 1)
     rng = np.random.default_rng(4)
     for _ in range(3):
         q, qd = rng.uniform(-0.05, 0.05, a.n), rng.uniform(-1, 1, a.n)
