@@ -12,11 +12,9 @@ forms: bending ω_k = (β_k L)² √(EI/(ρA L⁴)), β_k L = 1.8751, 4.6941, 7.
 and stretch modes (π/2L) √(GJ/(ρ I_p)) and (π/2L) √(E/ρ). Each mode's error is that of the
 nearest frequency femdyn finds; its order is log2 of the ratio of the errors at n and 2n.
 """
-import json
 import math
 import os
 import sys
-import tempfile
 
 import numpy as np
 
@@ -48,37 +46,27 @@ def exact_modes():
     return modes
 
 
-def load(doc):
-    with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
-        json.dump(doc, f)
-    try:
-        return femdyn.load(f.name)
-    finally:
-        os.unlink(f.name)
-
-
 def frequencies(m, qd=None):
     z = np.zeros(m.n)
-    ev = np.linalg.eigvals(m.linearize(z, z if qd is None else qd, z)[0])
+    ev = np.linalg.eigvals(m.linearize(np.zeros(m.n_q), z if qd is None else qd, z)[0])
     return np.sort(ev.imag[ev.imag > 0])
 
 
 def cantilever(n):
-    return load({"name": "cantilever", "bodies": [], "flexible_bars": [{
-        "name": "bar", "parent": "world", "length": L, "segments": n,
-        "section": {"E": E, "G": G, "density": RHO, "area": A, "Iy": IY, "Iz": IZ, "J": J}}]})
+    b = femdyn.Builder("cantilever")
+    b.flexible_bar("bar", "world", length=L, segments=n,
+                   section={"E": E, "G": G, "density": RHO, "area": A, "Iy": IY, "Iz": IZ, "J": J})
+    return b.build()
 
 
 def spinning(n):
     """The bar on a hub turning about z, inextensible and without torsion (as the reference)."""
-    return load({"name": "spinning", "bodies": [{
-        "name": "hub", "parent": "world", "joint": {"type": "revolute", "axis": [0, 0, 1]},
-        "elements": [{"type": "rigid_body", "mass": 1,
-                      "inertia": {"ixx": 1, "iyy": 1, "izz": 1}}]}],
-        "flexible_bars": [{"name": "bar", "parent": "hub", "length": L, "segments": n,
-                           "axial": False, "torsion": False,
-                           "section": {"E": E, "density": RHO, "area": A, "Iy": IY,
-                                       "Iz": 4 * IY}}]})
+    b = femdyn.Builder("spinning")
+    b.body("hub", "world", type="revolute", joint="hub", axis=[0, 0, 1])
+    b.rigid_body("hub", 1.0, [0, 0, 0], np.eye(3))
+    b.flexible_bar("bar", "hub", length=L, segments=n, axial=False, torsion=False,
+                   section={"E": E, "density": RHO, "area": A, "Iy": IY, "Iz": 4 * IY})
+    return b.build()
 
 
 def spinning_table():
