@@ -227,3 +227,64 @@ TEST_CASE("a spinning cantilever stiffens as the rotating-beam references say", 
     previous = errors;
   }
 }
+
+TEST_CASE("linearize's frequencies are the modal analysis' ω² = eig(K, M^s)", "[flexible]") {
+  // At rest without gravity the bar's stiffness is its springs alone, K = diag(EI_y/Δ, EI_z/Δ,
+  // GJ/Δ, EA/Δ) per joint: the generalized symmetric eigenproblem K x = ω² M^s x, solved apart,
+  // must give the frequencies linearize's A does.
+  const int n = 6;
+  const Model m = load_text(cantilever(n));
+  const double delta = kL / n;
+  VecX k(m.n());
+  for (int i = 0; i < m.n(); ++i) {
+    const std::string& c = m.coordinate_names[i];
+    const std::string rate = c.substr(c.rfind('.') + 1);
+    k[i] = (rate == "ry"   ? kE * kIy
+            : rate == "rz" ? kE * kIz
+            : rate == "rx" ? kG * kJ
+                           : kE * kA) /
+           delta;
+  }
+  Workspace ws(m);
+  mass_matrix(m, ws, VecX::Zero(m.n()));
+  const MatX K = k.asDiagonal();
+  const Eigen::GeneralizedSelfAdjointEigenSolver<MatX> modal(K, ws.Ms);
+  const std::vector<double> w = frequencies(m);
+  REQUIRE(static_cast<int>(w.size()) == m.n());
+  for (int i = 0; i < m.n(); ++i) {
+    INFO("mode " << i);
+    CHECK(std::abs(w[i] / std::sqrt(modal.eigenvalues()[i]) - 1) < 1e-6);
+  }
+}
+
+TEST_CASE("a flexible bar at rest moves its hub as the rigid bar of the same section",
+          "[flexible]") {
+  // With the elastic coordinates at 0 and still, the pieces make up the whole uniform bar: the
+  // hub's M^s entry, its velocity terms and gravity's Q equal those of a rigid space bar with
+  // the same density, area and second moments (elements/space_bar.hpp).
+  const std::string hub = R"({"name": "hub", "parent": "world", "joint": {"type": "revolute",
+      "axis": [0.2, 1, 0.3]}, "elements": [{"type": "lumped_point", "node": [0, 0, 0.1],
+      "mass": 1}]})";
+  const Model flexible = load_text(R"({"name": "flexible", "gravity": [0.3, -1, -9.81],
+    "bodies": [)" + hub + R"(], "flexible_bars": [{"name": "bar", "parent": "hub",
+    "length": 1, "segments": 5, "section": )" +
+                                   section_e() + "}]}");
+  const Model rigid = load_text(R"({"name": "rigid", "gravity": [0.3, -1, -9.81], "bodies": [)" +
+                                hub + R"(, {"name": "bar", "parent": "hub", "joint": {"type":
+      "fixed"}, "elements": [{"type": "space_bar", "nodes": [[0, 0, 0], [1, 0, 0]],
+      "density": )" + num(kRho) +
+                                R"(, "area": )" + num(kA) + R"(, "Iy": )" + num(kIy) +
+                                R"(, "Iz": )" + num(kIz) + "}]}]}");
+  Workspace wf(flexible), wr(rigid);
+  for (const double angle : {0.0, 0.7, -2.0}) {
+    VecX qf = VecX::Zero(flexible.n()), qdf = VecX::Zero(flexible.n());
+    qf[0] = angle, qdf[0] = 1.3;
+    const VecX qr = qf.head(1), qdr = qdf.head(1);
+    evaluate(flexible, wf, qf, qdf, VecX::Zero(flexible.n()));
+    evaluate(rigid, wr, qr, qdr, VecX::Zero(1));
+    INFO("hub at " << angle);
+    CHECK(std::abs(wf.Ms(0, 0) / wr.Ms(0, 0) - 1) < 1e-13);
+    CHECK(std::abs(wf.Q[0] - wr.Q[0]) < 1e-13 * std::abs(wr.Q[0]) + 1e-15);
+    CHECK(std::abs(wf.h[0] - wr.h[0]) < 1e-13 * (std::abs(wr.Ms(0, 0)) + 1));
+  }
+}
