@@ -14,6 +14,10 @@ NaturalModes natural_modes(const Args& a, const Model& m) {
     out.missing = "closed loops (statics does not take them yet)";
     return out;
   }
+  if (!m.prescribed.empty()) {
+    out.missing = "joint '" + m.prescribed[0].joint + "' is prescribed in time: no rest";
+    return out;
+  }
   const StaticsResult rest = solve_statics(read_spec(a.positional[0], load_options(a)), {});
   if (!rest.status.ok) {
     out.missing = "no equilibrium: " + rest.status.message;

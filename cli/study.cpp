@@ -563,6 +563,10 @@ int cmd_study(int argc, char** argv) {
                  "): rebuild with -DCMAKE_BUILD_TYPE=Release");
 #endif
   const Model m = load(a);
+  if (!m.prescribed.empty())  // (Simbody's runs would be of the undriven mechanism)
+    throw ModelError(a.positional[0], "joint '" + m.prescribed[0].joint +
+                                          "' is prescribed in time, which the Simbody twin does "
+                                          "not take: a study would compare two mechanisms");
   validation::StudyOptions o;
   o.quick = a.has("quick");
   o.interpolate = !a.has("land-on-samples");

@@ -84,6 +84,10 @@ std::string failure_text(const Status& st, const ControlLoop& loop, ComputedTorq
 // applied, and the loops' forces left out) and a coordinate no actuator drives (Model::actuated:
 // a floating base nothing pushes, a passive joint).
 void require_fully_actuated(const std::string& file, const Model& m) {
+  if (!m.prescribed.empty())
+    throw ModelError(file, "joint '" + m.prescribed[0].joint +
+                               "' is prescribed in time (a driven joint): computed torque would "
+                               "fight its drive (not supported)");
   if (!m.constraints.empty())
     throw ModelError(file, "the model has closed loops (" + std::to_string(m.constraint_rows) +
                                " constraint equations); computed torque by the spanning tree's "

@@ -139,4 +139,22 @@ void actuate_free_joints(Model& m) {
   compile_actuators(m);
 }
 
+void compile_prescribed(const MechanismSpec& spec, const std::vector<int>& body_of_spec, Model& m) {
+  m.prescribed.clear();
+  for (std::size_t s = 0; s < spec.bodies.size(); ++s) {
+    const JointSpec& js = spec.bodies[s].joint;
+    if (!js.prescribed) continue;
+    const int b = body_of_spec[s];
+    const Joint& J = m.bodies[b].joint;
+    int coordinate = -1;
+    for (const CoordinateJoint& c : m.coordinate_joints)
+      if (c.body == b) coordinate = c.v;
+    if (J.nv != 1 || coordinate < 0)
+      throw ModelError(js.where + "/prescribed",
+                       "only a joint of one rate that is a coordinate of its own (not one that "
+                       "follows a coupling) can be prescribed");
+    m.prescribed.push_back({coordinate, J.name, *js.prescribed});
+  }
+}
+
 }  // namespace femdyn

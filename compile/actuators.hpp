@@ -16,6 +16,9 @@ void compile_actuator(const JointSpec& js, Joint& j);
 // of q (that of the joint owning it; a coupled joint's limit is not applied) and the actuated
 // rates of q.
 void compile_actuators(Model& m);
+// Model::prescribed from the joints' "prescribed": each a joint of one rate that is a coordinate
+// of its own (not one that follows a coupling), named in messages by its spec's path.
+void compile_prescribed(const MechanismSpec& spec, const std::vector<int>& body_of_spec, Model& m);
 
 // Every free joint of m taken as actuated (as "actuated": true on it: thrusters push the base),
 // and m's actuated rates derived again (`femdyn track --actuated-base`).

@@ -421,6 +421,7 @@ Model compile_tree(MechanismSpec spec, const CompileOptions& options) {
   lay_out_coordinates(m);
   configuration_coupling(m);
   compile_actuators(m);
+  compile_prescribed(spec, body_of_spec, m);
   compile_loops(spec, m);
   provisional_routes(m);  // (the node level samples the kinematics)
   build_node_level(spec, body_of_spec, m);

@@ -13,6 +13,7 @@
 #include "core/model/coupling_function.hpp"
 #include "core/model/element.hpp"
 #include "core/model/joint_type.hpp"
+#include "core/model/prescribed_motion.hpp"
 
 namespace femdyn {
 
@@ -39,6 +40,8 @@ struct JointSpec {
   // Whether an actuator drives the joint's rates (docs/control.md#actuation); not given: every
   // joint but a free one (a floating base has no thrusters unless the model says so).
   std::optional<bool> actuated;
+  // A driven joint: its coordinate follows this motion in time (one-rate joints).
+  std::optional<PrescribedMotion> prescribed;
   std::string where;
 };
 

@@ -64,10 +64,35 @@ void read_joint_parameters(const Params& p, JointSpec& j) {
       p.fail(it.key().c_str(), joint_scalar_refusal(it.key()));
 }
 
+// {"spin_up": {"rate": ω_s, "time": T_s}} or {"polynomial": [c_0, c_1, …]}
+// (core/model/prescribed_motion.hpp).
+PrescribedMotion read_prescribed(const Params& p) {
+  p.allow_only({"spin_up", "polynomial"});
+  PrescribedMotion m;
+  if (p.has("spin_up") == p.has("polynomial"))
+    p.fail("spin_up",
+           "give one motion: {\"spin_up\": {\"rate\", \"time\"}} or "
+           "{\"polynomial\": [c0, c1, …]}");
+  if (p.has("spin_up")) {
+    const Params s = p.child("spin_up");
+    s.allow_only({"rate", "time"});
+    m.kind = PrescribedMotion::Kind::SpinUp;
+    m.rate = s.number("rate");
+    m.time = s.positive("time");
+    return m;
+  }
+  const Json& c = p.json().at("polynomial");
+  if (!c.is_array() || c.empty() || c.size() > 16)
+    p.fail("polynomial", "expected 1 to 16 coefficients [c0, c1, …] (q = Σ c_k t^k)");
+  for (std::size_t k = 0; k < c.size(); ++k)
+    m.coefficients.push_back(json_number(c[k], p.path("polynomial") + "/" + std::to_string(k)));
+  return m;
+}
+
 JointSpec read_joint(const Params& p) {
   p.allow_only({"name", "type", "origin", "axis", "axis2", "limits", "spring", "damping",
                 "armature", "gear", "friction", "friction_velocity", "effort_limit",
-                "velocity_limit", "stop", "initial", "actuated"},
+                "velocity_limit", "stop", "initial", "actuated", "prescribed"},
                is_joint_scalar);
   JointSpec j;
   j.where = p.where();
@@ -95,7 +120,7 @@ JointSpec read_joint(const Params& p) {
   if (p.has("initial")) j.initial = p.number("initial");  // (compile: joints of one coordinate)
   if (j.type == JointType::Fixed)
     for (const char* key : {"armature", "gear", "friction", "friction_velocity", "effort_limit",
-                            "velocity_limit", "stop", "actuated"})
+                            "velocity_limit", "stop", "actuated", "prescribed"})
       if (p.has(key)) p.fail(key, "a fixed joint has no motion: no actuator, friction or stop");
   if (p.has("limits")) {
     const Json& l = p.json().at("limits");
@@ -111,6 +136,7 @@ JointSpec read_joint(const Params& p) {
   }
   if (p.has("damping")) j.damping = p.non_negative("damping");
   read_actuator(p, j);
+  if (p.has("prescribed")) j.prescribed = read_prescribed(p.child("prescribed"));
   return j;
 }
 

@@ -142,8 +142,8 @@ Status Motion::rhs(double t, const double* y, double* ydot) {
                                    : "the actuation tau(t) is NaN or Inf"),
             -1};
   if (model_.has_effort_limits) count_saturation(u_);
-  Status st = loops_ ? constrained_forward_dynamics(model_, ws_, *loops_, q_, qd_, u_, baumgarte_)
-                     : tree_forward_dynamics(model_, ws_, q_, qd_, u_);
+  Status st = accelerations();
+  if (st.ok && !model_.prescribed.empty()) st = drive_prescribed(t);
   if (!st.ok) {
     st.message = at_time(t) + st.message;
     return st;
@@ -151,6 +151,47 @@ Status Motion::rhs(double t, const double* y, double* ydot) {
   chart_rates(y, y + n, ydot);
   Eigen::Map<VecX>(ydot + n, n) = ws_.qdd;
   ydot[2 * n] = nonconservative_power(model_, ws_, qd_, u_);
+  return {};
+}
+
+Status Motion::accelerations() {
+  return loops_ ? constrained_forward_dynamics(model_, ws_, *loops_, q_, qd_, u_, baumgarte_)
+                : tree_forward_dynamics(model_, ws_, q_, qd_, u_);
+}
+
+// q̈ is affine in τ: q̈(u + Σ_p τ_p e_p) = q̈(u) + Σ_p τ_p M⁻¹ e_p (M⁻¹ projected onto the loops
+// where there are loops), so (M⁻¹)_PP τ_P = q̈*_P − q̈_P gives the prescribed coordinates their
+// q̈* exactly. Each column of M⁻¹ costs one more forward dynamics, with a unit torque added.
+Status Motion::drive_prescribed(double t) {
+  const std::vector<PrescribedCoordinate>& P = model_.prescribed;
+  const int k = static_cast<int>(P.size());
+  free_qdd_ = ws_.qdd;
+  driven_cols_.resize(n(), k);
+  driven_gain_.resize(k, k);
+  driven_need_.resize(k);
+  for (int j = 0; j < k; ++j) {
+    const int c = P[j].coordinate;
+    const auto [q, v, a] = P[j].motion.at(t);
+    const double w = kPrescribedRate;
+    driven_need_[j] = a + 2 * w * (v - qd_[c]) + w * w * (q - q_[c]) - free_qdd_[c];
+    u_[c] += 1;
+    if (Status st = accelerations(); !st.ok) return st;
+    u_[c] -= 1;
+    driven_cols_.col(j) = ws_.qdd - free_qdd_;
+  }
+  for (int j = 0; j < k; ++j)
+    for (int i = 0; i < k; ++i) driven_gain_(i, j) = driven_cols_(P[i].coordinate, j);
+  if (k == 1)
+    driven_need_[0] /= driven_gain_(0, 0);
+  else
+    driven_need_ = driven_gain_.partialPivLu().solve(driven_need_);
+  if (!driven_need_.allFinite())
+    return {false,
+            "the torque that holds the prescribed joint '" + P[0].joint +
+                "' on its motion is NaN or Inf (it moves no inertia of its own)",
+            P[0].coordinate, true};
+  for (int j = 0; j < k; ++j) u_[P[j].coordinate] += driven_need_[j];
+  ws_.qdd = free_qdd_ + driven_cols_ * driven_need_;
   return {};
 }
 

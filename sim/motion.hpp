@@ -146,7 +146,20 @@ class Motion {
   bool last_saturated_ = false;  // the last evaluation's τ was saturated
   std::vector<long> saturations_;
   void count_saturation(VecX& tau);
+  // q̈ into ws_.qdd at (q_, qd_) under u_: the tree's, or the constrained one with loops.
+  Status accelerations();
+  // The torques that hold the prescribed coordinates on their motion (Model::prescribed), added
+  // to u_ and their effect to ws_.qdd.
+  Status drive_prescribed(double t);
+  VecX free_qdd_;     // q̈ before the prescribed torques
+  MatX driven_cols_;  // M⁻¹'s columns of the prescribed coordinates (n × k)
+  MatX driven_gain_;  // their rows: (M⁻¹)_PP (k × k)
+  VecX driven_need_;  // q̈*_P − q̈_P, then τ_P (k)
 };
+
+// The rate (1/s) at which the simulator pulls a prescribed coordinate back onto its motion after
+// the integrator's drift or a start off it: q̈* = q̈(t) + 2ω (q̇(t) − q̇) + ω² (q(t) − q).
+inline constexpr double kPrescribedRate = 10;
 
 // Power of the non-conservative forces at the state of the last evaluate(model, ws, q, q̇, τ):
 //   P_nc = q̇ᵀ τ + Σ_j P_j(θ_j, θ̇_j) + Σ_b τ_b · ω_b      (actuation, joints, body torques),

@@ -124,6 +124,10 @@ StaticsResult solve_statics(const MechanismSpec& spec, const StaticsOptions& o) 
   if (o.tau.size() && o.tau.size() != first.n())
     throw ArgumentError("statics: tau has " + std::to_string(o.tau.size()) +
                         " entries, the model " + std::to_string(first.n()));
+  if (!first.prescribed.empty())
+    throw ModelError(spec.where + "/bodies",
+                     "statics: joint '" + first.prescribed[0].joint +
+                         "' is prescribed in time (a driven joint); a rest has no time");
   out.q = o.q0.size() ? o.q0 : neutral_posture(first);
   double step = 1;
   std::string why;

@@ -8,7 +8,10 @@
 #include <fstream>
 #include <sstream>
 
+#include "tests/helpers.hpp"
+
 namespace fs = std::filesystem;
+using femdyn::test::read_file;  // (its own: a unity build must not lend it)
 
 namespace {
 

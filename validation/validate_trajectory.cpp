@@ -286,6 +286,11 @@ TrajectoryReport Validator::Impl::trajectory(const VecX& q0, const VecX& qd0,
     tr.skipped = "--t-end 0";
     return tr;
   }
+  if (!m.prescribed.empty()) {  // (the twin has no driven joints: its run would be another's)
+    tr.skipped = "the model prescribes joint '" + m.prescribed[0].joint +
+                 "' in time, which the Simbody twin does not: pointwise only";
+    return tr;
+  }
   if (!twin->can_simulate(&tr.skipped)) return tr;
   VecX q = q0, qd = qd0;
   if (tr.constrained) {  // a consistent start: Φ = 0, Φ_q q̇ = 0

@@ -18,6 +18,7 @@
 #include "core/model/element.hpp"
 #include "core/model/joint_type.hpp"
 #include "core/model/loop_constraint.hpp"
+#include "core/model/prescribed_motion.hpp"
 #include "core/model/routes.hpp"
 #include "core/model/spanning_mass.hpp"
 #include "core/model/two_point_spring.hpp"
@@ -207,6 +208,8 @@ struct Model {
   VecX F_constant;  // nodal forces that do not depend on the state (gravity, point loads)
   std::vector<BodyTorque> torques;
   std::vector<PointLoad> point_loads;
+  // Coordinates whose motion is given in time (driven joints; sim/motion.cpp holds them).
+  std::vector<PrescribedCoordinate> prescribed;
   // Body level (core/dynamics/body_inertia.hpp): M^s = Σ_b J_bᵀ Λ_b J_b where `condensable`.
   std::vector<RigidInertia>
       body_inertia;                // Λ_b = Σ X_eᵀ m_e X_e, body axes (core/spatial/spatial.hpp)

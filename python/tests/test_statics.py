@@ -77,3 +77,32 @@ def test_check_lists_the_natural_modes_about_the_equilibrium(tmp_path):
     assert modes[0]["omega"] == pytest.approx(first, rel=5e-3)
     assert modes[0]["omega"] != pytest.approx(first, rel=1e-3)  # (8 parts: not yet converged)
     assert modes[0]["coordinate"].startswith("beam.")
+
+
+DRIVEN = {"name": "driven", "gravity": [0, -3, -9.81], "bodies": [
+    {"name": "hub", "parent": "world",
+     "joint": {"name": "hub", "type": "revolute", "axis": [0, 0, 1],
+               "prescribed": {"polynomial": [0, 0.5, -0.3, 0.1]}},
+     "elements": [{"type": "rigid_body", "mass": 2, "com": [0.1, 0, 0],
+                   "inertia": {"ixx": 0.02, "iyy": 0.03, "izz": 0.04}}]},
+    {"name": "arm", "parent": "hub",
+     "joint": {"name": "swing", "type": "revolute", "axis": [0, 1, 0],
+               "origin": {"xyz": [0.3, 0, 0]}},
+     "elements": [{"type": "lumped_point", "node": [0.4, 0, 0], "mass": 1}]}]}
+
+
+def test_a_driven_joint_through_the_python_doors(tmp_path):
+    # femdyn.simulate holds the hub on q(t) = 0.5 t − 0.3 t² + 0.1 t³; statics refuses (a rest
+    # has no time); validate compares pointwise and says why the trajectory is left out.
+    path = tmp_path / "driven.json"
+    path.write_text(json.dumps(DRIVEN))
+    m = femdyn.load(str(path))
+    run = femdyn.simulate(m, 1.0, q0=[0, 0.2], qd0=[0.5, 0], integrator="dopri", rtol=1e-10,
+                          atol=1e-12)
+    t = np.asarray(run["t"])
+    assert np.abs(run["q"][:, 0] - (0.5 * t - 0.3 * t ** 2 + 0.1 * t ** 3)).max() < 1e-8
+    with pytest.raises(femdyn.ModelError, match="statics: joint 'hub' is prescribed in time"):
+        m.statics()
+    if femdyn.with_simbody:
+        r = femdyn.validate(m, states=4, t_end=0.1)
+        assert "prescribes joint 'hub'" in r["trajectory"]["skipped"]
