@@ -182,7 +182,9 @@ TEST_CASE("derivatives agree with differences on random trees of every joint typ
 TEST_CASE("derivatives agree with differences on a flexible bar on a hub", "[derivatives]") {
   // The bar's bodies and springs (io/flexible_bar.hpp) under gravity, with stiffness-
   // proportional damping, clamped to a turning hub: docs/flexible.md's "every derivative
-  // applies as it is", checked.
+  // applies as it is", checked. The rotary inertias keep cond(M^s) moderate: the differences'
+  // round-off grows with it (with 100 times less, Richardson's error was 1.1e-9 in the
+  // sanitizer build, above the shared 1e-9).
   Agreement worst;
   const Model m = load_text(R"({"name": "hub and bar", "gravity": [0.5, -1, -9.81], "bodies": [
     {"name": "hub", "parent": "world", "joint": {"type": "revolute", "axis": [0, 0, 1]},
@@ -190,8 +192,8 @@ TEST_CASE("derivatives agree with differences on a flexible bar on a hub", "[der
                    "izz": 0.2}}]}],
     "flexible_bars": [{"name": "arm", "parent": "hub", "length": 0.8, "segments": 3,
       "origin": {"xyz": [0.1, 0, 0], "rpy": [0, 0.2, 0]},
-      "section": {"EA": 2e5, "EIy": 30, "EIz": 40, "GJ": 20, "rhoA": 0.5, "rhoIy": 1e-4,
-                  "rhoIz": 2e-4},
+      "section": {"EA": 2e4, "EIy": 30, "EIz": 40, "GJ": 20, "rhoA": 0.5, "rhoIy": 1e-2,
+                  "rhoIz": 2e-2},
       "damping": {"stiffness_proportional": 1e-3}}]})");
   for (unsigned seed = 1; seed <= 3; ++seed) check_model(m, seed, worst, 0.05);
   WARN("flexible bar: central " << worst.central << ", Richardson " << worst.richardson);
