@@ -171,6 +171,21 @@ Json joint_properties(const Joint& j) {
   return p;
 }
 
+// A driven joint's motion: "spin-up to 4 rad/s in 15 s" or "q = 0 + 0.5 t + …".
+std::string prescribed_text(const PrescribedMotion& m) {
+  if (m.kind == PrescribedMotion::Kind::SpinUp)
+    return "spin-up to rate " + format_number(m.rate) + " in " + format_number(m.time) +
+           " s (Simo & Vu-Quoc's profile), steady after";
+  std::string s = "q(t) =";
+  for (std::size_t k = 0; k < m.coefficients.size(); ++k) {
+    const double c = m.coefficients[k];
+    const std::string sign = k == 0 ? (c < 0 ? " -" : " ") : (c < 0 ? " - " : " + ");
+    const std::string power = k == 0 ? "" : k == 1 ? " t" : " t^" + std::to_string(k);
+    s += sign + format_number(std::abs(c)) + power;
+  }
+  return s;
+}
+
 // The same on one line: "limits [-1, 0.5] with a stop (k 1e4, d 0.5); damping 2; …".
 std::string joint_properties_text(const Joint& j) {
   std::vector<std::string> parts;
@@ -276,6 +291,8 @@ void joints_text(std::ostream& out, const Model& model) {
     joint_relation(out, model, j, j.idx_v >= 0 ? law_of[j.idx_v] : nullptr);
     out << "\n";
     if (const std::string p = joint_properties_text(j); !p.empty()) out << "      " << p << "\n";
+    for (const PrescribedCoordinate& d : model.prescribed)
+      if (d.joint == j.name) out << "      prescribed: " << prescribed_text(d.motion) << "\n";
   }
 }
 
@@ -379,6 +396,8 @@ Json info_json(const Model& model) {
                   {"parent", b.parent < 0 ? std::string("world") : model.bodies[b.parent].name},
                   {"body", b.name}};
     joint.update(joint_properties(b.joint));
+    for (const PrescribedCoordinate& d : model.prescribed)
+      if (d.joint == b.joint.name) joint["prescribed"] = prescribed_text(d.motion);
     joints.push_back(joint);
   }
   j["joints"] = joints;

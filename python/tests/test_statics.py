@@ -101,6 +101,8 @@ def test_a_driven_joint_through_the_python_doors(tmp_path):
                           atol=1e-12)
     t = np.asarray(run["t"])
     assert np.abs(run["q"][:, 0] - (0.5 * t - 0.3 * t ** 2 + 0.1 * t ** 3)).max() < 1e-8
+    hub = next(j for j in m.info()["joints"] if j["name"] == "hub")
+    assert hub["prescribed"] == "q(t) = 0 + 0.5 t - 0.3 t^2 + 0.1 t^3"
     with pytest.raises(femdyn.ModelError, match="statics: joint 'hub' is prescribed in time"):
         m.statics()
     if femdyn.with_simbody:
