@@ -171,7 +171,8 @@ Json joint_properties(const Joint& j) {
   return p;
 }
 
-// A driven joint's motion: "spin-up to 4 rad/s in 15 s" or "q = 0 + 0.5 t + …".
+namespace {
+// A driven joint's motion: "spin-up to rate 4 in 15 s …" or "q(t) = 0 + 0.5 t - …".
 std::string prescribed_text(const PrescribedMotion& m) {
   if (m.kind == PrescribedMotion::Kind::SpinUp)
     return "spin-up to rate " + format_number(m.rate) + " in " + format_number(m.time) +
@@ -185,6 +186,7 @@ std::string prescribed_text(const PrescribedMotion& m) {
   }
   return s;
 }
+}  // namespace
 
 // The same on one line: "limits [-1, 0.5] with a stop (k 1e4, d 0.5); damping 2; …".
 std::string joint_properties_text(const Joint& j) {

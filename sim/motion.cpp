@@ -191,7 +191,8 @@ Status Motion::drive_prescribed(double t) {
                 "' on its motion is NaN or Inf (it moves no inertia of its own)",
             P[0].coordinate, true};
   for (int j = 0; j < k; ++j) u_[P[j].coordinate] += driven_need_[j];
-  ws_.qdd = free_qdd_ + driven_cols_ * driven_need_;
+  ws_.qdd = free_qdd_;
+  ws_.qdd.noalias() += driven_cols_ * driven_need_;  // (no temporary: every evaluation)
   return {};
 }
 
