@@ -22,9 +22,8 @@ bool has_actuator(const JointSpec& js) {
          std::isfinite(js.velocity_limit) || js.stop;
 }
 
-}  // namespace
-
-void compile_actuator(const JointSpec& js, Joint& j) {
+// Each value finite and within the magnitudes femdyn takes (core/model/limits.hpp).
+void check_magnitudes(const JointSpec& js) {
   const std::string& w = js.where;
   check_finite(js.armature, w + "/armature", "armature");
   check_finite(js.gear, w + "/gear", "gear ratio");
@@ -34,6 +33,11 @@ void compile_actuator(const JointSpec& js, Joint& j) {
   check_finite(js.velocity_limit, w + "/velocity_limit", "velocity_limit");
   check_finite(js.stop_stiffness, w + "/stop/stiffness", "stop stiffness");
   check_finite(js.stop_dissipation, w + "/stop/dissipation", "stop dissipation");
+}
+
+// Which joint types take an actuator and an armature.
+void check_joint_takes_them(const JointSpec& js, const Joint& j) {
+  const std::string& w = js.where;
   if (has_actuator(js) && j.nv != 1)
     throw ModelError(w, std::string("a ") + std::string(joint_type_name(j.type)) +
                             " joint takes no gear, friction, effort or velocity limit or "
@@ -44,6 +48,10 @@ void compile_actuator(const JointSpec& js, Joint& j) {
     throw ModelError(w + "/armature", std::string("a ") + std::string(joint_type_name(j.type)) +
                                           " joint takes no armature (joints of one coordinate, "
                                           "spherical and free joints do)");
+}
+
+void check_ranges(const JointSpec& js) {
+  const std::string& w = js.where;
   if (!(js.armature >= 0) || !std::isfinite(js.armature))
     throw ModelError(w + "/armature",
                      "must be finite and not negative, got " + format_number(js.armature));
@@ -61,18 +69,30 @@ void compile_actuator(const JointSpec& js, Joint& j) {
   if (!(js.velocity_limit > 0))
     throw ModelError(w + "/velocity_limit",
                      "must be positive, got " + format_number(js.velocity_limit));
-  if (js.stop) {
-    if (!std::isfinite(js.lower) && !std::isfinite(js.upper))
-      throw ModelError(w + "/stop", "a stop needs finite limits [lower, upper]");
-    if (!(js.lower <= js.upper))
-      throw ModelError(w + "/limits", "lower > upper: the stop would push both ways");
-    if (!(js.stop_stiffness > 0) || !std::isfinite(js.stop_stiffness))
-      throw ModelError(w + "/stop/stiffness",
-                       "must be finite and positive, got " + format_number(js.stop_stiffness));
-    if (!(js.stop_dissipation >= 0) || !std::isfinite(js.stop_dissipation))
-      throw ModelError(w + "/stop/dissipation", "must be finite and not negative, got " +
-                                                    format_number(js.stop_dissipation));
-  }
+}
+
+void check_stop(const JointSpec& js) {
+  if (!js.stop) return;
+  const std::string& w = js.where;
+  if (!std::isfinite(js.lower) && !std::isfinite(js.upper))
+    throw ModelError(w + "/stop", "a stop needs finite limits [lower, upper]");
+  if (!(js.lower <= js.upper))
+    throw ModelError(w + "/limits", "lower > upper: the stop would push both ways");
+  if (!(js.stop_stiffness > 0) || !std::isfinite(js.stop_stiffness))
+    throw ModelError(w + "/stop/stiffness",
+                     "must be finite and positive, got " + format_number(js.stop_stiffness));
+  if (!(js.stop_dissipation >= 0) || !std::isfinite(js.stop_dissipation))
+    throw ModelError(w + "/stop/dissipation",
+                     "must be finite and not negative, got " + format_number(js.stop_dissipation));
+}
+
+}  // namespace
+
+void compile_actuator(const JointSpec& js, Joint& j) {
+  check_magnitudes(js);
+  check_joint_takes_them(js, j);
+  check_ranges(js);
+  check_stop(js);
   j.armature = js.armature;
   j.gear = js.gear;
   j.reflected_inertia = js.armature * js.gear * js.gear;  // I_a G²
@@ -86,9 +106,10 @@ void compile_actuator(const JointSpec& js, Joint& j) {
   j.actuated = js.actuated.value_or(j.type != JointType::Free);
 }
 
-void compile_actuators(Model& m) {
-  const int n = m.n();
-  // M_a = Cᵀ diag(a) C, a_j = I_a G² of θ̇_j's joint: Σ_j a_j C_jᵀ C_j over the rows of C.
+namespace {
+
+// M_a = Cᵀ diag(a) C, a_j = I_a G² of θ̇_j's joint: Σ_j a_j C_jᵀ C_j over the rows of C.
+void compile_armature_mass(Model& m) {
   std::vector<Eigen::Triplet<double>> entries;
   for (int j = 0; j < m.n_theta(); ++j) {
     const double a = m.bodies[m.theta_joint[j]].joint.reflected_inertia;
@@ -98,9 +119,13 @@ void compile_actuators(Model& m) {
         entries.emplace_back(ck.col(), ci.col(), ck.value() * a * ci.value());
   }
   m.has_armature = !entries.empty();
-  m.armature_mass.resize(n, n);
+  m.armature_mass.resize(m.n(), m.n());
   m.armature_mass.setFromTriplets(entries.begin(), entries.end());
   m.armature_mass.makeCompressed();
+}
+
+// The terms on a joint of several rates: a free joint's rotor, a damper on each rate.
+void compile_rate_terms(Model& m) {
   m.free_rotors.clear();  // (a free or spherical joint is coupled to nothing: its rates are q̇'s)
   m.rate_dampers.clear();
   for (const CoordinateJoint& c : m.coordinate_joints) {
@@ -110,27 +135,40 @@ void compile_actuators(Model& m) {
     if (J.nv > 1 && J.damping != 0 && J.idx_v >= 0)
       m.rate_dampers.push_back({c.v, J.idx_v, J.nv, J.damping});
   }
+}
 
-  // Effort limits, on the rates of q that the joints own. A coupled joint's is kept but not
-  // applied: no τ acts on it directly (simulate says so, sim/recorded_run.hpp).
-  m.effort_limit = VecX::Constant(n, INFINITY);
+// Effort limits, on the rates of q that the joints own. A coupled joint's is kept but not
+// applied: no τ acts on it directly (simulate says so, sim/recorded_run.hpp).
+void compile_effort_limits(Model& m) {
+  m.effort_limit = VecX::Constant(m.n(), INFINITY);
   for (const CoordinateJoint& c : m.coordinate_joints) {
     const Joint& J = m.bodies[c.body].joint;
     if (J.nv == 1) m.effort_limit[c.v] = J.effort_limit;
   }
   m.has_effort_limits = (m.effort_limit.array() < INFINITY).any();
+}
 
-  // Actuation: every rate of q but those a joint that is not actuated owns (a coupled
-  // coordinate, owned by no joint, is driven through the joints its coupling moves).
-  std::vector<bool> driven(n, true);
+// Actuation: every rate of q but those a joint that is not actuated owns (a coupled
+// coordinate, owned by no joint, is driven through the joints its coupling moves).
+void compile_actuated_rates(Model& m) {
+  std::vector<bool> driven(m.n(), true);
   for (const CoordinateJoint& c : m.coordinate_joints) {
     const Joint& J = m.bodies[c.body].joint;
     if (!J.actuated)
       for (int k = 0; k < J.nv; ++k) driven[c.v + k] = false;
   }
   m.actuated.clear();
-  for (int i = 0; i < n; ++i)
+  for (int i = 0; i < m.n(); ++i)
     if (driven[i]) m.actuated.push_back(i);
+}
+
+}  // namespace
+
+void compile_actuators(Model& m) {
+  compile_armature_mass(m);
+  compile_rate_terms(m);
+  compile_effort_limits(m);
+  compile_actuated_rates(m);
 }
 
 void actuate_free_joints(Model& m) {

@@ -23,8 +23,8 @@
 namespace femdyn {
 namespace {
 
-// Bodies in depth-first order from the world, children in file order. Returns spec indices.
-std::vector<int> tree_order(const MechanismSpec& spec) {
+// Each body's spec index by name; the names checked (not empty, not 'world', unique).
+std::map<std::string, int> body_index(const MechanismSpec& spec) {
   std::map<std::string, int> index;
   for (std::size_t i = 0; i < spec.bodies.size(); ++i) {
     const BodySpec& b = spec.bodies[i];
@@ -35,7 +35,12 @@ std::vector<int> tree_order(const MechanismSpec& spec) {
     if (!index.emplace(b.name, static_cast<int>(i)).second)
       throw ModelError(b.where, "duplicate body name '" + b.name + "'");
   }
-  // children[k + 1]: the bodies hanging from body k (children[0]: from the world).
+  return index;
+}
+
+// children[k + 1]: the bodies hanging from body k (children[0]: from the world), in file order.
+std::vector<std::vector<int>> children_of(const MechanismSpec& spec,
+                                          const std::map<std::string, int>& index) {
   std::vector<std::vector<int>> children(spec.bodies.size() + 1);
   for (std::size_t i = 0; i < spec.bodies.size(); ++i) {
     const BodySpec& b = spec.bodies[i];
@@ -44,10 +49,14 @@ std::vector<int> tree_order(const MechanismSpec& spec) {
     if (b.parent == b.name) throw ModelError(b.where + "/parent", "body is its own parent");
     children[b.parent == "world" ? 0 : index.at(b.parent) + 1].push_back(static_cast<int>(i));
   }
-  // Depth-first, parents before children, siblings in file order; an explicit stack (not
-  // recursion), so that a chain of any length cannot overflow the call stack.
+  return children;
+}
+
+// Depth-first, parents before children, siblings in file order; an explicit stack (not
+// recursion), so that a chain of any length cannot overflow the call stack.
+std::vector<int> depth_first(const std::vector<std::vector<int>>& children) {
   std::vector<int> order;
-  order.reserve(spec.bodies.size());
+  order.reserve(children.size() - 1);
   std::vector<std::pair<int, std::size_t>> stack = {{0, 0}};  // (children slot, next child)
   while (!stack.empty()) {
     auto& [slot, next] = stack.back();
@@ -59,6 +68,12 @@ std::vector<int> tree_order(const MechanismSpec& spec) {
     order.push_back(c);
     stack.emplace_back(c + 1, 0);
   }
+  return order;
+}
+
+// Bodies in depth-first order from the world, children in file order. Returns spec indices.
+std::vector<int> tree_order(const MechanismSpec& spec) {
+  const std::vector<int> order = depth_first(children_of(spec, body_index(spec)));
   if (order.size() != spec.bodies.size()) {
     std::set<int> reached(order.begin(), order.end());
     for (std::size_t i = 0; i < spec.bodies.size(); ++i)
@@ -103,11 +118,8 @@ Mat3 quaternion_origin(const Eigen::Vector4d& w, const std::string& where) {
   return quaternion_rotation(u.data());
 }
 
-Joint compile_joint(const JointSpec& js, const std::string& body_name) {
-  Joint j;
-  j.name = js.name.empty() ? body_name : js.name;
-  j.type = js.type;
-  j.where = js.where;
+// The joint frame in its parent (xyz and rpy or a quaternion) and its unit axis.
+void place_joint(const JointSpec& js, Joint& j) {
   check_magnitude(js.xyz, js.where + "/origin/xyz", "origin xyz");
   check_magnitude(js.rpy, js.where + "/origin/rpy", "origin rpy");
   j.p_pj = js.xyz;
@@ -119,8 +131,10 @@ Joint compile_joint(const JointSpec& js, const std::string& body_name) {
     if (!(norm > 1e-12)) throw ModelError(js.where + "/axis", "axis is zero");
     j.axis = js.axis / norm;
   }
-  check_joint_parameters(js, j);
-  prepare_joint(j);
+}
+
+// The spring, damper, limits and initial value: checked, then copied.
+void compile_joint_terms(const JointSpec& js, Joint& j) {
   for (auto [x, what] :
        {std::pair{js.stiffness, "stiffness"}, {js.rest, "rest"}, {js.damping, "damping"}})
     check_magnitude(x, js.where, what);
@@ -136,17 +150,28 @@ Joint compile_joint(const JointSpec& js, const std::string& body_name) {
   if (js.damping < 0) throw ModelError(js.where + "/damping", "negative damping");
   if (std::isnan(js.lower) || std::isnan(js.upper) || js.lower > js.upper)
     throw ModelError(js.where + "/limits", "joint limits are NaN or lower > upper");
-  j.stiffness = js.stiffness;
-  j.rest = js.rest;
   check_magnitude(js.initial, js.where + "/initial", "initial");
   if (js.initial != 0 && j.nq != 1)
     throw ModelError(js.where + "/initial", "is the coordinate of a joint of one: this " +
                                                 std::string(joint_type_name(j.type)) +
                                                 " joint has " + std::to_string(j.nq));
+  j.stiffness = js.stiffness;
+  j.rest = js.rest;
   j.initial = js.initial;
   j.damping = js.damping;
   j.lower = js.lower;
   j.upper = js.upper;
+}
+
+Joint compile_joint(const JointSpec& js, const std::string& body_name) {
+  Joint j;
+  j.name = js.name.empty() ? body_name : js.name;
+  j.type = js.type;
+  j.where = js.where;
+  place_joint(js, j);
+  check_joint_parameters(js, j);
+  prepare_joint(j);
+  compile_joint_terms(js, j);
   compile_actuator(js, j);
   return j;
 }
@@ -224,51 +249,59 @@ std::vector<int> number_coordinates(Model& m, const Coupled& coupled) {
   return q_of;
 }
 
-// C row by row (O(non-zeros), not nθ × n) and θ0: each joint's row after the rows of the joints
-// it follows, depth-first with an explicit stack (a chain of couplings of any length cannot
-// overflow the call stack); a cycle is reported at a joint on it.
+// How far coupling_rows has got with each joint.
+enum class RowState { New, InProgress, Done };
+
+// Joint t0's row of C and θ0, after the rows of the joints it follows, depth-first with an
+// explicit stack (a chain of couplings of any length cannot overflow the call stack); a cycle
+// is reported at a joint on it.
+void coupling_row(int t0, Model& m, const Coupled& coupled, const ThetaOf& theta_of,
+                  const std::vector<int>& q_of, std::vector<RowState>& state,
+                  std::vector<std::map<int, double>>& rows) {
+  std::vector<std::pair<int, std::size_t>> stack = {{t0, 0}};  // (joint, next term)
+  while (!stack.empty()) {
+    const auto [t, k] = stack.back();
+    if (k == 0 && state[t] == RowState::New) {
+      state[t] = RowState::InProgress;
+      if (q_of[t] >= 0) {  // a coordinate: its own row
+        rows[t][q_of[t]] = 1.0;
+        state[t] = RowState::Done;
+        stack.pop_back();
+        continue;
+      }
+      m.theta0[t] = coupled.at(t)->offset;
+    }
+    const auto& terms = coupled.at(t)->terms;
+    if (k == terms.size()) {
+      state[t] = RowState::Done;
+      stack.pop_back();
+      continue;
+    }
+    const auto& [name, ratio] = terms[k];
+    const int f = theta_of.at(name);
+    if (state[f] == RowState::InProgress)
+      throw ModelError(coupled.at(f)->where, "couplings form a cycle through joint '" +
+                                                 m.bodies[m.theta_joint[f]].joint.name + "'");
+    if (state[f] == RowState::New) {
+      stack.emplace_back(f, 0);
+      continue;
+    }
+    for (const auto& [a, c] : rows[f]) rows[t][a] += ratio * c;  // θ_t += ratio θ_f
+    m.theta0[t] += ratio * m.theta0[f];
+    ++stack.back().second;
+  }
+}
+
+// C row by row (O(non-zeros), not nθ × n) and θ0.
 std::vector<std::map<int, double>> coupling_rows(Model& m, const Coupled& coupled,
                                                  const ThetaOf& theta_of,
                                                  const std::vector<int>& q_of) {
   const int nt = m.n_theta();
   std::vector<std::map<int, double>> rows(nt);
   m.theta0 = VecX::Zero(nt);
-  std::vector<int> state(nt, 0);  // 0 new, 1 in progress, 2 done
-  for (int t0 = 0; t0 < nt; ++t0) {
-    if (state[t0] == 2) continue;
-    std::vector<std::pair<int, std::size_t>> stack = {{t0, 0}};  // (joint, next term)
-    while (!stack.empty()) {
-      const auto [t, k] = stack.back();
-      if (k == 0 && state[t] == 0) {
-        state[t] = 1;
-        if (q_of[t] >= 0) {  // a coordinate: its own row
-          rows[t][q_of[t]] = 1.0;
-          state[t] = 2;
-          stack.pop_back();
-          continue;
-        }
-        m.theta0[t] = coupled.at(t)->offset;
-      }
-      const auto& terms = coupled.at(t)->terms;
-      if (k == terms.size()) {
-        state[t] = 2;
-        stack.pop_back();
-        continue;
-      }
-      const auto& [name, ratio] = terms[k];
-      const int f = theta_of.at(name);
-      if (state[f] == 1)
-        throw ModelError(coupled.at(f)->where, "couplings form a cycle through joint '" +
-                                                   m.bodies[m.theta_joint[f]].joint.name + "'");
-      if (state[f] == 0) {
-        stack.emplace_back(f, 0);
-        continue;
-      }
-      for (const auto& [a, c] : rows[f]) rows[t][a] += ratio * c;  // θ_t += ratio θ_f
-      m.theta0[t] += ratio * m.theta0[f];
-      ++stack.back().second;
-    }
-  }
+  std::vector<RowState> state(nt, RowState::New);
+  for (int t0 = 0; t0 < nt; ++t0)
+    if (state[t0] != RowState::Done) coupling_row(t0, m, coupled, theta_of, q_of, state, rows);
   return rows;
 }
 
@@ -373,8 +406,10 @@ Model compile(MechanismSpec spec, const CompileOptions& options) {
   return m;
 }
 
-Model compile_tree(MechanismSpec spec, const CompileOptions& options) {
-  Model m;
+namespace {
+
+// The spec's own checks: its name, gravity and number of bodies.
+void compile_header(const MechanismSpec& spec, Model& m) {
   m.name = spec.name;
   m.where = spec.where.size() >= 2 ? spec.where.substr(0, spec.where.size() - 2) : spec.where;
   check_magnitude(spec.gravity,
@@ -385,7 +420,11 @@ Model compile_tree(MechanismSpec spec, const CompileOptions& options) {
     throw ModelError(spec.where + "/bodies", too_many_bodies_text(spec.bodies.size()));
   m.gravity = spec.gravity;
   if (spec.bodies.empty()) throw ModelError(spec.where + "/bodies", "the model has no bodies");
+}
 
+// The bodies in tree order with their joints, their addresses in θ and θ̇ (they differ after
+// a joint with nq ≠ nv) and each rate's parent rate. Returns each spec body's index in m.bodies.
+std::vector<int> compile_bodies(const MechanismSpec& spec, Model& m) {
   const std::vector<int> order = tree_order(spec);
   std::vector<int> body_of_spec(spec.bodies.size());
   std::set<std::string> joint_names;
@@ -394,15 +433,11 @@ Model compile_tree(MechanismSpec spec, const CompileOptions& options) {
   for (std::size_t k = 0; k < order.size(); ++k) {
     const BodySpec& bs = spec.bodies[order[k]];
     body_of_spec[order[k]] = static_cast<int>(k);
-    Body b;
-    b.name = bs.name;
-    b.where = bs.where;
-    b.joint = compile_joint(bs.joint, bs.name);
+    Body b{.name = bs.name, .joint = compile_joint(bs.joint, bs.name), .where = bs.where};
     if (!joint_names.insert(b.joint.name).second)
       throw ModelError(bs.joint.where + "/name", "duplicate joint name '" + b.joint.name + "'");
     b.parent = bs.parent == "world" ? -1 : compiled.at(bs.parent);  // (placed before: tree order)
     compiled.emplace(bs.name, static_cast<int>(k));
-    // Addresses in θ and θ̇ (they differ after a joint with nq ≠ nv), in tree order, and λ.
     last_rate.push_back(b.parent >= 0 ? last_rate[b.parent] : -1);
     if (moves(b.joint)) {
       b.joint.idx_q = m.n_theta_q;
@@ -416,6 +451,15 @@ Model compile_tree(MechanismSpec spec, const CompileOptions& options) {
     }
     m.bodies.push_back(std::move(b));
   }
+  return body_of_spec;
+}
+
+}  // namespace
+
+Model compile_tree(MechanismSpec spec, const CompileOptions& options) {
+  Model m;
+  compile_header(spec, m);
+  const std::vector<int> body_of_spec = compile_bodies(spec, m);
   compile_frames(spec, m);
   compile_coupling(spec, m);
   lay_out_coordinates(m);

@@ -120,8 +120,8 @@ struct PathSpan {
   }
 };
 
-void row_max_by_paths(const Model& m, Workspace& ws, std::vector<PathSpan>& span, VecX& row_max,
-                      double enough) {
+// The span of the joint columns S_a on each body's path from the world, parents first.
+void path_spans(const Model& m, const Workspace& ws, std::vector<PathSpan>& span) {
   const int nb = static_cast<int>(m.bodies.size());
   for (int b = 0; b < nb; ++b) {  // parents first
     const Body& B = m.bodies[b];
@@ -137,6 +137,11 @@ void row_max_by_paths(const Model& m, Workspace& ws, std::vector<PathSpan>& span
       if (P.size < 6 && r.norm() > 1e-9 * S.norm()) P.basis[P.size++] = r.normalized();
     }
   }
+}
+
+void row_max_by_paths(const Model& m, Workspace& ws, std::vector<PathSpan>& span, VecX& row_max,
+                      double enough) {
+  path_spans(m, ws, span);
   // max |T_ia| = max |S_a · w| over the columns a of the joints on the path.
   const auto over_path = [&](int body, const Vec6& w) {
     double big = 0;

@@ -90,6 +90,30 @@ void compile_gear(const ConstraintSpec& s, const Model& m, LoopConstraint& c) {
                      "constrains nothing");
 }
 
+// The constraint's own geometry: the axes a ball, line or plane constraint removes, a
+// distance's length.
+void compile_constraint_geometry(const ConstraintSpec& s, LoopConstraint& c) {
+  switch (c.type) {
+    case ConstraintType::Ball:
+      if (s.axis) c.axes = normal_plane(unit_axis(s, "normal"));
+      break;
+    case ConstraintType::PointOnLine:
+      c.axes = normal_plane(unit_axis(s, "direction"));
+      break;
+    case ConstraintType::PointOnPlane:
+      c.axes = {unit_axis(s, "normal")};
+      break;
+    case ConstraintType::Distance:
+      check_magnitude(s.length, s.where + "/length", "length");
+      if (!(s.length > 0)) throw ModelError(s.where + "/length", "must be a positive length");
+      c.length = s.length;
+      break;
+    case ConstraintType::Weld:
+    case ConstraintType::Gear:
+      break;
+  }
+}
+
 LoopConstraint compile_constraint(const ConstraintSpec& s, const Model& m) {
   check_name(s.name, s.where + "/name", "constraint name");  // (printed by info, check, reports)
   LoopConstraint c;
@@ -110,25 +134,7 @@ LoopConstraint compile_constraint(const ConstraintSpec& s, const Model& m) {
                                   (c.a.body < 0 ? std::string("the world")
                                                 : "body " + quoted_text(m.bodies[c.a.body].name)) +
                                   ": a constraint closes a loop between two bodies");
-  switch (c.type) {
-    case ConstraintType::Ball:
-      if (s.axis) c.axes = normal_plane(unit_axis(s, "normal"));
-      break;
-    case ConstraintType::PointOnLine:
-      c.axes = normal_plane(unit_axis(s, "direction"));
-      break;
-    case ConstraintType::PointOnPlane:
-      c.axes = {unit_axis(s, "normal")};
-      break;
-    case ConstraintType::Distance:
-      check_magnitude(s.length, s.where + "/length", "length");
-      if (!(s.length > 0)) throw ModelError(s.where + "/length", "must be a positive length");
-      c.length = s.length;
-      break;
-    case ConstraintType::Weld:
-    case ConstraintType::Gear:
-      break;
-  }
+  compile_constraint_geometry(s, c);
   return c;
 }
 

@@ -9,6 +9,30 @@
 namespace femdyn {
 namespace {
 
+// A route asked for: any reference route, a body-level one only where it was chosen (exact).
+void take_asked_routes(Model& m, const RouteChoice& asked) {
+  const auto refuse = [&](const char* route) {
+    throw ModelError(m.where, std::string("the ") + route +
+                                  " route is not exact for this model (compile options)");
+  };
+  if (asked.mass) {
+    if (*asked.mass == MassRoute::Composite && m.mass_route != MassRoute::Composite)
+      refuse("composite mass");
+    m.mass_route = *asked.mass;
+  }
+  if (asked.force) {
+    if (*asked.force == ForceRoute::Bodies && m.force_route != ForceRoute::Bodies)
+      refuse("body-level force");
+    m.force_route = *asked.force;
+  }
+  if (asked.dynamics) {
+    if (*asked.dynamics == DynamicsRoute::Articulated &&
+        m.dynamics_route != DynamicsRoute::Articulated)
+      refuse("articulated");
+    m.dynamics_route = *asked.dynamics;
+  }
+}
+
 // The tree routes of a model without a coupling law.
 void choose_tree_routes(Model& m, const RouteChoice& asked) {
   // Elements spanning bodies that use only their nodes' translations (a coupler rod) keep the
@@ -30,27 +54,7 @@ void choose_tree_routes(Model& m, const RouteChoice& asked) {
   m.dynamics_route = m.condensable && m.velocity_forces_rigid && m.identity_coupling
                          ? DynamicsRoute::Articulated
                          : DynamicsRoute::Cholesky;
-  // A route asked for: any reference route, a body-level one only where it was chosen (exact).
-  const auto refuse = [&](const char* route) {
-    throw ModelError(m.where, std::string("the ") + route +
-                                  " route is not exact for this model (compile options)");
-  };
-  if (asked.mass) {
-    if (*asked.mass == MassRoute::Composite && m.mass_route != MassRoute::Composite)
-      refuse("composite mass");
-    m.mass_route = *asked.mass;
-  }
-  if (asked.force) {
-    if (*asked.force == ForceRoute::Bodies && m.force_route != ForceRoute::Bodies)
-      refuse("body-level force");
-    m.force_route = *asked.force;
-  }
-  if (asked.dynamics) {
-    if (*asked.dynamics == DynamicsRoute::Articulated &&
-        m.dynamics_route != DynamicsRoute::Articulated)
-      refuse("articulated");
-    m.dynamics_route = *asked.dynamics;
-  }
+  take_asked_routes(m, asked);
   // The spanning masses where a body-level route carries them (never with the coupling level).
   const bool carried = m.mass_route == MassRoute::Composite || m.force_route == ForceRoute::Bodies;
   m.spanning_masses = spans_on_bodies && carried ? spanning_masses(m) : std::vector<SpanningMass>{};
