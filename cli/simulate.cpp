@@ -29,7 +29,7 @@ constexpr const char* kSimulateHelp =
                         [--dt h | --rtol r --atol a] [--q0 …] [--qd0 …] [--tau … | --tau-csv FILE]
                         [--out traj.csv] [--every k | --sample-dt s] [--max-steps N] [--force]
                         [--max-memory GB] [--json] [--gravity gx,gy,gz] [--baumgarte W]
-                        [--jacobian analytic|differences]
+                        [--jacobian analytic|differences] [--max-order K]
 
 Integrates M^s q̈ + h = Q from (q0, q̇0) (default 0) over [0, T] and prints a summary:
 integrator, steps, rejected steps, evaluations of forward dynamics, Jacobians, wall time,
@@ -51,7 +51,9 @@ integrators (docs/simulation.md):
   dopri  Dormand–Prince 5(4), adaptive (SUNDIALS ARKODE), --rtol (1e-6) --atol (1e-8); default
   bdf    BDF orders 1–5 with Newton (SUNDIALS CVODE), for stiff models; --rtol --atol;
          --jacobian analytic (default: the analytic derivatives where they cover the model,
-         else differences) or differences (forward differences of forward dynamics always)
+         else differences) or differences (forward differences of forward dynamics always);
+         --max-order K (1–5, default 5): 2 for undamped fast oscillation (a flexible bar's
+         axial modes), where orders 3–5 are unstable at large steps and 1–2 are not
 --tau a,b,… is a constant actuation on the coordinates; --tau-csv FILE a time table with the
 header t,<coordinate>,… (or tau_<coordinate>), interpolated linearly; it must cover [0, T].
 --out writes t, q_*, qd_*, kinetic, potential, total, work every k-th step (--every, default 1;
@@ -127,7 +129,8 @@ SimulationRequest simulation_request(const Args& a, const Model& m, const Door& 
   r.t_end = number_option(a, "t-end", 0);
   r.options = integrator_options(
       {optional_text(a, "integrator"), optional_number(a, "dt"), optional_number(a, "rtol"),
-       optional_number(a, "atol"), optional_text(a, "jacobian"), optional_number(a, "max-steps")},
+       optional_number(a, "atol"), optional_text(a, "jacobian"), optional_number(a, "max-steps"),
+       optional_number(a, "max-order")},
       door);
   r.q0 = configuration_vector(a, "q0", m);
   r.qd0 = state_vector(a, "qd0", m);
@@ -233,7 +236,7 @@ int cmd_simulate(int argc, char** argv) {
   const Args a = parse_args(
       argc, argv, 2, {"help", "json", "force"},
       {"gravity", "t-end", "integrator", "dt", "rtol", "atol", "q0", "qd0", "tau", "tau-csv", "out",
-       "every", "sample-dt", "max-steps", "max-memory", "baumgarte", "jacobian"});
+       "every", "sample-dt", "max-steps", "max-memory", "baumgarte", "jacobian", "max-order"});
   if (a.has("help")) {
     std::cout << kSimulateHelp;
     return 0;

@@ -78,11 +78,12 @@ SimulationRequest request_of(const Model& m, double t_end, const OptArray& q0_in
                              std::optional<double> atol, const OptArray& tau_in,
                              const OptArray& tau_t_in, const OptArray& t_eval_in,
                              std::optional<long> every, std::optional<double> max_steps,
-                             std::optional<double> baumgarte) {
+                             std::optional<double> baumgarte, std::optional<double> max_order) {
   SimulationRequest r;
   r.t_end = t_end;
   r.options = integrator_options(
-      {text_arg(integrator, "integrator"), dt, rtol, atol, std::nullopt, max_steps}, kPython);
+      {text_arg(integrator, "integrator"), dt, rtol, atol, std::nullopt, max_steps, max_order},
+      kPython);
   r.q0 = configuration_arg(q0_in, "q0", m);
   r.qd0 = vector_arg(qd0_in, "qd0", m);
   r.baumgarte = baumgarte;
@@ -108,13 +109,14 @@ py::dict simulate(const PyModel& self, double t_end, const OptArray& q0_in, cons
                   const std::string& integrator, std::optional<double> dt,
                   std::optional<double> rtol, std::optional<double> atol, const OptArray& tau_in,
                   const OptArray& tau_t_in, const OptArray& t_eval_in, std::optional<long> every,
-                  bool check, std::optional<double> max_steps, std::optional<double> baumgarte) {
+                  bool check, std::optional<double> max_steps, std::optional<double> baumgarte,
+                  std::optional<double> max_order) {
   const Model& m = *self.model;
   SimulationRequest request;
   StateAssembly loops;
   try {
     request = request_of(m, t_end, q0_in, qd0_in, integrator, dt, rtol, atol, tau_in, tau_t_in,
-                         t_eval_in, every, max_steps, baumgarte);
+                         t_eval_in, every, max_steps, baumgarte, max_order);
     loops = check_request(m, request, kPython);
   } catch (const RequestError& e) {
     throw py::value_error(e.what());
@@ -177,10 +179,12 @@ void bind_simulate(py::module_& m) {
       py::arg("rtol") = py::none(), py::arg("atol") = py::none(), py::arg("tau") = py::none(),
       py::arg("tau_t") = py::none(), py::arg("t_eval") = py::none(), py::arg("every") = py::none(),
       py::arg("check") = true, py::arg("max_steps") = py::none(), py::arg("baumgarte") = py::none(),
+      py::arg("max_order") = py::none(),
       "Integrates M^s q̈ + h = Q over [0, t_end] from (q0, qd0) under tau: constant (n,), or "
       "sampled, tau (m, n) at the times tau_t (m,) covering [0, t_end], interpolated "
       "linearly as --tau-csv; by rk4, "
-      "euler (dt) or dopri, bdf (rtol, atol). Rows every `every` steps (first and last "
+      "euler (dt) or dopri, bdf (rtol, atol; bdf's largest order max_order, 1 to 5, default 5: "
+      "2 for undamped fast oscillation, as --max-order). Rows every `every` steps (first and last "
       "always), or at the times t_eval. Returns a dict: t, q, qd, kinetic, potential, total, "
       "work, stats. A numerical failure raises NumericalError, or with check=False returns the "
       "rows up to the last good step with stats['ok'] False (a solution that diverges is "

@@ -21,7 +21,7 @@ using OptArray = std::optional<Array>;
 
 IntegratorOptions stepper_options(const std::string& integrator, double dt,
                                   std::optional<long> substeps, std::optional<double> rtol,
-                                  std::optional<double> atol) {
+                                  std::optional<double> atol, std::optional<int> max_order) {
   IntegratorOptions o;
   if (!parse_integrator(text_arg(integrator, "integrator"), o.kind))
     throw py::value_error("integrator: " + integrator + " is not one of rk4, euler, dopri, bdf");
@@ -40,6 +40,11 @@ IntegratorOptions stepper_options(const std::string& integrator, double dt,
     const long s = substeps.value_or(1);
     if (s < 1 || s > 1000000) throw py::value_error("substeps: expected an integer in [1, 1e6]");
     o.fixed.dt = dt / static_cast<double>(s);
+  }
+  if (max_order) {
+    if (o.kind != IntegratorKind::Bdf)
+      throw py::value_error("max_order applies to bdf, the one integrator of variable order");
+    o.adaptive.max_order = *max_order;
   }
   if (const std::string why = o.check(); !why.empty()) throw py::value_error(why);
   return o;
@@ -124,9 +129,9 @@ class Simulator {
  public:
   Simulator(const PyModel& model, const std::string& integrator, double dt,
             std::optional<long> substeps, std::optional<double> rtol, std::optional<double> atol,
-            const OptArray& q0, const OptArray& qd0)
+            const OptArray& q0, const OptArray& qd0, std::optional<int> max_order)
       : model_(model.model),
-        options_(stepper_options(integrator, dt, substeps, rtol, atol)),
+        options_(stepper_options(integrator, dt, substeps, rtol, atol, max_order)),
         loop_(std::make_unique<ControlLoop>(
             *model_, options_,
             ControlLoopOptions{.mode = ControlMode::PerEvaluation, .period = dt})) {
@@ -342,18 +347,21 @@ class Simulator {
 }  // namespace
 
 void bind_simulator(py::module_& m) {
-  py::class_<Simulator>(m, "Simulator",
-                        "A stepper with a controller in the loop (docs/control.md): "
-                        "Simulator(model, integrator='rk4', dt=1e-3, substeps=None, rtol=None, "
-                        "atol=None, q0=None, qd0=None). dt is the control period; rk4 and euler "
-                        "take substeps steps of dt/substeps in it (default 1), dopri and bdf "
-                        "their own, restarted at every period where tau jumps.")
+  py::class_<Simulator>(
+      m, "Simulator",
+      "A stepper with a controller in the loop (docs/control.md): "
+      "Simulator(model, integrator='rk4', dt=1e-3, substeps=None, rtol=None, "
+      "atol=None, q0=None, qd0=None, max_order=None). dt is the control period; rk4 and euler "
+      "take substeps steps of dt/substeps in it (default 1), dopri and bdf "
+      "their own, restarted at every period where tau jumps; bdf's largest order is max_order "
+      "(1 to 5, default 5; 2 for undamped fast oscillation).")
       .def(py::init<const PyModel&, const std::string&, double, std::optional<long>,
-                    std::optional<double>, std::optional<double>, const OptArray&,
-                    const OptArray&>(),
+                    std::optional<double>, std::optional<double>, const OptArray&, const OptArray&,
+                    std::optional<int>>(),
            py::arg("model"), py::arg("integrator") = "rk4", py::arg("dt") = 1e-3,
            py::arg("substeps") = py::none(), py::arg("rtol") = py::none(),
-           py::arg("atol") = py::none(), py::arg("q0") = py::none(), py::arg("qd0") = py::none())
+           py::arg("atol") = py::none(), py::arg("q0") = py::none(), py::arg("qd0") = py::none(),
+           py::arg("max_order") = py::none())
       .def("step", &Simulator::step, py::arg("tau"),
            "Advances one control period dt with tau (n,) held. A numerical failure raises "
            "NumericalError (reset() before going on). The GIL is released.")

@@ -74,6 +74,8 @@ std::string AdaptiveOptions::check() const {
   if (!(h_max >= 0) || !std::isfinite(h_max))
     return bad("h_max", "must be >= 0 (0: no limit)", h_max);
   if (max_steps < 1) return bad("max_steps", "must be at least 1", static_cast<double>(max_steps));
+  if (max_order < 1 || max_order > 5)
+    return bad("max_order", "BDF's order is 1 to 5", static_cast<double>(max_order));
   return {};
 }
 

@@ -54,6 +54,11 @@ struct AdaptiveOptions {
   // model and τ does not depend on the state; false: forward differences of forward dynamics
   // always.
   bool analytic_jacobian = true;
+  // BDF's largest order (1–5). BDF1 and BDF2 are A-stable; BDF3–5 are not: their regions leave
+  // out a wedge about the imaginary axis (A(α)-stable, α = 86°, 73°, 52°), so an undamped fast
+  // oscillation (a flexible bar's axial modes) holds them to steps near 1/ω, and 2 lets the
+  // step follow the slow motion instead (docs/simulation.md).
+  int max_order = 5;
   std::string check() const;
 };
 

@@ -196,6 +196,27 @@ Status Motion::drive_prescribed(double t) {
   return {};
 }
 
+void Motion::drive_jacobian(const MatX& Minv, MatX& dqdd_dq, MatX& dqdd_dv) const {
+  const std::vector<PrescribedCoordinate>& P = model_.prescribed;
+  const int k = static_cast<int>(P.size());
+  if (k == 0) return;
+  const double w = kPrescribedRate;
+  MatX cols(n(), k), gain(k, k), need_q(k, n()), need_v(k, n());
+  for (int j = 0; j < k; ++j) {
+    const int c = P[j].coordinate;
+    cols.col(j) = Minv.col(c);
+    need_q.row(j) = -dqdd_dq.row(c);
+    need_v.row(j) = -dqdd_dv.row(c);
+    need_q(j, c) -= w * w;
+    need_v(j, c) -= 2 * w;
+  }
+  for (int j = 0; j < k; ++j)
+    for (int i = 0; i < k; ++i) gain(i, j) = cols(P[i].coordinate, j);
+  const auto lu = gain.partialPivLu();
+  dqdd_dq += cols * lu.solve(need_q);
+  dqdd_dv += cols * lu.solve(need_v);
+}
+
 void Motion::requested_actuation(double t, VecX& tau) const {
   if (tau_)
     tau_(t, tau);

@@ -103,6 +103,14 @@ class Motion {
   // ẏ = f(t, y) into ydot (both of size(); may be SUNDIALS' arrays). Counts the evaluation.
   Status rhs(double t, const double* y, double* ydot);
   long evaluations() const { return evaluations_; }
+  // The τ the last rhs applied: the actuation (or the controller's), with the prescribed
+  // coordinates' driving torques.
+  const VecX& applied_actuation() const { return u_; }
+  // ∂q̈/∂q and ∂q̈/∂v at τ held (the analytic derivatives at applied_actuation(), with (M^s)⁻¹)
+  // made those of the driven motion, whose τ_P(q, v) holds q̈_P = q̈*_P:
+  //   ∂τ_P/∂x = ((M⁻¹)_PP)⁻¹ (∂q̈*_P/∂x − E_Pᵀ ∂q̈/∂x),   ∂q̈/∂x += M⁻¹_{:,P} ∂τ_P/∂x,
+  // with ∂q̈*_P/∂q_P = −ω², ∂q̈*_P/∂v_P = −2ω (kPrescribedRate). Nothing without prescribed ones.
+  void drive_jacobian(const MatX& Minv, MatX& dqdd_dq, MatX& dqdd_dv) const;
 
   // The first non-finite entry of y as a failed Status ("q_name", "qd_name" or "W"), or ok.
   Status check_state(double t, const double* y) const;

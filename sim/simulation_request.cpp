@@ -116,6 +116,16 @@ IntegratorOptions integrator_options(const IntegratorChoice& c, const Door& door
                          " is not one of analytic, differences");
     o.adaptive.analytic_jacobian = *c.jacobian == "analytic";
   }
+  if (c.max_order) {
+    if (o.kind != IntegratorKind::Bdf)
+      throw RequestError(door.option("max_order") +
+                         " applies to bdf, the one integrator of "
+                         "variable order");
+    const double k = *c.max_order;
+    if (!(k >= 1 && k <= 5) || k != std::floor(k))
+      throw RequestError(door.option("max_order") + " expects an integer in [1, 5]");
+    o.adaptive.max_order = static_cast<int>(k);
+  }
   if (c.max_steps) {  // the fixed-step plan's limit, and adaptive's per advance
     const double s = *c.max_steps;
     if (!(s >= 1 && s <= 1e15) || s != std::floor(s))

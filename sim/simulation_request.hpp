@@ -39,6 +39,7 @@ struct IntegratorChoice {
   std::optional<double> rtol, atol;       // dopri, bdf
   std::optional<std::string> jacobian;    // bdf: analytic (default) or differences
   std::optional<double> max_steps;        // an integer in [1, 1e15]
+  std::optional<double> max_order;        // bdf: an integer in [1, 5] (default 5)
 };
 IntegratorOptions integrator_options(const IntegratorChoice& choice, const Door& door);
 

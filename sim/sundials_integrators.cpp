@@ -297,6 +297,7 @@ void Bdf::start() {
   // A controller's τ(q, v) is part of f, and its derivatives are not known here.
   analytic_ = derivatives_ && !motion_.controlled();
   CVodeSetMaxNumSteps(r.cvode, options_.max_steps);
+  CVodeSetMaxOrd(r.cvode, options_.max_order);
   if (options_.h_max > 0) CVodeSetMaxStep(r.cvode, options_.h_max);
   if (std::isfinite(t_stop_)) CVodeSetStopTime(r.cvode, t_stop_);
   rhs_failure_ = {};

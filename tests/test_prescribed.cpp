@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 
+#include "core/derivatives/derivatives.hpp"
 #include "core/dynamics/equations.hpp"
 #include "sim/integrator.hpp"
 #include "sim/motion.hpp"
@@ -88,4 +89,40 @@ TEST_CASE("a bad prescribed motion is refused naming the key", "[prescribed]") {
       "elements": [{"type": "rigid_body", "mass": 1, "inertia": {"ixx": 1, "iyy": 1,
       "izz": 1}}]}]})"),
              Catch::Contains("/bodies/0/joint/prescribed: only a joint of one rate"));
+}
+
+TEST_CASE("the driven motion's Jacobian (bdf's) equals differences of the driven q̈",
+          "[prescribed]") {
+  // ∂q̈/∂(q, v) of f with the driving torque τ_P(q, v) inside it, against central differences of
+  // Motion::rhs; and differs from the undriven Jacobian at the same τ (the check means something).
+  const Model m = load_text(driven(R"({"spin_up": {"rate": 3, "time": 2}})"));
+  Motion motion(m);
+  DerivativeWorkspace d(m);
+  Workspace ws(m);
+  const int n = m.n();
+  VecX y(2 * n + 1), f(2 * n + 1), fp(2 * n + 1), fm(2 * n + 1);
+  y << 0.4, -0.7, 1.1, 0.3, 0;  // off the motion: the pull-back acts too
+  const double t = 0.8;
+  REQUIRE(motion.rhs(t, y.data(), f.data()).ok);
+  const VecX tau = motion.applied_actuation();
+  REQUIRE(forward_dynamics_derivatives(m, ws, d, y.head(n), y.segment(n, n), tau).ok);
+  MatX Jq = d.dqdd_dq, Jv = d.dqdd_dv;
+  const MatX undriven_q = Jq;
+  motion.drive_jacobian(d.Minv, Jq, Jv);
+  MatX Dq(n, n), Dv(n, n);
+  const double h = 1e-6;
+  for (int j = 0; j < 2 * n; ++j) {
+    VecX yp = y, ym = y;
+    yp[j] += h;
+    ym[j] -= h;
+    REQUIRE(motion.rhs(t, yp.data(), fp.data()).ok);
+    REQUIRE(motion.rhs(t, ym.data(), fm.data()).ok);
+    (j < n ? Dq.col(j) : Dv.col(j - n)) = (fp - fm).segment(n, n) / (2 * h);
+  }
+  CHECK(max_abs(Jq - Dq) < 1e-7 * (1 + max_abs(Dq)));
+  CHECK(max_abs(Jv - Dv) < 1e-7 * (1 + max_abs(Dv)));
+  CHECK(max_abs(undriven_q - Dq) > 1.0);
+  // The hub's row is the pull-back's alone: q̈_hub = q̈(t) + 2ω (q̇(t) − q̇) + ω² (q(t) − q).
+  CHECK(Jq(0, 0) == Approx(-kPrescribedRate * kPrescribedRate).epsilon(1e-9));
+  CHECK(Jv(0, 0) == Approx(-2 * kPrescribedRate).epsilon(1e-9));
 }

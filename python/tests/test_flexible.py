@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import femdyn
-from conftest import ROOT
+from conftest import ROOT, cli_json
 
 SECTION = {"E": 7e10, "G": 2.6e10, "density": 2700, "area": 1e-4, "Iy": 2e-9, "Iz": 3e-9,
            "J": 4e-9}
@@ -114,3 +114,27 @@ def test_free_floating_bar_keeps_momentum_and_energy():
     assert np.abs(last - first).max() < 1e-9 * scale
     e0, e1 = m.energy(run["q"][0], run["qd"][0])["total"], m.energy(run["q"][-1], run["qd"][-1])["total"]
     assert abs(e1 - e0) < 1e-8 * abs(e0)
+
+
+def test_bdf_max_order_is_one_door_and_refused_elsewhere():
+    """simulate(max_order=2) equals femdyn simulate --max-order 2 and steps over the bar's
+    undamped modes; max_order is refused off bdf and outside 1..5, at every door."""
+    m = femdyn.load(str(ROOT / "examples" / "spin_up_beam.json"))
+    low = femdyn.simulate(m, 2.0, integrator="bdf", rtol=1e-7, atol=1e-9, max_order=2)
+    high = femdyn.simulate(m, 2.0, integrator="bdf", rtol=1e-7, atol=1e-9)
+    assert low["stats"]["steps"] * 10 < high["stats"]["steps"]
+    assert np.abs(low["q"][-1] - high["q"][-1]).max() < 1e-5
+    cli = cli_json("simulate", "examples/spin_up_beam.json", "--t-end", "2", "--integrator", "bdf",
+                   "--rtol", "1e-7", "--atol", "1e-9", "--max-order", "2", "--json")
+    assert cli["steps"] == low["stats"]["steps"]
+    for bad in [dict(integrator="dopri", max_order=2), dict(integrator="bdf", max_order=0),
+                dict(integrator="bdf", max_order=6), dict(integrator="bdf", max_order=2.5)]:
+        with pytest.raises(ValueError, match="max_order"):
+            femdyn.simulate(m, 0.1, **bad)
+    with pytest.raises(ValueError, match="max_order"):
+        femdyn.Simulator(m, integrator="rk4", max_order=2)
+    with pytest.raises(ValueError, match="max_order"):
+        femdyn.Simulator(m, integrator="bdf", max_order=9)
+    sim = femdyn.Simulator(m, integrator="bdf", dt=0.5, rtol=1e-7, atol=1e-9, max_order=2)
+    sim.step(np.zeros(m.n))
+    assert sim.state["t"] == pytest.approx(0.5)
