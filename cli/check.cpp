@@ -398,7 +398,7 @@ Diagnosis diagnose(const Model& m, Workspace& ws, int K, std::mt19937& rng,
   Progress progress(K, "states");
   for (int k = 0; k < K; ++k) {
     VecX q = k == 0 ? neutral_posture(m) : random_posture(m, rng);
-    VecX qd = k == 0 ? VecX::Zero(n) : random_uniform(n, 1.0, rng);
+    VecX qd = k == 0 ? VecX::Zero(n) : random_rates(m, 1.0, rng);
     if (m.constraints.empty() || diagnose_loops(m, k, q, qd, d))
       diagnose_state(m, ws, q, qd, dampers, d);
     progress.update(k + 1);
@@ -514,7 +514,13 @@ void print_check(const Model& m, const CheckReport& r) {
               << (std::isfinite(r.d.h_max[i]) ? format_short(r.d.h_max[i]) + " s"
                                               : std::string("unlimited"))
               << (i < 2 ? "," : "");
-  std::cout << " (bdf: unlimited)\n" << natural_modes_text(m, r.natural) << "\n";
+  // BDF1–2 are A-stable; BDF3–5 are not, and undamped modes at many frequencies hold them near
+  // 1/ω_max (docs/simulation.md, "BDF's order").
+  const bool undamped = r.d.stiffest.kind == ModeKind::Oscillatory && !r.d.stiffest.dissipative();
+  std::cout << (undamped ? " (bdf: unlimited at --max-order 2; at orders 3-5 undamped modes can "
+                           "hold it near 1/omega)\n"
+                         : " (bdf: unlimited)\n")
+            << natural_modes_text(m, r.natural) << "\n";
   if (r.bodies.empty()) std::cout << "suspicious bodies: none\n";
   for (const auto& b : r.bodies)
     std::cout << (b.note ? "note: body '" : "suspicious body '") << b.name << "': " << b.why

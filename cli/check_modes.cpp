@@ -31,9 +31,12 @@ NaturalModes natural_modes(const Args& a, const Model& m) {
     return out;
   }
   for (const Mode& x : modes(lin, has_dampers(m))) {
-    if (x.lambda.real() > 1e-9 * std::max(1.0, x.omega)) ++out.unstable;
+    if (x.kind != ModeKind::None && x.lambda.real() > 1e-9 * std::max(1.0, x.omega))
+      ++out.unstable;  // (a rigid-body mode's round-off is no instability)
     if (x.kind == ModeKind::Oscillatory && x.lambda.imag() > 0) out.oscillatory.push_back(x);
+    if (x.kind == ModeKind::None) ++out.rigid;
   }
+  out.rigid /= 2;  // (each a double zero eigenvalue of A: position and rate)
   std::sort(out.oscillatory.begin(), out.oscillatory.end(),
             [](const Mode& p, const Mode& q) { return p.lambda.imag() < q.lambda.imag(); });
   return out;
@@ -55,6 +58,7 @@ std::string natural_modes_text(const Model& m, const NaturalModes& modes) {
   std::string s = "natural modes at rest (the static equilibrium, q̇ = 0): " +
                   std::to_string(modes.oscillatory.size()) + " oscillatory";
   if (modes.unstable) s += ", " + std::to_string(modes.unstable) + " unstable (a falling posture)";
+  if (modes.rigid) s += ", " + std::to_string(modes.rigid) + " rigid-body (0 rad/s)";
   const std::size_t shown = std::min<std::size_t>(6, modes.oscillatory.size());
   for (std::size_t k = 0; k < shown; ++k)
     s += (k ? "; " : "; lowest ") + one_mode(m, modes.oscillatory[k]);
@@ -70,7 +74,7 @@ Json natural_modes_json(const Model& m, const NaturalModes& modes) {
                     {"damping_ratio", -x.lambda.real() / std::abs(x.lambda)},
                     {"coordinate",
                      x.coordinate >= 0 ? Json(m.coordinate_names[x.coordinate]) : Json(nullptr)}});
-  Json j = {{"oscillatory", list}, {"unstable", modes.unstable}};
+  Json j = {{"oscillatory", list}, {"unstable", modes.unstable}, {"rigid", modes.rigid}};
   j["missing"] = modes.missing.empty() ? Json(nullptr) : Json(modes.missing);
   return j;
 }

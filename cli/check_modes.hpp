@@ -13,7 +13,8 @@ namespace femdyn::cli {
 struct NaturalModes {
   std::vector<Mode> oscillatory;  // ascending in ω
   int unstable = 0;               // modes with Re λ > 0 at the equilibrium (it is not stable)
-  std::string missing;            // why none are listed (no equilibrium, closed loops), or ""
+  int rigid = 0;  // rigid-body modes, ω = 0: coordinates no spring holds (a free base, a joint)
+  std::string missing;  // why none are listed (no equilibrium, closed loops), or ""
 };
 
 // At the equilibrium the model file `path` (loaded as `a` says) rests in under its springs,

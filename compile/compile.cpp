@@ -155,6 +155,10 @@ void compile_joint_terms(const JointSpec& js, Joint& j) {
     throw ModelError(js.where + "/initial", "is the coordinate of a joint of one: this " +
                                                 std::string(joint_type_name(j.type)) +
                                                 " joint has " + std::to_string(j.nq));
+  check_magnitude(js.sample_range, js.where + "/sample_range", "sample_range");
+  if (js.sample_range != 0 && j.nv != 1)
+    throw ModelError(js.where + "/sample_range", "is the half range of a joint of one coordinate");
+  j.sample_range = js.sample_range;
   j.stiffness = js.stiffness;
   j.rest = js.rest;
   j.initial = js.initial;

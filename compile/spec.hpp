@@ -40,6 +40,9 @@ struct JointSpec {
   // Whether an actuator drives the joint's rates (docs/control.md#actuation); not given: every
   // joint but a free one (a floating base has no thrusters unless the model says so).
   std::optional<bool> actuated;
+  // > 0: random states (check, stress, validate) draw the coordinate within ± this (a flexible
+  // bar's strains); 0: the joint type's range narrowed to the limits.
+  double sample_range = 0;
   // A driven joint: its coordinate follows this motion in time (one-rate joints).
   std::optional<PrescribedMotion> prescribed;
   std::string where;

@@ -74,13 +74,11 @@ Json body(const std::string& name, const std::string& parent, Json joint, Json e
 }
 
 Json one_rate_joint(const std::string& name, const char* type, const Vec3& axis, double k, double c,
-                    const Vec3& xyz) {
+                    const Vec3& xyz, double sample_range) {
   // No actuator drives a bar's strain: its rates are left out of τ = S u (docs/control.md).
-  Json j = {{"name", name},
-            {"type", type},
-            {"axis", vec(axis)},
-            {"spring", {{"stiffness", k}}},
-            {"actuated", false}};
+  Json j = {{"name", name},      {"type", type},
+            {"axis", vec(axis)}, {"spring", {{"stiffness", k}}},
+            {"actuated", false}, {"sample_range", sample_range}};
   if (c > 0) j["damping"] = c;
   if (xyz != Vec3::Zero()) j["origin"] = {{"xyz", vec(xyz)}};
   return j;
@@ -93,6 +91,7 @@ Json flexible_bar_bodies(const Params& p) {
       {"name", "parent", "origin", "length", "segments", "section", "axial", "torsion", "damping"});
   const std::string name = p.string("name"), parent = p.string("parent");
   const double L = p.positive("length");
+  if (!p.has("segments")) p.fail("segments", "is missing");
   const Json& jn = p.json().at("segments");
   if (!jn.is_number_integer() || jn.get<long long>() < 1 || jn.get<long long>() > kMaxBodies / 4)
     p.fail("segments", "expected an integer from 1 to " + std::to_string(kMaxBodies / 4));
@@ -119,11 +118,15 @@ Json flexible_bar_bodies(const Params& p) {
       Vec3 axis;
       double k;
       bool used;
+      double sample_range;
     };
-    const Rate rates[] = {{"ry", "revolute", Vec3::UnitY(), s.EIy / delta, true},
-                          {"rz", "revolute", Vec3::UnitZ(), s.EIz / delta, true},
-                          {"rx", "revolute", Vec3::UnitX(), s.GJ / delta, torsion},
-                          {"ux", "prismatic", Vec3::UnitX(), s.EA / delta, axial}};
+    // Random states (check, stress) keep the bar at small strains: 0.05 rad a part in bending
+    // and torsion, a stretch of 1e-3 (a metal's elastic range: 6061-T6 yields at 4e-3). The
+    // ±π and ±0.5 m of free joints would fold and invert it.
+    const Rate rates[] = {{"ry", "revolute", Vec3::UnitY(), s.EIy / delta, true, 0.05},
+                          {"rz", "revolute", Vec3::UnitZ(), s.EIz / delta, true, 0.05},
+                          {"rx", "revolute", Vec3::UnitX(), s.GJ / delta, torsion, 0.05},
+                          {"ux", "prismatic", Vec3::UnitX(), s.EA / delta, axial, 1e-3 * delta}};
     std::string chain = previous;
     Vec3 xyz = offset;
     for (const Rate& r : rates) {
@@ -132,9 +135,10 @@ Json flexible_bar_bodies(const Params& p) {
       const bool last = &r == &rates[axial     ? 3
                                      : torsion ? 2
                                                : 1];  // the piece hangs from the last rate
-      bodies.push_back(body(last ? at : joint, chain,
-                            one_rate_joint(joint, r.type, r.axis, r.k, beta * r.k, xyz),
-                            last ? piece(s, i == n ? delta / 2 : delta) : Json::array()));
+      bodies.push_back(
+          body(last ? at : joint, chain,
+               one_rate_joint(joint, r.type, r.axis, r.k, beta * r.k, xyz, r.sample_range),
+               last ? piece(s, i == n ? delta / 2 : delta) : Json::array()));
       chain = joint;
       xyz = Vec3::Zero();
     }

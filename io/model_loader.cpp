@@ -37,6 +37,7 @@ void read_actuator(const Params& p, JointSpec& j) {
   if (p.has("effort_limit")) j.effort_limit = p.positive("effort_limit");
   if (p.has("velocity_limit")) j.velocity_limit = p.positive("velocity_limit");
   if (p.has("actuated")) j.actuated = p.boolean_or("actuated", true);
+  if (p.has("sample_range")) j.sample_range = p.positive("sample_range");
   if (p.has("stop")) {
     const Params s = p.child("stop");
     s.allow_only({"stiffness", "dissipation"});
@@ -92,7 +93,7 @@ PrescribedMotion read_prescribed(const Params& p) {
 JointSpec read_joint(const Params& p) {
   p.allow_only({"name", "type", "origin", "axis", "axis2", "limits", "spring", "damping",
                 "armature", "gear", "friction", "friction_velocity", "effort_limit",
-                "velocity_limit", "stop", "initial", "actuated", "prescribed"},
+                "velocity_limit", "stop", "initial", "actuated", "prescribed", "sample_range"},
                is_joint_scalar);
   JointSpec j;
   j.where = p.where();
@@ -120,7 +121,7 @@ JointSpec read_joint(const Params& p) {
   if (p.has("initial")) j.initial = p.number("initial");  // (compile: joints of one coordinate)
   if (j.type == JointType::Fixed)
     for (const char* key : {"armature", "gear", "friction", "friction_velocity", "effort_limit",
-                            "velocity_limit", "stop", "actuated", "prescribed"})
+                            "velocity_limit", "stop", "actuated", "prescribed", "sample_range"})
       if (p.has(key)) p.fail(key, "a fixed joint has no motion: no actuator, friction or stop");
   if (p.has("limits")) {
     const Json& l = p.json().at("limits");

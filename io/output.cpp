@@ -443,13 +443,14 @@ bool is_flat(const Json& a) {
 }
 
 int key_rank(const std::string& k) {
-  static const char* order[] = {
-      "$schema", "name", "description", "model", "gravity", "params", "type", "parent", "joint",
-      "origin", "xyz", "rpy", "axis", "limits", "spring", "damping", "armature", "gear", "friction",
-      "friction_velocity", "effort_limit", "velocity_limit", "stop", "actuated", "nodes",
-      "elements", "mass", "com", "inertia", "bodies", "couplings", "loads", "correlation_table",
-      // equations --json
-      "n", "coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd", "D"};
+  static const char* order[] = {"$schema", "name", "description", "model", "gravity", "params",
+                                "type", "parent", "joint", "origin", "xyz", "rpy", "axis", "limits",
+                                "spring", "damping", "armature", "gear", "friction",
+                                "friction_velocity", "effort_limit", "velocity_limit", "stop",
+                                "actuated", "sample_range", "nodes", "elements", "mass", "com",
+                                "inertia", "bodies", "couplings", "loads", "correlation_table",
+                                // equations --json
+                                "n", "coordinates", "q", "qd", "tau", "M", "h", "Q", "qdd", "D"};
   for (std::size_t i = 0; i < std::size(order); ++i)
     if (k == order[i]) return static_cast<int>(i);
   return static_cast<int>(std::size(order));

@@ -236,12 +236,16 @@ std::vector<Mode> modes(const Linearization& lin, bool dissipative_model) {
   const int n = static_cast<int>(lin.A.rows()) / 2;
   double largest = 0;
   for (Eigen::Index i = 0; i < ev.size(); ++i) largest = std::max(largest, std::abs(ev[i]));
+  const double jordan_noise = 4 * std::sqrt(std::numeric_limits<double>::epsilon() *
+                                            lin.A.cwiseAbs().colwise().sum().maxCoeff());
   std::vector<Mode> out;
   for (Eigen::Index i = 0; i < ev.size(); ++i) {
     Mode md;
     md.lambda = ev[i];
     md.omega = std::abs(ev[i]);
-    const double tiny = 1e-9 * std::max(largest, 1e-300);
+    // A zero eigenvalue of a free coordinate (a rigid-body mode) is a 2 × 2 Jordan block of A,
+    // which round-off ε‖A‖ splits into ±√(ε‖A‖): below that, ω is no frequency.
+    const double tiny = std::max(1e-9 * std::max(largest, 1e-300), jordan_noise);
     if (md.omega <= tiny) {
       md.kind = ModeKind::None;
     } else if (std::abs(ev[i].imag()) > 1e-9 * md.omega) {

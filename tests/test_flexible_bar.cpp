@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "core/dynamics/equations.hpp"
+#include "core/kinematics/sampling.hpp"
 #include "core/model/names.hpp"
 #include "sim/stability.hpp"
 #include "tests/helpers.hpp"
@@ -182,6 +183,36 @@ TEST_CASE("a flexible bar's bad input is refused in one line naming the key", "[
        "section": )" + section_e() +
                         "}]}"),
              Catch::Contains("/flexible_bars/0") && Catch::Contains("bar.0"));
+}
+
+TEST_CASE("random states keep a flexible bar at small strains (sample_range)", "[flexible]") {
+  // 0.05 rad a part in bending and torsion, a stretch of 1e-3 of a part: the random postures
+  // and rates of check, stress and validate stay there; a joint's own sample_range likewise.
+  const Model m = load_text(cantilever(4));
+  std::mt19937 rng(3);
+  const double delta = kL / 4;
+  for (int k = 0; k < 20; ++k) {
+    const VecX q = random_posture(m, rng), v = random_rates(m, 1.0, rng);
+    for (int i = 0; i < m.n(); ++i) {
+      const bool stretch = m.coordinate_names[i].ends_with(".ux");
+      const double range = stretch ? 1e-3 * delta : 0.05;
+      CHECK(std::abs(q[i]) <= range);
+      CHECK(std::abs(v[i]) <= range / (stretch ? 0.5 : std::numbers::pi));
+    }
+  }
+  const Model own = load_text(R"({"name": "r", "bodies": [{"name": "a", "parent": "world",
+    "joint": {"type": "revolute", "axis": [0, 0, 1], "sample_range": 0.2},
+    "elements": [{"type": "lumped_point", "node": [1, 0, 0], "mass": 1}]}]})");
+  for (int k = 0; k < 20; ++k) CHECK(std::abs(random_posture(own, rng)[0]) <= 0.2);
+  CHECK_THAT(text_error(R"({"name": "r", "bodies": [{"name": "a", "parent": "world",
+    "joint": {"type": "spherical", "sample_range": 0.2},
+    "elements": [{"type": "lumped_point", "node": [1, 0, 0], "mass": 1}]}]})"),
+             Catch::Contains("/bodies/0/joint/sample_range: is the half range of a joint of one "
+                             "coordinate"));
+  CHECK_THAT(text_error(R"({"name": "r", "bodies": [{"name": "a", "parent": "world",
+    "joint": {"type": "revolute", "axis": [0, 0, 1], "sample_range": -1},
+    "elements": [{"type": "lumped_point", "node": [1, 0, 0], "mass": 1}]}]})"),
+             Catch::Contains("/bodies/0/joint/sample_range: must be positive"));
 }
 
 TEST_CASE("a spinning cantilever stiffens as the rotating-beam references say", "[flexible]") {

@@ -2,6 +2,7 @@
 // give the same equations: each new route is checked against the one it replaces, on random trees
 // of every element type, with fixed joints, springs, dampers, loads and couplings, and at the sizes
 // where the choice switches.
+#include <Eigen/SVD>
 #include <array>
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -26,9 +27,13 @@ void check_same_equations(const Model& a, const Model& b, unsigned seed, double 
                tau = random_uniform(a.n(), 3, rng), qdd = random_uniform(a.n(), 3, rng);
     REQUIRE(tree_forward_dynamics(a, wa, q, qd, tau).ok);
     REQUIRE(tree_forward_dynamics(b, wb, q, qd, tau).ok);
-    CHECK(rel_error(wa.qdd, wb.qdd) < tol);
-    evaluate(a, wa, q, qd, tau);
     evaluate(b, wb, q, qd, tau);
+    // q̈ by two backward-stable solves differs by up to ~ε cond(M^s) (a flexible bar's M^s
+    // reaches 1e7); the assembled terms by round-off alone.
+    const Eigen::VectorXd sv = Eigen::JacobiSVD<MatX>(wb.Ms).singularValues();
+    const double tol_qdd = std::max(tol, 4 * 2.2e-16 * sv[0] / sv[sv.size() - 1]);
+    CHECK(rel_error(wa.qdd, wb.qdd) < tol_qdd);
+    evaluate(a, wa, q, qd, tau);
     CHECK(rel_error(wa.Ms, wb.Ms) < tol);
     // h vanishes for one joint: relative to the size of its terms, ‖M^s‖ ‖q̇‖², not to itself.
     CHECK(rel_error(wa.h, wb.h, wb.Ms.cwiseAbs().maxCoeff() * qd.squaredNorm()) < tol);
@@ -37,7 +42,7 @@ void check_same_equations(const Model& a, const Model& b, unsigned seed, double 
     mass_matrix(a, wa, q);  // M^s alone
     CHECK(rel_error(wa.Ms, Ms) < tol);
     // q̈ solves the assembled equations.
-    CHECK(rel_error(wb.Ms * wa.qdd + wb.h, wb.Q) < tol);
+    CHECK(rel_error(wb.Ms * wa.qdd + wb.h, wb.Q) < tol_qdd);
     inverse_dynamics(a, wa, q, qd, qdd);
     inverse_dynamics(b, wb, q, qd, qdd);
     CHECK(rel_error(wa.tau, wb.tau) < tol);

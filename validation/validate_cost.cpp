@@ -155,7 +155,7 @@ void Validator::Impl::probe() {
 double Validator::Impl::probe_state() {
   const int n = m.n();
   std::mt19937 rng(o.seed + 104729);
-  const VecX q = random_posture(m, rng), qd = random_uniform(n, o.qd_scale, rng),
+  const VecX q = random_posture(m, rng), qd = random_rates(m, o.qd_scale, rng),
              tau = random_uniform(n, o.tau_scale, rng), qdd = random_uniform(n, o.qdd_scale, rng);
   t_fd = timed([&] { (void)tree_forward_dynamics(m, ws, q, qd, tau); });
   const double t_id = timed([&] { inverse_dynamics(m, ws, q, qd, qdd); });
@@ -196,7 +196,7 @@ double Validator::Impl::probe_trajectory() {
   double seconds = steps * 4 * t_fd + samples * t_energy;
   if (!twin->can_simulate()) return seconds;
   std::mt19937 first(o.seed);  // the first state of run(): the trajectory's start
-  VecX q0 = random_posture(m, first), qd0 = random_uniform(m.n(), o.qd_scale, first);
+  VecX q0 = random_posture(m, first), qd0 = random_rates(m, o.qd_scale, first);
   std::string why;
   if (!m.constraints.empty()) (void)consistent_state(m, q0, qd0, why);
   const double stretch = o.t_end / kSimbodyProbeParts;

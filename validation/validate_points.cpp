@@ -190,7 +190,7 @@ ValidationReport Validator::Impl::run() {
   double cond = 1;  // the largest cond(M^s) over the states (n ≤ kConditionLimit)
   for (int k = 0; k < o.states; ++k) {
     const VecX q = random_posture(m, rng);
-    const VecX qd = random_uniform(m.n(), o.qd_scale, rng);
+    const VecX qd = random_rates(m, o.qd_scale, rng);
     const VecX tau = random_uniform(m.n(), o.tau_scale, rng);
     const VecX qdd = random_uniform(m.n(), o.qdd_scale, rng);
     if (k == 0) q0 = q, qd0 = qd;
@@ -265,7 +265,7 @@ QuantityError validate_urdf_import(const Model& m, const std::string& path,
   std::mt19937 rng(o.seed);
   for (int k = 0; k < o.states; ++k) {
     const VecX q = random_posture(m, rng);
-    const VecX qd = random_uniform(m.n(), o.qd_scale, rng);
+    const VecX qd = random_rates(m, o.qd_scale, rng);
     evaluate(m, ws, q, qd, VecX());
     const UrdfTwinEquations s = twin->equations(m.coordinate_names, m.configuration_names, q, qd);
     accumulate(e, ws.Ms, s.M);

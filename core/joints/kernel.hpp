@@ -306,8 +306,12 @@ inline void prepare_joint(Joint& j) {
 }
 
 // Half the width of the range random configurations are drawn from: ±π rad, ±0.5 m.
+inline double type_random_half_range(JointType type) {
+  return visit_joint(type, []<class J>(J) { return J::kRandomHalfRange; });
+}
+// The model's own where it gives one (a flexible bar's strains), else the type's.
 inline double random_half_range(const Joint& j) {
-  return visit_joint(j.type, []<class J>(J) { return J::kRandomHalfRange; });
+  return j.sample_range > 0 ? j.sample_range : type_random_half_range(j.type);
 }
 
 }  // namespace femdyn

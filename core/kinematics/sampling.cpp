@@ -124,4 +124,13 @@ VecX random_uniform(int n, double scale, std::mt19937& rng) {
   return x;
 }
 
+VecX random_rates(const Model& m, double scale, std::mt19937& rng) {
+  VecX v = random_uniform(m.n(), scale, rng);
+  for (const CoordinateJoint& c : m.coordinate_joints) {
+    const Joint& J = m.bodies[c.body].joint;
+    if (J.sample_range > 0) v[c.v] *= J.sample_range / type_random_half_range(J.type);
+  }
+  return v;
+}
+
 }  // namespace femdyn

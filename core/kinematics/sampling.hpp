@@ -11,6 +11,9 @@ VecX random_posture(const Model& model, std::mt19937& rng);
 // Each coordinate at 0, or at its joint's nearest limit when 0 is outside them.
 VecX reference_posture(const Model& model);
 VecX random_uniform(int n, double scale, std::mt19937& rng);
+// Rates uniform in ±scale (the draws of random_uniform(n, scale)), those of a joint whose model
+// narrows its random range (Joint::sample_range: a flexible bar's strains) narrowed alike.
+VecX random_rates(const Model& model, double scale, std::mt19937& rng);
 // Every joint at its neutral configuration: its "initial" value (0 unless the model gives one),
 // the identity rotation. q of size n_q.
 VecX neutral_posture(const Model& model);

@@ -53,6 +53,7 @@ struct Joint {
   bool stop = false;
   double stop_stiffness = 1e4, stop_dissipation = 0.5;
   bool actuated = true;          // an actuator drives its rates (docs/control.md#actuation)
+  double sample_range = 0;       // > 0: random postures draw within ± this (JointSpec's)
   double reflected_inertia = 0;  // derived: I_a G²
   std::string where;
   // Derived by compile() for the pose (core/joints/): R_pj [a]×, R_pj [a]×², R_pj a.
