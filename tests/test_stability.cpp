@@ -237,6 +237,16 @@ TEST_CASE("stress speeds: 1e3 rad/s joints and a fast gyroscope", "[stress]") {
 TEST_CASE("stress slender bars with negative lumped rotary inertia", "[stress]") {
   stress_class("slender bars");
 }
+TEST_CASE("stress flexible: a tube's stiffest mode is its axial chain's 2 c / delta", "[stress]") {
+  // 8 parts of Δ = 0.25 m, masses ρAΔ joined by springs EA/Δ: the chain's top mode is
+  // 2 √(k/m) = 2 c / Δ, c = √(E/ρ). Undamped it is stiff and undamped; with c = 1e-4 k it is
+  // dissipative (ζ = 2 there), which bdf cures.
+  const auto cases = stress_class("flexible");
+  REQUIRE(cases.size() == 2);
+  const double top = 2 * std::sqrt(6.89e10 / 2700) / 0.25;
+  CHECK(std::abs(cases[0]["stiffest"].get<double>() / top - 1) < 0.02);
+}
+
 TEST_CASE("stress near-singular postures", "[stress]") { stress_class("postures"); }
 TEST_CASE("stress a long chain", "[stress]") { stress_class("size"); }
 TEST_CASE("stress zero gravity and 1000 g", "[stress]") { stress_class("gravity"); }
