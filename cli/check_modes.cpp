@@ -1,5 +1,6 @@
 #include "cli/check_modes.hpp"
 
+#include <Eigen/QR>
 #include <algorithm>
 #include <numbers>
 
@@ -34,9 +35,12 @@ NaturalModes natural_modes(const Args& a, const Model& m) {
     if (x.kind != ModeKind::None && x.lambda.real() > 1e-9 * std::max(1.0, x.omega))
       ++out.unstable;  // (a rigid-body mode's round-off is no instability)
     if (x.kind == ModeKind::Oscillatory && x.lambda.imag() > 0) out.oscillatory.push_back(x);
-    if (x.kind == ModeKind::None) ++out.rigid;
   }
-  out.rigid /= 2;  // (each a double zero eigenvalue of A: position and rate)
+  // Rigid-body modes: the coordinates no spring holds, n − rank K, K = −M^s ∂q̈/∂q (A's lower
+  // left block is −M⁻¹K, of K's rank), whether a damper acts on them or not.
+  const int n = m.n();
+  out.rigid =
+      n - static_cast<int>(Eigen::ColPivHouseholderQR<MatX>(lin.A.bottomLeftCorner(n, n)).rank());
   std::sort(out.oscillatory.begin(), out.oscillatory.end(),
             [](const Mode& p, const Mode& q) { return p.lambda.imag() < q.lambda.imag(); });
   return out;
