@@ -189,3 +189,26 @@ def test_flexible_space_robot_keeps_momentum_and_rings_at_checks_frequencies():
     assert len(peaks) >= 2
     for i in peaks:
         assert np.abs(listed - hz[i]).min() < 2 * resolution, (hz[i], listed[:12])
+
+
+def test_check_counts_rigid_body_modes_damped_or_not(tmp_path):
+    """n − rank K: a free joint is a rigid-body mode with or without a damper on it; a sprung one
+    oscillates."""
+    for damping, rigid in [(0.0, 2), (0.3, 2)]:
+        doc = {"name": "two free, one sprung", "gravity": [0, 0, 0], "bodies": [
+            {"name": "a", "parent": "world",
+             "joint": {"type": "revolute", "axis": [0, 0, 1], "damping": damping},
+             "elements": [{"type": "lumped_point", "node": [0.5, 0, 0], "mass": 1}]},
+            {"name": "b", "parent": "a",
+             "joint": {"type": "revolute", "axis": [0, 0, 1], "origin": {"xyz": [0.5, 0, 0]},
+                       "damping": damping},
+             "elements": [{"type": "lumped_point", "node": [0.5, 0, 0], "mass": 1}]},
+            {"name": "c", "parent": "b",
+             "joint": {"type": "revolute", "axis": [0, 0, 1], "origin": {"xyz": [0.5, 0, 0]},
+                       "spring": {"stiffness": 40}},
+             "elements": [{"type": "lumped_point", "node": [0.5, 0, 0], "mass": 1}]}]}
+        path = tmp_path / "m.json"
+        path.write_text(json.dumps(doc))
+        modes = cli_json("check", str(path), "--json")["natural_modes"]
+        assert modes["rigid"] == rigid and len(modes["oscillatory"]) == 1
+        assert modes["unstable"] == 0
