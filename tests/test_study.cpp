@@ -2,15 +2,20 @@
 // report, the sampling both engines share (Simbody's integrators interpolate like femdyn's),
 // the timed repeats after a warm-up, the error's scales, the legend grouped by engine, the
 // machine and its load; and the twin's two ways of sampling a trajectory.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <set>
 #include <sstream>
 
+#include "core/kinematics/sampling.hpp"
+#include "sim/integrator.hpp"
 #include "tests/helpers.hpp"
+#include "validation/study.hpp"
 #include "validation/validate.hpp"
 
 using namespace femdyn;
@@ -281,4 +286,73 @@ TEST_CASE("study on a floating base measures quaternions on their manifold", "[s
   const double coarsest = it->second, next = (++it)->second;
   CHECK(coarsest > 10 * next);
   CHECK(simbody_best < 1e-6);  // Simbody's tightest accuracy tracks the same reference
+}
+
+// Bounded work: the reference is estimated from a probe of its method and refused beyond
+// --budget, in one line with the --t-end that fits; the estimate is checked against the
+// reference runs timed here, on a model whose probe covers only half of the run.
+TEST_CASE("study estimates its reference and refuses it beyond the budget", "[study]") {
+#ifndef NDEBUG
+  return;  // (study refuses to time a build with asserts; see above)
+#endif
+  Scratch s("study_budget");
+  const std::string model = model_path("andrews.json");
+  const Run refused = run("study " + model + " --quick --budget 0.01 --out " + s / "refused");
+  CHECK(refused.code == 1);
+  CHECK(std::count(refused.out.begin(), refused.out.end(), '\n') == 1);
+  CHECK_THAT(refused.out,
+             Catch::StartsWith("femdyn study: " + model +
+                               ": the reference solution (dopri at "
+                               "rtol 1e-14, then 1e-13, over 0.5 s) would take about ") &&
+                 Catch::Contains("beyond the budget of 0.01 s: use --t-end ") &&
+                 Catch::Contains(" or raise --budget"));
+  CHECK_FALSE(fs::exists(fs::path(s / "refused") / "study.csv"));
+
+  // The estimate against the two reference runs timed here (dopri landing on the 20 samples at
+  // rtol = atol 1e-14, then 1e-13) from the same state, over --quick's 0.5 s.
+  const Model m = load_model(model);
+  validation::StudyOptions o;
+  o.t_end = 0.5;
+  std::mt19937 rng(1);
+  o.q0 = random_posture(m, rng);
+  o.qd0 = random_rates(m, 1.0, rng);
+  const validation::StudyEstimate e = validation::estimate_study(m, o);
+  INFO("probe " << e.probe_t << " s in " << e.probe_wall << " s; estimate " << e.reference);
+  CHECK(e.probe_wall == Approx(validation::StudyEstimate::kProbeSeconds).margin(0.05));
+  CHECK(e.probe_t < o.t_end);  // the probe stopped inside the run
+  double measured = 0;
+  for (double rtol : {1e-14, 1e-13}) {
+    auto integ = make_integrator(
+        m, {.kind = IntegratorKind::Dopri,
+            .adaptive = {
+                .rtol = rtol, .atol = rtol, .max_steps = 100'000'000, .stop_at_outputs = true}});
+    integ->reset(0, o.q0, o.qd0, o.t_end);
+    for (int k = 1; k <= 20; ++k) REQUIRE(integ->advance_to(o.t_end * k / 20).ok);
+    measured += integ->stats().wall_time;
+  }
+  INFO("measured " << measured << " s");
+  CHECK(e.reference / measured > 0.5);
+  CHECK(e.reference / measured < 2);
+}
+
+// A model with loop constraints: study starts both engines from one assembled state and
+// Simbody integrates the closed mechanism, so its error falls with its accuracy (against the
+// tree without its constraints it stayed at 4e-2).
+TEST_CASE("study closes a model's loop constraints in both engines", "[study][loops]") {
+#ifndef NDEBUG
+  return;  // (study refuses to time a build with asserts; see above)
+#endif
+  Scratch s("study_loop");
+  const Run r = study(model_path("finger_fourbar_loop.json") + " --quick --json --out " + s / "o");
+  REQUIRE(r.code == 0);
+  const Json j = Json::parse(r.out);
+  double best = INFINITY;
+  for (const Json& run : j["runs"])
+    if (run["integrator"] == "RungeKuttaMerson" && run["ok"] == true)
+      best = std::min(best, run["error"].get<double>());
+  CHECK(best < 1e-5);
+  bool noted = false;
+  for (const Json& n : j["notes"])
+    noted = noted || n.get<std::string>().rfind("loop constraints: both engines", 0) == 0;
+  CHECK(noted);
 }

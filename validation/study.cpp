@@ -26,7 +26,8 @@ using States = std::vector<VecX>;  // x = (θ, θ̇) at each sample
 struct Sweep {
   std::string engine, integrator, setting;
   std::vector<double> values;
-  std::function<StudyRun(double)> run;  // one timed run, error not yet filled in
+  // One timed run at a setting, error not yet filled in; stopped past `limit` s (0: none).
+  std::function<StudyRun(double value, double limit)> run;
   std::size_t next = 0;
   bool active = true;
 };
@@ -36,17 +37,34 @@ struct Sampled {
   std::vector<double> energy;
   IntegratorStats stats;
   Status status;
+  double t_reached = 0;
+};
+
+// Bounds on a femdyn run: stopped past `wall` seconds (0: none), and `watch(t)` told the
+// model time reached, both asked inside the steps at most every 20 ms (Motion::set_interrupt).
+// An unbounded run sets no interrupt, so that its timing is the integrator's alone.
+struct RunLimit {
+  double wall = 0;
+  std::function<void(double t)> watch;
 };
 
 // femdyn's run: advance_to each sample time, x = (θ, θ̇) of every joint (core joint_state).
 Sampled femdyn_run(const Model& m, const IntegratorOptions& o, const StudyOptions& so,
-                   const std::vector<double>& times) {
+                   const std::vector<double>& times, const RunLimit& limit = {}) {
   Sampled s;
   const auto begin = std::chrono::steady_clock::now();  // set-up counts, as Simbody's does
+  const auto since_begin = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  };
   auto integ = make_integrator(m, o);
   integ->reset(0, so.q0, so.qd0, so.t_end);
-  const double setup =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  const double setup = since_begin();
+  std::optional<Motion::InterruptScope> bounded;
+  if (limit.wall > 0 || limit.watch)
+    bounded.emplace(integ->motion(), [&] {
+      if (limit.watch) limit.watch(integ->t());
+      return limit.wall > 0 && since_begin() > limit.wall;
+    });
   Workspace ws(m);
   const auto sample = [&] {
     joint_state(m, ws, integ->q(), integ->qd());
@@ -61,9 +79,21 @@ Sampled femdyn_run(const Model& m, const IntegratorOptions& o, const StudyOption
     if (!s.status.ok) break;
     sample();
   }
+  if (s.status.interrupted)
+    s.status.message = "stopped at t = " + format_short(integ->t()) + " s of " +
+                       format_short(so.t_end) + " s, past " + format_short(limit.wall) +
+                       " s of wall time";
+  s.t_reached = integ->t();
   s.stats = integ->stats();
   s.stats.wall_time += setup;
   return s;
+}
+
+// The reference method: Dormand–Prince landing on every sample at rtol = atol.
+IntegratorOptions reference_options(double rtol) {
+  return {
+      .kind = IntegratorKind::Dopri,
+      .adaptive = {.rtol = rtol, .atol = rtol, .max_steps = 100'000'000, .stop_at_outputs = true}};
 }
 
 // x ⊖ ref joint by joint: (ξ, θ̇ − θ̇_ref) with ξ = θ ⊖ θ_ref on each joint's manifold (θ − θ_ref
@@ -203,6 +233,7 @@ class Study {
     const TwinModel tm = twin_model(m);
     note_formulation(tm);
     SimbodyTwin twin(tm);
+    twin.close_loops(!m.constraints.empty());  // the closed mechanism, as femdyn integrates it
     simbody_sweeps(twin);
     std::vector<Sweep*> order;  // the engines alternating
     for (std::size_t i = 0; i < std::max(femdyn.size(), simbody.size()); ++i) {
@@ -249,13 +280,16 @@ class Study {
               "land on the samples, their steps dividing the sample spacing";
   }
 
-  // Reference: Dormand–Prince landing on every sample, at rtol 1e-14 and 1e-13.
+  // Reference: Dormand–Prince landing on every sample, at rtol 1e-14 and 1e-13; stopped past
+  // the study's budget.
   Sampled reference(double rtol) const {
-    IntegratorOptions ro{
-        .kind = IntegratorKind::Dopri,
-        .adaptive = {
-            .rtol = rtol, .atol = rtol, .max_steps = 100'000'000, .stop_at_outputs = true}};
-    Sampled s = femdyn_run(m, ro, o, times);
+    const std::string run = "reference (rtol " + format_short(rtol) + ")";
+    RunLimit limit{.wall = o.budget};
+    if (o.reference_progress) limit.watch = [&](double t) { o.reference_progress(run, t); };
+    Sampled s = femdyn_run(m, reference_options(rtol), o, times, limit);
+    if (s.status.interrupted)
+      throw femdyn::Error("the " + run + " passed the budget: " + s.status.message +
+                          " (shorten --t-end, or raise --budget)");
     if (!s.status.ok) throw femdyn::Error("the reference solution failed: " + s.status.message);
     return s;
   }
@@ -267,6 +301,7 @@ class Study {
         "sample, rtol = atol = 1e-14";
     ref = reference(rep.reference_rtol);
     const Sampled coarse = reference(10 * rep.reference_rtol);
+    rep.reference_wall = ref.stats.wall_time + coarse.stats.wall_time;
     measure.emplace(m, ref.x);
     for (int g = 0; g < 4; ++g)
       if (measure->present[g])
@@ -288,7 +323,7 @@ class Study {
         for (int k = first; k <= first + doublings; ++k)
           s.values.push_back(o.t_end / (o.samples * std::pow(2.0, k)));
       }
-      s.run = [this, kind](double value) {
+      s.run = [this, kind](double value, double limit) {
         IntegratorOptions io{.kind = kind};
         if (is_adaptive(kind))
           io.adaptive = {.rtol = value,
@@ -297,7 +332,7 @@ class Study {
                          .stop_at_outputs = !o.interpolate};
         else
           io.fixed = {.dt = value};
-        const Sampled r = femdyn_run(m, io, o, times);
+        const Sampled r = femdyn_run(m, io, o, times, {.wall = limit});
         StudyRun run{.engine = "femdyn",
                      .integrator = integrator_name(kind),
                      .setting = is_adaptive(kind) ? "rtol" : "dt",
@@ -341,6 +376,13 @@ class Study {
     } else {
       rep.femdyn_formulation = rep.simbody_formulation = "tree coordinates";
     }
+    if (!m.constraints.empty())
+      rep.notes.push_back(
+          "loop constraints: both engines integrate the tree with its " +
+          std::to_string(m.constraint_rows) +
+          " constraint equations from the same assembled start; femdyn with Baumgarte's "
+          "stabilisation (20/s) and projection after a step that leaves them, Simbody with its "
+          "projection after every step");
   }
 
   // Simbody sweeps over accuracies, when the twin can integrate the model.
@@ -358,8 +400,9 @@ class Study {
               "accuracy",
               o.quick ? decades(2, 8) : decades(2, 10),
               {}};
-      s.run = [this, &twin, which, twin_sampling](double accuracy) {
-        const TwinRun r = twin.simulate(o.q0, o.qd0, with_zero, accuracy, which, twin_sampling);
+      s.run = [this, &twin, which, twin_sampling](double accuracy, double limit) {
+        const TwinRun r = twin.simulate(o.q0, o.qd0, with_zero, accuracy, which, twin_sampling,
+                                        {.wall_time = limit});
         StudyRun run{.engine = "Simbody",
                      .integrator = simbody_integrator_name(which),
                      .setting = "accuracy",
@@ -398,7 +441,7 @@ class Study {
       for (Sweep* s : order) {
         if (!s->active || s->next >= s->values.size()) continue;
         any = true;
-        StudyRun r = s->run(s->values[s->next++]);
+        StudyRun r = s->run(s->values[s->next++], o.run_limit());
         r.warm_up_time = r.wall_time;
         r.resolved = r.ok && r.error >= rep.resolution;
         if (log)
@@ -427,7 +470,7 @@ class Study {
         for (const auto& [sweep, i] : made) {
           StudyRun& r = rep.runs[i];
           if (sweep != s || round >= wanted(r)) continue;
-          const StudyRun again = s->run(r.value);
+          const StudyRun again = s->run(r.value, 0);
           r.times.push_back(again.wall_time);
           if (again.steps != r.steps)  // a run is deterministic: the same steps every time
             rep.notes.push_back(r.engine + " " + r.integrator + " " + r.setting + " " +
@@ -443,6 +486,20 @@ class Study {
 };
 
 }  // namespace
+
+StudyEstimate estimate_study(const Model& m, const StudyOptions& o) {
+  std::vector<double> times;
+  for (int k = 1; k <= o.samples; ++k) times.push_back(o.t_end * k / o.samples);
+  const Sampled probe =
+      femdyn_run(m, reference_options(1e-14), o, times, {.wall = StudyEstimate::kProbeSeconds});
+  if (!probe.status.ok && !probe.status.interrupted)
+    throw femdyn::Error("the reference solution failed: " + probe.status.message);
+  StudyEstimate e{.probe_t = probe.t_reached, .probe_wall = probe.stats.wall_time};
+  const double runs = 1 + std::pow(10.0, -0.2);  // rtol 1e-14, then 1e-13
+  e.reference = e.probe_t > 0 ? runs * e.probe_wall * o.t_end / e.probe_t
+                              : std::numeric_limits<double>::infinity();
+  return e;
+}
 
 StudyReport run_study(const Model& m, const StudyOptions& o,
                       const std::function<void(const std::string&)>& log) {

@@ -48,7 +48,30 @@ struct StudyOptions {
   double repeat_below = 0.05;  // s
   double run_budget = 2.0;     // s: a sweep stops tightening after a run this long
   bool quick = false;          // fewer sweep points, tighter budgets, 3 repeats (CI smoke)
+  // s: a reference run still going past it is stopped and the study fails (0: no limit). The
+  // caller refuses beforehand what estimate_study puts beyond it.
+  double budget = 0;
+  // Told the reference runs' progress, at most every 20 ms: which run ("reference (rtol
+  // 1e-14)"), and the model time it has reached.
+  std::function<void(const std::string& run, double t)> reference_progress;
+  // s: the warm-up runs are stopped past it (a failed run that ends its sweep): 4x the
+  // run budget (0.2 s with quick).
+  double run_limit() const { return 4 * (quick ? 0.2 : run_budget); }
 };
+
+// The study's cost up front. The sweeps are bounded by their rules (each ends at its first run
+// over run_budget, a warm-up is stopped at run_limit(), its repeats are of runs that ended
+// below it); the reference is not, and is estimated by a probe: the reference method (dopri at
+// rtol 1e-14, landing on the samples) run from the start for up to kProbeSeconds of wall time
+// or to t_end, its pace extrapolated to t_end, for the two reference runs (rtol 1e-14 and 1e-13:
+// 10^(1/5) fewer steps, a fifth-order method's).
+struct StudyEstimate {
+  static constexpr double kProbeSeconds = 0.5;
+  double probe_t = 0;     // s of model time the probe reached
+  double probe_wall = 0;  // s of wall time it took
+  double reference = 0;   // s: both reference runs, extrapolated
+};
+StudyEstimate estimate_study(const Model& model, const StudyOptions& options);
 
 struct StudyRun {
   std::string engine;      // "femdyn" or "Simbody"
@@ -98,6 +121,7 @@ struct StudyReport {
   std::string reference_method;
   double reference_rtol = 0, reference_error = 0;  // the estimate
   double resolution = 0;                           // 100x reference_error
+  double reference_wall = 0;  // s: both reference runs' wall time (StudyEstimate::reference's)
   // Whether both engines integrate the same equations: false where the Simbody twin is a
   // constrained system (a closed loop, or linear coordinate couplers) while femdyn integrates
   // the reduced coordinates; then `formulation` says how each does it.

@@ -3,6 +3,8 @@
 // twin.cpp (C++17, without NDEBUG).
 #include <Simbody.h>
 #include <dlfcn.h>
+#include <fcntl.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -178,6 +180,32 @@ std::unique_ptr<SimTK::Integrator> configured_integrator(SimbodyIntegrator which
   return integ;
 }
 
+// CPODES, inside Simbody's CPodesIntegrator, prints its own warnings and errors on stderr
+// ("[CPODES ERROR] … mxstep steps taken before reaching tout"), which Simbody gives no way to
+// turn off; its failures reach the caller as stats.failure. While `quiet`, fd 2 is /dev/null.
+class QuietStderr {
+ public:
+  explicit QuietStderr(bool quiet) {
+    if (!quiet) return;
+    std::fflush(stderr);
+    saved_ = dup(STDERR_FILENO);
+    const int null = open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (saved_ >= 0 && null >= 0) dup2(null, STDERR_FILENO);
+    if (null >= 0) close(null);
+  }
+  ~QuietStderr() {
+    if (saved_ < 0) return;
+    std::fflush(stderr);
+    dup2(saved_, STDERR_FILENO);
+    close(saved_);
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  int saved_ = -1;
+};
+
 std::string out_of_time_text(SimbodyIntegrator which, double t, double t_end, double bound) {
   char text[160];
   std::snprintf(text, sizeof text,
@@ -207,6 +235,7 @@ TwinRun SimbodyTwin::simulate(const VecX& q0, const VecX& qd0, const std::vector
     return run;
   }
   std::unique_ptr<SimTK::Integrator> integ;
+  const QuietStderr quiet(which == SimbodyIntegrator::CPodes);
   try {
     s.enable_loops(s.simulate_closed);  // the integrator starts from (a copy of) this state
     s.set_state(q0, qd0, SimTK::Stage::Velocity);
