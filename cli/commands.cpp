@@ -22,7 +22,7 @@ namespace {
 constexpr const char* kInfoHelp = R"(usage: femdyn info MODEL [--json] [--gravity gx,gy,gz]
 
 Prints the generalized coordinates, joints (with the coupling level θ = C q + θ0), bodies and
-their elements, the transition coordinates u kept and those left out, the routes (which
+their elements, the flexible bars (each with its parts and stations, --json "bars"), the transition coordinates u kept and those left out, the routes (which
 algorithm computes M^s, h and τ, q̈, and the closed loops' q̈: docs/design.md), and the
 correlation table N_m (one row per element; per node x y z rx ry rz; 0 = left out).
 A model whose M^s is singular (a massless chain end) is described all the same, with a note

@@ -203,6 +203,22 @@ void compile_frames(const MechanismSpec& spec, Model& m) {
   }
 }
 
+// Each flexible bar's centreline, its stations by body index.
+void compile_bars(const MechanismSpec& spec, Model& m) {
+  if (spec.bars.empty()) return;
+  std::map<std::string, int> body_of;
+  for (int b = 0; b < static_cast<int>(m.bodies.size()); ++b) body_of.emplace(m.bodies[b].name, b);
+  for (const BarSpec& bar : spec.bars) {
+    BarCentreline& c = m.bars.emplace_back(BarCentreline{bar.name, {}, bar.radius});
+    for (const std::string& station : bar.stations) {
+      const auto it = body_of.find(station);
+      if (it == body_of.end())  // (the bar's own bodies: a builder's mistake)
+        throw ModelError(bar.where, "unknown body " + quoted_text(station));
+      c.stations.push_back(it->second);
+    }
+  }
+}
+
 // Couplings join joints of one rate (a coupled multi-rate joint would need a law per rate).
 void check_one_rate(const Model& m, int t, const std::string& where) {
   const Joint& j = m.bodies[m.theta_joint[t]].joint;
@@ -465,6 +481,7 @@ Model compile_tree(MechanismSpec spec, const CompileOptions& options) {
   compile_header(spec, m);
   const std::vector<int> body_of_spec = compile_bodies(spec, m);
   compile_frames(spec, m);
+  compile_bars(spec, m);
   compile_coupling(spec, m);
   lay_out_coordinates(m);
   configuration_coupling(m);

@@ -133,6 +133,14 @@ struct SpringSpec {
   std::string where;
 };
 
+// A flexible bar's centreline (Model::bars): its stations by body name.
+struct BarSpec {
+  std::string name;
+  std::vector<std::string> stations;
+  double radius = 0;
+  std::string where;
+};
+
 struct MechanismSpec {
   std::string name;
   Vec3 gravity = Vec3::Zero();
@@ -143,6 +151,7 @@ struct MechanismSpec {
   std::vector<FrameSpec> frames;
   std::vector<ConstraintSpec> constraints;
   std::vector<SpringSpec> springs;
+  std::vector<BarSpec> bars;
   std::optional<CorrelationSpec> correlation;
   std::string where;  // the file
 };

@@ -2,7 +2,7 @@
 """Damping a flexible space arm's vibration (models/flexible_space_robot.json, docs/flexible.md).
 
     PYTHONPATH=build/python python3 examples/flexible_space_robot.py [--t-end 5]
-        [--plot flexible_space_robot.png]
+        [--plot flexible_space_robot.png] [--view slew.html]
 
 A satellite floats with a two-link arm of 3 m aluminium tubes. A joint servo slews the shoulder
 by 0.6 rad and the elbow by −0.9 rad in 2 s (quintic), which sets the tubes vibrating. Then:
@@ -17,7 +17,8 @@ by 0.6 rad and the elbow by −0.9 rad in 2 s (quintic), which sets the tubes vi
   plus the joints' errors.
 
 Prints the tip's elastic deflection (the tip's position minus that of the same joints with every
-strain zero) over the last second in each case, and plots it.
+strain zero) over the last second in each case, and plots it. --view writes the 3-D page of
+the run with the motors off (`femdyn view`'s, each tube drawn along its centreline).
 """
 import argparse
 import math
@@ -112,6 +113,7 @@ class Arm:
                                atol=1e-10, q0=self.rest)
         out = sim.run(lambda t, q, v: self.servo(t, q, v) if t < SLEW else after(t, q, v),
                       t_end, mode="evaluation")
+        self.last_run = out
         return out["t"], np.array([self.deflection(q) for q in out["q"]])
 
 
@@ -119,11 +121,16 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--t-end", type=float, default=5.0)
     parser.add_argument("--plot")
+    parser.add_argument("--view", help="write the 3-D page of the run with the motors off")
     a = parser.parse_args()
     arm = Arm()
     cases = {"motors off": lambda t, q, v: np.zeros(arm.m.n), "servo kept on": arm.servo,
              "LQR": arm.lqr}
-    runs = {name: arm.run(after, a.t_end) for name, after in cases.items()}
+    runs = {}
+    for name, after in cases.items():
+        runs[name] = arm.run(after, a.t_end)
+        if a.view and name == "motors off":  # the tubes drawn along their centrelines
+            print(f"wrote {arm.m.view(arm.last_run, path=a.view, force=True)}")
     for name, (t, d) in runs.items():
         last = t >= a.t_end - 1.0
         print(f"{name:14s} tip deflection over the last second: rms {np.sqrt(np.mean(d[last]**2)):.3e}"

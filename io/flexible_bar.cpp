@@ -1,5 +1,6 @@
 #include "io/flexible_bar.hpp"
 
+#include <cmath>
 #include <string>
 #include <tuple>
 
@@ -86,7 +87,7 @@ Json one_rate_joint(const std::string& name, const char* type, const Vec3& axis,
 
 }  // namespace
 
-Json flexible_bar_bodies(const Params& p) {
+FlexibleBarParts flexible_bar_parts(const Params& p) {
   p.allow_only(
       {"name", "parent", "origin", "length", "segments", "section", "axial", "torsion", "damping"});
   const std::string name = p.string("name"), parent = p.string("parent");
@@ -148,7 +149,10 @@ Json flexible_bar_bodies(const Params& p) {
                          {"type", "fixed"},
                          {"origin", {{"xyz", vec(Vec3(delta / 2, 0, 0))}}}},
                         Json::array()));
-  return bodies;
+  BarSpec centreline{name, {}, std::sqrt((s.rhoIy + s.rhoIz) / s.rhoA), p.where()};
+  for (int i = 0; i <= n; ++i) centreline.stations.push_back(name + "." + std::to_string(i));
+  centreline.stations.push_back(name + ".tip");
+  return {std::move(bodies), std::move(centreline)};
 }
 
 }  // namespace femdyn

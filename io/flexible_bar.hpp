@@ -9,13 +9,19 @@
 // "<bar>.<i>.ux", ".rx", ".ry", ".rz"; the pieces are bodies "<bar>.0" … "<bar>.<n>" and the
 // bar's far end is the massless body "<bar>.tip" (its frame at the end, the bar's axes).
 #pragma once
+#include "compile/spec.hpp"
 #include "io/params.hpp"
 
 namespace femdyn {
 
-// The bodies of the bar described by p ({"name", "parent", "origin", "length", "segments",
-// "section", "axial", "torsion", "damping"}, docs/model-format.md#flexible-bars), as JSON bodies
-// of the model format. Every number is checked here, with p's paths.
-Json flexible_bar_bodies(const Params& p);
+// The bar described by p ({"name", "parent", "origin", "length", "segments", "section", "axial",
+// "torsion", "damping"}, docs/model-format.md#flexible-bars): its bodies as JSON bodies of the
+// model format, and its centreline (the stations "<bar>.0" … "<bar>.<n>", "<bar>.tip"). Every
+// number is checked here, with p's paths.
+struct FlexibleBarParts {
+  Json bodies;
+  BarSpec centreline;
+};
+FlexibleBarParts flexible_bar_parts(const Params& p);
 
 }  // namespace femdyn

@@ -275,10 +275,12 @@ MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std
   for (std::size_t i = 0; i < bodies.size(); ++i)
     where.push_back(path("bodies/" + std::to_string(i)));
   read_list(root, "flexible_bars", source, [&](const Params& p, std::size_t) {
-    for (Json& b : flexible_bar_bodies(p)) {
+    FlexibleBarParts bar = flexible_bar_parts(p);
+    for (Json& b : bar.bodies) {
       where.push_back(p.where() + " (its body " + quoted_text(b["name"].get<std::string>()) + ")");
       bodies.push_back(std::move(b));
     }
+    spec.bars.push_back(std::move(bar.centreline));
     if (bodies.size() > static_cast<std::size_t>(kMaxBodies))
       throw ModelError(p.where(), too_many_bodies_text(bodies.size()));
   });
@@ -305,11 +307,12 @@ MechanismSpec parse_document(const Catalog& catalog, const Json& root, const std
 
 }  // namespace
 
-std::vector<BodySpec> parse_flexible_bar(const Catalog& catalog, const Json& bar,
-                                         const std::string& where) {
-  std::vector<BodySpec> out;
-  for (const Json& b : flexible_bar_bodies(Params(bar, where)))
-    out.push_back(read_body(
+FlexibleBarSpec parse_flexible_bar(const Catalog& catalog, const Json& bar,
+                                   const std::string& where) {
+  FlexibleBarParts parts = flexible_bar_parts(Params(bar, where));
+  FlexibleBarSpec out{{}, std::move(parts.centreline)};
+  for (const Json& b : parts.bodies)
+    out.bodies.push_back(read_body(
         catalog, b, where + " (its body " + quoted_text(b["name"].get<std::string>()) + ")", {}));
   return out;
 }

@@ -35,10 +35,15 @@ MechanismSpec parse_spec(const std::string& text, const std::string& source_name
 MechanismSpec parse_model_json(const Json& root, const std::string& source_name,
                                const Catalog& catalog);
 Model load_model(const Catalog& catalog, const std::string& path, const LoadOptions& options = {});
-// The bodies of one entry of "flexible_bars" (io/flexible_bar.hpp) as the JSON format writes it,
-// read and checked as in a file; `where` names it in messages. For builders.
-std::vector<BodySpec> parse_flexible_bar(const Catalog& catalog, const Json& bar,
-                                         const std::string& where);
+// The bodies and the centreline of one entry of "flexible_bars" (io/flexible_bar.hpp) as the
+// JSON format writes it, read and checked as in a file; `where` names it in messages. For
+// builders.
+struct FlexibleBarSpec {
+  std::vector<BodySpec> bodies;
+  BarSpec centreline;
+};
+FlexibleBarSpec parse_flexible_bar(const Catalog& catalog, const Json& bar,
+                                   const std::string& where);
 // One entry of "couplings" as the JSON format writes it ({"joint", "follows", "ratio" |
 // "polynomial" | "spline" | "four_bar", …}), read and checked as in a file; `where` names it in
 // messages. For builders that take a coupling in that form (the Python module).

@@ -323,6 +323,13 @@ void bodies_text(std::ostream& out, const Model& model) {
       out << "\n";
     }
   }
+  if (!model.bars.empty()) {
+    out << "flexible bars (docs/flexible.md):\n";
+    for (const BarCentreline& bar : model.bars)
+      out << "  " << bar.name << ": " << bar.stations.size() - 2 << " parts, from "
+          << model.bodies[bar.stations.front()].name << " to "
+          << model.bodies[bar.stations.back()].name << "\n";
+  }
   if (!model.springs.empty()) {
     out << "springs:\n";
     for (const TwoPointSpring& s : model.springs)
@@ -418,6 +425,16 @@ Json info_json(const Model& model) {
                        {"rest_length", s.rest_length},
                        {"damping", s.damping}});
   j["constraints"] = constraints;
+  Json bars = Json::array();  // each flexible bar: its stations, clamp to tip
+  for (const BarCentreline& bar : model.bars) {
+    Json stations = Json::array();
+    for (int s : bar.stations) stations.push_back(model.bodies[s].name);
+    bars.push_back({{"name", bar.name},
+                    {"parts", bar.stations.size() - 2},
+                    {"stations", stations},
+                    {"radius", bar.radius}});
+  }
+  j["bars"] = bars;
   j["springs"] = springs;
   return j;
 }

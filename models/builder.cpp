@@ -193,8 +193,9 @@ void MechanismBuilder::space_bar(const std::string& body, const NodeDescription&
 
 void MechanismBuilder::flexible_bar(const Json& bar) {
   const std::string where = spec_.where + "/flexible_bars/" + std::to_string(flexible_bars_++);
-  for (BodySpec& b : parse_flexible_bar(default_catalog(), bar, where))
-    spec_.bodies.push_back(std::move(b));
+  FlexibleBarSpec parsed = parse_flexible_bar(default_catalog(), bar, where);
+  for (BodySpec& b : parsed.bodies) spec_.bodies.push_back(std::move(b));
+  spec_.bars.push_back(std::move(parsed.centreline));
 }
 
 void MechanismBuilder::rod(const std::string& body, const NodeDescription& a,

@@ -13,6 +13,8 @@
 
 #include "core/dynamics/body_inertia.hpp"
 #include "core/kinematics/frames.hpp"
+#include "core/kinematics/kinematics.hpp"
+#include "core/workspace/workspace.hpp"
 #include "io/mesh.hpp"
 #include "io/mjcf_loader.hpp"
 #include "io/urdf_loader.hpp"
@@ -404,6 +406,51 @@ TEST_CASE("view: inertia boxes hold each body's moments, and loop closures are i
   REQUIRE(scene["constraints"].size() == m.constraints.size());
   CHECK(scene["constraints"][0]["a"]["body"] == m.constraints[0].a.body);
   CHECK(scene["constraints"][0]["b"]["body"] == m.constraints[0].b.body);
+}
+
+// A flexible bar is drawn along its centreline: the scene names its stations, clamp to tip,
+// whose origins lie on the straight bar at rest at Δ/2 steps of Δ (the parts' joints, the middle
+// of each part) and at its ends, and its radius, the tube's √(J/A) = √((R² + r²)/2); its pieces
+// get no inertia box. Bent, the stations follow the bend: each lies at the posture's kinematics.
+TEST_CASE("view: a flexible bar's centreline and radius are in the scene", "[view][flexible]") {
+  const Model m = load_model(model_path("flexible_space_robot.json"));
+  const nlohmann::json scene = view::scene_json(m, view::posture(m, neutral_posture(m)), {}, "");
+  REQUIRE(scene["bars"].size() == 2);
+  REQUIRE(scene["counts"]["bars"] == 2);
+  const double R = 0.05, r = 0.047, L = 3, delta = L / 8;  // docs/flexible.md: 6061-T6 tubes
+  std::set<int> pieces;
+  for (const nlohmann::json& bar : scene["bars"]) {
+    CHECK(bar["radius"].get<double>() == Approx(std::sqrt((R * R + r * r) / 2)).epsilon(2e-3));
+    const std::vector<int> stations = bar["stations"];
+    REQUIRE(stations.size() == 10);  // the clamp, 8 joints, the tip
+    pieces.insert(stations.begin(), stations.end());
+    const auto origin = [&](int k) {
+      const nlohmann::json& p = scene["motion"]["poses"][0];
+      return Vec3(p[7 * stations[k]], p[7 * stations[k] + 1], p[7 * stations[k] + 2]);
+    };
+    const Vec3 axis = (origin(9) - origin(0)).normalized();
+    CHECK((origin(9) - origin(0)).norm() == Approx(L).epsilon(1e-6));
+    for (int k = 1; k < 10; ++k) {
+      const double step = (origin(k) - origin(k - 1)).norm();
+      CHECK(step == Approx(k == 1 || k == 9 ? delta / 2 : delta).epsilon(1e-6));
+      CHECK((origin(k) - origin(k - 1)).cross(axis).norm() < 1e-6);
+    }
+  }
+  for (const nlohmann::json& box : scene["inertia_boxes"])
+    CHECK(pieces.count(box["body"].get<int>()) == 0);
+  // Bent: every station where the kinematics put its body.
+  VecX q = neutral_posture(m);
+  for (int i = 0; i < m.n_q(); ++i)
+    if (m.configuration_names[i].find(".rz") != std::string::npos) q[i] = 0.1;
+  const nlohmann::json bent = view::scene_json(m, view::posture(m, q), {}, "");
+  Workspace ws(m);
+  propagate(m, ws, q, VecX::Zero(m.n()), {.jacobian = false, .bias = false, .rows = false});
+  for (const nlohmann::json& bar : bent["bars"])
+    for (int s : bar["stations"]) {
+      const nlohmann::json& p = bent["motion"]["poses"][0];
+      CHECK((Vec3(p[7 * s], p[7 * s + 1], p[7 * s + 2]) - (ws.origin + ws.body[s].p)).norm() <
+            2e-6);
+    }
 }
 
 // A visual the page cannot draw never stops the view: it is listed with its link and why; a

@@ -2,7 +2,7 @@
 """The page of `femdyn view` in a real browser: headless Chromium (Debian's `chromium`).
 
 usage: view_browser.py FEMDYN SOURCE_DIR WORK_DIR CASE
-       (CASE: finger, hand, arm7, meshes, loop or urdf_meshes)
+       (CASE: finger, hand, arm7, meshes, loop, urdf_meshes or flexible)
 
 For the case's model it simulates a short trajectory, writes the page of one posture and the
 page of the trajectory, and in one headless Chromium (driven over the DevTools protocol):
@@ -20,12 +20,19 @@ page of the trajectory, and in one headless Chromium (driven over the DevTools p
     its two places together (within 1e-4 of the model's size) at every screenshot; the model is
     renamed with quotes, a backslash, markup and a script end tag, which the page's title and
     model line show exactly as `femdyn info` names it;
+  - flexible (the flexible space robot, started bent, its joints driven): each flexible bar of
+    `femdyn info` is drawn as a tube along its centreline: every vertex within its radius (and
+    the curve's bow off a chord) of the polyline through the bar's stations at every
+    screenshot, where at t = 0 the stations stand off the clamp-to-tip chord by more than twice
+    the radius (so a straight tube would fail);
   - finger, again in a Chromium without WebGL (--disable-3d-apis): the page says so, holds the
     same counts and draws its plots.
 Exit 77 (ctest's SKIP_RETURN_CODE) when Chromium is absent; tools/setup.sh --all installs it.
 """
 import base64
+import fnmatch
 import json
+import math
 import os
 import select
 import shutil
@@ -53,6 +60,9 @@ CASES = {
     "loop": ("models/five_bar.json", ["--t-end", "0.6", "--every", "10"]),
     "urdf_meshes": ("tests/data/urdf/meshed/meshed_arm.urdf",
                     ["--t-end", "0.6", "--q0", "0.5,0.2", "--every", "10"]),
+    "flexible": ("models/flexible_space_robot.json",
+                 ["--t-end", "0.3", "--tau-on", "shoulder=400,elbow=-300",
+                  "--bent", "upper.*.rz=0.1,fore.*.ry=0.08", "--every", "10"]),
 }
 
 
@@ -167,6 +177,8 @@ class Chromium:
     def hover(self, x, y):
         """Moves the mouse to (x, y); the text of the page's tooltip then, or None."""
         self.call("Input.dispatchMouseEvent", type="mouseMoved", x=x, y=y)
+        # (Chromium delivers pointermove with the next animation frame: two frames, then read)
+        self.evaluate("new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))")
         return self.evaluate("(() => { const t = document.getElementById('tooltip');"
                              " return t.style.display === 'block' ? t.textContent : null; })()")
 
@@ -247,6 +259,7 @@ def expected_counts(femdyn, model, source_dir):
         counts["not_drawn"] = sum(g.get("mesh") in inline for g in geoms)
         counts["meshes"] = len({g.get("mesh") for g in geoms if g.get("mesh")} - inline)
     counts["constraints"] = sum(c["type"] != "gear" for c in info.get("constraints", []))
+    counts["bars"] = len(info.get("bars", []))
     return info, counts
 
 
@@ -287,8 +300,12 @@ def check_hover(browser, info, case):
     spots = [s for s in browser.evaluate("window.femdynView.labelsOnScreen()")
              if 0 < s["x"] < VIEW3D and 0 < s["y"] < HEIGHT]
     assert spots, f"{case}: nothing named on the screen"
-    names = [browser.hover(s["x"], s["y"]) for s in spots[:5]]
-    named = [n for n in names if n and any(b in n for b in bodies)]
+    names, named = [], []
+    for s in spots[:20]:  # (a ring's centre, a joint's, may have nothing under it)
+        names.append(browser.hover(s["x"], s["y"]))
+        named = [n for n in names if n and any(b in n for b in bodies)]
+        if named:
+            break
     assert named, f"{case}: hovering named no body of the model: {names}"
     return named[0]
 
@@ -301,6 +318,39 @@ def check_closures(browser, counts, case, t):
         assert c["distance"] <= 1e-4 * c["extent"], \
             f"{case}: at t = {t} a loop is drawn open by {c['distance']:.3g} m"
     return len(closures)
+
+
+def segment_distance(p, a, b):
+    ab = [y - x for x, y in zip(a, b)]
+    ap = [y - x for x, y in zip(a, p)]
+    s = max(0.0, min(1.0, sum(x * y for x, y in zip(ab, ap)) / max(sum(x * x for x in ab), 1e-30)))
+    return sum((x + s * d - y) ** 2 for x, d, y in zip(a, ab, p)) ** 0.5
+
+
+def check_bars(browser, counts, case, t, bent):
+    """Each flexible bar drawn along its centreline: a tube about the polyline through its
+    stations, from the clamp to the tip."""
+    bars = browser.evaluate("window.femdynView.bars()")
+    assert len(bars) == counts["bars"], f"{case}: {len(bars)} bars drawn"
+    for bar in bars:
+        s, r = bar["stations"], bar["radius"]
+        # The curve bows off each chord by about its sagitta, c θ / 8 for a chord c between
+        # turns of θ: allowed twice that, with the longest chord and the largest turn.
+        chords = [[y - x for x, y in zip(s[i], s[i + 1])] for i in range(len(s) - 1)]
+        length = [sum(x * x for x in c) ** 0.5 for c in chords]
+        turn = max(math.acos(max(-1.0, min(1.0, sum(x * y for x, y in zip(a, b)) / (la * lb))))
+                   for a, b, la, lb in zip(chords, chords[1:], length, length[1:]))
+        bow = max(length) * turn / 4
+        # (bent: the stations stand off the chord from clamp to tip by more than the radius, so
+        # a straight tube would fail the test below)
+        bend = max(segment_distance(p, s[0], s[-1]) for p in s)
+        assert bar["vertices"], f"{case}: a bar without a tube"
+        far = max(min(segment_distance(v, s[i], s[i + 1]) for i in range(len(s) - 1))
+                  for v in bar["vertices"])
+        assert far <= r * 1.001 + bow, \
+            f"{case}: at t = {t} the tube strays {far:.3g} m from its centreline (radius {r:.3g})"
+        assert bend > 2 * r or not bent, f"{case}: at t = {t} a bar bends by {bend:.3g} m only"
+    return len(bars)
 
 
 def check_without_webgl(exe, work, page, counts, case):
@@ -339,6 +389,16 @@ def main():
         with open(model, "w") as f:
             json.dump(doc, f)
     info, counts = expected_counts(femdyn, model, source_dir)
+    if "--tau-on" in simulate:  # an actuation on named coordinates, zero on the others
+        k = simulate.index("--tau-on")
+        on = dict(x.split("=") for x in simulate[k + 1].split(","))
+        simulate[k:k + 2] = ["--tau", ",".join(on.get(c, "0") for c in info["coordinates"])]
+    if "--bent" in simulate:  # a floating base at rest (x, y, z, qw … qz), then these angles
+        k = simulate.index("--bent")
+        on = [x.split("=") for x in simulate[k + 1].split(",")]
+        angle = [next((float(v) for p, v in on if fnmatch.fnmatch(c, p)), 0.0)
+                 for c in info["coordinates"][6:]]
+        simulate[k:k + 2] = ["--q0", ",".join(map(str, [0, 0, 0, 1, 0, 0, 0] + angle))]
     if "--tau-each" in simulate:  # the same actuation on every coordinate
         k = simulate.index("--tau-each")
         simulate[k:k + 2] = ["--tau", ",".join([simulate[k + 1]] * info["n"])]
@@ -364,6 +424,7 @@ def main():
             browser.screenshot_at(t, png)
             shots.append(png_pixels(png)[2])
             closures = check_closures(browser, counts, case, t)
+            check_bars(browser, counts, case, t, bent=t == times[0])
         hovered = check_hover(browser, info, case)
         assert not browser.status()["errors"], f"{case}: JavaScript errors while playing"
     finally:

@@ -201,10 +201,12 @@ Json visual_json(const Model& m, const Visual& v, MeshTable& table, Json& not_dr
 }
 
 // A body without visuals drawn as the box of its inertia: the same mass and principal moments
-// (edges √(6 (I_j + I_k − I_i)/m)), at its centre of mass along its principal axes.
+// (edges √(6 (I_j + I_k − I_i)/m)), at its centre of mass along its principal axes. A flexible
+// bar's pieces are not: the bar is drawn along its centreline (bars_json).
 Json inertia_boxes_json(const Model& m, const Json& visuals) {
-  std::set<int> seen;  // the bodies visual_json placed visuals on
+  std::set<int> seen;  // the bodies visual_json placed visuals on, and the bars' pieces
   for (const Json& v : visuals) seen.insert(v["body"].get<int>());
+  for (const BarCentreline& bar : m.bars) seen.insert(bar.stations.begin(), bar.stations.end());
   Json out = Json::array();
   const std::vector<MassProperties> mp = body_mass_properties(m);
   for (std::size_t b = 0; b < m.bodies.size(); ++b) {
@@ -222,6 +224,15 @@ Json inertia_boxes_json(const Model& m, const Json& visuals) {
                    {"size", vec_json(edges)},
                    {"quaternion", quaternion_json(axes)}});
   }
+  return out;
+}
+
+// Each flexible bar: the bodies whose origins lie on its centreline, from the clamp to the tip
+// (the page draws a tube through them at every frame), and the section's radius.
+Json bars_json(const Model& m) {
+  Json out = Json::array();
+  for (const BarCentreline& bar : m.bars)
+    out.push_back({{"name", bar.name}, {"stations", bar.stations}, {"radius", bar.radius}});
   return out;
 }
 
@@ -289,7 +300,8 @@ Json scene_json(const Model& m, const Motion& motion, const std::vector<Visual>&
   for (const ElementEntry& e : m.elements) elements.push_back(element_json(e));
   MeshTable table;
   for (const Visual& v : visuals) shapes.push_back(visual_json(m, v, table, not_drawn));
-  const Json boxes = inertia_boxes_json(m, shapes), constraints = constraints_json(m);
+  const Json boxes = inertia_boxes_json(m, shapes), constraints = constraints_json(m),
+             bars = bars_json(m);
   int joints = 0;
   for (const Body& b : m.bodies) joints += b.joint.type != JointType::Fixed;
   return {{"model", m.name},
@@ -304,6 +316,7 @@ Json scene_json(const Model& m, const Motion& motion, const std::vector<Visual>&
           {"not_drawn", not_drawn},
           {"inertia_boxes", boxes},
           {"constraints", constraints},
+          {"bars", bars},
           {"motion", motion_json(m, motion)},
           {"counts",
            {{"bodies", bodies.size()},
@@ -315,6 +328,7 @@ Json scene_json(const Model& m, const Motion& motion, const std::vector<Visual>&
             {"not_drawn", not_drawn.size()},
             {"inertia_boxes", boxes.size()},
             {"constraints", constraints.size()},
+            {"bars", bars.size()},
             {"motion_frames", motion.frames.size()}}}};
 }
 

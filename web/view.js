@@ -74,7 +74,7 @@
 
   const pickable = [];  // meshes named on hover
   const counts = { bodies: 0, joints: 0, elements: 0, frames: 0, visuals: 0, meshes: 0,
-                   not_drawn: 0, inertia_boxes: 0, constraints: 0 };
+                   not_drawn: 0, inertia_boxes: 0, constraints: 0, bars: 0 };
   // What each toggle shows or hides (the side panel's check boxes).
   const layers = { visuals: [], elements: [], frames: [], joints: [], inertia: [], constraints: [] };
   function inLayer(layer, object) { layers[layer].push(object); return object; }
@@ -288,12 +288,35 @@
     counts.constraints += 1;
   }
 
+  // ---- Flexible bars: a tube through each bar's stations (the clamp, each part's joint, the
+  // tip), built again at every frame, so that the bar bends as its pieces turn -----------------
+  const bars = [];
+  for (const b of data.bars || []) {
+    const mesh = new THREE.Mesh(new THREE.BufferGeometry(), material(0x9aa3ad));
+    const parts = b.stations.length - 2;
+    const ends = `${bodyName(b.stations[0])} to ${bodyName(b.stations[parts + 1])}`;
+    world.add(inLayer('visuals', labelled(mesh, `flexible bar ${b.name} (${parts} parts, ${ends})`)));
+    // (its geometry is in world coordinates: where it is on the screen is its middle station)
+    const middle = b.stations[Math.floor(b.stations.length / 2)];
+    mesh.userData.anchor = () => groups[middle].getWorldPosition(new THREE.Vector3());
+    bars.push({ mesh: mesh, stations: b.stations, radius: Math.max(b.radius, 0.002 * L) });
+    counts.bars += 1;
+  }
+  function shapeBar(bar) {
+    const points = bar.stations.map((s) => groups[s].getWorldPosition(new THREE.Vector3()));
+    const curve = new THREE.CatmullRomCurve3(points, false, 'centripetal');
+    bar.mesh.geometry.dispose();
+    bar.mesh.geometry = new THREE.TubeGeometry(curve, 4 * (points.length - 1), bar.radius, 12,
+                                               false);
+  }
+
   // ---- Summary, legends, toggles -------------------------------------------------------------
   document.getElementById('model-name').textContent = `${data.model} (${data.source})`;
   document.getElementById('summary').textContent =
       `${counts.bodies} bodies, ${counts.joints} moving joints, ${counts.elements} elements, ` +
       `${counts.frames} named frames, ${counts.visuals} visuals (${counts.meshes} meshes), ` +
       `${counts.constraints} loop constraints` +
+      (counts.bars ? `, ${counts.bars} flexible bars` : '') +
       (counts.inertia_boxes ? `, ${counts.inertia_boxes} bodies drawn as their inertia box` : '') +
       (motion.trajectory ? `; ${motion.t.length} frames` : '; one posture');
   const notDrawn = document.getElementById('not-drawn');
@@ -349,6 +372,7 @@
     for (const sp of spanning)
       bar(sp.mesh, groupOf(sp.a.body).localToWorld(v3(sp.a.p)),
           groupOf(sp.b.body).localToWorld(v3(sp.b.p)), sp.radius);
+    for (const b of bars) shapeBar(b);
     for (const c of closures) {
       c.line.geometry.setFromPoints(c.ends.map((dot) => dot.getWorldPosition(new THREE.Vector3())));
       c.line.computeLineDistances();
@@ -522,6 +546,17 @@
       const [a, b] = c.ends.map((dot) => dot.getWorldPosition(new THREE.Vector3()));
       return { a: a.toArray(), b: b.toArray(), distance: a.distanceTo(b), extent: L };
     }),
+    // Each flexible bar as drawn: its stations (world coordinates, from femdyn's poses) and
+    // every tenth vertex of its tube.
+    bars: () => bars.map((b) => {
+      const position = b.mesh.geometry.getAttribute('position');
+      const vertices = [];
+      for (let i = 0; position && i < position.count; i += 10)
+        vertices.push([position.getX(i), position.getY(i), position.getZ(i)]);
+      return { radius: b.radius, vertices: vertices,
+               stations: b.stations.map((s) => groups[s].getWorldPosition(new THREE.Vector3())
+                                                         .toArray()) };
+    }),
     // The share of each plot's pixels drawn (not blank), WebGL or not.
     plotInk: () => plots.map((plot) => {
       const c = plot.canvas, px = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
@@ -530,7 +565,9 @@
       return ink / (px.length / 4);
     }),
     labelsOnScreen: () => (renderer ? pickable : []).filter((mesh) => mesh.visible).map((mesh) => {
-      const p = mesh.getWorldPosition(new THREE.Vector3()).project(camera);
+      const at = mesh.userData.anchor ? mesh.userData.anchor()
+                                      : mesh.getWorldPosition(new THREE.Vector3());
+      const p = at.project(camera);
       const r = renderer.domElement.getBoundingClientRect();
       return { label: mesh.userData.label, x: r.left + (p.x + 1) / 2 * r.width,
                y: r.top + (1 - p.y) / 2 * r.height };

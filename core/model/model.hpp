@@ -165,6 +165,15 @@ struct MassPattern {
                                        // coordinate sparse_order[k]
 };
 
+// A flexible bar's centreline: the bodies whose origins lie on it, in order from the clamp (the
+// clamp's piece, each part's joint, the tip), and the section's polar radius of gyration
+// √((ρI_y + ρI_z)/ρA) (m; a thin tube's radius), which a drawing gives the bar.
+struct BarCentreline {
+  std::string name;
+  std::vector<int> stations;
+  double radius = 0;
+};
+
 struct Model {
   Model() = default;
   // Movable into containers. Eigen 3.4's SparseMatrix has no move constructor, so moving M
@@ -203,6 +212,9 @@ struct Model {
   std::vector<std::string> left_out;             // descriptions of DOFs left out, and why
   bool explicit_table = false;
   std::vector<std::string> approximations;  // joins made by an explicit table
+  // Each flexible bar's centreline as built (docs/flexible.md), for drawing: the equations see
+  // only its bodies.
+  std::vector<BarCentreline> bars;
 
   std::vector<ElementEntry> elements;
   SpMat M;          // system lumped mass, N_u x N_u

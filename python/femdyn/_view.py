@@ -7,8 +7,13 @@ import tempfile
 
 
 def _trajectory_csv(model, traj):
-    """The rows femdyn.simulate returns (a dict of t, q, kinetic, potential, work) as the
+    """The rows femdyn.simulate returns (a dict of t, q, kinetic, potential, work), or
+    Simulator.run's (t, q, qd, work: the energies are computed here from q and qd), as the
     trajectory CSV `femdyn simulate --out` writes (io/trajectory_csv.hpp)."""
+    if "kinetic" not in traj and "qd" in traj:
+        energies = [model.energy(q, qd) for q, qd in zip(traj["q"], traj["qd"])]
+        traj = dict(traj, kinetic=[e["kinetic"] for e in energies],
+                    potential=[e["potential"] for e in energies])
     out = io.StringIO()
     writer = csv.writer(out, lineterminator="\n")
     writer.writerow(["t"] + ["q_" + c for c in model.configuration] +
@@ -32,7 +37,8 @@ def _in_notebook():
 def view(self, traj=None, q=None, path=None, force=False):
     """Writes the model's self-contained 3-D page (as `femdyn view`) and returns its path.
 
-    traj: a trajectory CSV file (`femdyn simulate --out`) or the dict femdyn.simulate returns;
+    traj: a trajectory CSV file (`femdyn simulate --out`), or the dict femdyn.simulate or
+    Simulator.run returns;
     q: one posture (n_q values) instead; neither: the neutral configuration. path: the HTML file
     to write (default: a new file in a temporary directory); an existing file is replaced only
     with force=True. In a Jupyter kernel the page is also shown inline (an iframe holding it)."""

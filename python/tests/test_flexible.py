@@ -56,6 +56,17 @@ def test_builder_bar_is_the_files(tmp_path):
             assert np.allclose(ea[key], eb[key], rtol=1e-13, atol=1e-13 * np.abs(eb[key]).max()), key
 
 
+def test_builder_bar_has_the_files_centreline(tmp_path):
+    # info's "bars" (what view draws the bar along): the same stations, clamp to tip, through
+    # either door; the radius √((ρIy + ρIz)/ρA) = √((Iy + Iz)/A) of the section.
+    a, b = built().info()["bars"], from_file(tmp_path).info()["bars"]
+    assert a == b
+    assert [bar["name"] for bar in a] == ["arm"]
+    assert a[0]["stations"] == ["arm.0", "arm.1", "arm.2", "arm.3", "arm.tip"]
+    assert a[0]["parts"] == 3
+    assert a[0]["radius"] == pytest.approx(np.sqrt((2e-9 + 3e-9) / 1e-4), rel=1e-14)
+
+
 def test_spring_forces_are_minus_k_q():
     # Q of each elastic rate with the bar straight but that rate at 1e-3, gravity off: −k θ,
     # k = EI/Δ, GJ/Δ, EA/Δ (docs/flexible.md).
