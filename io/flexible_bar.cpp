@@ -57,15 +57,57 @@ Section read_section(const Params& s, bool axial, bool torsion) {
 
 Json vec(const Vec3& v) { return Json::array({v[0], v[1], v[2]}); }
 
-// A rigid piece of the bar, of length l from its body's origin along x.
-Json piece(const Section& s, double l) {
-  const double m = s.rhoA * l;
-  const double Ixx = (s.rhoIy + s.rhoIz) * l, Iyy = s.rhoIy * l + m * l * l / 12,
-               Izz = s.rhoIz * l + m * l * l / 12;
+// The bar's rest shape: straight (κ = 0), or an arc of curvature κ = 1/R turning about `axis`
+// (a unit vector across the bar, in its frame). A stretch of arc length s turns its tangent by
+// κ s and spans the chord 2 sin(κ s/2)/κ, at half that turn from the tangent where it starts.
+struct RestShape {
+  double kappa = 0;
+  Vec3 axis = Vec3::UnitZ();
+  Mat3 turn(double s) const { return axis_rotation(axis, kappa * s); }
+  double chord(double s) const { return kappa == 0 ? s : 2 * std::sin(kappa * s / 2) / kappa; }
+  // The chord of a stretch s, in the frame of the tangent where it starts.
+  Vec3 chord_vector(double s) const { return turn(s / 2) * Vec3(chord(s), 0, 0); }
+};
+
+// A rigid piece of the bar: the stretch of arc length s from its body's origin, as the straight
+// piece along its chord (its mass ρA s, its rotary inertia about the chord's direction).
+Json piece(const Section& sec, const RestShape& shape, double s) {
+  const double m = sec.rhoA * s, l = shape.chord(s);
+  const double Ixx = (sec.rhoIy + sec.rhoIz) * s, Iyy = sec.rhoIy * s + m * l * l / 12,
+               Izz = sec.rhoIz * s + m * l * l / 12;
+  const Mat3 R = shape.turn(s / 2);  // the chord's axes in the body's
+  const Mat3 I = R * Vec3(Ixx, Iyy, Izz).asDiagonal() * R.transpose();
   return Json::array({{{"type", "rigid_body"},
                        {"mass", m},
-                       {"com", vec(Vec3(l / 2, 0, 0))},
-                       {"inertia", {{Ixx, 0, 0}, {0, Iyy, 0}, {0, 0, Izz}}}}});
+                       {"com", vec(shape.chord_vector(s) / 2)},
+                       {"inertia",
+                        {{I(0, 0), I(0, 1), I(0, 2)},
+                         {I(1, 0), I(1, 1), I(1, 2)},
+                         {I(2, 0), I(2, 1), I(2, 2)}}}}});
+}
+
+// A joint's origin: the chord before it, and (on a curved bar) the turn of the tangent.
+Json origin(const RestShape& shape, double s) {
+  Json o = {{"xyz", vec(shape.chord_vector(s))}};
+  if (shape.kappa != 0) {
+    const Eigen::Quaterniond q(shape.turn(s));
+    o["quat"] = Json::array({q.w(), q.x(), q.y(), q.z()});
+  }
+  return o;
+}
+
+// "curvature": {"radius": R, "axis": [ax, ay, az]} (the axis across the bar, default z).
+RestShape read_rest_shape(const Params& p) {
+  RestShape shape;
+  if (!p.has("curvature")) return shape;
+  const Params c = p.child("curvature");
+  c.allow_only({"radius", "axis"});
+  shape.kappa = 1 / c.positive("radius");
+  const Vec3 axis = c.vec3_or("axis", Vec3::UnitZ());
+  if (!(axis.norm() > 0) || std::abs(axis.x()) > 1e-9 * axis.norm())
+    c.fail("axis", "expected a direction across the bar (its x component 0), e.g. [0, 0, 1]");
+  shape.axis = axis.normalized();
+  return shape;
 }
 
 Json body(const std::string& name, const std::string& parent, Json joint, Json elements) {
@@ -75,21 +117,21 @@ Json body(const std::string& name, const std::string& parent, Json joint, Json e
 }
 
 Json one_rate_joint(const std::string& name, const char* type, const Vec3& axis, double k, double c,
-                    const Vec3& xyz, double sample_range) {
+                    Json origin, double sample_range) {
   // No actuator drives a bar's strain: its rates are left out of τ = S u (docs/control.md).
   Json j = {{"name", name},      {"type", type},
             {"axis", vec(axis)}, {"spring", {{"stiffness", k}}},
             {"actuated", false}, {"sample_range", sample_range}};
   if (c > 0) j["damping"] = c;
-  if (xyz != Vec3::Zero()) j["origin"] = {{"xyz", vec(xyz)}};
+  if (!origin.is_null()) j["origin"] = std::move(origin);
   return j;
 }
 
 }  // namespace
 
 FlexibleBarParts flexible_bar_parts(const Params& p) {
-  p.allow_only(
-      {"name", "parent", "origin", "length", "segments", "section", "axial", "torsion", "damping"});
+  p.allow_only({"name", "parent", "origin", "length", "segments", "section", "axial", "torsion",
+                "damping", "curvature"});
   const std::string name = p.string("name"), parent = p.string("parent");
   const double L = p.positive("length");
   if (!p.has("segments")) p.fail("segments", "is missing");
@@ -99,6 +141,7 @@ FlexibleBarParts flexible_bar_parts(const Params& p) {
   const int n = jn.get<int>();
   const bool axial = p.boolean_or("axial", true), torsion = p.boolean_or("torsion", true);
   const Section s = read_section(p.child("section"), axial, torsion);
+  const RestShape shape = read_rest_shape(p);
   double beta = 0;  // c = β k on every spring (stiffness-proportional Rayleigh damping)
   if (p.has("damping")) {
     const Params d = p.child("damping");
@@ -108,11 +151,11 @@ FlexibleBarParts flexible_bar_parts(const Params& p) {
   Json clamp = {{"name", name + ".0"}, {"type", "fixed"}};
   if (p.has("origin")) clamp["origin"] = p.json().at("origin");
   const double delta = L / n;
-  Json bodies = Json::array({body(name + ".0", parent, clamp, piece(s, delta / 2))});
+  Json bodies = Json::array({body(name + ".0", parent, clamp, piece(s, shape, delta / 2))});
   for (int i = 1; i <= n; ++i) {
     const std::string at = name + "." + std::to_string(i),
                       previous = name + "." + std::to_string(i - 1);
-    const Vec3 offset(i == 1 ? delta / 2 : delta, 0, 0);  // from the previous piece's origin
+    const double before = i == 1 ? delta / 2 : delta;  // the arc from the previous piece's origin
     struct Rate {
       const char* suffix;
       const char* type;
@@ -129,7 +172,7 @@ FlexibleBarParts flexible_bar_parts(const Params& p) {
                           {"rx", "revolute", Vec3::UnitX(), s.GJ / delta, torsion, 0.05},
                           {"ux", "prismatic", Vec3::UnitX(), s.EA / delta, axial, 1e-3 * delta}};
     std::string chain = previous;
-    Vec3 xyz = offset;
+    Json at_origin = origin(shape, before);
     for (const Rate& r : rates) {
       if (!r.used) continue;
       const std::string joint = at + "." + r.suffix;
@@ -138,17 +181,16 @@ FlexibleBarParts flexible_bar_parts(const Params& p) {
                                                : 1];  // the piece hangs from the last rate
       bodies.push_back(
           body(last ? at : joint, chain,
-               one_rate_joint(joint, r.type, r.axis, r.k, beta * r.k, xyz, r.sample_range),
-               last ? piece(s, i == n ? delta / 2 : delta) : Json::array()));
+               one_rate_joint(joint, r.type, r.axis, r.k, beta * r.k, at_origin, r.sample_range),
+               last ? piece(s, shape, i == n ? delta / 2 : delta) : Json::array()));
       chain = joint;
-      xyz = Vec3::Zero();
+      at_origin = nullptr;
     }
   }
-  bodies.push_back(body(name + ".tip", name + "." + std::to_string(n),
-                        {{"name", name + ".tip"},
-                         {"type", "fixed"},
-                         {"origin", {{"xyz", vec(Vec3(delta / 2, 0, 0))}}}},
-                        Json::array()));
+  bodies.push_back(
+      body(name + ".tip", name + "." + std::to_string(n),
+           {{"name", name + ".tip"}, {"type", "fixed"}, {"origin", origin(shape, delta / 2)}},
+           Json::array()));
   BarSpec centreline{name, {}, std::sqrt((s.rhoIy + s.rhoIz) / s.rhoA), p.where()};
   for (int i = 0; i <= n; ++i) centreline.stations.push_back(name + "." + std::to_string(i));
   centreline.stations.push_back(name + ".tip");

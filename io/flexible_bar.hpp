@@ -7,7 +7,9 @@
 // the turned x (axial stretch, EA/Δ): each a one-rate joint with its spring, so that every route,
 // derivative and the Simbody twin apply as they are. The elastic coordinates are
 // "<bar>.<i>.ux", ".rx", ".ry", ".rz"; the pieces are bodies "<bar>.0" … "<bar>.<n>" and the
-// bar's far end is the massless body "<bar>.tip" (its frame at the end, the bar's axes).
+// bar's far end is the massless body "<bar>.tip" (its frame at the end, the bar's axes). A curved
+// bar ("curvature") rests on an arc: its joints on it, its pieces the chords between them, each
+// body's frame along the arc's tangent.
 #pragma once
 #include "compile/spec.hpp"
 #include "io/params.hpp"
@@ -15,9 +17,9 @@
 namespace femdyn {
 
 // The bar described by p ({"name", "parent", "origin", "length", "segments", "section", "axial",
-// "torsion", "damping"}, docs/model-format.md#flexible-bars): its bodies as JSON bodies of the
-// model format, and its centreline (the stations "<bar>.0" … "<bar>.<n>", "<bar>.tip"). Every
-// number is checked here, with p's paths.
+// "torsion", "damping", "curvature"}, docs/model-format.md#flexible-bars): its bodies as JSON
+// bodies of the model format, and its centreline (the stations "<bar>.0" … "<bar>.<n>",
+// "<bar>.tip"). Every number is checked here, with p's paths.
 struct FlexibleBarParts {
   Json bodies;
   BarSpec centreline;

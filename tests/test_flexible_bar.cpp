@@ -2,12 +2,15 @@
 // from femdyn's linearisation converge to beam theory's closed forms at order 2 in the number
 // of segments, in both bending planes, torsion and stretch; the two ways of giving the section
 // are one model; where the bar is clamped does not change its modes; the bar as the multibody
-// chain it is matches Simbody; bad input is refused naming the key.
+// chain it is matches Simbody; a curved bar rests on its arc and matches Simbody too; bad input
+// is refused naming the key.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <numbers>
 
+#include "core/dynamics/body_inertia.hpp"
 #include "core/dynamics/equations.hpp"
+#include "core/kinematics/kinematics.hpp"
 #include "core/kinematics/sampling.hpp"
 #include "core/model/names.hpp"
 #include "sim/stability.hpp"
@@ -165,7 +168,66 @@ TEST_CASE("a flexible bar on a moving body matches Simbody", "[flexible][validat
   }
 }
 
+// A curved bar (docs/flexible.md, "curvature"): its joints lie on the arc, the chords between
+// them, each body's frame along the arc's tangent there; its mass is ρA L; nearly straight it
+// is the straight bar; and as the multibody chain it is, it matches Simbody.
+TEST_CASE("a curved flexible bar rests on its arc and matches Simbody", "[flexible][validation]") {
+  const double radius = 0.5, kappa = 1 / radius;  // the 1 m bar turns by 2 rad
+  const Vec3 axis = Vec3(0, 0.6, 0.8), normal = axis.cross(Vec3::UnitX());
+  const std::string curved = R"(, "curvature": {"radius": 0.5, "axis": [0, 0.6, 0.8]})";
+  const int n = 6;
+  const Model m = load_text(cantilever(n, section_e(), curved));
+  Workspace ws(m);
+  const VecX z = VecX::Zero(m.n());
+  propagate(m, ws, VecX::Zero(m.n_q()), z, {.jacobian = false, .bias = false, .rows = false});
+  const auto body = [&](const std::string& name) {
+    for (std::size_t b = 0; b < m.bodies.size(); ++b)
+      if (m.bodies[b].name == name) return static_cast<int>(b);
+    FAIL("no body " << name);
+    return -1;
+  };
+  const auto on_arc = [&](double s) {  // the arc's point at arc length s from the clamp
+    return Vec3(std::sin(kappa * s) / kappa * Vec3::UnitX() +
+                (1 - std::cos(kappa * s)) / kappa * normal);
+  };
+  const double delta = kL / n;
+  for (int i = 1; i <= n + 1; ++i) {
+    const std::string name = i <= n ? "bar." + std::to_string(i) : "bar.tip";
+    const double s = i <= n ? (i - 0.5) * delta : kL;
+    const BodyState& B = ws.body[body(name)];
+    CHECK((ws.origin + B.p - on_arc(s)).norm() < 1e-14);
+    CHECK((B.R - axis_rotation(axis, kappa * s)).norm() < 1e-14);  // along the tangent
+  }
+  double mass = 0;
+  for (const MassProperties& p : body_mass_properties(m)) mass += p.mass;
+  CHECK(mass == Approx(kRho * kA * kL).epsilon(1e-14));
+  // Nearly straight (R = 1e6 m): the straight bar's equations, to the curvature's first order.
+  check_same_equations(load_text(cantilever(n)),
+                       load_text(cantilever(n, section_e(), R"(, "curvature": {"radius": 1e6})")),
+                       0.05, 1, 1e-5);
+  // On a hub under gravity, against Simbody (as the straight bar above).
+  const std::string text = R"({"name": "hub and curved bar", "gravity": [0, 0, -9.81],
+    "bodies": [{"name": "hub", "parent": "world", "joint": {"type": "revolute", "axis": [0, 0, 1]},
+     "elements": [{"type": "rigid_body", "mass": 2, "inertia": {"ixx": 0.1, "iyy": 0.1,
+                   "izz": 0.2}}]}],
+    "flexible_bars": [{"name": "arm", "parent": "hub", "length": 0.8, "segments": 3,
+      "curvature": {"radius": 0.6, "axis": [0, 1, 0]},
+      "section": {"E": 7e10, "G": 2.6e10, "density": 2700, "area": 1e-4, "Iy": 2e-9,
+                  "Iz": 3e-9, "J": 4e-9}, "axial": false}]})";
+  const validation::ValidationReport r = validation::validate(load_text(text), quick(8, 0));
+  REQUIRE(r.failure.empty());
+  for (const auto& q : r.quantities) {
+    INFO(q.name << " max rel error " << q.max_rel);
+    CHECK(q.max_rel < 1e-8);
+  }
+}
+
 TEST_CASE("a flexible bar's bad input is refused in one line naming the key", "[flexible]") {
+  CHECK_THAT(text_error(cantilever(4, section_e(), R"(, "curvature": {"radius": -1})")),
+             Catch::Contains("/flexible_bars/0/curvature/radius: must be positive"));
+  CHECK_THAT(text_error(cantilever(4, section_e(), R"(, "curvature": {"radius": 1,
+      "axis": [1, 0, 0]})")),
+             Catch::Contains("/flexible_bars/0/curvature/axis: expected a direction across"));
   CHECK_THAT(text_error(cantilever(0)),
              Catch::Contains("/flexible_bars/0/segments: expected an integer from 1 to"));
   CHECK_THAT(text_error(cantilever(4, R"({"EIy": 1, "EIz": 1, "rhoA": 1, "GJ": 1})")),
