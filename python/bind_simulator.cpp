@@ -75,13 +75,18 @@ void tau_of(const py::handle& value, const Model& m, double t, VecX& tau) {
 }
 
 // Rows of a run: (t, q, q̇, τ applied from t, W, E) at every period; τ as the dynamics sees it,
-// saturated at the joints' effort limits.
+// saturated at the joints' effort limits, with a driven joint's torque at the row's state
+// (Motion::driven_actuation).
 struct ControlRows {
   std::vector<double> t, q, qd, tau, work, total;
   void add(const ControlLoop& loop, Motion& motion, VecX tau_k, const Energy& E) {
     const Integrator& i = loop.integrator();
     if (const Model& m = motion.model(); m.has_effort_limits)
       tau_k = tau_k.cwiseMax(-m.effort_limit).cwiseMin(m.effort_limit);
+    if (!motion.model().prescribed.empty()) {
+      VecX driven;
+      if (motion.driven_actuation(i.t(), i.y().data(), tau_k, driven).ok) tau_k = driven;
+    }
     t.push_back(i.t());
     const VecX q_now = i.q(), qd_now = i.qd();
     q.insert(q.end(), q_now.data(), q_now.data() + q_now.size());

@@ -162,6 +162,18 @@ Status Motion::accelerations() {
 // q̈ is affine in τ: q̈(u + Σ_p τ_p e_p) = q̈(u) + Σ_p τ_p M⁻¹ e_p (M⁻¹ projected onto the loops
 // where there are loops), so (M⁻¹)_PP τ_P = q̈*_P − q̈_P gives the prescribed coordinates their
 // q̈* exactly. Each column of M⁻¹ costs one more forward dynamics, with a unit torque added.
+Status Motion::driven_actuation(double t, const double* y, const VecX& tau, VecX& out) {
+  out = tau;
+  if (model_.prescribed.empty()) return {};
+  configuration(y, q_);
+  qd_ = Eigen::Map<const VecX>(y + n(), n());
+  u_ = tau;
+  Status st = accelerations();
+  if (st.ok) st = drive_prescribed(t);
+  if (st.ok) out = u_;
+  return st;
+}
+
 Status Motion::drive_prescribed(double t) {
   const std::vector<PrescribedCoordinate>& P = model_.prescribed;
   const int k = static_cast<int>(P.size());

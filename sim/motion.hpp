@@ -106,6 +106,10 @@ class Motion {
   // The τ the last rhs applied: the actuation (or the controller's), with the prescribed
   // coordinates' driving torques.
   const VecX& applied_actuation() const { return u_; }
+  // τ as the dynamics applies it at (t, y) under the actuation `tau`: `tau` with the prescribed
+  // coordinates' driving torques τ_P added (Model::prescribed; `tau` itself without any). One
+  // evaluation of q̈, not counted in evaluations(); the last rhs's buffers are overwritten.
+  Status driven_actuation(double t, const double* y, const VecX& tau, VecX& out);
   // ∂q̈/∂q and ∂q̈/∂v at τ held (the analytic derivatives at applied_actuation(), with (M^s)⁻¹)
   // made those of the driven motion, whose τ_P(q, v) holds q̈_P = q̈*_P:
   //   ∂τ_P/∂x = ((M⁻¹)_PP)⁻¹ (∂q̈*_P/∂x − E_Pᵀ ∂q̈/∂x),   ∂q̈/∂x += M⁻¹_{:,P} ∂τ_P/∂x,
