@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "compile/actuators.hpp"
+#include "compile/bar_damping.hpp"
 #include "compile/compile_level.hpp"
 #include "compile/correlation.hpp"
 #include "compile/loops.hpp"
@@ -420,8 +421,10 @@ Model compile(MechanismSpec spec, const CompileOptions& options) {
                      "a model with a coupling law cannot also have two-point springs");
   const std::vector<CouplingSpec> couplings =
       law ? std::exchange(spec.couplings, {}) : std::vector<CouplingSpec>{};
+  const std::vector<BarSpec> bars = spec.bars;
   Model m = compile_tree(std::move(spec), options);
   if (law) m = with_coupling_level(std::move(m), couplings);
+  compile_bar_damping(bars, m);  // (M^s at rest: the routes are chosen)
   check_model(m, options);
   return m;
 }

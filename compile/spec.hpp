@@ -133,11 +133,16 @@ struct SpringSpec {
   std::string where;
 };
 
-// A flexible bar's centreline (Model::bars): its stations by body name.
+// A flexible bar (io/flexible_bar.hpp): its centreline (Model::bars, its stations by body
+// name), its elastic joints in order, and the damping compile builds on them (Model::
+// rate_damping): mass-proportional α M̄ and modal, ratio ζ_k for mode k (the last for the rest).
 struct BarSpec {
   std::string name;
   std::vector<std::string> stations;
   double radius = 0;
+  std::vector<std::string> joints;
+  double mass_proportional = 0;
+  std::vector<double> modal;
   std::string where;
 };
 

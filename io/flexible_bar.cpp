@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 #include <tuple>
+#include <vector>
 
 #include "core/model/limits.hpp"
 #include "core/model/names.hpp"
@@ -96,6 +97,35 @@ Json origin(const RestShape& shape, double s) {
   return o;
 }
 
+// "damping": {"stiffness_proportional": β, "mass_proportional": α, "modal": ζ or [ζ1, ζ2, …]}.
+struct Damping {
+  double stiffness_proportional = 0, mass_proportional = 0;
+  std::vector<double> modal;
+};
+Damping read_damping(const Params& p) {
+  Damping out;
+  if (!p.has("damping")) return out;
+  const Params d = p.child("damping");
+  d.allow_only({"stiffness_proportional", "mass_proportional", "modal"});
+  out.stiffness_proportional =
+      d.has("stiffness_proportional") ? d.non_negative("stiffness_proportional") : 0.0;
+  out.mass_proportional = d.has("mass_proportional") ? d.non_negative("mass_proportional") : 0.0;
+  if (!d.has("modal")) return out;
+  const Json& z = d.json().at("modal");
+  if (z.is_number()) {
+    out.modal = {d.non_negative("modal")};
+    return out;
+  }
+  if (!z.is_array() || z.empty())
+    d.fail("modal", "expected a damping ratio, or a non-empty array of them (mode by mode)");
+  for (std::size_t k = 0; k < z.size(); ++k) {
+    const double ratio = json_number(z[k], d.path("modal") + "/" + std::to_string(k));
+    if (!(ratio >= 0)) d.fail("modal", "ratio " + std::to_string(k) + " must be at least 0");
+    out.modal.push_back(ratio);
+  }
+  return out;
+}
+
 // "curvature": {"radius": R, "axis": [ax, ay, az]} (the axis across the bar, default z).
 RestShape read_rest_shape(const Params& p) {
   RestShape shape;
@@ -142,16 +172,17 @@ FlexibleBarParts flexible_bar_parts(const Params& p) {
   const bool axial = p.boolean_or("axial", true), torsion = p.boolean_or("torsion", true);
   const Section s = read_section(p.child("section"), axial, torsion);
   const RestShape shape = read_rest_shape(p);
-  double beta = 0;  // c = β k on every spring (stiffness-proportional Rayleigh damping)
-  if (p.has("damping")) {
-    const Params d = p.child("damping");
-    d.allow_only({"stiffness_proportional"});
-    beta = d.non_negative("stiffness_proportional");
-  }
+  const Damping damping = read_damping(p);
+  const double beta = damping.stiffness_proportional;  // c = β k beside every spring
   Json clamp = {{"name", name + ".0"}, {"type", "fixed"}};
   if (p.has("origin")) clamp["origin"] = p.json().at("origin");
   const double delta = L / n;
   Json bodies = Json::array({body(name + ".0", parent, clamp, piece(s, shape, delta / 2))});
+  BarSpec bar{.name = name,
+              .radius = std::sqrt((s.rhoIy + s.rhoIz) / s.rhoA),
+              .mass_proportional = damping.mass_proportional,
+              .modal = damping.modal,
+              .where = p.where()};
   for (int i = 1; i <= n; ++i) {
     const std::string at = name + "." + std::to_string(i),
                       previous = name + "." + std::to_string(i - 1);
@@ -176,6 +207,7 @@ FlexibleBarParts flexible_bar_parts(const Params& p) {
     for (const Rate& r : rates) {
       if (!r.used) continue;
       const std::string joint = at + "." + r.suffix;
+      bar.joints.push_back(joint);
       const bool last = &r == &rates[axial     ? 3
                                      : torsion ? 2
                                                : 1];  // the piece hangs from the last rate
@@ -191,10 +223,9 @@ FlexibleBarParts flexible_bar_parts(const Params& p) {
       body(name + ".tip", name + "." + std::to_string(n),
            {{"name", name + ".tip"}, {"type", "fixed"}, {"origin", origin(shape, delta / 2)}},
            Json::array()));
-  BarSpec centreline{name, {}, std::sqrt((s.rhoIy + s.rhoIz) / s.rhoA), p.where()};
-  for (int i = 0; i <= n; ++i) centreline.stations.push_back(name + "." + std::to_string(i));
-  centreline.stations.push_back(name + ".tip");
-  return {std::move(bodies), std::move(centreline)};
+  for (int i = 0; i <= n; ++i) bar.stations.push_back(name + "." + std::to_string(i));
+  bar.stations.push_back(name + ".tip");
+  return {std::move(bodies), std::move(bar)};
 }
 
 }  // namespace femdyn

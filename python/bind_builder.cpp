@@ -363,7 +363,8 @@ void bind_builder(py::module_& m) {
           "a flexible bar clamped to `parent` in the JSON format's words: length=, segments=, "
           "section={'E', 'G', 'density', 'area', 'Iy', 'Iz', 'J'} or {'EA', 'EIy', 'EIz', 'GJ', "
           "'rhoA', 'rhoIy', 'rhoIz'}, origin={'xyz', 'rpy'}, axial=, torsion=, "
-          "damping={'stiffness_proportional': β}, curvature={'radius', 'axis'} "
+          "damping={'stiffness_proportional': β, 'mass_proportional': α, 'modal': ζ}, "
+          "curvature={'radius', 'axis'} "
           "(docs/model-format.md#flexible-bars)")
       .def(
           "spring",

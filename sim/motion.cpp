@@ -28,6 +28,9 @@ double nonconservative_power(const Model& model, const Workspace& ws, const VecX
     else if (J.nv > 1)  // a spherical or free joint's damper on each rate
       P -= J.damping * ws.theta_dot[j] * ws.theta_dot[j];
   }
+  for (int k = 0; k < model.rate_damping.outerSize(); ++k)  // the bars' −q̇ᵀ D q̇
+    for (SpMat::InnerIterator it(model.rate_damping, k); it; ++it)
+      P -= qd[it.row()] * it.value() * qd[it.col()];
   for (const BodyTorque& t : model.torques) P += t.torque.dot(ws.body[t.body].w);
   if (!model.springs.empty()) P += ws.spring_power;  // (of this state: forward dynamics set it)
   return P;

@@ -148,7 +148,7 @@ RecordedRun run_recorded(Integrator& integ, double t_end, long every,
 }
 
 bool conservative(const Model& model, bool driven) {
-  bool c = !driven && model.torques.empty();
+  bool c = !driven && model.torques.empty() && !model.has_rate_damping;
   for (const Body& b : model.bodies) c = c && !dissipates(b.joint);
   return c;
 }

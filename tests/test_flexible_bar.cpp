@@ -2,12 +2,13 @@
 // from femdyn's linearisation converge to beam theory's closed forms at order 2 in the number
 // of segments, in both bending planes, torsion and stretch; the two ways of giving the section
 // are one model; where the bar is clamped does not change its modes; the bar as the multibody
-// chain it is matches Simbody; a curved bar rests on its arc and matches Simbody too; bad input
-// is refused naming the key.
+// chain it is matches Simbody; a curved bar rests on its arc and matches Simbody too; modal and
+// Rayleigh damping give the modes their ratios; bad input is refused naming the key.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <numbers>
 
+#include "core/derivatives/derivatives.hpp"
 #include "core/dynamics/body_inertia.hpp"
 #include "core/dynamics/equations.hpp"
 #include "core/kinematics/kinematics.hpp"
@@ -222,7 +223,77 @@ TEST_CASE("a curved flexible bar rests on its arc and matches Simbody", "[flexib
   }
 }
 
+// The damping ratios of the cantilever's modes, ascending in frequency: ζ = −Re λ / |λ|.
+std::vector<std::pair<double, double>> damped_modes(const Model& m) {
+  Workspace ws(m);
+  const VecX z = VecX::Zero(m.n());
+  const Linearization lin = linearize(m, ws, z, z, z);
+  REQUIRE(lin.status.ok);
+  std::vector<std::pair<double, double>> out;  // (ω_n, ζ)
+  for (const auto& l : lin.eigenvalues)
+    if (l.imag() > 0) out.emplace_back(std::abs(l), -l.real() / std::abs(l));
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// Modal damping gives each clamped mode its ratio; mass-proportional α adds α/(2ω), beside the
+// stiffness-proportional β's βω/2 (Rayleigh). The derivatives carry −D, the Simbody twin the same
+// force, and the damping dissipates: its power −q̇ᵀ D q̇ is in the energy balance.
+TEST_CASE("a flexible bar's modal and Rayleigh damping give the modes their ratios",
+          "[flexible][validation]") {
+  const int n = 6;
+  const auto with = [&](const std::string& damping) {
+    return load_text(cantilever(n, section_e(), R"(, "damping": )" + damping));
+  };
+  const std::vector<std::pair<double, double>> modal =
+      damped_modes(with(R"({"modal": [0.01, 0.02, 0.05]})"));
+  REQUIRE(modal.size() == 4 * n);
+  for (std::size_t k = 0; k < modal.size(); ++k)
+    CHECK(modal[k].second == Approx(k == 0 ? 0.01 : k == 1 ? 0.02 : 0.05).margin(1e-9));
+  const double alpha = 3, beta = 1e-6;
+  const std::vector<std::pair<double, double>> rayleigh =
+      damped_modes(with(R"({"mass_proportional": 3, "stiffness_proportional": 1e-6})"));
+  const std::vector<double> undamped = frequencies(load_text(cantilever(n)));
+  REQUIRE(rayleigh.size() == undamped.size());
+  for (std::size_t k = 0; k < rayleigh.size(); ++k) {
+    const double w = undamped[k];
+    CHECK(rayleigh[k].second == Approx(alpha / (2 * w) + beta * w / 2).epsilon(1e-7));
+  }
+  // ∂q̈/∂q̇ against central differences, at a state in motion (without the damping it is not
+  // the same matrix: the check can fail).
+  const Model m = with(R"({"modal": 0.03, "mass_proportional": 0.5})");
+  REQUIRE(m.has_rate_damping);
+  Workspace ws(m);
+  DerivativeWorkspace d(m);
+  std::mt19937 rng(3);
+  const VecX q = random_posture(m, rng), qd = random_rates(m, 1.0, rng), tau = VecX::Zero(m.n());
+  REQUIRE(forward_dynamics_derivatives(m, ws, d, q, qd, tau).ok);
+  MatX fd(m.n(), m.n());
+  for (int j = 0; j < m.n(); ++j) {
+    const double h = 0.1;  // (q̈ is quadratic in q̇: central differences are exact but for round-off)
+    VecX a = qd, b = qd;
+    a[j] += h;
+    b[j] -= h;
+    REQUIRE(forward_dynamics(m, ws, q, a, tau).ok);
+    const VecX qa = ws.qdd;
+    REQUIRE(forward_dynamics(m, ws, q, b, tau).ok);
+    fd.col(j) = (qa - ws.qdd) / (2 * h);
+  }
+  CHECK(rel_error(fd, d.dqdd_dv) < 1e-6);
+  // Simbody applies the same −D θ̇: Q and q̈ agree pointwise.
+  const validation::ValidationReport r = validation::validate(m, quick(6, 0));
+  REQUIRE(r.failure.empty());
+  for (const auto& x : r.quantities) {
+    INFO(x.name << " max rel error " << x.max_rel);
+    CHECK(x.max_rel < 1e-8);
+  }
+}
+
 TEST_CASE("a flexible bar's bad input is refused in one line naming the key", "[flexible]") {
+  CHECK_THAT(text_error(cantilever(4, section_e(), R"(, "damping": {"modal": []})")),
+             Catch::Contains("/flexible_bars/0/damping/modal: expected a damping ratio"));
+  CHECK_THAT(text_error(cantilever(4, section_e(), R"(, "damping": {"modal": [0.1, -1]})")),
+             Catch::Contains("/flexible_bars/0/damping/modal: ratio 1 must be at least 0"));
   CHECK_THAT(text_error(cantilever(4, section_e(), R"(, "curvature": {"radius": -1})")),
              Catch::Contains("/flexible_bars/0/curvature/radius: must be positive"));
   CHECK_THAT(text_error(cantilever(4, section_e(), R"(, "curvature": {"radius": 1,

@@ -266,7 +266,7 @@ class Study {
     rep.q0 = o.q0;
     rep.qd0 = o.qd0;
     rep.interpolate = o.interpolate;
-    rep.conservative = m.torques.empty();
+    rep.conservative = m.torques.empty() && !m.has_rate_damping;
     for (const Body& b : m.bodies) rep.conservative = rep.conservative && b.joint.damping == 0;
     rep.sampling =
         o.interpolate

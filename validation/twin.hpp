@@ -144,6 +144,13 @@ struct TwinModel {
   // with close_loops(true) enable them: every other entry point sees the tree) and springs.
   std::vector<TwinConstraint> constraints;
   std::vector<TwinSpring> springs;
+  // The flexible bars' damping −D θ̇ on one-rate joints (Model::rate_damping, whose q̇ is θ̇
+  // there): entries (rate a, rate b, D_ab).
+  struct RateDamping {
+    int a = -1, b = -1;
+    double d = 0;
+  };
+  std::vector<RateDamping> rate_damping;
   bool closed_loop() const { return !laws.empty() || !rods.empty(); }
   int n() const { return static_cast<int>(closed_loop() ? coordinate_theta.size() : C.cols()); }
   int n_theta() const { return static_cast<int>(theta_body.size()); }

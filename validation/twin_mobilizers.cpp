@@ -136,6 +136,12 @@ void SimbodyTwin::Impl::finish_system() {
       Force::ConstantForce(forces, mobod[l.body], to_simtk(l.point), to_simtk(l.force));
     if (!l.torque.isZero(0)) Force::ConstantTorque(forces, mobod[l.body], to_simtk(l.torque));
   }
+  if (!m.rate_damping.empty()) {  // (Simbody takes ownership of the implementation)
+    std::vector<RateDampingForce::Entry> entries;
+    for (const TwinModel::RateDamping& r : m.rate_damping)
+      entries.push_back({mobod[m.theta_body[r.a]], mobod[m.theta_body[r.b]], r.d});
+    Force::Custom(forces, new RateDampingForce(std::move(entries)));
+  }
   try {
     constraints::add_springs(forces, matter, m, mobod);
   } catch (const std::exception& e) {

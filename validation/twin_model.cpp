@@ -166,6 +166,10 @@ TwinModel twin_model(const Model& m) {
   }
   t.theta_body = m.theta_joint;
   t.n_theta_q = m.n_theta_q;
+  for (int k = 0; k < m.rate_damping.outerSize(); ++k)  // (identity coupling: q̇ = θ̇)
+    for (SpMat::InnerIterator it(m.rate_damping, k); it; ++it)
+      t.rate_damping.push_back(
+          {static_cast<int>(it.row()), static_cast<int>(it.col()), it.value()});
   t.C = m.C;
   t.theta0 = m.theta0;
   t.gravity = m.gravity;

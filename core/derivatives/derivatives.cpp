@@ -329,6 +329,7 @@ void inverse_derivatives(const Model& m, Workspace& ws, DerivativeWorkspace& d, 
   joint_level(m, ws, d, q, qd, qdd, Kq, Kv, articulated_ready);
   if (!m.springs.empty()) add_spring_derivatives(m, ws, d, Kq, Kv);
   if (!d.spans.elements.empty()) add_span_derivatives(m, ws, d, Kq, Kv);
+  if (m.has_rate_damping) d.dtau_dv += m.rate_damping;  // τ += D q̇ (identity coupling only)
   if (m.identity_coupling) return;
   d.KC.noalias() = Kq * m.C;  // ∂τ_q/∂q = Cᵀ (∂τ_θ/∂θ) C
   d.dtau_dq.noalias() = m.C.transpose() * d.KC;

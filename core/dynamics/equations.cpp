@@ -280,13 +280,16 @@ Energy energy_levels(const Model& model, Workspace& ws, const VecX& q, const Vec
 }
 
 // The spherical and free joints' velocity terms, out of the hot path of every other model: the
-// free rotors' h_a (core/joints/rotor.hpp) into `h`, times `sign_h`, and the dampers' −c θ̇
-// (core/joints/passive.hpp) into `Q`, times `sign_Q`.
-bool has_rate_terms(const Model& m) { return !m.free_rotors.empty() || !m.rate_dampers.empty(); }
+// free rotors' h_a (core/joints/rotor.hpp) into `h`, times `sign_h`, and the dampers' −c θ̇ and
+// the flexible bars' −D q̇ (core/joints/passive.hpp) into `Q`, times `sign_Q`.
+bool has_rate_terms(const Model& m) {
+  return !m.free_rotors.empty() || !m.rate_dampers.empty() || m.has_rate_damping;
+}
 [[gnu::noinline]] void add_rate_terms(const Model& m, const VecX& qd, VecX& h, VecX& Q,
                                       double sign_h = 1.0, double sign_Q = 1.0) {
   add_rotor_bias(m, qd, sign_h, h);
   add_rate_dampers(m, qd, sign_Q, Q);
+  if (m.has_rate_damping) add_rate_damping(m, qd, sign_Q, Q);
 }
 
 }  // namespace

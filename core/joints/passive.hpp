@@ -99,6 +99,13 @@ inline void add_rate_dampers(const Model& m, const VecX& rates, double sign, Vec
     y.segment(d.v, d.nv) -= (sign * d.c) * rates.segment(d.v, d.nv);
 }
 
+// The flexible bars' damping (Model::rate_damping, compile/bar_damping.hpp): y += sign · (−D q̇).
+inline void add_rate_damping(const Model& m, const VecX& qd, double sign, VecX& y) {
+  for (int k = 0; k < m.rate_damping.outerSize(); ++k)
+    for (SpMat::InnerIterator it(m.rate_damping, k); it; ++it)
+      y[it.row()] -= sign * it.value() * qd[it.col()];
+}
+
 // Whether the joint dissipates energy (damper, friction or a stop's dissipation).
 inline bool dissipates(const Joint& j) {
   return j.damping != 0 || j.friction != 0 || (j.stop && j.stop_dissipation != 0);

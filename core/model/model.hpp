@@ -274,6 +274,11 @@ struct Model {
     double c = 0;
   };
   std::vector<RateDamper> rate_dampers;
+  // The flexible bars' mass-proportional and modal damping (compile/bar_damping.hpp): a
+  // generalized force −D q̇, D (n × n) constant, symmetric and positive semi-definite, on the
+  // bars' own rates. Empty without.
+  SpMat rate_damping;
+  bool has_rate_damping = false;
   VecX effort_limit;
   bool has_effort_limits = false;
   // Actuation (docs/control.md#actuation): the rates of q an actuator drives, ascending (n_a of
