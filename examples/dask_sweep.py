@@ -19,7 +19,6 @@ import argparse
 import json
 import os
 import sys
-import tempfile
 
 import numpy as np
 
@@ -35,15 +34,10 @@ TIMINGS = ["wall_time"]  # the only columns that differ between runs
 
 
 def finger(proximal_length):
-    """The finger model with that proximal length (a plugin document in a temporary file)."""
+    """The finger model with that proximal length (a plugin document, read from its text)."""
     doc = {"model": "dexterous_finger",
            "params": {"lengths": [0.015, proximal_length, 0.030, 0.022]}}
-    with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
-        json.dump(doc, f)
-    try:
-        return femdyn.load(f.name)
-    finally:
-        os.unlink(f.name)
+    return femdyn.loads(json.dumps(doc), name=f"finger, proximal {proximal_length} m")
 
 
 def study_case(proximal_length, integrator, setting):

@@ -27,10 +27,8 @@ Usage: spin_up_beam.py [--segments N] [--rtol R] [--t-end T] [--csv] [--plot FIL
 import argparse
 import json
 import math
-import os
 import pathlib
 import sys
-import tempfile
 
 import numpy as np
 
@@ -56,12 +54,7 @@ def model(segments):
     """models/spin_up_beam.json with its bar cut into `segments` parts."""
     spec = json.loads(MODEL.read_text())
     spec["flexible_bars"][0]["segments"] = segments
-    with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
-        json.dump(spec, f)
-    try:
-        return femdyn.load(f.name)
-    finally:
-        os.unlink(f.name)
+    return femdyn.loads(json.dumps(spec), name=f"{MODEL} at {segments} parts")
 
 
 def run(segments, rtol, t_end=30.0):

@@ -3,7 +3,9 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <optional>
 
+#include "compile/compile.hpp"
 #include "core/dynamics/equations.hpp"
 #include "core/kinematics/frames.hpp"
 #include "core/kinematics/kinematics.hpp"
@@ -12,6 +14,7 @@
 #include "core/model/limits.hpp"
 #include "core/model/names.hpp"
 #include "core/workspace/memory.hpp"
+#include "io/model_loader.hpp"
 #include "io/output.hpp"
 #include "models/model_files.hpp"
 #include "python/py_model.hpp"
@@ -31,6 +34,17 @@ void require_finite(const Model& model, const double* x, Eigen::Index size, Eige
           overflow_text(std::string(what) + " of '" + model.coordinate_names[i % rows] + "'"));
 }
 
+// gravity= of load and loads: (3,), finite.
+std::optional<Vec3> gravity_arg(const OptArray& gravity) {
+  if (!gravity) return std::nullopt;
+  if (gravity->ndim() != 1 || gravity->shape(0) != 3)
+    throw py::value_error("gravity: expected shape (3,), got " + shape_text(*gravity));
+  const double* g = gravity->data();
+  if (!std::isfinite(g[0]) || !std::isfinite(g[1]) || !std::isfinite(g[2]))
+    throw py::value_error("gravity: NaN or Inf");
+  return Vec3(g[0], g[1], g[2]);
+}
+
 std::unique_ptr<PyModel> load(const std::string& path, const OptArray& gravity, bool floating_base,
                               bool balance_inertia) {
   LoadOptions options;
@@ -38,15 +52,7 @@ std::unique_ptr<PyModel> load(const std::string& path, const OptArray& gravity, 
   options.balance_inertia = balance_inertia;
   std::vector<std::string> warnings;
   options.warn = [&warnings](const std::string& w) { warnings.push_back(w); };
-  if (gravity) {
-    if (gravity->ndim() != 1 || gravity->shape(0) != 3)
-      throw py::value_error("gravity: expected shape (3,), got " + shape_text(*gravity));
-    const double* g = gravity->data();
-    if (!std::isfinite(g[0]) || !std::isfinite(g[1]) || !std::isfinite(g[2]))
-      throw py::value_error("gravity: NaN or Inf");
-    options.gravity = Vec3(g[0], g[1], g[2]);
-    options.gravity_source = "gravity";
-  }
+  if ((options.gravity = gravity_arg(gravity))) options.gravity_source = "gravity";
   std::unique_ptr<PyModel> model;
   {
     py::gil_scoped_release release;
@@ -59,6 +65,24 @@ std::unique_ptr<PyModel> load(const std::string& path, const OptArray& gravity, 
   for (const std::string& w : warnings)
     if (PyErr_WarnEx(PyExc_UserWarning, safe_message(w).c_str(), 1) != 0)
       throw py::error_already_set();
+  return model;
+}
+
+// A JSON model document given as text (femdyn.loads), named `name` in messages.
+std::unique_ptr<PyModel> loads(const std::string& text, const std::string& name,
+                               const OptArray& gravity) {
+  const std::optional<Vec3> g = gravity_arg(gravity);
+  std::unique_ptr<PyModel> model;
+  {
+    py::gil_scoped_release release;
+    MechanismSpec spec = parse_spec(text, text_arg(name, "name"), default_catalog());
+    if (g) {
+      spec.gravity = *g;
+      spec.gravity_where = spec.where + "gravity";
+    }
+    model = std::make_unique<PyModel>(compile(spec));
+    model->spec = std::make_shared<const MechanismSpec>(std::move(spec));
+  }
   return model;
 }
 
@@ -372,6 +396,11 @@ void bind_model(py::module_& m) {
         "CLI's --floating-base); balance_inertia replaces a URDF body's non-physical inertia by "
         "the nearest physical one, each change in the warnings (--balance-inertia). Raises "
         "femdyn.ModelError (a ValueError) naming the file, place "
+        "and problem.");
+  m.def("loads", &loads, py::arg("text"), py::arg("name") = "<text>",
+        py::arg("gravity") = py::none(),
+        "A femdyn JSON model given as a string (json.dumps of a dict) as a Model, as load reads a "
+        "file; `name` stands for the file in messages. Raises femdyn.ModelError naming the place "
         "and problem.");
 }
 

@@ -47,6 +47,7 @@ try:
         NumericalError,
         Simulator,
         load,
+        loads,
         set_max_memory,
         simulate,
         with_simbody,
@@ -62,7 +63,7 @@ if with_simbody:
     from ._femdyn import validate  # noqa: F401
 
 __all__ = ["Builder", "Equations", "Model", "ModelError", "NumericalError", "grid", "load",
-           "set_max_memory", "simulate", "sweep", "with_simbody"] + (["validate"] if with_simbody else [])
+           "loads", "set_max_memory", "simulate", "sweep", "with_simbody"] + (["validate"] if with_simbody else [])
 
 if hasattr(Model, "_write_view"):  # built with the 3-D view (web/node_modules, docs/view.md)
     from ._view import view as _view

@@ -342,12 +342,7 @@ def test_a_driven_joints_torque_is_in_the_rows():
                    "origin": {"xyz": [0.5, 0, 0]}, "spring": {"stiffness": 20}},
          "elements": [{"type": "lumped_point", "node": [0.4, 0, 0], "mass": 0.7}]}]}
     import json
-    import tempfile
-    with tempfile.TemporaryDirectory() as d:
-        path = os.path.join(d, "driven.json")
-        with open(path, "w") as f:
-            json.dump(doc, f)
-        m = femdyn.load(path)
+    m = femdyn.loads(json.dumps(doc), name="driven hub")
     out = femdyn.Simulator(m, integrator="rk4", dt=1e-3).run(lambda t, q, v: np.zeros(m.n), 1.5)
     t, tau, q, qd = out["t"], out["tau"], out["q"], out["qd"]
     assert np.abs(tau[:, 0]).max() > 0.1 and np.all(tau[:, 1] == 0)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import femdyn
-from conftest import cli_json, model_path, numbers
+from conftest import ROOT, cli_json, model_path, numbers
 
 
 def rel(a, b):
@@ -279,3 +279,25 @@ def test_check_promises_the_error_over_the_run_asked_for(tmp_path):
     text = subprocess.run([str(BINARY), "check", path], cwd=ROOT, capture_output=True,
                           text=True).stdout
     assert "the promise holds over that horizon" in text
+
+
+def test_loads_is_load_of_the_same_text(tmp_path):
+    # femdyn.loads(text) and femdyn.load(path) of the same document are one model: the same
+    # coordinates and info, the same equations to the bit at random states, gravity overridden
+    # alike; a bad document names the `name` given and the JSON path.
+    text = (ROOT / "models" / "flexible_space_robot.json").read_text()
+    path = tmp_path / "robot.json"
+    path.write_text(text)
+    for gravity in (None, [0.0, -9.81, 0.0]):
+        a, b = femdyn.load(str(path), gravity=gravity), femdyn.loads(text, gravity=gravity)
+        assert a.coordinates == b.coordinates and a.info() == b.info()
+        rng = np.random.default_rng(2)
+        for _ in range(3):
+            q = a.neutral_configuration()
+            q[7:] += rng.uniform(-0.05, 0.05, a.n_q - 7)
+            qd, tau = rng.uniform(-1, 1, a.n), np.zeros(a.n)
+            ea, eb = a.equations(q, qd, tau), b.equations(q, qd, tau)
+            for key in ("M", "h", "Q", "qdd"):
+                assert np.array_equal(ea[key], eb[key]), key
+    with pytest.raises(femdyn.ModelError, match=r"^mine: /bodies: expected an array"):
+        femdyn.loads('{"name": "x", "bodies": 3}', name="mine")
