@@ -168,6 +168,7 @@ Json joint_properties(const Joint& j) {
   if (std::isfinite(j.effort_limit)) p["effort_limit"] = j.effort_limit;
   if (std::isfinite(j.velocity_limit)) p["velocity_limit"] = j.velocity_limit;
   if (!j.actuated) p["actuated"] = false;
+  if (j.sample_range != 0) p["sample_range"] = j.sample_range;
   return p;
 }
 
@@ -212,6 +213,7 @@ std::string joint_properties_text(const Joint& j) {
   if (std::isfinite(j.velocity_limit))
     parts.push_back("velocity " + format_number(j.velocity_limit));
   if (!j.actuated) parts.push_back("not actuated");
+  if (j.sample_range != 0) parts.push_back("sampled within " + format_number(j.sample_range));
   std::string out;
   for (const std::string& part : parts) out += (out.empty() ? "" : "; ") + part;
   return out;

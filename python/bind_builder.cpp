@@ -220,7 +220,8 @@ void bind_builder(py::module_& m) {
              OptNumber rest, OptNumber damping, const OptArray& axis2, OptNumber armature,
              OptNumber gear, OptNumber friction, OptNumber friction_velocity,
              OptNumber effort_limit, OptNumber velocity_limit, const py::object& stop,
-             OptNumber initial, std::optional<bool> actuated, const py::kwargs& scalars) {
+             OptNumber initial, std::optional<bool> actuated, OptNumber sample_range,
+             const py::kwargs& scalars) {
             const ActuatorArgs act{armature,     gear,           friction, friction_velocity,
                                    effort_limit, velocity_limit, stop,     actuated};
             if (!type && act.given())
@@ -231,6 +232,10 @@ void bind_builder(py::module_& m) {
                                     rpy, limits, stiffness, rest, damping, axis2, scalars);
             actuator_arg(act, j);
             if (initial) j.initial = *initial;
+            if (sample_range) {  // (compile: finite, and a joint of one coordinate)
+              if (!(*sample_range > 0)) throw py::value_error("sample_range: must be positive");
+              j.sample_range = *sample_range;
+            }
             b.body(text_arg(name, "name"), text_arg(parent, "parent"), std::move(j));
           },
           py::arg("name"), py::arg("parent") = "world", py::arg("type") = py::none(),
@@ -242,7 +247,7 @@ void bind_builder(py::module_& m) {
           py::arg("friction") = py::none(), py::arg("friction_velocity") = py::none(),
           py::arg("effort_limit") = py::none(), py::arg("velocity_limit") = py::none(),
           py::arg("stop") = py::none(), py::arg("initial") = py::none(),
-          py::arg("actuated") = py::none(),
+          py::arg("actuated") = py::none(), py::arg("sample_range") = py::none(),
           "A body on `parent` ('world': the ground) by a joint of `type` (revolute, prismatic, "
           "fixed, helical, universal, planar, spherical, free; docs/notation.md) named `joint` "
           "(default: the body's name), at xyz, rpy (default 0), about axis (default (0, 0, 1)), "
@@ -252,8 +257,9 @@ void bind_builder(py::module_& m) {
           "(kg·m²) behind a `gear` ratio, Coulomb `friction` regularised at `friction_velocity`, "
           "`effort_limit`, `velocity_limit`, and `stop` (True or {'stiffness': k, "
           "'dissipation': d}) enforcing the limits (docs/control.md), `actuated` (default: True "
-          "but on a free joint; docs/control.md#actuation), and the joint's `initial` "
-          "coordinate (the start of a run). Without type the body "
+          "but on a free joint; docs/control.md#actuation), the joint's `initial` "
+          "coordinate (the start of a run) and `sample_range` (the half range random states "
+          "draw it from: check, stress, validate; docs/model-format.md). Without type the body "
           "is welded to its parent's origin and no other joint argument may be given (ValueError "
           "naming it); a fixed joint takes no axis, limits, spring or damper.")
       .def(

@@ -254,3 +254,24 @@ def test_builder_takes_every_joint_type_with_axis2_and_pitch(tmp_path):
     b2.lumped_point("a", [0.1, 0, 0], 1)
     with pytest.raises(femdyn.ModelError, match="a universal joint needs its second axis"):
         b2.build()
+
+
+def test_builder_joint_takes_a_sample_range():
+    # sample_range= is the JSON key's (docs/model-format.md): the same model, shown by info;
+    # refused where it is not positive, and on a joint of several coordinates (compile's words).
+    b = femdyn.Builder("arm")
+    b.body("link", "world", type="revolute", joint="j", sample_range=0.2)
+    b.lumped_point("link", [0.5, 0, 0], 1.0)
+    doc = {"name": "arm", "bodies": [{"name": "link", "parent": "world",
+           "joint": {"name": "j", "type": "revolute", "axis": [0, 0, 1], "sample_range": 0.2},
+           "elements": [{"type": "lumped_point", "node": [0.5, 0, 0], "mass": 1.0}]}]}
+    a, c = b.build(), femdyn.loads(json.dumps(doc))
+    assert a.info()["joints"] == c.info()["joints"]
+    assert a.info()["joints"][0]["sample_range"] == 0.2
+    with pytest.raises(ValueError, match="sample_range: must be positive"):
+        femdyn.Builder("x").body("link", "world", type="revolute", sample_range=0)
+    bad = femdyn.Builder("ball")
+    bad.body("link", "world", type="spherical", sample_range=0.2)
+    bad.lumped_point("link", [0.5, 0, 0], 1.0)
+    with pytest.raises(femdyn.ModelError, match="sample_range: is the half range of a joint of one"):
+        bad.build()
