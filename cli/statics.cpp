@@ -28,11 +28,15 @@ steps that halve where Newton fails (large deflections) and double where it conv
 --q0 (n_q values), else the neutral configuration. Converged when |r|∞ ≤ R times the largest
 force met (--tolerance, default 1e-10). No equilibrium found (a coordinate nothing holds, a load
 beyond what the springs can bear) is a failure naming the load factor reached, exit 1.
-A model with closed loops is refused (not written yet).
+A model with closed loops (constraints) starts from q0 assembled onto them and solves
+r(q) + Phi_q^T mu = 0 on Phi(q) = 0 for q and the constraint forces mu, each Newton step
+followed by the projection back onto the loops (docs/loops.md); r is then the force no
+constraint carries.
 
 Prints the load steps, Newton steps and residual, q by coordinate name and each body's origin
-in the world; --json gives {"coordinates", "q", "residual", "scale", "load_steps",
-"iterations", "bodies": {name: [x, y, z]}}.
+in the world (with loops also |Phi| and the constraint forces mu by equation); --json gives
+{"coordinates", "q", "residual", "scale", "load_steps", "iterations", "bodies": {name: [x, y,
+z]}} and with loops "constraint_residual" and "multipliers" [{"equation", "mu"}].
 )";
 
 // "BODY:fx,fy,fz[,tx,ty,tz][@x,y,z]" items separated by ';'.
@@ -100,14 +104,21 @@ int cmd_statics(int argc, char** argv) {
     return 1;
   }
   const Json bodies = body_origins(m, r.q);
+  Json multipliers = Json::array();  // with loops: μ by constraint equation
+  for (Eigen::Index i = 0; i < r.multipliers.size(); ++i)
+    multipliers.push_back(
+        {{"equation", constraint_row_name(m, static_cast<int>(i))}, {"mu", r.multipliers[i]}});
   if (a.has("json")) {
-    std::cout << readable_json(Json{{"coordinates", m.coordinate_names},
-                                    {"q", vector_json(r.q)},
-                                    {"residual", r.residual},
-                                    {"scale", r.scale},
-                                    {"load_steps", r.load_steps},
-                                    {"iterations", r.iterations},
-                                    {"bodies", bodies}});
+    Json j{{"coordinates", m.coordinate_names},
+           {"q", vector_json(r.q)},
+           {"residual", r.residual},
+           {"scale", r.scale},
+           {"load_steps", r.load_steps},
+           {"iterations", r.iterations},
+           {"bodies", bodies}};
+    if (!m.constraints.empty())
+      j["constraint_residual"] = r.constraint_residual, j["multipliers"] = multipliers;
+    std::cout << readable_json(j);
     return 0;
   }
   std::ostringstream text;
@@ -120,6 +131,11 @@ int cmd_statics(int argc, char** argv) {
   for (const auto& [name, p] : bodies.items())
     text << "  " << name << " = [" << p[0].get<double>() << ", " << p[1].get<double>() << ", "
          << p[2].get<double>() << "]\n";
+  if (!m.constraints.empty()) {
+    text << "loops: |Phi| = " << r.constraint_residual << "; constraint forces mu:\n";
+    for (const Json& x : multipliers)
+      text << "  " << x["equation"].get<std::string>() << " = " << x["mu"].get<double>() << "\n";
+  }
   std::cout << text.str();
   return 0;
 }

@@ -74,6 +74,10 @@ py::dict statics(const PyModel& self, const OptArray& tau, const std::optional<p
   d["load_steps"] = r.load_steps;
   d["iterations"] = r.iterations;
   d["bodies"] = bodies;
+  if (!m.constraints.empty()) {
+    d["multipliers"] = py::array_t<double>(r.multipliers.size(), r.multipliers.data());
+    d["constraint_residual"] = r.constraint_residual;
+  }
   return d;
 }
 
@@ -87,7 +91,9 @@ void bind_statics(py::module_& m) {
             "([{'body', 'force', 'torque', 'point'}], world force and torque at a point of the "
             "body's frame), as `femdyn statics`: Newton with the analytic stiffness and "
             "continuation in the load (sim/statics.hpp). Returns {q, residual, scale, "
-            "load_steps, iterations, bodies: {name: origin (3,)}}; raises femdyn.NumericalError "
+            "load_steps, iterations, bodies: {name: origin (3,)}} (with closed loops also "
+            "multipliers, the constraint forces μ, and constraint_residual |Φ|∞); raises "
+            "femdyn.NumericalError "
             "naming the load factor reached when there is no equilibrium.");
 }
 

@@ -2,12 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "compile/compile.hpp"
+#include "core/derivatives/constraint_derivatives.hpp"
 #include "core/derivatives/derivatives.hpp"
 #include "core/dynamics/equations.hpp"
+#include "core/kinematics/kinematics.hpp"
 #include "core/kinematics/sampling.hpp"
+#include "core/loops/assembly.hpp"
+#include "core/loops/constraint_kinematics.hpp"
 #include "core/model/arguments.hpp"
 #include "core/model/errors.hpp"
 #include "core/model/names.hpp"
@@ -112,13 +117,121 @@ bool newton(Problem& p, const StaticsOptions& o, VecX& q, StaticsResult& out, st
   return false;
 }
 
+// The closed loops' equilibrium: the balance with the constraint forces Φ_qᵀ μ, on Φ = 0,
+//   F(q, μ) = (r(q) + Φ_qᵀ μ, Φ(q)) = 0,
+//   ∂F = [[−K + G, Φ_qᵀ], [Φ_q, 0]],  K = ∂τ_id/∂q,  G = ∂(Φ_qᵀ μ)/∂q at μ held
+// (core/derivatives/constraint_derivatives.hpp). Each Newton step (the least-norm solution:
+// redundant equations leave μ's part along them free) is followed by the projection of q back
+// onto Φ = 0 (assemble_state) and μ by least squares there, so that every iterate is a
+// configuration of the mechanism and only the balance r + Φ_qᵀ μ, the force no constraint
+// carries, is driven to 0.
+struct LoopStatics {
+  Problem& p;
+  ConstraintKinematics k;
+  std::unique_ptr<ConstraintDerivatives> cd;
+  VecX mu;  // at the last accepted q
+
+  explicit LoopStatics(Problem& problem) : p(problem), k(problem.model) {
+    if (p.d) cd = std::make_unique<ConstraintDerivatives>(p.model);
+  }
+  // q projected onto Φ = 0, μ = argmin |r + Φ_qᵀ μ| there, and that balance F₁ (∞ if q does
+  // not assemble); the largest force into `forces`.
+  double balance(VecX& q, VecX& mu_out, VecX& F1, double& forces) {
+    VecX v = VecX::Zero(p.model.n());
+    if (!assemble_state(p.model, q, v, {.rank = false}).assembly.status.ok)
+      return std::numeric_limits<double>::infinity();
+    const VecX r = p.residual(q, forces);
+    constraint_kinematics(p.model, p.ws, q, p.zero, k);
+    mu_out = MatX(k.J.transpose()).completeOrthogonalDecomposition().solve(-r);
+    const VecX f = k.J.transpose() * mu_out;
+    forces = std::max(forces, f.cwiseAbs().maxCoeff());
+    F1 = r + f;
+    return F1.cwiseAbs().maxCoeff();
+  }
+  // ∂F at (q, μ): analytic where the derivatives cover the model, else by differences of F₁.
+  MatX jacobian(const VecX& q) {
+    const int n = p.model.n(), m = p.model.constraint_rows;
+    MatX A = MatX::Zero(n + m, n + m);
+    constraint_kinematics(p.model, p.ws, q, p.zero, k);
+    const MatX J = k.J;
+    A.topRightCorner(n, m) = J.transpose();
+    A.bottomLeftCorner(m, n) = J;
+    if (cd) {
+      A.topLeftCorner(n, n) = -p.stiffness(q);  // (leaves d's recursion at (q, 0, 0))
+      constraint_derivatives(p.model, p.ws, *p.d, mu, 0.0, *cd);
+      A.topLeftCorner(n, n) += cd->G;
+      return A;
+    }
+    double forces = 0;
+    const auto F1 = [&](const VecX& x) {  // r + Φ_qᵀ μ at x, μ held
+      constraint_kinematics(p.model, p.ws, x, p.zero, k);
+      return VecX(p.residual(x, forces) + k.J.transpose() * mu);
+    };
+    for (int j = 0; j < n; ++j) {
+      const double h = 1e-6 * (flat_model(p.model) ? std::max(1.0, std::abs(q[j])) : 1.0);
+      A.col(j).head(n) = (F1(integrate_posture(p.model, q, VecX::Unit(n, j) * h)) -
+                          F1(integrate_posture(p.model, q, VecX::Unit(n, j) * -h))) /
+                         (2 * h);
+    }
+    return A;
+  }
+};
+
+// Newton on the loops at one λ from q (on them): true when |r + Φ_qᵀ μ|∞ ≤ tolerance × scale;
+// q, μ and the counts updated.
+bool newton_loops(Problem& p, const StaticsOptions& o, VecX& q, VecX& mu, StaticsResult& out,
+                  std::string& why) {
+  const int n = p.model.n();
+  LoopStatics loops(p);
+  VecX F1;
+  double forces = 0;
+  double e = loops.balance(q, loops.mu, F1, forces);
+  out.scale = std::max({out.scale, forces, p.tau.size() ? p.tau.cwiseAbs().maxCoeff() : 0.0});
+  for (int it = 0; it <= o.max_iterations; ++it) {
+    if (!std::isfinite(e)) {
+      why = "the residual is NaN or Inf, or the loops do not close";
+      return false;
+    }
+    if (e <= o.tolerance * out.scale) {
+      out.residual = e;
+      out.constraint_residual = loops.k.phi.cwiseAbs().maxCoeff();
+      mu = loops.mu;
+      return true;
+    }
+    if (it == o.max_iterations) break;
+    MatX A = loops.jacobian(q);
+    VecX rhs = VecX::Zero(A.rows());
+    rhs.head(n) = -F1;
+    // Newton's step, halved until the balance falls (at most 20 times); where none does (a
+    // direction the loads barely hold), a Levenberg–Marquardt step with μ_LM the largest
+    // |∂F₁/∂q| or force on the q block, as the tree's.
+    bool fell = false;
+    for (int attempt = 0; attempt < 2 && !fell; ++attempt) {
+      if (attempt == 1)
+        A.topLeftCorner(n, n).diagonal().array() -=
+            std::max({A.topLeftCorner(n, n).cwiseAbs().maxCoeff(), out.scale, 1e-300});
+      const VecX step = A.completeOrthogonalDecomposition().solve(rhs);
+      double alpha = 1;
+      for (int k = 0; k < 20 && !fell; ++k, alpha /= 2) {
+        VecX trial = integrate_posture(p.model, q, alpha * step.head(n)), trial_mu, Ft;
+        double f = 0;
+        const double et = loops.balance(trial, trial_mu, Ft, f);
+        if ((fell = et < e)) {
+          q = trial, loops.mu = trial_mu, F1 = Ft, e = et;
+          out.scale = std::max(out.scale, f);
+        }
+      }
+    }
+    ++out.iterations;
+  }
+  why = "Newton did not converge in " + std::to_string(o.max_iterations) +
+        " steps on the closed loops";
+  return false;
+}
+
 }  // namespace
 
 StaticsResult solve_statics(const MechanismSpec& spec, const StaticsOptions& o) {
-  if (!spec.constraints.empty())
-    throw ModelError(spec.where + "/constraints",
-                     "statics does not take closed loops yet (the constrained equilibrium is not "
-                     "written)");
   StaticsResult out;
   const Model first = compile(scaled(spec, o.loads, 0));
   if (o.tau.size() && o.tau.size() != first.n())
@@ -129,14 +242,24 @@ StaticsResult solve_statics(const MechanismSpec& spec, const StaticsOptions& o) 
                      "statics: joint '" + first.prescribed[0].joint +
                          "' is prescribed in time (a driven joint); a rest has no time");
   out.q = o.q0.size() ? o.q0 : neutral_posture(first);
+  const bool loops = !first.constraints.empty();
+  if (loops) {  // the start on the loops (Newton's least-norm steps)
+    VecX v = VecX::Zero(first.n());
+    if (const StateAssembly s = assemble_state(first, out.q, v); !s.assembly.status.ok) {
+      out.status = {false, "the loops do not close from the start: " + s.assembly.status.message,
+                    -1};
+      return out;
+    }
+    out.multipliers = VecX::Zero(first.constraint_rows);
+  }
   double step = 1;
   std::string why;
   while (out.lambda < 1) {
     const double lambda = std::min(1.0, out.lambda + step);
     Problem p(compile(scaled(spec, o.loads, lambda)), o.tau, lambda);
-    VecX q = out.q;
-    if (newton(p, o, q, out, why)) {
-      out.q = q, out.lambda = lambda, ++out.load_steps;
+    VecX q = out.q, mu = out.multipliers;
+    if (loops ? newton_loops(p, o, q, mu, out, why) : newton(p, o, q, out, why)) {
+      out.q = q, out.multipliers = mu, out.lambda = lambda, ++out.load_steps;
       step *= 2;
       continue;
     }

@@ -1,5 +1,6 @@
 // Statics: the configuration q at which the mechanism rests under its loads,
 //   r(q) = λ τ − τ_id(q, 0, 0) = 0,      τ_id(q, 0, 0) = −Q(q)  (springs, gravity, loads),
+// (with closed loops r(q) + Φ_qᵀ μ = 0 and Φ(q) = 0, for q and the constraint forces μ),
 // by Newton's method with the analytic stiffness ∂τ_id/∂q (core/derivatives; where it is
 // singular, a Levenberg–Marquardt step (K + μ 1) Δ = r, μ the largest |K| or force), a step halved
 // until the residual falls, and continuation in the load: λ scales the applied τ, gravity and
@@ -28,14 +29,17 @@ struct StaticsResult {
   Status status;        // a failure says at which λ and why
   VecX q;               // the last converged configuration (λ = lambda)
   double lambda = 0;    // the load factor reached (1 when status.ok)
-  double residual = 0;  // |r|∞ at q, N or N m
-  double scale = 0;     // the largest |τ_id|∞ or |λ τ|∞ met: the residual's yardstick
-  int load_steps = 0;   // converged load steps
-  int iterations = 0;   // Newton steps in all
+  double residual = 0;  // |r|∞ at q, N or N m (with loops: |r + Φ_qᵀ μ|∞)
+  // Closed loops: the constraint forces μ (M^s q̈ + h = Q + Φ_qᵀ μ, core/loops/) and |Φ|∞ at q.
+  VecX multipliers;
+  double constraint_residual = 0;
+  double scale = 0;    // the largest |τ_id|∞ or |λ τ|∞ met: the residual's yardstick
+  int load_steps = 0;  // converged load steps
+  int iterations = 0;  // Newton steps in all
 };
 
-// A model with closed loops is refused (ModelError, one line): the constrained statics is not
-// written yet.
+// A model with closed loops starts from q0 assembled onto them and solves the balance with the
+// constraint forces, r(q) + Φ_qᵀ μ = 0 on Φ(q) = 0 (sim/statics.cpp, newton_loops).
 StaticsResult solve_statics(const MechanismSpec& spec, const StaticsOptions& options);
 
 }  // namespace femdyn

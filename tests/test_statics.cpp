@@ -8,6 +8,9 @@
 #include <numbers>
 
 #include "core/dynamics/equations.hpp"
+#include "core/kinematics/kinematics.hpp"
+#include "core/loops/constrained_dynamics.hpp"
+#include "core/loops/constraint_kinematics.hpp"
 #include "core/model/names.hpp"
 #include "sim/statics.hpp"
 #include "tests/helpers.hpp"
@@ -178,8 +181,33 @@ TEST_CASE("statics refuses what it cannot solve, in one line", "[statics]") {
   CHECK_FALSE(r.status.ok);
   CHECK_THAT(r.status.message, Catch::StartsWith("no equilibrium found beyond load factor"));
   CHECK(r.status.message.find('\n') == std::string::npos);
-  // Closed loops are refused, naming them.
-  const MechanismSpec loop = parse_spec(read_file(model_path("five_bar.json")), "five_bar.json");
-  CHECK_THROWS_WITH(solve_statics(loop, {}),
-                    Catch::Contains("/constraints: statics does not take closed loops yet"));
+}
+
+// Closed loops: the rest of the five-bar, the delta robot and the hand's four-bars under
+// gravity. Checked by other routes: the configuration closes the loops (|Φ| ≤ 1e-12 of the
+// size), the constrained forward dynamics at rest there gives q̈ = 0 (to 1e-9 of g over the
+// mechanism's size), and its multipliers carry the same joint forces Φ_qᵀ λ as the statics' μ.
+TEST_CASE("statics finds the rest of closed loops, checked by the constrained dynamics",
+          "[statics][loops]") {
+  for (const char* name : {"five_bar.json", "delta.json", "hand_fourbar_loop.json"}) {
+    INFO(name);
+    const MechanismSpec spec = parse_spec(read_file(model_path(name)), name);
+    const StaticsResult r = solve_statics(spec, {});
+    REQUIRE(r.status.ok);
+    const Model m = compile(spec);
+    Workspace ws(m);
+    LoopWorkspace lws(m);
+    ConstraintKinematics k(m);
+    constraint_kinematics(m, ws, r.q, VecX::Zero(m.n()), k);
+    double size = 0;
+    for (const BodyState& B : ws.body) size = std::max(size, (B.p - ws.body.front().p).norm());
+    CHECK(k.phi.cwiseAbs().maxCoeff() <= 1e-12 * size);
+    CHECK(r.constraint_residual <= 1e-12 * size);
+    const VecX zero = VecX::Zero(m.n());
+    REQUIRE(mechanism_forward_dynamics(m, ws, &lws, r.q, zero, zero).ok);
+    CHECK(ws.qdd.cwiseAbs().maxCoeff() < 1e-9 * m.gravity.norm() / size);
+    const VecX forces = k.J.transpose() * r.multipliers, dynamics = k.J.transpose() * lws.lambda;
+    CHECK((forces - dynamics).cwiseAbs().maxCoeff() < 1e-8 * r.scale);
+    CHECK(r.residual <= 1e-10 * r.scale);
+  }
 }

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import femdyn
-from conftest import cli_json
+from conftest import cli_json, model_path
 
 CANTILEVER = {"name": "cantilever", "bodies": [], "flexible_bars": [{
     "name": "beam", "parent": "world", "length": 2, "segments": 8, "torsion": False,
@@ -108,3 +108,17 @@ def test_a_driven_joint_through_the_python_doors(tmp_path):
     if femdyn.with_simbody:
         r = femdyn.validate(m, states=4, t_end=0.1)
         assert "prescribes joint 'hub'" in r["trajectory"]["skipped"]
+
+
+def test_statics_on_closed_loops_is_the_commands():
+    # The five-bar under gravity: the Python door and `femdyn statics --json` give the same rest
+    # and constraint forces, and there the constrained dynamics has the mechanism at rest.
+    path = model_path("models/five_bar.json")
+    m = femdyn.load(path)
+    r = m.statics()
+    cli = cli_json("statics", path, "--json")
+    assert np.allclose(r["q"], cli["q"], rtol=0, atol=1e-13)
+    assert np.allclose(r["multipliers"], [x["mu"] for x in cli["multipliers"]], rtol=0, atol=1e-13)
+    assert r["constraint_residual"] < 1e-12
+    z = np.zeros(m.n)
+    assert np.abs(m.equations(r["q"], z, z)["qdd"]).max() < 1e-9
