@@ -14,6 +14,7 @@
 #include "core/joints/kernel.hpp"
 #include "core/model/errors.hpp"
 #include "sim/integrator.hpp"
+#include "sim/recorded_run.hpp"
 #include "validation/twin.hpp"
 #include "validation/validate.hpp"
 
@@ -87,6 +88,13 @@ Sampled femdyn_run(const Model& m, const IntegratorOptions& o, const StudyOption
   s.stats = integ->stats();
   s.stats.wall_time += setup;
   return s;
+}
+
+// The sample times t_end·k/samples, k = 1 … samples.
+std::vector<double> sample_times(const StudyOptions& o) {
+  std::vector<double> times;
+  for (int k = 1; k <= o.samples; ++k) times.push_back(o.t_end * k / o.samples);
+  return times;
 }
 
 // The reference method: Dormand–Prince landing on every sample at rtol = atol.
@@ -220,8 +228,7 @@ namespace {
 // against it, the sweeps of both engines, and the report they fill.
 class Study {
  public:
-  Study(const Model& m, const StudyOptions& o) : m(m), o(o) {
-    for (int k = 1; k <= o.samples; ++k) times.push_back(o.t_end * k / o.samples);
+  Study(const Model& m, const StudyOptions& o) : m(m), o(o), times(sample_times(o)) {
     with_zero = times;  // Simbody samples t = 0 too
     with_zero.insert(with_zero.begin(), 0.0);
     describe();
@@ -266,8 +273,7 @@ class Study {
     rep.q0 = o.q0;
     rep.qd0 = o.qd0;
     rep.interpolate = o.interpolate;
-    rep.conservative = m.torques.empty() && !m.has_rate_damping;
-    for (const Body& b : m.bodies) rep.conservative = rep.conservative && b.joint.damping == 0;
+    rep.conservative = conservative(m, false);  // (a driven model is refused)
     rep.sampling =
         o.interpolate
             ? "both engines step freely and interpolate at the samples: femdyn's dopri and bdf by "
@@ -488,10 +494,8 @@ class Study {
 }  // namespace
 
 StudyEstimate estimate_study(const Model& m, const StudyOptions& o) {
-  std::vector<double> times;
-  for (int k = 1; k <= o.samples; ++k) times.push_back(o.t_end * k / o.samples);
-  const Sampled probe =
-      femdyn_run(m, reference_options(1e-14), o, times, {.wall = StudyEstimate::kProbeSeconds});
+  const Sampled probe = femdyn_run(m, reference_options(1e-14), o, sample_times(o),
+                                   {.wall = StudyEstimate::kProbeSeconds});
   if (!probe.status.ok && !probe.status.interrupted)
     throw femdyn::Error("the reference solution failed: " + probe.status.message);
   StudyEstimate e{.probe_t = probe.t_reached, .probe_wall = probe.stats.wall_time};
